@@ -1,0 +1,197 @@
+//! The contract between models and solvers. Models implement [`OdeSystem`];
+//! callers pick a [`Method`] and [`Options`] and get a [`Solution`].
+
+use thiserror::Error;
+
+/// Direction of a switching function's zero crossing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Crossing {
+    /// g went from negative to positive.
+    Rising,
+    /// g went from positive to negative.
+    Falling,
+}
+
+/// What the solver does after a located event.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EventAction {
+    /// Restart the integration from the (possibly edited) state at the event time.
+    Continue,
+    /// End the integration at the event time.
+    Stop,
+}
+
+/// A system of ordinary differential equations `dx/dt = f(t, x)` with
+/// optional analytic Jacobian and switching functions.
+pub trait OdeSystem {
+    /// Number of states.
+    fn dim(&self) -> usize;
+
+    /// The right-hand side `dx = f(t, x)`. Must not allocate in hot loops.
+    fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]);
+
+    /// Analytic Jacobian `∂f/∂x`, written row-major into `jac` (`dim × dim`,
+    /// `jac[i * dim + j] = ∂f_i/∂x_j`). Return `false` (the default) when the
+    /// model has none; the stiff solver then uses finite differences.
+    fn jacobian(&self, _t: f64, _x: &[f64], _jac: &mut [f64]) -> bool {
+        false
+    }
+
+    /// Number of switching functions.
+    fn n_events(&self) -> usize {
+        0
+    }
+
+    /// Values of the switching functions `g_i(t, x)`; an event is a sign change
+    /// of one of them between two accepted points.
+    fn events(&self, _t: f64, _x: &[f64], _g: &mut [f64]) {}
+
+    /// Called at a located event `which`, at time `t` with state `x`. The model
+    /// may change its mode and edit `x` (e.g. clamp a velocity at an end stop).
+    fn on_event(&mut self, _t: f64, _x: &mut [f64], _which: usize, _dir: Crossing) -> EventAction {
+        EventAction::Continue
+    }
+}
+
+/// The integration method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Dormand–Prince 5(4), adaptive, with dense output.
+    DormandPrince45,
+    /// Stiff L-stable Rosenbrock method, adaptive.
+    Rosenbrock,
+    /// Classical Runge–Kutta 4 with a fixed step (`Options::h0`).
+    Rk4,
+}
+
+/// Solver settings.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance, one per state; a single entry applies to all states.
+    pub atol: Vec<f64>,
+    /// Initial step (adaptive methods; `None` = estimated); the fixed step for RK4.
+    pub h0: Option<f64>,
+    /// Largest step allowed.
+    pub h_max: f64,
+    /// Step below which the solver gives up with [`SolveError::StepTooSmall`].
+    pub h_min: f64,
+    /// Most steps (accepted + rejected) before [`SolveError::TooManySteps`].
+    pub max_steps: usize,
+    /// Time tolerance to which event times are located.
+    pub event_tol: f64,
+    /// Output times (sorted, within `[t0, t_end]`); `None` = every accepted step.
+    pub t_eval: Option<Vec<f64>>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            rtol: 1e-6,
+            atol: vec![1e-9],
+            h0: None,
+            h_max: f64::INFINITY,
+            h_min: 1e-14,
+            max_steps: 10_000_000,
+            event_tol: 1e-12,
+            t_eval: None,
+        }
+    }
+}
+
+/// Counters of the work a solve did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Accepted steps.
+    pub steps: usize,
+    /// Rejected steps.
+    pub rejected: usize,
+    /// Right-hand-side evaluations (including those for finite-difference Jacobians).
+    pub rhs_evals: usize,
+    /// Jacobian evaluations (analytic or finite-difference).
+    pub jac_evals: usize,
+    /// LU decompositions.
+    pub lu_decomps: usize,
+    /// Events located and handled.
+    pub events: usize,
+}
+
+/// One located event.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EventRecord {
+    /// Time of the event.
+    pub t: f64,
+    /// Index of the switching function.
+    pub which: usize,
+    /// Direction of its crossing.
+    pub dir: Crossing,
+}
+
+/// The result of a solve.
+#[derive(Clone, Debug, Default)]
+pub struct Solution {
+    /// Output times.
+    pub t: Vec<f64>,
+    /// States at the output times, row-major: `x[k * dim + i]` is state `i` at `t[k]`.
+    pub x: Vec<f64>,
+    /// Number of states.
+    pub dim: usize,
+    /// Work counters.
+    pub stats: Stats,
+    /// Located events, in time order.
+    pub events: Vec<EventRecord>,
+}
+
+impl Solution {
+    /// The state at output index `k`.
+    pub fn state(&self, k: usize) -> &[f64] {
+        &self.x[k * self.dim..(k + 1) * self.dim]
+    }
+    /// The last state.
+    pub fn last(&self) -> Option<&[f64]> {
+        if self.t.is_empty() {
+            None
+        } else {
+            Some(self.state(self.t.len() - 1))
+        }
+    }
+}
+
+/// Why a solve failed. Each variant says where (time) and, where it can, which state.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum SolveError {
+    /// The step size fell below `Options::h_min`.
+    #[error("step size {h:e} s fell below the minimum at t = {t} s: the solver cannot meet its tolerance")]
+    StepTooSmall {
+        /// Time reached.
+        t: f64,
+        /// Step size tried.
+        h: f64,
+    },
+    /// `Options::max_steps` was reached.
+    #[error("more than {max} steps before t = {t} s")]
+    TooManySteps {
+        /// Time reached.
+        t: f64,
+        /// The limit.
+        max: usize,
+    },
+    /// A state or derivative became NaN or infinite.
+    #[error("state {index} is not finite at t = {t} s")]
+    NonFinite {
+        /// Time reached.
+        t: f64,
+        /// Index of the offending state.
+        index: usize,
+    },
+    /// The stiff method's iteration matrix was singular.
+    #[error("singular iteration matrix at t = {t} s")]
+    Singular {
+        /// Time reached.
+        t: f64,
+    },
+    /// The inputs to the solver were invalid.
+    #[error("invalid solver input: {0}")]
+    InvalidInput(String),
+}

@@ -1,0 +1,46 @@
+//! `cargo xtask validate`: every section runs, prints what it measured, and the
+//! task fails if any check failed. Sections for work not yet in hydrocyl say so
+//! and report no result.
+
+use crate::report::Section;
+
+mod diagnose;
+mod friction;
+mod hybrid;
+mod integrators;
+mod valve_rig;
+mod xfactor;
+
+/// A validation section: its name and the function that measures it.
+type SectionFn = fn() -> Section;
+
+fn sections() -> Vec<(&'static str, SectionFn)> {
+    vec![
+        ("integrators", integrators::section),
+        ("xfactor", xfactor::section),
+        ("friction", friction::section),
+        ("valve-rig", valve_rig::section),
+        ("hybrid", hybrid::section),
+        ("diagnose", diagnose::section),
+    ]
+}
+
+/// Runs the sections whose name contains `only` (all when `None`); returns
+/// `true` when every check passed.
+pub fn run(only: Option<&str>) -> bool {
+    let mut all_ok = true;
+    let mut n_checks = 0;
+    let mut n_failed = 0;
+    for (name, f) in sections() {
+        if only.is_some_and(|o| !name.contains(o)) {
+            continue;
+        }
+        let s = f();
+        s.print();
+        n_checks += s.checks.len();
+        n_failed += s.checks.iter().filter(|c| !c.pass).count();
+        all_ok &= s.passed();
+    }
+    println!("\nvalidate: {} checks, {} failed", n_checks, n_failed);
+    all_ok
+}

@@ -1,0 +1,10 @@
+//! Validation section: diagnose.
+
+use crate::report::Section;
+
+/// Runs this section and returns what it measured.
+pub fn section() -> Section {
+    let mut s = Section::new("diagnose");
+    s.note("not in hydrocyl yet: nothing measured");
+    s
+}

@@ -1,0 +1,10 @@
+//! Validation section: valve_rig.
+
+use crate::report::Section;
+
+/// Runs this section and returns what it measured.
+pub fn section() -> Section {
+    let mut s = Section::new("valve_rig");
+    s.note("not in hydrocyl yet: nothing measured");
+    s
+}

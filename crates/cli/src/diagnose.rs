@@ -1,14 +1,274 @@
-//! `hydrocyl diagnose` (being written).
+//! `hydrocyl diagnose`: run a rig against measured records, trace the
+//! residual to catalog effects, add the ones that earn their place, and
+//! report before and after (human table on stdout, JSON with `--report`,
+//! SVG plots with `--plots`). Nothing is written when anything fails.
+
+use std::io::IsTerminal as _;
+use std::path::{Path, PathBuf};
+
+use hydrocyl_identify::bench::{self, FrictionBench};
+use hydrocyl_identify::catalog::EffectId;
+use hydrocyl_identify::data::{write_atomic, Record};
+use hydrocyl_identify::diagnose::{diagnose_bench, DiagnoseOptions, Outcome, RecordTrace};
 
 use crate::error::CliError;
 
 /// Arguments of this subcommand.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Rig: a preset name (friction benches: tudelft-seal-25,
+    /// tudelft-seal-257, emps) or a rig JSON file.
+    #[arg(long)]
+    pub rig: String,
+    /// Measured record(s) (CSV); repeat for several records of one rig
+    /// (e.g. one per pressure level), fitted jointly.
+    #[arg(long, required = true, num_args = 1..)]
+    pub data: Vec<PathBuf>,
+    /// Where to write the JSON report.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Folder for SVG plots (measured vs simulated, residual vs regressor).
+    #[arg(long)]
+    pub plots: Option<PathBuf>,
+    /// Least share of the residual an effect must explain to be added.
+    #[arg(long, default_value_t = 0.03)]
+    pub min_share: f64,
+    /// Share at the end of each record held out from the tracing fit.
+    #[arg(long, default_value_t = 0.3)]
+    pub holdout: f64,
+    /// Smoother half-width in samples (default: chosen by GCV).
+    #[arg(long)]
+    pub window: Option<usize>,
+    /// Restrict the effects the loop may add (comma separated catalog ids).
+    #[arg(long, value_delimiter = ',')]
+    pub effects: Option<Vec<String>>,
+    /// Print nothing but errors.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+fn load_rig(spec: &str) -> Result<FrictionBench, CliError> {
+    if let Some(r) = bench::preset(spec) {
+        return Ok(r);
+    }
+    let path = Path::new(spec);
+    if !path.exists() {
+        return Err(CliError::Input(format!(
+            "--rig '{spec}': neither a preset ({}) nor an existing rig file",
+            bench::PRESETS.join(", ")
+        )));
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
+        path: spec.to_string(),
+        source: e,
+    })?;
+    let v: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| CliError::Input(format!("{spec}: not valid JSON: {e}")))?;
+    let kind = v.get("kind").and_then(|k| k.as_str()).unwrap_or("");
+    if kind != bench::KIND {
+        return Err(CliError::Input(format!(
+            "{spec}: rig kind '{kind}' cannot be diagnosed yet (only '{}'); hydraulic rigs wait for the assembler's effect switches",
+            bench::KIND
+        )));
+    }
+    FrictionBench::from_json(&text).map_err(|e| CliError::Input(format!("{spec}: {e}")))
+}
 
 /// Runs the subcommand.
-pub fn run(_args: Args) -> Result<(), CliError> {
-    Err(CliError::Input(
-        "this subcommand is not in hydrocyl yet".into(),
-    ))
+pub fn run(args: Args) -> Result<(), CliError> {
+    if !(0.0..1.0).contains(&args.min_share) {
+        return Err(CliError::Input(format!(
+            "--min-share {}: must be in [0, 1)",
+            args.min_share
+        )));
+    }
+    if !(0.05..=0.5).contains(&args.holdout) {
+        return Err(CliError::Input(format!(
+            "--holdout {}: must be in [0.05, 0.5]",
+            args.holdout
+        )));
+    }
+    if args.window == Some(0) {
+        return Err(CliError::Input("--window 0: must be at least 1".into()));
+    }
+    let candidates = match &args.effects {
+        None => None,
+        Some(ids) => Some(
+            ids.iter()
+                .map(|id| {
+                    EffectId::from_id(id.trim())
+                        .ok_or_else(|| CliError::Input(format!("--effects: unknown effect '{id}'")))
+                })
+                .collect::<Result<Vec<_>, _>>()?,
+        ),
+    };
+    let rig = load_rig(&args.rig)?;
+    let records = args
+        .data
+        .iter()
+        .map(|p| Record::read_mapped(p, &rig.columns))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| CliError::Input(e.to_string()))?;
+    let opts = DiagnoseOptions {
+        min_share: args.min_share,
+        holdout: args.holdout,
+        half_window: args.window,
+        candidates,
+        ..DiagnoseOptions::default()
+    };
+    let show_bar = !args.quiet && std::io::stderr().is_terminal();
+    let bar = show_bar.then(|| {
+        let b = indicatif::ProgressBar::new(1);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} [{bar:30}] {pos}/{len} {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    });
+    let mut progress = |stage: &str, done: usize, total: usize| {
+        if let Some(b) = &bar {
+            b.set_length(total as u64);
+            b.set_position(done as u64);
+            b.set_message(stage.to_string());
+        }
+    };
+    let outcome = diagnose_bench(&rig, &records, &opts, &mut progress)
+        .map_err(|e| CliError::Input(e.to_string()))?;
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    // Everything computed: now write, plots first, the report last.
+    if let Some(dir) = &args.plots {
+        write_plots(dir, &outcome)?;
+    }
+    if let Some(path) = &args.report {
+        let json = serde_json::to_string_pretty(&outcome.report)
+            .map_err(|e| CliError::Input(format!("report: {e}")))?;
+        write_atomic(path, json.as_bytes()).map_err(|e| CliError::Io {
+            path: path.display().to_string(),
+            source: e,
+        })?;
+    }
+    if !args.quiet {
+        print!("{}", outcome.report.human());
+    }
+    Ok(())
+}
+
+/// Writes, per record, `<stem>-force.svg` (measured, before, after) and, when
+/// an effect was added, `<stem>-residual.svg` (residual before vs the first
+/// added effect's regressor).
+fn write_plots(dir: &Path, outcome: &Outcome) -> Result<(), CliError> {
+    std::fs::create_dir_all(dir).map_err(|e| CliError::Io {
+        path: dir.display().to_string(),
+        source: e,
+    })?;
+    for (k, tr) in outcome.traces.iter().enumerate() {
+        let stem = Path::new(&tr.source)
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .map_or_else(|| format!("record{k}"), |s| s.to_string());
+        let f = dir.join(format!("{stem}-{}.svg", tr.channel));
+        plot_series(&f, tr).map_err(|e| CliError::Input(format!("{}: {e}", f.display())))?;
+        if tr.regressor.is_some() {
+            let f = dir.join(format!("{stem}-residual.svg"));
+            plot_residual(&f, tr).map_err(|e| CliError::Input(format!("{}: {e}", f.display())))?;
+        }
+    }
+    Ok(())
+}
+
+fn bounds(series: &[&[f64]]) -> (f64, f64) {
+    let lo = series
+        .iter()
+        .flat_map(|s| s.iter())
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let hi = series
+        .iter()
+        .flat_map(|s| s.iter())
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max);
+    let pad = 0.05 * (hi - lo).max(1e-12);
+    (lo - pad, hi + pad)
+}
+
+fn plot_series(path: &Path, tr: &RecordTrace) -> Result<(), Box<dyn std::error::Error>> {
+    use plotters::prelude::*;
+    let root = SVGBackend::new(path, (1000, 450)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (lo, hi) = bounds(&[&tr.measured, &tr.before, &tr.after]);
+    let t0 = tr.t[0];
+    let t1 = *tr.t.last().unwrap_or(&t0);
+    let mut ch = ChartBuilder::on(&root)
+        .caption(
+            format!("{}: {} measured vs simulated", tr.source, tr.channel),
+            ("sans-serif", 16),
+        )
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(60)
+        .build_cartesian_2d(t0..t1, lo..hi)?;
+    ch.configure_mesh()
+        .x_desc("time [s]")
+        .y_desc(format!("{} [SI]", tr.channel))
+        .draw()?;
+    let series = [
+        ("measured", &tr.measured, BLACK),
+        ("before", &tr.before, RED),
+        ("after", &tr.after, BLUE),
+    ];
+    for (name, y, colour) in series {
+        ch.draw_series(LineSeries::new(
+            tr.t.iter().copied().zip(y.iter().copied()),
+            colour,
+        ))?
+        .label(name)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], colour));
+    }
+    ch.configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+fn plot_residual(path: &Path, tr: &RecordTrace) -> Result<(), Box<dyn std::error::Error>> {
+    use plotters::prelude::*;
+    let Some((name, phi)) = &tr.regressor else {
+        return Ok(());
+    };
+    let resid: Vec<f64> = tr
+        .measured
+        .iter()
+        .zip(&tr.before)
+        .map(|(m, b)| m - b)
+        .collect();
+    let root = SVGBackend::new(path, (700, 500)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (xlo, xhi) = bounds(&[phi]);
+    let (ylo, yhi) = bounds(&[&resid]);
+    let mut ch = ChartBuilder::on(&root)
+        .caption(
+            format!("{}: residual before vs {name} regressor", tr.source),
+            ("sans-serif", 15),
+        )
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(60)
+        .build_cartesian_2d(xlo..xhi, ylo..yhi)?;
+    ch.configure_mesh()
+        .x_desc(format!("{name} regressor [SI]"))
+        .y_desc("residual before [SI]")
+        .draw()?;
+    let step = (phi.len() / 4000).max(1);
+    ch.draw_series(
+        phi.iter()
+            .zip(&resid)
+            .step_by(step)
+            .map(|(x, y)| Circle::new((*x, *y), 1, BLUE.filled())),
+    )?;
+    root.present()?;
+    Ok(())
 }

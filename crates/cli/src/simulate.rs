@@ -1,14 +1,239 @@
-//! `hydrocyl simulate` (being written).
+//! `hydrocyl simulate`: simulate a rig on a command signal and write the
+//! measured-data CSV format.
+//!
+//! ```text
+//! hydrocyl simulate --rig leaney-moog --command cmd.csv --out run.csv \
+//!     [--set cylinder.formulation=generalised-analytical] [--set initial.p1=2e6] \
+//!     [--solver dp45|rosenbrock|rk4] [--rtol 1e-6] [--print-rig]
+//! ```
+//!
+//! The command file is CSV with a `time` column (`time`, `time [s]` or
+//! `time [ms]`) and a `command` column (the normalised spool demand of a
+//! valve rig, the drive voltage of a pump rig); other columns are ignored.
+//! The output has one row per command sample: `time, command, position,
+//! velocity, p1, p2`, then the rig's other outputs (`ps`, `spool`, `p_le`,
+//! ...), all SI without unit suffixes. It is written to a temporary file in
+//! the output's folder and renamed into place, so a failed run leaves no file.
 
 use crate::error::CliError;
+use hydrocyl_system::rig;
+use hydrocyl_system::run::{Run, RunOptions, Solver};
+use hydrocyl_system::signal::Signal;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
 
-/// Arguments of this subcommand.
+/// Arguments of `hydrocyl simulate`.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// A preset name (leaney-moog, ...) or a rig JSON file.
+    #[arg(long)]
+    rig: String,
+    /// CSV with `time` and `command` columns; the output is sampled at its times.
+    #[arg(long, required_unless_present = "print_rig")]
+    command: Option<PathBuf>,
+    /// Output CSV (measured-data format).
+    #[arg(long, required_unless_present = "print_rig")]
+    out: Option<PathBuf>,
+    /// Override a rig parameter by its JSON path, e.g. `--set load.mass_kg=50`
+    /// or `--set initial.p1=2.5e6` (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    set: Vec<String>,
+    /// Integration method: dp45 (default), rosenbrock or rk4.
+    #[arg(long, default_value = "dp45")]
+    solver: String,
+    /// Relative tolerance of the adaptive methods.
+    #[arg(long, default_value_t = 1e-6)]
+    rtol: f64,
+    /// Fixed step of rk4 [s].
+    #[arg(long, default_value_t = 2e-5)]
+    rk4_step: f64,
+    /// Print the rig (after --set) as JSON and exit.
+    #[arg(long)]
+    print_rig: bool,
+}
 
-/// Runs the subcommand.
-pub fn run(_args: Args) -> Result<(), CliError> {
-    Err(CliError::Input(
-        "this subcommand is not in hydrocyl yet".into(),
-    ))
+/// Reads the command CSV: `(time [s], command)`; errors name file, row and column.
+pub fn read_command(path: &Path) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| CliError::Io {
+        path: file.clone(),
+        source,
+    })?;
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let headers = rdr
+        .headers()
+        .map_err(|e| CliError::Input(format!("{file}: row 1: {e}")))?
+        .clone();
+    let mut time_col = None;
+    let mut cmd_col = None;
+    for (i, h) in headers.iter().enumerate() {
+        let (name, unit) = match h.find('[') {
+            Some(o) if h.ends_with(']') => (h[..o].trim(), Some(h[o + 1..h.len() - 1].trim())),
+            _ => (h.trim(), None),
+        };
+        match name {
+            "time" => {
+                let f = match unit {
+                    None | Some("s") => 1.0,
+                    Some("ms") => 1e-3,
+                    Some(u) => {
+                        return Err(CliError::Input(format!(
+                            "{file}: column `{h}`: unknown time unit `{u}` (use s or ms)"
+                        )))
+                    }
+                };
+                time_col = Some((i, f));
+            }
+            "command" => cmd_col = Some(i),
+            _ => {}
+        }
+    }
+    let (ti, tf) = time_col.ok_or_else(|| CliError::Input(format!("{file}: no `time` column")))?;
+    let ci = cmd_col.ok_or_else(|| CliError::Input(format!("{file}: no `command` column")))?;
+    let (mut t, mut u) = (Vec::new(), Vec::new());
+    for (k, rec) in rdr.records().enumerate() {
+        let row = k + 2;
+        let rec = rec.map_err(|e| CliError::Input(format!("{file}: row {row}: {e}")))?;
+        let cell = |i: usize, col: &str| -> Result<f64, CliError> {
+            let s = rec.get(i).unwrap_or("");
+            let v: f64 = s.parse().map_err(|_| {
+                CliError::Input(format!(
+                    "{file}: row {row}, column `{col}`: `{s}` is not a number"
+                ))
+            })?;
+            if !v.is_finite() {
+                return Err(CliError::Input(format!(
+                    "{file}: row {row}, column `{col}`: {v} is not finite"
+                )));
+            }
+            Ok(v)
+        };
+        let tv = cell(ti, "time")? * tf;
+        if let Some(&prev) = t.last() {
+            if tv <= prev {
+                return Err(CliError::Input(format!(
+                    "{file}: row {row}, column `time`: {tv} s does not increase (previous {prev} s)"
+                )));
+            }
+        }
+        t.push(tv);
+        u.push(cell(ci, "command")?);
+    }
+    if t.len() < 2 {
+        return Err(CliError::Input(format!(
+            "{file}: needs at least two samples, found {}",
+            t.len()
+        )));
+    }
+    Ok((t, u))
+}
+
+/// The run as CSV text in the measured-data format.
+pub fn to_csv(run: &Run) -> String {
+    let mut s = String::from("time");
+    for c in &run.channels {
+        s.push(',');
+        s.push_str(&c.name);
+    }
+    s.push('\n');
+    for (k, t) in run.time.iter().enumerate() {
+        s.push_str(&format!("{t:?}"));
+        for c in &run.channels {
+            s.push_str(&format!(",{:?}", c.values[k]));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Writes `text` to `path` through a temporary file in the same folder.
+fn write_atomic(path: &Path, text: &str) -> Result<(), CliError> {
+    let io = |source| CliError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| CliError::Input(format!("{}: not a file name", path.display())))?;
+    let tmp = path.with_file_name(format!(
+        ".{}.tmp{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = std::fs::File::create(&tmp)
+        .and_then(|mut f| f.write_all(text.as_bytes()).and_then(|_| f.sync_all()))
+        .and_then(|_| std::fs::rename(&tmp, path));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io(e));
+    }
+    Ok(())
+}
+
+/// Runs `hydrocyl simulate`.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let rig_err = |e: rig::RigError| CliError::Input(e.to_string());
+    let mut value = rig::load(&args.rig).map_err(rig_err)?;
+    for s in &args.set {
+        rig::apply_set(&mut value, s).map_err(rig_err)?;
+    }
+    rig::check(&value).map_err(rig_err)?;
+    if args.print_rig {
+        let text = serde_json::to_string_pretty(&value)
+            .map_err(|e| CliError::Input(format!("rig: {e}")))?;
+        println!("{text}");
+        return Ok(());
+    }
+    let solver = Solver::parse(&args.solver).ok_or_else(|| {
+        CliError::Input(format!(
+            "--solver: unknown method `{}` (use dp45, rosenbrock or rk4)",
+            args.solver
+        ))
+    })?;
+    if !(args.rtol > 0.0 && args.rtol < 1.0) {
+        return Err(CliError::Input(format!(
+            "--rtol: {} is not in (0, 1)",
+            args.rtol
+        )));
+    }
+    if !(args.rk4_step > 0.0 && args.rk4_step.is_finite()) {
+        return Err(CliError::Input(format!(
+            "--rk4-step: {} is not positive",
+            args.rk4_step
+        )));
+    }
+    let (Some(cmd_path), Some(out)) = (args.command, args.out) else {
+        return Err(CliError::Input("--command and --out are required".into()));
+    };
+    let (t, u) = read_command(&cmd_path)?;
+    let signal = Signal::table(t.clone(), u)
+        .map_err(|e| CliError::Input(format!("{}: {e}", cmd_path.display())))?;
+    let opts = RunOptions {
+        solver,
+        rtol: args.rtol,
+        rk4_step: args.rk4_step,
+        ..RunOptions::default()
+    };
+    let run = rig::simulate(&value, signal, &t, &opts).map_err(rig_err)?;
+    write_atomic(&out, &to_csv(&run))?;
+    let cav = run.cavitation_entries();
+    eprintln!(
+        "hydrocyl: simulated {:.4} s in {:.3} s ({} steps, {} rejected, {} rhs); {}",
+        t[t.len() - 1] - t[0],
+        run.wall.as_secs_f64(),
+        run.stats.steps,
+        run.stats.rejected,
+        run.stats.rhs_evals,
+        if cav > 0 {
+            format!(
+                "CAVITATION: {cav} entries below the cavitation pressure (min chamber pressure {:.0} Pa)",
+                run.min_chamber_pressure()
+            )
+        } else {
+            "no cavitation".to_string()
+        }
+    );
+    Ok(())
 }

@@ -2,117 +2,83 @@
 //!
 //! Every model implements [`FrictionModel`]: velocity, acceleration and the
 //! chamber pressures in ([`FrictionInput`]), internal state where the model
-//! has one (the LuGre bristle deflection z), force out.
+//! has one (the bristle deflection z), force out; plus its Jacobian for the
+//! stiff integrator, its switching functions and modes for event location,
+//! and its stored energy and dissipated power for the energy ledger.
 //!
 //! ```text
-//!   piston velocity v ──▶ ┌──────────────┐
-//!   chamber p1, p2    ──▶ │   friction   │──▶ force F opposing motion [N]
-//!   acceleration a    ──▶ └──────────────┘
+//!   piston velocity v   [m/s] ──▶ ┌───────────────────┐
+//!   acceleration a    [m/s²]  ──▶ │  friction law     │──▶ force F [N] (opposes extension when > 0)
+//!   chamber p1, p2     [Pa]   ──▶ │  state z [m]      │──▶ acceleration coefficient c [kg]
+//!   drive force (events) [N]  ──▶ │  mode Slip/Stick  │──▶ dz/dt [m/s], ∂/∂(z, v, p1, p2)
+//!                                 └───────────────────┘──▶ stored ½σ0z² [J], dissipated [W]
 //! ```
 //!
-//! Models (thesis section 2.4 and chapter 5):
-//! * [`CoulombViscous`] — `F = Fc tanh(v/v_t) + b v`, the `leaney-moog` preset's law.
+//! Models (thesis section 2.4 and chapter 5), each module citing its equations:
+//! * [`CoulombViscous`] — `F = Fc tanh(v/v_t) + b v`, the `leaney-moog` preset's law;
+//! * [`Stribeck`] — static Stribeck curve, eq 2.40, extending/retracting sets;
+//! * [`Karnopp`] — stick as a mode with located stick/break-away events;
+//! * [`Dahl`] — pre-sliding bristle without stiction;
+//! * [`LuGre`] — eqs 2.34–2.36 / 5.1 in the **standard form** (eq 5.13 of the
+//!   thesis drops σ0 from dz/dt; hydrocyl does not), Table 5-11 set;
+//! * [`Wang`] — the thesis's new model, eq 5.4 pressure term `K (p1 − p2)² v`
+//!   and eq 5.12/5.14 acceleration term `K H a`, Tables 5-8, 5-9, 5-10.
+//!
+//! [`FrictionLaw`] holds any of them and (de)serialises with a `"model"` tag,
+//! so a rig file picks its friction by name. [`ident`] fits steady friction
+//! curves (eq 2.40 / 5.8) to measured points with [`hydrocyl_fit`].
+//!
+//! The thesis writes α for both the Stribeck exponent and the acceleration;
+//! hydrocyl calls the exponent δ ([`StribeckCurve::stribeck_exponent`]) and the
+//! acceleration a. Units are SI throughout: N, m, s, Pa, kg.
 //!
 //! ```
-//! use hydrocyl_friction::{CoulombViscous, FrictionInput, FrictionModel};
-//! use hydrocyl_ports::{Force, Velocity};
+//! use hydrocyl_friction::{CoulombViscous, FrictionInput, FrictionModel, Wang};
+//! use hydrocyl_ports::{Pressure, Velocity};
 //!
 //! let f = CoulombViscous::leaney_moog();
 //! let input = FrictionInput::at_velocity(Velocity::from_mm_per_s(100.0));
 //! let force = f.force(&input, &[]);
 //! assert!((force.n() - (50.0 * (100.0f64).tanh() + 500.0 * 0.1)).abs() < 1e-9);
+//!
+//! // Wang's model at 50 mm/s with 10 bar across the piston, in steady state.
+//! let wang = Wang::table_5_8();
+//! let input = FrictionInput {
+//!     velocity: Velocity::from_mm_per_s(50.0),
+//!     p1: Pressure::from_bar(12.0),
+//!     p2: Pressure::from_bar(2.0),
+//!     ..FrictionInput::default()
+//! };
+//! let mut z = [0.0];
+//! wang.steady_state(&input, &mut z);
+//! let f = wang.force(&input, &z).n();
+//! assert!((f - wang.static_curve(&input)).abs() < 1e-9);
+//! // K (p1 − p2)² v = 2.5e-8 × (1e6)² × 0.05 = 1250 N on top of g(v) ≈ 150 N.
+//! assert!(f > 1250.0 && f < 1250.0 + 180.0);
 //! ```
 #![warn(missing_docs)]
 
-use hydrocyl_ports::{Acceleration, Force, Mass, Pressure, Velocity};
-use serde::{Deserialize, Serialize};
+mod coulomb;
+mod curve;
+mod dahl;
+mod error;
+pub mod ident;
+mod karnopp;
+mod law;
+mod lugre;
+mod model;
+mod stribeck;
+mod wang;
 
-/// The signals a friction model may read.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct FrictionInput {
-    /// Piston velocity, + extending \[m·s⁻¹\].
-    pub velocity: Velocity,
-    /// Piston acceleration \[m·s⁻²\].
-    pub acceleration: Acceleration,
-    /// Cap-side chamber pressure p1 \[Pa\].
-    pub p1: Pressure,
-    /// Rod-side chamber pressure p2 \[Pa\].
-    pub p2: Pressure,
-}
-
-impl FrictionInput {
-    /// Input at velocity `v` with zero acceleration and zero pressures.
-    pub fn at_velocity(v: Velocity) -> Self {
-        Self {
-            velocity: v,
-            ..Self::default()
-        }
-    }
-}
-
-/// A friction law. The force is the friction force on the piston, positive
-/// when it opposes extension (so the load balance is
-/// `m a = p1 A1 − p2 A2 − F_friction − F_ext`, thesis eq 2.27).
-///
-/// Terms linear in acceleration (the thesis's `K H a`, eq 5.12) are **not**
-/// in [`FrictionModel::force`]; they are reported by
-/// [`FrictionModel::acceleration_coefficient`] so that the assembler can move
-/// them to the mass side of the balance and solve it explicitly:
-/// `(m + c) a = p1 A1 − p2 A2 − force(..) − F_ext`.
-pub trait FrictionModel {
-    /// Number of internal states (0 for static laws, 1 for LuGre/Dahl's z).
-    fn n_states(&self) -> usize {
-        0
-    }
-
-    /// Friction force without the acceleration-proportional term \[N\].
-    fn force(&self, input: &FrictionInput, state: &[f64]) -> Force;
-
-    /// Coefficient `c` of a friction term `c a` \[kg\] (zero by default).
-    fn acceleration_coefficient(&self, _input: &FrictionInput) -> Mass {
-        Mass::ZERO
-    }
-
-    /// Time derivative of the internal states.
-    fn state_derivative(&self, _input: &FrictionInput, _state: &[f64], _dstate: &mut [f64]) {}
-
-    /// The internal state that is steady at this input (for initial conditions).
-    fn steady_state(&self, _input: &FrictionInput, _state: &mut [f64]) {}
-
-    /// Steady-state force at constant velocity (the static friction curve).
-    fn steady_force(&self, input: &FrictionInput) -> Force {
-        let mut z = vec![0.0; self.n_states()];
-        self.steady_state(input, &mut z);
-        self.force(input, &z)
-    }
-}
-
-/// Coulomb + viscous friction, `F = Fc tanh(v / v_t) + b v` (the `leaney-moog`
-/// preset's law, rigs.md; tanh smoothing instead of a discontinuous sign).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct CoulombViscous {
-    /// Coulomb level Fc \[N\].
-    pub coulomb: Force,
-    /// Viscous coefficient b \[N·s·m⁻¹\].
-    pub viscous: f64,
-    /// Smoothing velocity v_t of the tanh \[m·s⁻¹\].
-    pub smoothing_velocity: Velocity,
-}
-
-impl CoulombViscous {
-    /// The `leaney-moog` preset: Fc = 50 N, b = 500 N s/m, v_t = 1 mm/s.
-    pub fn leaney_moog() -> Self {
-        Self {
-            coulomb: Force::new(50.0),
-            viscous: 500.0,
-            smoothing_velocity: Velocity::new(1.0e-3),
-        }
-    }
-}
-
-impl FrictionModel for CoulombViscous {
-    fn force(&self, input: &FrictionInput, _state: &[f64]) -> Force {
-        let v = input.velocity.si();
-        Force::new(self.coulomb.si() * (v / self.smoothing_velocity.si()).tanh() + self.viscous * v)
-    }
-}
+pub use coulomb::CoulombViscous;
+pub use curve::StribeckCurve;
+pub use dahl::Dahl;
+pub use error::FrictionError;
+pub use karnopp::Karnopp;
+pub use law::FrictionLaw;
+pub use lugre::LuGre;
+pub use model::{
+    finite_difference_jacobian, FrictionInput, FrictionJacobian, FrictionMode, FrictionModel,
+};
+pub use stribeck::{SteadySet, Stribeck};
+pub use wang::{Wang, WangSet};

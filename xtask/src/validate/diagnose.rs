@@ -1,10 +1,232 @@
-//! Validation section: diagnose.
+//! Validation section: diagnose — the measured-data loop on the generated
+//! fixtures (effect planted vs effect found, NRMSE before/after vs the noise
+//! floor), the speed goal, and the real EMPS and TU Delft records when
+//! `../shared/data` is present.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use hydrocyl_identify::bench::{self, FrictionBench};
+use hydrocyl_identify::catalog::EffectId;
+use hydrocyl_identify::data::Record;
+use hydrocyl_identify::diagnose::{diagnose_bench, DiagnoseOptions, Outcome};
+use hydrocyl_identify::synth::{self, Foreign, Noise};
 
 use crate::report::Section;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+}
+
+fn run(rig: &FrictionBench, recs: &[Record]) -> Result<Outcome, String> {
+    diagnose_bench(rig, recs, &DiagnoseOptions::default(), &mut |_, _, _| {})
+        .map_err(|e| e.to_string())
+}
+
+fn ids(o: &Outcome) -> String {
+    let v: Vec<&str> = o
+        .report
+        .effects_added
+        .iter()
+        .map(|e| e.id.as_str())
+        .collect();
+    if v.is_empty() {
+        "none".into()
+    } else {
+        v.join("+")
+    }
+}
 
 /// Runs this section and returns what it measured.
 pub fn section() -> Section {
     let mut s = Section::new("diagnose");
-    s.note("not in hydrocyl yet: nothing measured");
+    let dir = root().join("fixtures/measured");
+    s.note(&format!(
+        "{:<40} {:<38} {:<38} {:>9} {:>9} {:>9}",
+        "fixture", "planted", "found", "nrmse0", "nrmse1", "floor"
+    ));
+    for case in synth::fixture_cases() {
+        let csv = dir.join(format!("{}.csv", case.name));
+        let rigf = dir.join(format!("{}.rig.json", case.name));
+        let loaded = std::fs::read_to_string(&rigf)
+            .map_err(|e| format!("{}: {e}", rigf.display()))
+            .and_then(|t| FrictionBench::from_json(&t))
+            .and_then(|rig| {
+                Record::read(&csv)
+                    .map(|r| (rig, r))
+                    .map_err(|e| e.to_string())
+            });
+        let (rig, rec) = match loaded {
+            Ok(x) => x,
+            Err(e) => {
+                s.check(&case.name, e, "readable fixture".into(), false);
+                continue;
+            }
+        };
+        let o = match run(&rig, &[rec]) {
+            Ok(o) => o,
+            Err(e) => {
+                s.check(&case.name, e, "diagnosed".into(), false);
+                continue;
+            }
+        };
+        let r = &o.report;
+        let planted = match case.foreign {
+            Foreign::None if case.planted.is_empty() => "none".to_string(),
+            Foreign::None => case
+                .planted
+                .iter()
+                .map(|e| e.id())
+                .collect::<Vec<_>>()
+                .join("+"),
+            Foreign::Spring(_) => "spring (not in catalog)".into(),
+            Foreign::ForceDelay(_) => "force delay (not in catalog)".into(),
+        };
+        let found = ids(&o);
+        let found_text = match (&r.unexplained_resembles, case.foreign) {
+            (Some(p), Foreign::Spring(_) | Foreign::ForceDelay(_)) => {
+                format!("{found}; unexplained ~ {}", p.kind)
+            }
+            _ => found.clone(),
+        };
+        let (n0, n1, fl) = (
+            r.nrmse_before["force"],
+            r.nrmse_after["force"],
+            r.noise_floor["force"],
+        );
+        s.note(&format!(
+            "{:<40} {:<38} {:<38} {:>9.5} {:>9.5} {:>9.5}",
+            case.name, planted, found_text, n0, n1, fl
+        ));
+        let pass = match case.foreign {
+            Foreign::None => {
+                let mut want: Vec<&str> = case.planted.iter().map(|e| e.id()).collect();
+                let mut got: Vec<&str> = r.effects_added.iter().map(|e| e.id.as_str()).collect();
+                want.sort();
+                got.sort();
+                want == got && n1 <= 1.5 * fl
+            }
+            _ => r.effects_added.is_empty() && r.unexplained_resembles.is_some(),
+        };
+        s.check(
+            &format!("{}: found / NRMSE", case.name),
+            format!("{found}, {n1:.5}"),
+            format!("{planted}, <= 1.5 x {fl:.5}"),
+            pass,
+        );
+    }
+    // Speed: a 12 s record at 1 kHz with one planted effect.
+    let truth = synth::truth_with(&[EffectId::PressureViscous]);
+    let rec = synth::record(&truth, 12_000, 1e-3, Noise::default(), Foreign::None, 7);
+    let t0 = Instant::now();
+    let ok = run(&synth::declared_for(&[EffectId::PressureViscous]), &[rec]).is_ok();
+    let el = t0.elapsed().as_secs_f64();
+    s.check(
+        "12 s at 1 kHz diagnosed (wall time)",
+        format!("{el:.2} s"),
+        "< 10 s".into(),
+        ok && el < 10.0,
+    );
+    real_data(&mut s);
     s
+}
+
+fn real_data(s: &mut Section) {
+    let data = root().join("../shared/data");
+    let emps = data.join("emps_friction_benchmark/DATA_EMPS.csv");
+    if let (true, Some(rig)) = (emps.exists(), bench::preset("emps")) {
+        match Record::read_mapped(&emps, &rig.columns)
+            .map_err(|e| e.to_string())
+            .and_then(|r| run(&rig, &[r]))
+        {
+            Ok(o) => {
+                let r = &o.report;
+                let get = |n: &str| {
+                    r.declared_refit
+                        .iter()
+                        .find(|p| p.name == n)
+                        .map_or(f64::NAN, |p| p.fitted)
+                };
+                // Reference IDIM-LS model of the benchmark (Janot et al. 2019):
+                // M = 95.1089 kg, Fv = 203.5034 N s/m, Fc = 20.3935 N, offset -3.1648 N.
+                let rel = |a: f64, b: f64| (a / b - 1.0).abs();
+                s.check(
+                    "EMPS mass m [kg]",
+                    format!("{:.2}", get("m")),
+                    "95.11 (IDIM-LS), within 3 %".into(),
+                    rel(get("m"), 95.1089) < 0.03,
+                );
+                s.check(
+                    "EMPS viscous b [N s/m]",
+                    format!("{:.1}", get("viscous.b")),
+                    "203.5 (IDIM-LS), within 5 %".into(),
+                    rel(get("viscous.b"), 203.5034) < 0.05,
+                );
+                s.check(
+                    "EMPS Coulomb Fc [N]",
+                    format!("{:.2}", get("Fc")),
+                    "20.39 (IDIM-LS), within 5 %".into(),
+                    rel(get("Fc"), 20.3935) < 0.05,
+                );
+                let off = r
+                    .effects_added
+                    .iter()
+                    .find(|e| e.id == "coulomb_asymmetry")
+                    .map_or(f64::NAN, |e| 0.5 * e.params["dFc"]);
+                s.check(
+                    "EMPS offset while moving dFc/2 [N]",
+                    format!("{off:.2}"),
+                    "-3.16 (IDIM-LS offset), within 0.5 N".into(),
+                    (off + 3.1648).abs() < 0.5,
+                );
+                s.note(&format!(
+                    "EMPS: added {}; force NRMSE declared {:.4} -> refit {:.4} -> after {:.4}",
+                    ids(&o),
+                    r.nrmse_declared["force"],
+                    r.nrmse_before["force"],
+                    r.nrmse_after["force"]
+                ));
+            }
+            Err(e) => s.check("EMPS diagnosed", e, "a report".into(), false),
+        }
+    } else {
+        s.note("EMPS: ../shared/data/emps_friction_benchmark not present, skipped");
+    }
+    let tud = data.join("pneumatic_seal_friction_tudelft/csv_with_header");
+    if tud.exists() {
+        let Some(rig) = bench::preset("tudelft-seal-25") else {
+            return;
+        };
+        let recs: Result<Vec<Record>, String> = [1, 3, 5, 7]
+            .iter()
+            .map(|p| {
+                Record::read_mapped(&tud.join(format!("NAPN_{p}bar.csv")), &rig.columns)
+                    .map_err(|e| e.to_string())
+            })
+            .collect();
+        match recs.and_then(|r| run(&rig, &r)) {
+            Ok(o) => {
+                let r = &o.report;
+                let found = r.effects_added.iter().any(|e| e.id == "pressure_viscous");
+                s.check(
+                    "TU Delft NAPN 1-7 bar: pressure dependence found",
+                    ids(&o),
+                    "pressure_viscous among the added".into(),
+                    found,
+                );
+                s.note(&format!(
+                    "TU Delft NAPN: force NRMSE declared {:.4} -> refit {:.4} -> after {:.4}; unexplained {:.0} %",
+                    r.nrmse_declared["force"],
+                    r.nrmse_before["force"],
+                    r.nrmse_after["force"],
+                    100.0 * r.unexplained_share
+                ));
+            }
+            Err(e) => s.check("TU Delft NAPN diagnosed", e, "a report".into(), false),
+        }
+    } else {
+        s.note("TU Delft: ../shared/data/pneumatic_seal_friction_tudelft not present, skipped");
+    }
 }

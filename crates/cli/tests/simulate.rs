@@ -1,0 +1,249 @@
+//! `hydrocyl simulate` end to end: output format, sampling, overrides,
+//! solvers, and one-line errors with no output file.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn hydrocyl() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_hydrocyl"))
+}
+
+fn write_command(dir: &Path, name: &str, rows: &[(f64, f64)]) -> PathBuf {
+    let mut s = String::from("time,command,comment\n");
+    for (t, u) in rows {
+        s.push_str(&format!("{t},{u},x\n"));
+    }
+    let p = dir.join(name);
+    std::fs::write(&p, s).unwrap();
+    p
+}
+
+fn square(n: usize, dt: f64) -> Vec<(f64, f64)> {
+    (0..n)
+        .map(|k| {
+            let t = k as f64 * dt;
+            (t, if (t % 1.0) < 0.5 { 0.15 } else { -0.2 })
+        })
+        .collect()
+}
+
+fn read_csv(p: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(p).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|c| c.parse::<f64>().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn writes_the_measured_data_format_at_the_command_times() {
+    let dir = tempfile::tempdir().unwrap();
+    // uneven sampling: the output must follow it
+    let mut rows = square(400, 0.005);
+    rows.push((2.0013, 0.1));
+    let cmd = write_command(dir.path(), "cmd.csv", &rows);
+    let out = dir.path().join("out.csv");
+    let st = hydrocyl()
+        .args(["simulate", "--rig", "leaney-moog", "--command"])
+        .arg(&cmd)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let (h, data) = read_csv(&out);
+    assert_eq!(
+        &h[..6],
+        ["time", "command", "position", "velocity", "p1", "p2"]
+    );
+    assert!(h.contains(&"spool".to_string()) && h.contains(&"ps".to_string()));
+    assert_eq!(data.len(), rows.len());
+    for (r, (t, u)) in data.iter().zip(&rows) {
+        assert_eq!(r[0], *t);
+        assert_eq!(r[1], *u);
+        assert!(r[4] >= 0.0 && r[4] <= 7e6 && r[5] >= 0.0 && r[5] <= 7e6);
+        assert!(r[2].abs() <= 0.26);
+    }
+    // the piston moves out in the first half second
+    assert!(data[99][3] > 0.05, "velocity {}", data[99][3]);
+}
+
+#[test]
+fn overrides_and_solvers_change_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let cmd = write_command(dir.path(), "cmd.csv", &square(200, 0.005));
+    let run = |extra: &[&str], name: &str| {
+        let out = dir.path().join(name);
+        let st = hydrocyl()
+            .args(["simulate", "--rig", "leaney-moog", "--command"])
+            .arg(&cmd)
+            .arg("--out")
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            st.status.success(),
+            "{extra:?}: {}",
+            String::from_utf8_lossy(&st.stderr)
+        );
+        read_csv(&out).1
+    };
+    let base = run(&[], "a.csv");
+    let start = run(
+        &[
+            "--set",
+            "initial.position=0.1",
+            "--set",
+            "initial.p1=2e6",
+            "--set",
+            "initial.p2=4e6",
+        ],
+        "b.csv",
+    );
+    assert_eq!(start[0][2], 0.1);
+    assert_eq!((start[0][4], start[0][5]), (2e6, 4e6));
+    let heavy = run(&["--set", "load.mass_kg=1000"], "c.csv");
+    assert!((heavy[20][3] - base[20][3]).abs() > 1e-3);
+    for solver in ["rosenbrock", "rk4"] {
+        let other = run(&["--solver", solver], &format!("{solver}.csv"));
+        let k = other.len() - 1;
+        assert!((other[k][3] - base[k][3]).abs() < 1e-4, "{solver}");
+    }
+    let gen = run(
+        &["--set", "cylinder.formulation=generalised-analytical"],
+        "g.csv",
+    );
+    assert!((gen[90][3] - base[90][3]).abs() < 5e-3);
+}
+
+#[test]
+fn errors_are_one_line_with_exit_code_2_and_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = write_command(dir.path(), "cmd.csv", &square(50, 0.01));
+    let bad_time = write_command(dir.path(), "bad.csv", &[(0.0, 0.0), (0.1, 0.1), (0.1, 0.2)]);
+    let text = dir.path().join("text.csv");
+    std::fs::write(&text, "time,command\n0,0\n0.1,abc\n").unwrap();
+    let nocol = dir.path().join("nocol.csv");
+    std::fs::write(&nocol, "time,u\n0,0\n0.1,1\n").unwrap();
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["--set".into(), "cylinder.area_1_m2=-1".into()],
+            "cylinder.area_1_m2",
+        ),
+        (
+            vec!["--set".into(), "cylinder.colour=red".into()],
+            "cylinder.colour",
+        ),
+        (
+            vec!["--set".into(), "initial.position=1".into()],
+            "initial.position",
+        ),
+        (vec!["--solver".into(), "euler".into()], "euler"),
+        (vec!["--rig".into(), "no-such-rig".into()], "no-such-rig"),
+    ];
+    let out = dir.path().join("out.csv");
+    for (extra, needle) in cases {
+        let mut c = hydrocyl();
+        c.args(["simulate", "--command"])
+            .arg(&good)
+            .arg("--out")
+            .arg(&out);
+        if !extra.contains(&"--rig".to_string()) {
+            c.args(["--rig", "leaney-moog"]);
+        }
+        let st = c.args(&extra).output().unwrap();
+        let err = String::from_utf8_lossy(&st.stderr);
+        assert_eq!(st.status.code(), Some(2), "{extra:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(needle), "{needle}: {err}");
+        assert!(!out.exists(), "{extra:?} left an output file");
+    }
+    for (file, needle) in [(&bad_time, "row 4"), (&text, "row 3"), (&nocol, "command")] {
+        let st = hydrocyl()
+            .args(["simulate", "--rig", "leaney-moog", "--command"])
+            .arg(file)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&st.stderr);
+        assert_eq!(st.status.code(), Some(2), "{err}");
+        assert!(err.contains(needle), "{needle}: {err}");
+        assert!(!out.exists());
+    }
+    // an unwritable output: error, no stray temporary file
+    let st = hydrocyl()
+        .args(["simulate", "--rig", "leaney-moog", "--command"])
+        .arg(&good)
+        .arg("--out")
+        .arg(dir.path().join("missing-dir").join("out.csv"))
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(2));
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert!(
+        left.iter().all(|n| !n.to_string_lossy().contains(".tmp")),
+        "{left:?}"
+    );
+}
+
+#[test]
+fn rig_files_and_print_rig_round_trip() {
+    let dir = tempfile::tempdir().unwrap();
+    let st = hydrocyl()
+        .args([
+            "simulate",
+            "--rig",
+            "leaney-moog",
+            "--print-rig",
+            "--set",
+            "load.mass_kg=42",
+        ])
+        .output()
+        .unwrap();
+    assert!(st.status.success());
+    let rig = dir.path().join("rig.json");
+    std::fs::write(&rig, &st.stdout).unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
+    assert_eq!(v["load"]["mass_kg"], 42.0);
+    let cmd = write_command(dir.path(), "cmd.csv", &square(20, 0.01));
+    let out = dir.path().join("out.csv");
+    let st = hydrocyl()
+        .args(["simulate", "--rig"])
+        .arg(&rig)
+        .arg("--command")
+        .arg(&cmd)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    // the fixture file itself is a valid rig
+    let fixture =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/rigs/leaney-moog.json");
+    let st = hydrocyl()
+        .args(["simulate", "--print-rig", "--rig"])
+        .arg(&fixture)
+        .output()
+        .unwrap();
+    assert!(st.status.success());
+}

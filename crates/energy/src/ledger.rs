@@ -1,0 +1,261 @@
+//! The energy ledger of one run: energy in, out to the load, each loss by
+//! component, change in storage, and the balance error.
+//!
+//! The assembler integrates four quadratures per component
+//! ([`Circuit::set_ledger`]): ∫source, ∫dissipated, ∫storage, ∫load dt \[J\].
+//! Over a window `[t0, t1]` of output samples the ledger takes their
+//! differences and closes
+//!
+//! ```text
+//! E_in = E_load + Σ E_loss + ΔE_stored          (balance error = residual / E_in)
+//! ```
+//!
+//! Two storage figures are kept: the integrated storage power (what closes the
+//! balance) and the change of the stored energy recomputed from the states at
+//! the window's ends (`½ V p²/B` per volume, `½ (m + c) v²` for the load with
+//! the friction's acceleration term `c` as added mass, `½ σ0 z²` per bristle).
+//! Their difference is [`Ledger::storage_error`], an independent check of the
+//! integration: a state edited by an event without the ledger seeing it (a
+//! plastic impact at a stroke end) shows there.
+
+use crate::error::EnergyError;
+use hydrocyl_system::circuit::LEDGER_TERMS;
+use hydrocyl_system::run::Run;
+use hydrocyl_system::Circuit;
+use serde::Serialize;
+
+/// One named energy \[J\] over the window.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Term {
+    /// Name: the component's, with a `.part` suffix where one component's
+    /// term is split (`return.needle_valve`).
+    pub name: String,
+    /// Energy over the window \[J\].
+    pub energy_j: f64,
+}
+
+/// The ledger of one run over one window.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Ledger {
+    /// Window start and end \[s\].
+    pub window_s: (f64, f64),
+    /// Energy brought in by sources (the supply, the pump's hydraulic
+    /// power `(p_A − p_B) Q`) \[J\].
+    pub energy_in_j: f64,
+    /// Sources by component \[J\].
+    pub sources: Vec<Term>,
+    /// Work done on the external load (gravity: the potential energy gained,
+    /// `∫ F_ext v dt`) \[J\].
+    pub load_out_j: f64,
+    /// The cylinder's mechanical output of eq 8.7, `∫ v (p1 A1 − p2 A2) dt`
+    /// \[J\]: friction, load and kinetic energy together (what the thesis
+    /// calls output).
+    pub cylinder_out_j: f64,
+    /// Energy turned into heat, by component \[J\] (zero terms left out).
+    pub losses: Vec<Term>,
+    /// Integrated storage power by component (fluid compression, kinetic,
+    /// bristle) \[J\] (zero terms left out).
+    pub storage: Vec<Term>,
+    /// Change of the stored energy recomputed from the end states \[J\].
+    pub stored_change_from_states_j: f64,
+    /// Balance residual `E_in − E_load − Σ E_loss − Σ storage` as a fraction
+    /// of `E_in` \[-\].
+    pub error: f64,
+    /// `(Σ storage − stored_change_from_states)` as a fraction of `E_in` \[-\].
+    pub storage_error: f64,
+}
+
+impl Ledger {
+    /// Sum of the losses \[J\].
+    pub fn total_loss_j(&self) -> f64 {
+        self.losses.iter().map(|t| t.energy_j).sum()
+    }
+
+    /// Sum of the integrated storage \[J\].
+    pub fn total_storage_j(&self) -> f64 {
+        self.storage.iter().map(|t| t.energy_j).sum()
+    }
+
+    /// The efficiency of eqs 8.1–8.7: cylinder output over energy in \[-\].
+    pub fn efficiency(&self) -> f64 {
+        self.cylinder_out_j / self.energy_in_j
+    }
+
+    /// A loss by name \[J\] (0 when absent).
+    pub fn loss(&self, name: &str) -> f64 {
+        self.losses
+            .iter()
+            .filter(|t| t.name == name)
+            .map(|t| t.energy_j)
+            .sum()
+    }
+
+    /// Replaces loss `name` by the parts given (names `name.part`), keeping
+    /// the total: the last part takes whatever the others leave, so the
+    /// balance is unchanged.
+    pub fn split_loss(&mut self, name: &str, parts: &[(&str, f64)]) {
+        let Some(i) = self.losses.iter().position(|t| t.name == name) else {
+            return;
+        };
+        let total = self.losses.remove(i).energy_j;
+        let mut rest = total;
+        for (k, (part, e)) in parts.iter().enumerate() {
+            let e = if k + 1 == parts.len() { rest } else { *e };
+            rest -= e;
+            self.losses.push(Term {
+                name: format!("{name}.{part}"),
+                energy_j: e,
+            });
+        }
+    }
+
+    /// Every term by name, for reports: `in.<source>`, `load`, `loss.<c>`,
+    /// `storage.<c>` \[J\].
+    pub fn named_terms(&self) -> Vec<(String, f64)> {
+        let mut v: Vec<(String, f64)> = self
+            .sources
+            .iter()
+            .map(|t| (format!("in.{}", t.name), t.energy_j))
+            .collect();
+        v.push(("load".into(), self.load_out_j));
+        v.extend(
+            self.losses
+                .iter()
+                .map(|t| (format!("loss.{}", t.name), t.energy_j)),
+        );
+        v.extend(
+            self.storage
+                .iter()
+                .map(|t| (format!("storage.{}", t.name), t.energy_j)),
+        );
+        v
+    }
+}
+
+/// Where the rod lives in the circuit: the mechanical node and the
+/// components acting on it whose powers make the cylinder's output (eq 8.7).
+#[derive(Clone, Debug)]
+pub struct RodSide {
+    /// The mechanical node (`rod` in both rigs).
+    pub node: String,
+    /// The components on the rod other than the cylinder: the mass and the
+    /// friction law (`load`, `friction` in both rigs).
+    pub components: Vec<String>,
+}
+
+impl Default for RodSide {
+    fn default() -> Self {
+        Self {
+            node: "rod".into(),
+            components: vec!["load".into(), "friction".into()],
+        }
+    }
+}
+
+/// Energy (magnitudes) below this fraction of `E_in` is left out of the
+/// term lists as zero.
+const NEGLIGIBLE: f64 = 1e-12;
+
+/// The ledger of `run` (made with `RunOptions::ledger` on) over output
+/// samples `k0..=k1`. `circuit` is the one the run was made on.
+pub fn ledger(
+    circuit: &Circuit,
+    run: &Run,
+    k0: usize,
+    k1: usize,
+    rod: &RodSide,
+) -> Result<Ledger, EnergyError> {
+    let n_comp = circuit.components().count();
+    let off = circuit.ledger_offset();
+    if run.dim != off + LEDGER_TERMS * n_comp {
+        return Err(EnergyError::Ledger(format!(
+            "the run has {} entries per state, the circuit with its ledger {}: run with `ledger: true`",
+            run.dim,
+            off + LEDGER_TERMS * n_comp
+        )));
+    }
+    if !(k0 < k1 && k1 < run.time.len()) {
+        return Err(EnergyError::Ledger(format!(
+            "window samples {k0}..{k1} not inside the run's {} samples",
+            run.time.len()
+        )));
+    }
+    let (x0, x1) = (run.state(k0), run.state(k1));
+    let d = |i: usize, term: usize| {
+        let k = off + LEDGER_TERMS * i + term;
+        x1[k] - x0[k]
+    };
+    let mut sources = Vec::new();
+    let mut losses = Vec::new();
+    let mut storage = Vec::new();
+    let (mut e_in, mut e_load, mut e_cyl) = (0.0, 0.0, 0.0);
+    let names: Vec<String> = circuit.components().map(|c| c.name().to_string()).collect();
+    for (i, name) in names.iter().enumerate() {
+        let (src, diss, sto, load) = (d(i, 0), d(i, 1), d(i, 2), d(i, 3));
+        e_in += src;
+        e_load += load;
+        if rod.components.contains(name) {
+            e_cyl += diss + sto + load;
+        }
+        let push = |v: &mut Vec<Term>, e: f64| {
+            v.push(Term {
+                name: name.clone(),
+                energy_j: e,
+            })
+        };
+        if src != 0.0 {
+            push(&mut sources, src);
+        }
+        if diss != 0.0 {
+            push(&mut losses, diss);
+        }
+        if sto != 0.0 {
+            push(&mut storage, sto);
+        }
+    }
+    if !(e_in.is_finite() && e_in > 0.0) {
+        return Err(EnergyError::Ledger(format!(
+            "energy in over the window is {e_in} J: nothing to take a fraction of"
+        )));
+    }
+    let tiny = NEGLIGIBLE * e_in;
+    losses.retain(|t| t.energy_j.abs() > tiny);
+    storage.retain(|t| t.energy_j.abs() > tiny);
+    let sum_loss: f64 = losses.iter().map(|t| t.energy_j).sum();
+    let sum_sto: f64 = storage.iter().map(|t| t.energy_j).sum();
+    let stored = |k: usize| stored_energy(circuit, run.time[k], run.state(k), rod);
+    let from_states = stored(k1) - stored(k0);
+    Ok(Ledger {
+        window_s: (run.time[k0], run.time[k1]),
+        energy_in_j: e_in,
+        sources,
+        load_out_j: e_load,
+        cylinder_out_j: e_cyl,
+        losses,
+        storage,
+        stored_change_from_states_j: from_states,
+        error: (e_in - e_load - sum_loss - sum_sto) / e_in,
+        storage_error: (sum_sto - from_states) / e_in,
+    })
+}
+
+/// Energy stored in the circuit at `(t, x)` \[J\]: every component's
+/// `stored`, plus `½ c v²` of the added mass `c` on the rod (the friction's
+/// acceleration term, booked with the kinetic energy).
+pub fn stored_energy(circuit: &Circuit, t: f64, x: &[f64], rod: &RodSide) -> f64 {
+    let terms: f64 = circuit.power_terms(t, x).iter().map(|p| p.stored).sum();
+    let w = circuit.wires_at(t, x);
+    let wire = |k: &str| circuit.find_wire(&format!("mech:{}:{k}", rod.node));
+    let added = match (wire("m"), wire("v")) {
+        (Some(m), Some(v)) => 0.5 * w.get(m) * w.get(v) * w.get(v),
+        _ => 0.0,
+    };
+    terms + added
+}
+
+/// `∫ y dt` by the trapezoidal rule over samples `k0..=k1` \[unit of y · s\].
+pub fn trapezoid(time: &[f64], y: &[f64], k0: usize, k1: usize) -> f64 {
+    (k0..k1)
+        .map(|k| 0.5 * (y[k] + y[k + 1]) * (time[k + 1] - time[k]))
+        .sum()
+}

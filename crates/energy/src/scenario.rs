@@ -1,0 +1,526 @@
+//! The chapter-8 scenarios: a drive (valve-controlled, hybrid, or a hybrid
+//! variant), a speed, a wave and a load; running one gives its ledger, its
+//! efficiency (eqs 8.1–8.7) and its power traces.
+//!
+//! Choices where the thesis is silent (docs/energy.md):
+//! * period: the piston travels 125 mm per half period of the square wave
+//!   (`T = 0.25 m / v`: 5 s at 50 mm/s, 2.5 s at 100 mm/s), and the sine wave
+//!   has the same period; the piston starts half its travel below mid-stroke;
+//! * the first period is start-up; the ledger is taken over the following
+//!   [`Plan::measured_periods`];
+//! * commands are the open-loop biased waves the thesis uses (section 3.1.3
+//!   for the valve, section 7.1 for the pump): levels that give ±v in steady
+//!   state on the asymmetric cylinder;
+//! * the 20 kg gravity load is an external force `m g` opposing extension
+//!   (cylinder vertical, rod up); the moving mass is the rig's 20 kg in both
+//!   load cases (Table 8-1: "20 kg, include tray and piston rod").
+
+use crate::error::EnergyError;
+use crate::ledger::{ledger, trapezoid, Ledger, RodSide};
+use crate::switched::SwitchedOrifice;
+use crate::variant::HybridVariant;
+use hydrocyl_friction::FrictionLaw;
+use hydrocyl_ports::{Area, Pressure};
+use hydrocyl_system::hybrid::{nodes, ReturnPath, WangHybrid};
+use hydrocyl_system::rig::RigError;
+use hydrocyl_system::run::{run, RunOptions, SimError, Solver};
+use hydrocyl_system::signal::Signal;
+use hydrocyl_system::valve_rig::ValveRig;
+use hydrocyl_system::{Circuit, Component};
+use serde::Serialize;
+use std::time::Instant;
+
+/// Standard gravity \[m·s⁻²\].
+pub const G: f64 = 9.80665;
+
+/// Command wave.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Wave {
+    /// Biased sine.
+    Sine,
+    /// Biased square.
+    Square,
+}
+
+impl Wave {
+    /// `sine` or `square`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Wave::Sine => "sine",
+            Wave::Square => "square",
+        }
+    }
+}
+
+/// One cell of the matrix.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Scenario {
+    /// `valve`, `hybrid` or a variant's name.
+    pub system: String,
+    /// Speed amplitude \[mm/s\].
+    pub speed_mm_s: f64,
+    /// Wave.
+    pub wave: Wave,
+    /// Gravity load \[kg\] (0: none).
+    pub load_kg: f64,
+}
+
+impl Scenario {
+    /// A label such as `hybrid ±50 mm/s sine 20 kg`.
+    pub fn label(&self) -> String {
+        format!(
+            "{} ±{} mm/s {} {} kg",
+            self.system,
+            self.speed_mm_s,
+            self.wave.name(),
+            self.load_kg
+        )
+    }
+
+    /// Speed \[m/s\].
+    pub fn speed(&self) -> f64 {
+        self.speed_mm_s * 1e-3
+    }
+
+    /// The command period \[s\] (125 mm per half square period).
+    pub fn period(&self) -> f64 {
+        0.25 / self.speed()
+    }
+
+    /// Initial position \[m\]: half the travel of one half period below mid-stroke.
+    pub fn start_position(&self) -> f64 {
+        let travel = match self.wave {
+            Wave::Square => 0.5 * self.speed() * self.period(),
+            Wave::Sine => self.speed() * self.period() / std::f64::consts::PI,
+        };
+        -0.5 * travel
+    }
+
+    fn check(&self) -> Result<(), EnergyError> {
+        let bad = |why: &str| {
+            Err(EnergyError::Scenario {
+                scenario: self.label(),
+                why: why.into(),
+            })
+        };
+        if !(self.speed_mm_s.is_finite() && self.speed_mm_s > 0.0 && self.speed_mm_s <= 500.0) {
+            return bad("speed must be in (0, 500] mm/s");
+        }
+        if !(self.load_kg.is_finite() && self.load_kg >= 0.0) {
+            return bad("load must be finite and non-negative");
+        }
+        Ok(())
+    }
+}
+
+/// The 8 scenarios of one system: ±50 and ±100 mm/s, sine and square, no
+/// load and 20 kg, in the order of Tables 8-2 and 8-3.
+pub fn scenarios_for(system: &str) -> Vec<Scenario> {
+    let mut v = Vec::new();
+    for load_kg in [0.0, 20.0] {
+        for speed_mm_s in [50.0, 100.0] {
+            for wave in [Wave::Sine, Wave::Square] {
+                v.push(Scenario {
+                    system: system.into(),
+                    speed_mm_s,
+                    wave,
+                    load_kg,
+                });
+            }
+        }
+    }
+    v
+}
+
+/// The 16 base scenarios of Tables 8-2 and 8-3: valve and hybrid, ±50 and
+/// ±100 mm/s, sine and square, no load and 20 kg.
+pub fn base_matrix() -> Vec<Scenario> {
+    let mut v = scenarios_for("valve");
+    v.extend(scenarios_for("hybrid"));
+    v
+}
+
+/// The thesis's efficiency (Tables 8-2, 8-3) for a base scenario \[-\].
+pub fn thesis_efficiency(system: &str, speed_mm_s: f64, wave: Wave, load_kg: f64) -> Option<f64> {
+    let fast = if speed_mm_s == 50.0 {
+        false
+    } else if speed_mm_s == 100.0 {
+        true
+    } else {
+        return None;
+    };
+    let loaded = if load_kg == 0.0 {
+        false
+    } else if load_kg == 20.0 {
+        true
+    } else {
+        return None;
+    };
+    let sine = wave == Wave::Sine;
+    let pct = match (system, loaded, fast, sine) {
+        ("valve", false, false, true) => 3.70,
+        ("valve", false, false, false) => 4.16,
+        ("valve", false, true, true) => 7.39,
+        ("valve", false, true, false) => 8.59,
+        ("valve", true, false, true) => 2.75,
+        ("valve", true, false, false) => 3.29,
+        ("valve", true, true, true) => 4.95,
+        ("valve", true, true, false) => 5.88,
+        ("hybrid", false, false, true) => 24.65,
+        ("hybrid", false, false, false) => 24.15,
+        ("hybrid", false, true, true) => 13.97,
+        ("hybrid", false, true, false) => 14.6,
+        ("hybrid", true, false, true) => 24.65,
+        ("hybrid", true, false, false) => 24.78,
+        ("hybrid", true, true, true) => 27.59,
+        ("hybrid", true, true, false) => 27.14,
+        _ => return None,
+    };
+    Some(pct / 100.0)
+}
+
+/// A drive to run scenarios on.
+#[derive(Clone, Debug)]
+pub enum Drive {
+    /// A valve-controlled rig (`valve-cylinder` kind, e.g. `wang-valve-c10`).
+    Valve(Box<ValveRig>),
+    /// The hybrid pump-controlled rig, optionally modified by a variant.
+    Hybrid(Box<WangHybrid>, Option<HybridVariant>),
+}
+
+impl Drive {
+    /// The `wang-valve-c10` preset.
+    pub fn wang_valve_c10() -> Result<Self, EnergyError> {
+        let v = hydrocyl_system::rig::preset("wang-valve-c10").ok_or_else(|| EnergyError::Rig {
+            rig: "wang-valve-c10".into(),
+            source: RigError::Invalid {
+                path: "wang-valve-c10".into(),
+                why: "no such preset".into(),
+            },
+        })?;
+        let r = hydrocyl_system::rig::valve_rig_from(&v).map_err(|source| EnergyError::Rig {
+            rig: "wang-valve-c10".into(),
+            source,
+        })?;
+        Ok(Drive::Valve(Box::new(r)))
+    }
+
+    /// The `wang-hybrid` preset.
+    pub fn wang_hybrid() -> Self {
+        Drive::Hybrid(Box::new(WangHybrid::preset()), None)
+    }
+}
+
+/// Which friction the scenarios run with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FrictionCase {
+    /// The rig's own friction law (the presets: eq 5.14, Table 5-8).
+    AsRig,
+    /// Eq 5.14 with the pressure-energised seal gain K = 0 (which also
+    /// removes the acceleration term `K H a`): the bristle and Stribeck curve
+    /// only. With K of Table 5-8 neither drive has a steady state at
+    /// 100 mm/s (the fold of `hydrocyl_system::hybrid::chapter7`); see
+    /// docs/energy.md.
+    WithoutSealTerm,
+}
+
+impl FrictionCase {
+    /// `as-rig` or `without-seal-term`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FrictionCase::AsRig => "as-rig",
+            FrictionCase::WithoutSealTerm => "without-seal-term",
+        }
+    }
+
+    fn apply(self, law: &mut FrictionLaw) {
+        if self == FrictionCase::WithoutSealTerm {
+            if let FrictionLaw::Wang(w) = law {
+                w.extending.k_pressure = 0.0;
+                w.retracting.k_pressure = 0.0;
+            }
+        }
+    }
+}
+
+/// How long and how finely to run.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// The friction case.
+    pub friction: FrictionCase,
+    /// Periods run before the ledger window (start-up).
+    pub warmup_periods: usize,
+    /// Periods in the ledger window.
+    pub measured_periods: usize,
+    /// Output sample interval \[s\].
+    pub sample_s: f64,
+    /// Relative tolerance of the solver.
+    pub rtol: f64,
+}
+
+impl Default for Plan {
+    fn default() -> Self {
+        Self {
+            friction: FrictionCase::WithoutSealTerm,
+            warmup_periods: 1,
+            measured_periods: 2,
+            sample_s: 2e-3,
+            rtol: 1e-6,
+        }
+    }
+}
+
+/// Power traces over the ledger window, for plots.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Trace {
+    /// Time from the window start \[s\].
+    pub time_s: Vec<f64>,
+    /// Power in (supply or pump) \[W\].
+    pub power_in_w: Vec<f64>,
+    /// Cylinder output power of eq 8.7 \[W\].
+    pub power_out_w: Vec<f64>,
+    /// Velocity \[m/s\].
+    pub velocity_m_s: Vec<f64>,
+}
+
+/// The result of one scenario.
+#[derive(Clone, Debug, Serialize)]
+pub struct Outcome {
+    /// The scenario.
+    pub scenario: Scenario,
+    /// The ledger over the measured periods.
+    pub ledger: Ledger,
+    /// Efficiency of eqs 8.1–8.7 \[-\].
+    pub efficiency: f64,
+    /// The thesis's value \[-\], where it has one.
+    pub thesis_efficiency: Option<f64>,
+    /// Component counters of the run (cavitation entries, stop impacts, ...).
+    pub diagnostics: Vec<(String, f64)>,
+    /// Wall time of the solve \[s\].
+    pub wall_s: f64,
+    /// Highest extending and retracting speed in the window \[mm/s\].
+    pub peak_speeds_mm_s: (f64, f64),
+    /// Power traces over the window.
+    #[serde(skip)]
+    pub trace: Trace,
+}
+
+impl Outcome {
+    /// Number of stroke-end impacts in the run.
+    pub fn stop_impacts(&self) -> f64 {
+        self.diagnostics
+            .iter()
+            .filter(|(n, _)| n.ends_with("stop_impacts"))
+            .map(|(_, v)| *v)
+            .sum()
+    }
+}
+
+fn rig_err(rig: &str) -> impl Fn(RigError) -> EnergyError + '_ {
+    move |source| EnergyError::Rig {
+        rig: rig.into(),
+        source,
+    }
+}
+
+/// Runs scenario `sc` on `drive`.
+pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome, EnergyError> {
+    sc.check()?;
+    if plan.measured_periods == 0 || !(plan.sample_s > 0.0) {
+        return Err(EnergyError::Scenario {
+            scenario: sc.label(),
+            why: "the plan needs at least one measured period and a positive sample interval"
+                .into(),
+        });
+    }
+    let label = sc.label();
+    let v = sc.speed();
+    let period = sc.period();
+    let force = sc.load_kg * G;
+    let (mut circuit, solver, hybrid) = match drive {
+        Drive::Valve(rig) => {
+            let mut r = (**rig).clone();
+            r.load.external_force_n = force;
+            plan.friction.apply(&mut r.friction);
+            r.initial.position = sc.start_position();
+            let (bias, amplitude) = r.open_loop_square(v).map_err(rig_err(&label))?;
+            let cmd = wave_signal(sc.wave, amplitude, period, bias);
+            (r.circuit(cmd).map_err(rig_err(&label))?, Solver::Dp45, None)
+        }
+        Drive::Hybrid(rig, variant) => {
+            let mut r = (**rig).clone();
+            r.external_force = force;
+            plan.friction.apply(&mut r.friction);
+            r.initial_position = sc.start_position();
+            if let Some(var) = variant {
+                if let Some(a) = var.needle_area_for(sc.speed_mm_s) {
+                    r.needle.area = Area::new(a);
+                }
+            }
+            let (a1, a2) = (r.cylinder.area_1.si(), r.cylinder.area_2.si());
+            let k = r.pump.gain;
+            let amplitude = v * (a1 + a2) / (2.0 * k);
+            let bias = v * (a1 - a2) / (2.0 * k);
+            let cmd = wave_signal(sc.wave, amplitude, period, bias);
+            let mut comps = r
+                .components(cmd)
+                .map_err(|e| rig_err(&label)(RigError::Build(e)))?;
+            if let Some(s) = variant.as_ref().and_then(|v| v.solenoid_valves) {
+                replace_reliefs(&mut comps, s.area_m2, s.orifice);
+            }
+            let c = Circuit::build(comps).map_err(|e| rig_err(&label)(RigError::Build(e)))?;
+            (c, Solver::Rosenbrock, Some(r))
+        }
+    };
+    let n_per = (period / plan.sample_s).round().max(1.0) as usize;
+    let dt = period / n_per as f64;
+    let n = n_per * (plan.warmup_periods + plan.measured_periods);
+    let t: Vec<f64> = (0..=n).map(|k| k as f64 * dt).collect();
+    let opts = RunOptions {
+        solver,
+        rtol: plan.rtol,
+        ledger: true,
+        ..RunOptions::default()
+    };
+    let x0 = circuit.initial_state();
+    let start = Instant::now();
+    let out = run(&mut circuit, &x0, &t, &opts).map_err(|e| {
+        rig_err(&label)(match e {
+            SimError::Build(b) => RigError::Build(b),
+            other => RigError::Sim(other.to_string()),
+        })
+    })?;
+    let wall_s = start.elapsed().as_secs_f64();
+    let (k0, k1) = (n_per * plan.warmup_periods, n);
+    let rod = RodSide::default();
+    let mut led = ledger(&circuit, &out, k0, k1, &rod)?;
+    if let Some(r) = &hybrid {
+        let needle = needle_energy(r, &out, k0, k1)?;
+        led.split_loss("return", &[("needle_valve", needle), ("pilot_valve", 0.0)]);
+    }
+    // power traces: the ledger's integrands at each sample
+    let names: Vec<String> = circuit.components().map(|c| c.name().to_string()).collect();
+    let mut trace = Trace::default();
+    let vel = out.channel("velocity").unwrap_or(&[]);
+    for k in k0..=k1 {
+        let p = circuit.power_terms(out.time[k], out.state(k));
+        let p_in: f64 = p.iter().map(|p| p.source).sum();
+        let p_out: f64 = p
+            .iter()
+            .zip(&names)
+            .filter(|(_, n)| rod.components.contains(n))
+            .map(|(p, _)| p.dissipated + p.storage + p.load)
+            .sum();
+        trace.time_s.push(out.time[k] - out.time[k0]);
+        trace.power_in_w.push(p_in);
+        trace.power_out_w.push(p_out);
+        trace.velocity_m_s.push(vel.get(k).copied().unwrap_or(f64::NAN));
+    }
+    let efficiency = led.efficiency();
+    let peak = |sign: f64| {
+        1e3 * trace
+            .velocity_m_s
+            .iter()
+            .map(|v| sign * v)
+            .fold(0.0, f64::max)
+    };
+    Ok(Outcome {
+        peak_speeds_mm_s: (peak(1.0), peak(-1.0)),
+        thesis_efficiency: thesis_efficiency(&sc.system, sc.speed_mm_s, sc.wave, sc.load_kg),
+        scenario: sc.clone(),
+        ledger: led,
+        efficiency,
+        diagnostics: out.diagnostics.clone(),
+        wall_s,
+        trace,
+    })
+}
+
+fn wave_signal(wave: Wave, amplitude: f64, period_s: f64, bias: f64) -> Signal {
+    match wave {
+        Wave::Square => Signal::Square {
+            amplitude,
+            period_s,
+            bias,
+        },
+        Wave::Sine => Signal::Sine {
+            amplitude,
+            period_s,
+            bias,
+            phase_rad: 0.0,
+        },
+    }
+}
+
+/// Replaces relief valves 1 and 2 of the hybrid rig by solenoid valves
+/// switched by the pump command's sign (variant (a)).
+fn replace_reliefs(
+    comps: &mut [Box<dyn Component>],
+    area_m2: f64,
+    orifice: hydrocyl_valves::orifice::Orifice,
+) {
+    for c in comps.iter_mut() {
+        let (name, line, chamber, dir) = match c.name() {
+            "relief_1" => ("solenoid_1", nodes::LINE_1, nodes::CHAMBER_1, 1.0),
+            "relief_2" => ("solenoid_2", nodes::LINE_2, nodes::CHAMBER_2, -1.0),
+            _ => continue,
+        };
+        *c = Box::new(SwitchedOrifice::new(
+            name,
+            nodes::COMMAND,
+            line,
+            chamber,
+            Area::new(area_m2),
+            orifice,
+            dir,
+        ));
+    }
+}
+
+/// The needle valve's share of the return path's loss over samples
+/// `k0..=k1` \[J\]: the pressure between the four-way's T port and the needle
+/// from the series law, `∫ Q (p_mid − p_tank) dt` by the trapezoidal rule.
+fn needle_energy(
+    r: &WangHybrid,
+    out: &hydrocyl_system::run::Run,
+    k0: usize,
+    k1: usize,
+) -> Result<f64, EnergyError> {
+    let ch = |n: &str| {
+        out.channel(n)
+            .ok_or_else(|| EnergyError::Ledger(format!("hybrid run has no `{n}` channel")))
+    };
+    let (pp1, pp2, p1, p2) = (ch("pp1")?, ch("pp2")?, ch("p1")?, ch("p2")?);
+    let (qa, qb) = (ch("return_flow_1")?, ch("return_flow_2")?);
+    let path = ReturnPath::new(
+        "split",
+        r.four_way,
+        r.needle,
+        nodes::LINE_1,
+        nodes::LINE_2,
+        nodes::CHAMBER_1,
+        nodes::CHAMBER_2,
+        nodes::TANK,
+    );
+    let pt = r.tank_pressure;
+    let power: Vec<f64> = (0..out.time.len())
+        .map(|k| {
+            if k < k0 || k > k1 {
+                return 0.0;
+            }
+            let y = r
+                .four_way
+                .opening(Pressure::new(pp1[k]), Pressure::new(pp2[k]));
+            let (px, q) = if y > 0.0 {
+                (p2[k], qb[k])
+            } else {
+                (p1[k], qa[k])
+            };
+            let (_, pm) = path.series_flow(r.four_way.return_coefficient(y), px, pt);
+            q * (pm - pt)
+        })
+        .collect();
+    Ok(trapezoid(&out.time, &power, k0, k1))
+}

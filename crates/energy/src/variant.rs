@@ -1,0 +1,179 @@
+//! The thesis's proposed improvements of the hybrid drive (sections 8.2 and
+//! 9.2) as rig files of kind `hybrid-variant`: a base hybrid rig plus
+//! changes assembled from existing components.
+//!
+//! ```json
+//! { "kind": "hybrid-variant", "name": "hybrid-solenoid", "description": "...",
+//!   "base": "wang-hybrid",
+//!   "solenoid_valves": { "area_m2": 1.5e-5,
+//!                        "orifice": { "cd": 0.65, "density": 900.0, "dp_transition": 1000.0 } },
+//!   "needle_area_by_speed": [ { "speed_mm_s": 50.0, "area_m2": 4.2e-6 } ] }
+//! ```
+//!
+//! * `base`: a preset name or the path of a `hybrid-pump` rig file (relative
+//!   to the variant file);
+//! * `solenoid_valves` (variant (a)): relief valves 1 and 2 replaced by on/off
+//!   valves ([`SwitchedOrifice`](crate::switched::SwitchedOrifice)) open while
+//!   the pump command feeds their line (valve 1 for a positive command);
+//! * `needle_area_by_speed` (variant (b)): the needle valve's opening area
+//!   \[m²\] per speed; a scenario takes the entry of the nearest speed.
+
+use crate::error::EnergyError;
+use hydrocyl_system::hybrid::WangHybrid;
+use hydrocyl_valves::orifice::Orifice;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The JSON `kind` of a variant file.
+pub const KIND: &str = "hybrid-variant";
+
+/// Solenoid valves replacing relief valves 1 and 2.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolenoidSpec {
+    /// Open area of each valve \[m²\].
+    pub area_m2: f64,
+    /// Orifice law of the open valve.
+    pub orifice: Orifice,
+}
+
+/// One needle opening for one speed.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NeedleSetting {
+    /// Speed amplitude \[mm/s\].
+    pub speed_mm_s: f64,
+    /// Needle opening area Avn \[m²\].
+    pub area_m2: f64,
+}
+
+/// A variant rig file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HybridVariant {
+    /// Always `hybrid-variant`.
+    pub kind: String,
+    /// The variant's name (the `system` column of the matrix).
+    pub name: String,
+    /// Free text: what is changed and why.
+    pub description: String,
+    /// The base hybrid rig: a preset name or a rig-file path.
+    pub base: String,
+    /// Variant (a): solenoid valves instead of relief valves 1 and 2.
+    #[serde(default)]
+    pub solenoid_valves: Option<SolenoidSpec>,
+    /// Variant (b): needle opening per speed.
+    #[serde(default)]
+    pub needle_area_by_speed: Option<Vec<NeedleSetting>>,
+}
+
+impl HybridVariant {
+    /// Checks the parameters; errors name the field.
+    pub fn validate(&self) -> Result<(), EnergyError> {
+        let bad = |why: String| {
+            Err(EnergyError::Variant {
+                path: self.name.clone(),
+                why,
+            })
+        };
+        if self.kind != KIND {
+            return bad(format!("`kind` must be `{KIND}`, got `{}`", self.kind));
+        }
+        if let Some(s) = &self.solenoid_valves {
+            if !(s.area_m2.is_finite() && s.area_m2 > 0.0) {
+                return bad(format!(
+                    "`solenoid_valves.area_m2` = {} must be positive",
+                    s.area_m2
+                ));
+            }
+            if !(s.orifice.cd > 0.0 && s.orifice.cd <= 1.0) {
+                return bad(format!(
+                    "`solenoid_valves.orifice.cd` = {} must be in (0, 1]",
+                    s.orifice.cd
+                ));
+            }
+            if !(s.orifice.density.si() > 0.0 && s.orifice.dp_transition.si() > 0.0) {
+                return bad(
+                    "`solenoid_valves.orifice` density and dp_transition must be positive".into(),
+                );
+            }
+        }
+        if let Some(t) = &self.needle_area_by_speed {
+            if t.is_empty() {
+                return bad("`needle_area_by_speed` is empty (leave it out instead)".into());
+            }
+            for (i, s) in t.iter().enumerate() {
+                if !(s.speed_mm_s.is_finite() && s.speed_mm_s > 0.0) {
+                    return bad(format!(
+                        "`needle_area_by_speed[{i}].speed_mm_s` = {} must be positive",
+                        s.speed_mm_s
+                    ));
+                }
+                if !(s.area_m2.is_finite() && s.area_m2 > 0.0) {
+                    return bad(format!(
+                        "`needle_area_by_speed[{i}].area_m2` = {} must be positive",
+                        s.area_m2
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The needle area for `speed_mm_s` \[m²\]: the entry of the nearest speed.
+    pub fn needle_area_for(&self, speed_mm_s: f64) -> Option<f64> {
+        self.needle_area_by_speed.as_ref().and_then(|t| {
+            t.iter()
+                .min_by(|a, b| {
+                    (a.speed_mm_s - speed_mm_s)
+                        .abs()
+                        .total_cmp(&(b.speed_mm_s - speed_mm_s).abs())
+                })
+                .map(|s| s.area_m2)
+        })
+    }
+
+    /// Parses and checks a variant from JSON text; `origin` names it in errors.
+    pub fn from_json(text: &str, origin: &str) -> Result<Self, EnergyError> {
+        let v: Self = serde_json::from_str(text).map_err(|e| EnergyError::Variant {
+            path: origin.into(),
+            why: format!("line {} column {}: {e}", e.line(), e.column()),
+        })?;
+        v.validate()?;
+        Ok(v)
+    }
+
+    /// Reads a variant file and its base rig.
+    pub fn load(path: &Path) -> Result<(WangHybrid, Self), EnergyError> {
+        let origin = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| EnergyError::Variant {
+            path: origin.clone(),
+            why: format!("cannot read: {e}"),
+        })?;
+        let v = Self::from_json(&text, &origin)?;
+        let base = v.base_rig(path.parent())?;
+        Ok((base, v))
+    }
+
+    /// The base rig: a preset, or a rig file (relative paths from `dir`).
+    pub fn base_rig(&self, dir: Option<&Path>) -> Result<WangHybrid, EnergyError> {
+        let name = if hydrocyl_system::rig::preset(&self.base).is_some() {
+            self.base.clone()
+        } else {
+            match dir {
+                Some(d) if Path::new(&self.base).is_relative() => {
+                    d.join(&self.base).display().to_string()
+                }
+                _ => self.base.clone(),
+            }
+        };
+        let value = hydrocyl_system::rig::load(&name).map_err(|e| EnergyError::Variant {
+            path: self.name.clone(),
+            why: format!("base `{}`: {e}", self.base),
+        })?;
+        WangHybrid::from_value(&value).map_err(|e| EnergyError::Variant {
+            path: self.name.clone(),
+            why: format!("base `{}` is not a hybrid rig: {e}", self.base),
+        })
+    }
+}

@@ -1,0 +1,381 @@
+//! The bounded Levenberg–Marquardt iteration.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::error::FitError;
+use crate::report::{FitReport, Termination};
+
+/// A least-squares model: residuals `r(p)` (measured − model, or any vector
+/// whose squared norm is to be minimised) and optionally their Jacobian.
+///
+/// Any closure `Fn(&[f64], &mut [f64])` is a `Residuals`; wrap a closure pair
+/// in [`WithJacobian`] to supply an analytic Jacobian.
+pub trait Residuals {
+    /// Writes the residuals at parameters `p` into `r`.
+    fn residuals(&self, p: &[f64], r: &mut [f64]);
+
+    /// Writes the Jacobian `∂r_i/∂p_j` row-major into `jac`
+    /// (`jac[i * n_params + j]`) and returns `true`; the default returns
+    /// `false` and the solver uses finite differences.
+    fn jacobian(&self, _p: &[f64], _jac: &mut [f64]) -> bool {
+        false
+    }
+}
+
+impl<F: Fn(&[f64], &mut [f64])> Residuals for F {
+    fn residuals(&self, p: &[f64], r: &mut [f64]) {
+        self(p, r)
+    }
+}
+
+/// A residual closure with its analytic Jacobian closure (row-major, see
+/// [`Residuals::jacobian`]).
+pub struct WithJacobian<R, J> {
+    /// The residuals `r(p)`.
+    pub residuals: R,
+    /// The Jacobian `∂r/∂p`, row-major.
+    pub jacobian: J,
+}
+
+impl<R, J> Residuals for WithJacobian<R, J>
+where
+    R: Fn(&[f64], &mut [f64]),
+    J: Fn(&[f64], &mut [f64]),
+{
+    fn residuals(&self, p: &[f64], r: &mut [f64]) {
+        (self.residuals)(p, r)
+    }
+    fn jacobian(&self, p: &[f64], jac: &mut [f64]) -> bool {
+        (self.jacobian)(p, jac);
+        true
+    }
+}
+
+/// Solver settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    /// Most residual evaluations (trial points and finite-difference columns)
+    /// before [`FitError::NotConverged`].
+    pub max_evaluations: usize,
+    /// Converged when an accepted step lowers the cost by less than `ftol` × cost.
+    pub ftol: f64,
+    /// Converged when the step is below `xtol` × (‖p‖ + `xtol`).
+    pub xtol: f64,
+    /// Converged when every free parameter's gradient cosine
+    /// `|g_j| / (‖J_j‖ ‖r‖)` is below `gtol`.
+    pub gtol: f64,
+    /// Initial damping λ (relative to the diagonal of JᵀJ, Marquardt scaling).
+    pub initial_lambda: f64,
+    /// Relative finite-difference step (absolute where a parameter is zero).
+    pub fd_step: f64,
+    /// Confidence level of the reported intervals (0.95 = 95 %).
+    pub confidence_level: f64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            max_evaluations: 5000,
+            ftol: 1e-12,
+            xtol: 1e-12,
+            gtol: 1e-10,
+            initial_lambda: 1e-3,
+            fd_step: 1e-7,
+            confidence_level: 0.95,
+        }
+    }
+}
+
+/// A bounded nonlinear least-squares problem: minimise ½‖r(p)‖² subject to
+/// `lower ≤ p ≤ upper`.
+pub struct Problem<R> {
+    model: R,
+    n_residuals: usize,
+    names: Vec<String>,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    options: Options,
+}
+
+impl<R: Residuals> Problem<R> {
+    /// A problem with `n_residuals` residuals and one parameter per name,
+    /// unbounded until [`Problem::bounds`] is called.
+    pub fn new(model: R, n_residuals: usize, names: &[&str]) -> Self {
+        Self {
+            model,
+            n_residuals,
+            names: names.iter().map(|s| s.to_string()).collect(),
+            lower: vec![f64::NEG_INFINITY; names.len()],
+            upper: vec![f64::INFINITY; names.len()],
+            options: Options::default(),
+        }
+    }
+
+    /// Sets the parameter bounds (checked by [`Problem::solve`]); use
+    /// infinities for an open side.
+    pub fn bounds(mut self, lower: &[f64], upper: &[f64]) -> Self {
+        self.lower = lower.to_vec();
+        self.upper = upper.to_vec();
+        self
+    }
+
+    /// Replaces the solver settings.
+    pub fn options(mut self, options: Options) -> Self {
+        self.options = options;
+        self
+    }
+
+    /// Number of parameters.
+    pub fn n_params(&self) -> usize {
+        self.names.len()
+    }
+
+    fn validate(&self, p0: &[f64]) -> Result<(), FitError> {
+        let m = self.n_params();
+        if m == 0 || self.n_residuals == 0 {
+            return Err(FitError::Empty {
+                n_params: m,
+                n_residuals: self.n_residuals,
+            });
+        }
+        for (what, got) in [
+            ("initial guess", p0.len()),
+            ("lower bounds", self.lower.len()),
+            ("upper bounds", self.upper.len()),
+        ] {
+            if got != m {
+                return Err(FitError::Dimension {
+                    what,
+                    got,
+                    expected: m,
+                });
+            }
+        }
+        for (j, &value) in p0.iter().enumerate() {
+            let (lo, hi) = (self.lower[j], self.upper[j]);
+            if lo.is_nan() || hi.is_nan() || lo > hi {
+                return Err(FitError::InvalidBounds {
+                    index: j,
+                    name: self.names[j].clone(),
+                    lower: lo,
+                    upper: hi,
+                });
+            }
+            if !value.is_finite() || value < lo || value > hi {
+                return Err(FitError::InitialOutsideBounds {
+                    index: j,
+                    name: self.names[j].clone(),
+                    value,
+                    lower: lo,
+                    upper: hi,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn eval(&self, p: &[f64], r: &mut DVector<f64>) -> bool {
+        self.model.residuals(p, r.as_mut_slice());
+        r.iter().all(|x| x.is_finite())
+    }
+
+    /// Jacobian at `p` (analytic or finite differences), column-major matrix.
+    fn jacobian(
+        &self,
+        p: &[f64],
+        r: &DVector<f64>,
+        buf: &mut Vec<f64>,
+        evaluations: &mut usize,
+    ) -> DMatrix<f64> {
+        let (n, m) = (self.n_residuals, self.n_params());
+        buf.resize(n * m, 0.0);
+        if self.model.jacobian(p, buf) {
+            return DMatrix::from_row_slice(n, m, buf);
+        }
+        let mut jac = DMatrix::zeros(n, m);
+        let mut pp = p.to_vec();
+        let mut rp = DVector::zeros(n);
+        let mut rm = DVector::zeros(n);
+        for j in 0..m {
+            let h = self.options.fd_step * p[j].abs().max(1e-3 * self.options.fd_step.sqrt());
+            let (lo, hi) = (self.lower[j], self.upper[j]);
+            let up_ok = p[j] + h <= hi;
+            let down_ok = p[j] - h >= lo;
+            if up_ok && down_ok {
+                pp[j] = p[j] + h;
+                self.model.residuals(&pp, rp.as_mut_slice());
+                pp[j] = p[j] - h;
+                self.model.residuals(&pp, rm.as_mut_slice());
+                jac.set_column(j, &((&rp - &rm) / (2.0 * h)));
+            } else if up_ok {
+                pp[j] = p[j] + h;
+                self.model.residuals(&pp, rp.as_mut_slice());
+                jac.set_column(j, &((&rp - r) / h));
+            } else {
+                pp[j] = p[j] - h;
+                self.model.residuals(&pp, rm.as_mut_slice());
+                jac.set_column(j, &((r - &rm) / h));
+            }
+            pp[j] = p[j];
+            *evaluations += if up_ok && down_ok { 2 } else { 1 };
+        }
+        jac
+    }
+
+    /// Runs the bounded Levenberg–Marquardt iteration from `p0` and returns the
+    /// fitted parameters with their statistics.
+    ///
+    /// Bounds are kept by projection: each trial point is the damped
+    /// Gauss–Newton point projected onto the box, and parameters sitting on a
+    /// bound with the gradient pushing outward are held fixed for that
+    /// iteration (an active set). Such parameters are flagged
+    /// [`crate::Parameter::at_bound`] and get no confidence interval.
+    pub fn solve(&self, p0: &[f64]) -> Result<FitReport, FitError> {
+        self.validate(p0)?;
+        let (n, m) = (self.n_residuals, self.n_params());
+        let o = &self.options;
+        let mut p = p0.to_vec();
+        let mut r = DVector::zeros(n);
+        if !self.eval(&p, &mut r) {
+            let index = r.iter().position(|x| !x.is_finite()).unwrap_or(0);
+            return Err(FitError::NonFiniteResidual { index });
+        }
+        let mut cost = 0.5 * r.norm_squared();
+        let mut buf = Vec::new();
+        let mut evaluations = 1usize;
+        let mut jac = self.jacobian(&p, &r, &mut buf, &mut evaluations);
+        let mut lambda = o.initial_lambda;
+        let mut nu = 2.0;
+        let mut iterations = 0usize;
+        let mut r_new = DVector::zeros(n);
+        let termination;
+        'outer: loop {
+            check_finite(&jac, iterations)?;
+            let a = jac.transpose() * &jac;
+            let g = jac.transpose() * &r;
+            let free: Vec<usize> = (0..m)
+                .filter(|&j| {
+                    !((p[j] <= self.lower[j] && g[j] > 0.0)
+                        || (p[j] >= self.upper[j] && g[j] < 0.0))
+                })
+                .collect();
+            // Gradient test (MINPACK's cosine form) on the free parameters.
+            let rnorm = r.norm();
+            if rnorm == 0.0 {
+                termination = Termination::ZeroResidual;
+                break;
+            }
+            let gmax = free
+                .iter()
+                .map(|&j| {
+                    let cn = a[(j, j)].sqrt();
+                    if cn > 0.0 {
+                        g[j].abs() / (cn * rnorm)
+                    } else {
+                        0.0
+                    }
+                })
+                .fold(0.0, f64::max);
+            if free.is_empty() || gmax <= o.gtol {
+                termination = Termination::Gradient;
+                break;
+            }
+            let k = free.len();
+            let max_diag = free.iter().map(|&j| a[(j, j)]).fold(0.0, f64::max);
+            let floor = (max_diag * 1e-12).max(f64::MIN_POSITIVE);
+            loop {
+                if evaluations >= o.max_evaluations {
+                    return Err(FitError::NotConverged {
+                        iterations,
+                        cost,
+                        gradient: gmax,
+                        lambda,
+                    });
+                }
+                let mut sys = DMatrix::zeros(k, k);
+                let mut rhs = DVector::zeros(k);
+                for (ii, &i) in free.iter().enumerate() {
+                    rhs[ii] = -g[i];
+                    for (jj, &j) in free.iter().enumerate() {
+                        sys[(ii, jj)] = a[(i, j)];
+                    }
+                    sys[(ii, ii)] += lambda * a[(i, i)].max(floor);
+                }
+                let Some(chol) = sys.cholesky() else {
+                    lambda *= nu;
+                    nu *= 2.0;
+                    continue;
+                };
+                let d = chol.solve(&rhs);
+                let mut trial = p.clone();
+                for (ii, &j) in free.iter().enumerate() {
+                    trial[j] = (p[j] + d[ii]).clamp(self.lower[j], self.upper[j]);
+                }
+                let step = DVector::from_iterator(m, (0..m).map(|j| trial[j] - p[j]));
+                let pnorm = p.iter().map(|x| x * x).sum::<f64>().sqrt();
+                if step.norm() <= o.xtol * (pnorm + o.xtol) {
+                    termination = Termination::Step;
+                    break 'outer;
+                }
+                evaluations += 1;
+                let finite = self.eval(&trial, &mut r_new);
+                let cost_new = 0.5 * r_new.norm_squared();
+                let predicted = -(g.dot(&step) + 0.5 * step.dot(&(&a * &step)));
+                let rho = if finite && predicted > 0.0 {
+                    (cost - cost_new) / predicted
+                } else {
+                    -1.0
+                };
+                if rho > 1e-4 {
+                    let reduction = cost - cost_new;
+                    p = trial;
+                    std::mem::swap(&mut r, &mut r_new);
+                    cost = cost_new;
+                    iterations += 1;
+                    lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+                    nu = 2.0;
+                    jac = self.jacobian(&p, &r, &mut buf, &mut evaluations);
+                    if reduction <= o.ftol * cost {
+                        termination = Termination::Cost;
+                        break 'outer;
+                    }
+                    break;
+                }
+                lambda *= nu;
+                nu *= 2.0;
+                if lambda > 1e30 {
+                    termination = Termination::NoReduction;
+                    break 'outer;
+                }
+            }
+        }
+        check_finite(&jac, iterations)?;
+        Ok(FitReport::build(
+            &self.names,
+            p,
+            r,
+            &jac,
+            &self.lower,
+            &self.upper,
+            o.confidence_level,
+            iterations,
+            evaluations,
+            termination,
+        ))
+    }
+}
+
+fn check_finite(jac: &DMatrix<f64>, iteration: usize) -> Result<(), FitError> {
+    for col in 0..jac.ncols() {
+        for row in 0..jac.nrows() {
+            if !jac[(row, col)].is_finite() {
+                return Err(FitError::NonFiniteJacobian {
+                    row,
+                    col,
+                    iteration,
+                });
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,327 @@
+//! Generated friction-bench records with planted effects: the test cases of
+//! the loop (and the fixtures in `fixtures/measured/`).
+//!
+//! The drive moves the piston in smoothed strokes (velocity
+//! `V(t) tanh(sin(2π f t)/0.15)`, with the stroke speed `V(t)` swept between
+//! 20 and 100 mm/s so that speed-dependent terms are separable from Coulomb
+//! friction); the chamber pressure is swept between 1 and 7 bar (so that the
+//! pressure term is separable). The true model's force is computed from the
+//! exact motion, then Gaussian sensor noise is added to position, pressure and
+//! force. The record is what a rig would log: time, position, p2, force.
+
+use std::collections::BTreeMap;
+
+use crate::bench::{BenchFriction, BenchSignals, FrictionBench, KIND};
+use crate::catalog::EffectId;
+use crate::data::{ColumnMap, Record, Signal};
+use crate::smooth::gaussian_noise;
+
+/// Sensor noise standard deviations of generated records.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Noise {
+    /// Position noise \[m\].
+    pub position: f64,
+    /// Pressure noise \[Pa\].
+    pub pressure: f64,
+    /// Force noise \[N\].
+    pub force: f64,
+}
+
+impl Default for Noise {
+    fn default() -> Self {
+        Self {
+            position: 2e-6,
+            pressure: 2e3,
+            force: 0.5,
+        }
+    }
+}
+
+/// Something planted in a generated record that the catalog does not have.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Foreign {
+    /// Nothing.
+    None,
+    /// A spring along the stroke, `k x` \[N·m⁻¹\] (e.g. a cable or bellows).
+    Spring(f64),
+    /// A transport delay of the load-cell signal \[s\].
+    ForceDelay(f64),
+}
+
+/// The declared model of the generated bench: a 50 mm bore, 2 kg piston,
+/// Coulomb 20 N + viscous 300 N·s/m, pressure on the −x side.
+pub fn base_rig() -> FrictionBench {
+    let mut effects = BTreeMap::new();
+    effects.insert(
+        EffectId::Viscous,
+        BTreeMap::from([("b".to_string(), 300.0)]),
+    );
+    FrictionBench {
+        kind: KIND.into(),
+        name: "synthetic-bench".into(),
+        area1: 0.0,
+        area2: std::f64::consts::PI * 0.025f64.powi(2),
+        mass: 2.0,
+        force_sign: 1.0,
+        friction: BenchFriction {
+            coulomb: 20.0,
+            smoothing_velocity: 1e-3,
+            effects,
+        },
+        refit: vec![],
+        columns: ColumnMap::default(),
+        steady_state: false,
+    }
+}
+
+/// A realistic magnitude of each force-balance effect for [`base_rig`].
+pub fn planted(id: EffectId) -> BTreeMap<String, f64> {
+    let kv = |k: &str, v: f64| (k.to_string(), v);
+    match id {
+        EffectId::CoulombAsymmetry => BTreeMap::from([kv("dFc", 10.0)]),
+        EffectId::Stribeck => BTreeMap::from([kv("Fs", 45.0), kv("vs", 0.01), kv("alpha", 1.0)]),
+        EffectId::Viscous => BTreeMap::from([kv("b", 300.0)]),
+        EffectId::PressureViscous => BTreeMap::from([kv("K", 1e-9)]),
+        EffectId::AccelerationFriction => BTreeMap::from([kv("H", 5e9)]),
+        EffectId::LugreDynamics => BTreeMap::from([kv("sigma0", 2e5), kv("sigma1", 600.0)]),
+        EffectId::ExternalForce => BTreeMap::from([kv("F0", 15.0)]),
+        _ => BTreeMap::new(),
+    }
+}
+
+/// The exact motion and pressure of a generated record: `n` samples at `dt`
+/// (position by trapezoidal integration of the velocity, zero mean).
+pub fn motion(n: usize, dt: f64) -> BenchSignals {
+    use std::f64::consts::PI;
+    let t: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
+    let f = 0.8;
+    let vel = |t: f64| {
+        let speed = 0.06 + 0.04 * (2.0 * PI * 0.11 * t).sin();
+        speed * ((2.0 * PI * f * t).sin() / 0.15).tanh()
+    };
+    let v: Vec<f64> = t.iter().map(|&t| vel(t)).collect();
+    let h = 1e-6;
+    let a: Vec<f64> = t
+        .iter()
+        .map(|&t| (vel(t + h) - vel(t - h)) / (2.0 * h))
+        .collect();
+    let p2: Vec<f64> = t
+        .iter()
+        .map(|&t| 4e5 + 3e5 * (2.0 * PI * 0.13 * t + 0.5).sin())
+        .collect();
+    let mut x = vec![0.0; n];
+    for i in 1..n {
+        x[i] = x[i - 1] + 0.5 * (v[i] + v[i - 1]) * dt;
+    }
+    let mean = x.iter().sum::<f64>() / n as f64;
+    x.iter_mut().for_each(|v| *v -= mean);
+    BenchSignals {
+        source: "synthetic".into(),
+        x,
+        v,
+        a,
+        p1: vec![0.0; n],
+        p2,
+        force: vec![0.0; n],
+        t,
+    }
+}
+
+/// Generates a record of `truth` on [`motion`] with sensor `noise`, plus an
+/// out-of-catalog `foreign` term, seeded for reproducibility.
+pub fn record(
+    truth: &FrictionBench,
+    n: usize,
+    dt: f64,
+    noise: Noise,
+    foreign: Foreign,
+    seed: u64,
+) -> Record {
+    let m = motion(n, dt);
+    let mut force = truth.simulate(&m);
+    let x = m.x.clone();
+    match foreign {
+        Foreign::None => {}
+        Foreign::Spring(k) => {
+            for (f, xi) in force.iter_mut().zip(&x) {
+                *f += truth.force_sign * k * xi;
+            }
+        }
+        Foreign::ForceDelay(tau) => {
+            let f0 = force.clone();
+            for (i, f) in force.iter_mut().enumerate() {
+                *f = crate::data::interp_linear(&m.t, &f0, m.t[i] - tau);
+            }
+        }
+    }
+    let ex = gaussian_noise(n, seed);
+    let ep = gaussian_noise(n, seed.wrapping_add(1));
+    let ef = gaussian_noise(n, seed.wrapping_add(2));
+    let pos: Vec<f64> = x
+        .iter()
+        .zip(&ex)
+        .map(|(x, e)| x + noise.position * e)
+        .collect();
+    let p2: Vec<f64> =
+        m.p2.iter()
+            .zip(&ep)
+            .map(|(p, e)| p + noise.pressure * e)
+            .collect();
+    let force: Vec<f64> = force
+        .iter()
+        .zip(&ef)
+        .map(|(f, e)| f + noise.force * e)
+        .collect();
+    let mut signals = BTreeMap::new();
+    signals.insert(Signal::Position, pos);
+    signals.insert(Signal::P2, p2);
+    signals.insert(Signal::Force, force);
+    Record {
+        source: "synthetic".into(),
+        time: m.t,
+        signals,
+        ignored: vec![],
+    }
+}
+
+/// The true rig of a planted case: [`base_rig`] with `effects` on at their
+/// [`planted`] magnitude (acceleration friction needs pressure_viscous's K,
+/// which is then on in the base too).
+pub fn truth_with(effects: &[EffectId]) -> FrictionBench {
+    let mut r = declared_for(effects);
+    for &id in effects {
+        r.friction.effects.insert(id, planted(id));
+    }
+    r
+}
+
+/// The declared rig of a planted case: the truth without the planted effects.
+pub fn declared_for(effects: &[EffectId]) -> FrictionBench {
+    let mut r = base_rig();
+    if effects.contains(&EffectId::AccelerationFriction) {
+        r.friction.effects.insert(
+            EffectId::PressureViscous,
+            planted(EffectId::PressureViscous),
+        );
+    }
+    for id in effects {
+        r.friction.effects.remove(id);
+    }
+    r
+}
+
+/// One generated fixture: name, planted catalog effects, foreign term, seed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FixtureCase {
+    /// File stem in `fixtures/measured/`.
+    pub name: String,
+    /// Catalog effects planted (and left out of the declared rig).
+    pub planted: Vec<EffectId>,
+    /// Out-of-catalog term planted.
+    pub foreign: Foreign,
+    /// Noise seed.
+    pub seed: u64,
+}
+
+/// The fixture cases: nothing missing, each force-balance effect alone, two
+/// at once, and two out-of-catalog shapes.
+pub fn fixture_cases() -> Vec<FixtureCase> {
+    let mut v = vec![FixtureCase {
+        name: "bench-none".into(),
+        planted: vec![],
+        foreign: Foreign::None,
+        seed: 100,
+    }];
+    for (k, id) in crate::bench::BENCH_EFFECTS.iter().enumerate() {
+        v.push(FixtureCase {
+            name: format!("bench-{}", id.id()),
+            planted: vec![*id],
+            foreign: Foreign::None,
+            seed: 101 + k as u64,
+        });
+    }
+    v.push(FixtureCase {
+        name: "bench-pressure_viscous+external_force".into(),
+        planted: vec![EffectId::PressureViscous, EffectId::ExternalForce],
+        foreign: Foreign::None,
+        seed: 120,
+    });
+    v.push(FixtureCase {
+        name: "bench-foreign-spring".into(),
+        planted: vec![],
+        foreign: Foreign::Spring(400.0),
+        seed: 121,
+    });
+    v.push(FixtureCase {
+        name: "bench-foreign-delay".into(),
+        planted: vec![],
+        foreign: Foreign::ForceDelay(0.01),
+        seed: 122,
+    });
+    v
+}
+
+/// A realistic magnitude of each valve-rig effect on `leaney-moog`
+/// (`None` for effects the valve rig does not expose).
+pub fn valve_planted(id: EffectId) -> Option<(&'static str, f64)> {
+    Some(match id {
+        EffectId::ValveNullBias => ("xb", 0.03 * 0.375e-3),
+        EffectId::FlowGainError => ("kw", 0.85),
+        EffectId::InternalLeakage => ("Cl", 1e-11),
+        EffectId::BulkModulus => ("B", 3.5e8),
+        EffectId::ExternalForce => ("F0", 800.0),
+        _ => return None,
+    })
+}
+
+/// The command of generated valve-rig records: two sines (1 Hz, 0.3 and
+/// 3.3 Hz, 0.1 of full spool demand).
+pub fn valve_command(t: f64) -> f64 {
+    use std::f64::consts::PI;
+    0.3 * (2.0 * PI * t).sin() + 0.1 * (2.0 * PI * 3.3 * t).sin()
+}
+
+/// Generates a valve-rig record: `truth` simulated on [`valve_command`] for
+/// `n` samples at `dt` (integrated at rtol 1e-8), position noise 20 µm and
+/// pressure noise 20 kPa.
+pub fn valve_record(
+    truth: &hydrocyl_system::valve_rig::ValveRig,
+    n: usize,
+    dt: f64,
+    seed: u64,
+) -> Result<Record, String> {
+    let t: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
+    let u: Vec<f64> = t.iter().map(|&t| valve_command(t)).collect();
+    let cmd =
+        hydrocyl_system::signal::Signal::table(t.clone(), u.clone()).map_err(|e| e.to_string())?;
+    let run = truth
+        .simulate(
+            cmd,
+            &t,
+            &hydrocyl_system::run::RunOptions {
+                rtol: 1e-8,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| e.to_string())?;
+    let ch = |name: &str| -> Result<Vec<f64>, String> {
+        run.channel(name)
+            .map(<[f64]>::to_vec)
+            .ok_or_else(|| format!("no channel {name}"))
+    };
+    let mut signals = BTreeMap::new();
+    let noisy = |v: Vec<f64>, s: f64, k: u64| -> Vec<f64> {
+        let e = gaussian_noise(v.len(), seed.wrapping_add(k));
+        v.iter().zip(&e).map(|(a, e)| a + s * e).collect()
+    };
+    signals.insert(Signal::Command, u);
+    signals.insert(Signal::Position, noisy(ch("position")?, 2e-5, 0));
+    signals.insert(Signal::P1, noisy(ch("p1")?, 2e4, 1));
+    signals.insert(Signal::P2, noisy(ch("p2")?, 2e4, 2));
+    Ok(Record {
+        source: "synthetic-valve".into(),
+        time: t,
+        signals,
+        ignored: vec![],
+    })
+}

@@ -1,0 +1,149 @@
+//! The loop on generated friction-bench records with planted effects.
+
+use hydrocyl_identify::catalog::EffectId;
+use hydrocyl_identify::diagnose::{diagnose_bench, DiagnoseOptions, Outcome};
+use hydrocyl_identify::synth::{declared_for, record, truth_with, Foreign, Noise};
+
+fn run(planted: &[EffectId], foreign: Foreign, seed: u64) -> Outcome {
+    let truth = truth_with(planted);
+    let rec = record(&truth, 8000, 1e-3, Noise::default(), foreign, seed);
+    let declared = declared_for(planted);
+    diagnose_bench(
+        &declared,
+        &[rec],
+        &DiagnoseOptions::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap()
+}
+
+fn show(o: &Outcome) -> String {
+    o.report.human()
+}
+
+fn check_single(id: EffectId, seed: u64) {
+    let o = run(&[id], Foreign::None, seed);
+    let r = &o.report;
+    assert!(
+        !r.effects_added.is_empty(),
+        "{id}: nothing added\n{}",
+        show(&o)
+    );
+    let first = &r.effects_added[0];
+    assert_eq!(first.id, id.id(), "{}", show(&o));
+    let truth = hydrocyl_identify::synth::planted(id);
+    for (name, value) in &truth {
+        let got = first.params[name];
+        let ci = first.ci95[name].expect("interval");
+        assert!(
+            (got - value).abs() <= ci,
+            "{id}.{name}: {got} ± {ci} vs {value}\n{}",
+            show(&o)
+        );
+    }
+    let after = r.nrmse_after["force"];
+    let floor = r.noise_floor["force"];
+    assert!(
+        after <= 1.5 * floor,
+        "{id}: nrmse {after} vs floor {floor}\n{}",
+        show(&o)
+    );
+}
+
+#[test]
+fn viscous_is_found() {
+    check_single(EffectId::Viscous, 11);
+}
+
+#[test]
+fn pressure_viscous_is_found() {
+    check_single(EffectId::PressureViscous, 12);
+}
+
+#[test]
+fn coulomb_asymmetry_is_found() {
+    check_single(EffectId::CoulombAsymmetry, 13);
+}
+
+#[test]
+fn external_force_is_found() {
+    check_single(EffectId::ExternalForce, 14);
+}
+
+#[test]
+fn stribeck_is_found() {
+    check_single(EffectId::Stribeck, 15);
+}
+
+#[test]
+fn acceleration_friction_is_found() {
+    check_single(EffectId::AccelerationFriction, 16);
+}
+
+#[test]
+fn lugre_dynamics_is_found() {
+    check_single(EffectId::LugreDynamics, 17);
+}
+
+#[test]
+fn nothing_missing_adds_nothing() {
+    let o = run(&[], Foreign::None, 21);
+    assert!(o.report.effects_added.is_empty(), "{}", show(&o));
+    assert!(o.report.nrmse_after["force"] <= 1.5 * o.report.noise_floor["force"]);
+}
+
+#[test]
+fn out_of_catalog_spring_is_unexplained() {
+    let o = run(&[], Foreign::Spring(400.0), 22);
+    let r = &o.report;
+    assert!(r.effects_added.is_empty(), "{}", show(&o));
+    assert!(r.noise_share < 0.5, "{}", show(&o));
+    assert!(r.unexplained_share > 0.9, "{}", show(&o));
+    let p = r
+        .unexplained_resembles
+        .as_ref()
+        .expect("a probe names the shape");
+    assert!(p.what.contains("spring"), "{}", show(&o));
+    assert!((p.value / 400.0 - 1.0).abs() < 0.05, "{}", show(&o));
+}
+
+#[test]
+fn two_effects_are_both_found() {
+    let o = run(
+        &[EffectId::PressureViscous, EffectId::ExternalForce],
+        Foreign::None,
+        23,
+    );
+    let ids: Vec<&str> = o
+        .report
+        .effects_added
+        .iter()
+        .map(|e| e.id.as_str())
+        .collect();
+    assert_eq!(ids.len(), 2, "{}", show(&o));
+    assert!(
+        ids.contains(&"pressure_viscous") && ids.contains(&"external_force"),
+        "{}",
+        show(&o)
+    );
+    assert!(
+        o.report.nrmse_after["force"] <= 1.5 * o.report.noise_floor["force"],
+        "{}",
+        show(&o)
+    );
+}
+
+#[test]
+fn out_of_catalog_delay_is_unexplained() {
+    // A 10 ms transport delay of the load-cell signal: no catalog effect is
+    // a delay, so the residual must stay unexplained, not be dressed up.
+    let o = run(&[], Foreign::ForceDelay(0.01), 24);
+    let r = &o.report;
+    assert!(r.effects_added.is_empty(), "{}", show(&o));
+    let p = r
+        .unexplained_resembles
+        .as_ref()
+        .expect("a probe names the shape");
+    assert!(p.what.contains("delay"), "{}", show(&o));
+    assert!((p.value - 0.01).abs() < 1.5e-3, "{}", show(&o));
+}

@@ -1,0 +1,740 @@
+//! The method-independent part of a solve: input checks, the error norm, the
+//! step-size controller, event location, output at `t_eval`, and the
+//! accept/reject loop. Each method only supplies a [`Stepper`].
+
+use crate::api::{
+    Crossing, EventAction, EventRecord, OdeSystem, Options, Solution, SolveError, Stats,
+};
+use crate::events::{locate_root, Bracket};
+
+/// One integration method: attempts a step, and after acceptance offers a
+/// continuous extension (dense output) over the accepted step.
+pub(crate) trait Stepper {
+    /// `true` for methods with an error estimate and step-size control.
+    fn adaptive(&self) -> bool;
+
+    /// Forgets everything carried over from the previous step (FSAL stage,
+    /// Jacobian); called at the start and after every event.
+    fn restart(&mut self);
+
+    /// Attempts a step of size `h` from `(t, x)`; writes the candidate state
+    /// into `x_new` and the local error estimate into `err`.
+    #[allow(clippy::too_many_arguments)]
+    fn attempt<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        x: &[f64],
+        h: f64,
+        x_new: &mut [f64],
+        err: &mut [f64],
+        stats: &mut Stats,
+    ) -> Attempt;
+
+    /// The derivative `f(t, x)` at the start of the last attempted step.
+    fn f_start(&self) -> &[f64];
+
+    /// Index of a state whose derivative was non-finite in the last attempt,
+    /// when the method can tell (an implicit method mixes the states).
+    fn nonfinite_hint(&self) -> Option<usize> {
+        None
+    }
+
+    /// The error scale of the solve (validated absolute tolerances and the
+    /// relative tolerance), for methods that need it (finite differences).
+    fn set_scale(&mut self, _atol: &[f64], _rtol: f64) {}
+
+    /// The last attempted step was accepted: builds the dense output over it
+    /// and prepares the next step.
+    fn accept<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        x: &[f64],
+        h: f64,
+        x_new: &[f64],
+        stats: &mut Stats,
+    );
+
+    /// The dense output at `theta = (τ - t)/h ∈ [0, 1]` of the last accepted step.
+    fn dense(&self, theta: f64, out: &mut [f64]);
+}
+
+/// How a step attempt went.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Attempt {
+    /// `x_new` and `err` hold the candidate and its error estimate.
+    Done,
+    /// The iteration matrix was singular at this step size.
+    Singular,
+}
+
+/// Step-size controller of an adaptive method.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Controller {
+    /// Proportional–integral controller (Hairer, Nørsett & Wanner I, §II.4):
+    /// `h_new = h · safe · err^(-α) · err_prev^(β)`, `α = 1/q − 0.75 β`,
+    /// where `q` is the order of the error estimate plus one.
+    Pi {
+        /// `q`: the local error estimate behaves like `h^q`.
+        q: f64,
+        /// The integral gain `β`.
+        beta: f64,
+    },
+    /// Gustafsson's predictive controller (Hairer & Wanner II, §IV.8), the
+    /// one Rodas uses: `h_new = h · min(h/h_prev · (err_prev/err)^(1/q), err^(-1/q))`.
+    Predictive {
+        /// `q`: the local error estimate behaves like `h^q`.
+        q: f64,
+    },
+}
+
+/// Safety factor on the step-size proposal.
+const SAFE: f64 = 0.9;
+/// Largest shrink factor per step.
+const FAC_MIN: f64 = 0.2;
+/// Largest growth factor per step.
+const FAC_MAX: f64 = 10.0;
+/// Largest number of consecutive singular-matrix retries before giving up.
+const MAX_SINGULAR_RETRIES: usize = 8;
+
+struct ControlState {
+    controller: Controller,
+    err_prev: f64,
+    h_prev: f64,
+    first: bool,
+    last_rejected: bool,
+}
+
+impl ControlState {
+    fn new(controller: Controller) -> Self {
+        Self {
+            controller,
+            err_prev: 1e-4,
+            h_prev: 0.0,
+            first: true,
+            last_rejected: false,
+        }
+    }
+
+    fn reset(&mut self) {
+        self.err_prev = 1e-4;
+        self.first = true;
+        self.last_rejected = false;
+    }
+
+    /// The next step size after an accepted step with normed error `err ≤ 1`.
+    fn accepted(&mut self, h: f64, err: f64) -> f64 {
+        let err = err.max(1e-10);
+        let mut fac = match self.controller {
+            Controller::Pi { q, beta } => {
+                let alpha = 1.0 / q - 0.75 * beta;
+                SAFE * err.powf(-alpha) * self.err_prev.powf(beta)
+            }
+            Controller::Predictive { q } => {
+                let plain = SAFE * err.powf(-1.0 / q);
+                if self.first {
+                    plain
+                } else {
+                    let pred = SAFE * (h / self.h_prev) * (self.err_prev / err).powf(1.0 / q)
+                        / err.powf(1.0 / q);
+                    plain.min(pred)
+                }
+            }
+        };
+        fac = fac.clamp(FAC_MIN, FAC_MAX);
+        if self.last_rejected {
+            fac = fac.min(1.0);
+        }
+        self.err_prev = match self.controller {
+            Controller::Pi { .. } => err.max(1e-4),
+            Controller::Predictive { .. } => err.max(1e-2),
+        };
+        self.h_prev = h;
+        self.first = false;
+        self.last_rejected = false;
+        h * fac
+    }
+
+    /// The retry step size after a rejected step with normed error `err > 1`.
+    fn rejected(&mut self, h: f64, err: f64) -> f64 {
+        let q = match self.controller {
+            Controller::Pi { q, .. } | Controller::Predictive { q } => q,
+        };
+        let fac = if err.is_finite() {
+            (SAFE * err.powf(-1.0 / q)).clamp(FAC_MIN, 1.0)
+        } else {
+            FAC_MIN
+        };
+        self.last_rejected = true;
+        h * fac
+    }
+}
+
+/// The mixed absolute/relative RMS error norm (Hairer's):
+/// `‖e‖ = sqrt( (1/n) Σ (e_i / (atol_i + rtol·max(|x_i|, |x̂_i|)))² )`.
+pub(crate) fn error_norm(err: &[f64], x: &[f64], x_new: &[f64], atol: &[f64], rtol: f64) -> f64 {
+    let n = err.len();
+    let mut sum = 0.0;
+    for i in 0..n {
+        let sc = (atol[i] + rtol * x[i].abs().max(x_new[i].abs())).max(f64::MIN_POSITIVE);
+        let r = err[i] / sc;
+        sum += r * r;
+    }
+    (sum / n as f64).sqrt()
+}
+
+/// Per-state absolute tolerances, expanded from `Options::atol`.
+fn expand_atol(opts: &Options, n: usize) -> Result<Vec<f64>, SolveError> {
+    let atol = match opts.atol.len() {
+        1 => vec![opts.atol[0]; n],
+        m if m == n => opts.atol.clone(),
+        m => {
+            return Err(SolveError::InvalidInput(format!(
+                "Options::atol has {m} entries; expected 1 or the system dimension {n}"
+            )))
+        }
+    };
+    for (i, &a) in atol.iter().enumerate() {
+        if !(a.is_finite() && a >= 0.0) {
+            return Err(SolveError::InvalidInput(format!(
+                "Options::atol[{i}] = {a} must be finite and >= 0"
+            )));
+        }
+        if a == 0.0 && opts.rtol == 0.0 {
+            return Err(SolveError::InvalidInput(format!(
+                "Options::atol[{i}] and Options::rtol are both zero: no error scale for state {i}"
+            )));
+        }
+    }
+    Ok(atol)
+}
+
+/// Checks the solver inputs; returns the expanded absolute tolerances.
+fn check_inputs(
+    n: usize,
+    t0: f64,
+    x0: &[f64],
+    t_end: f64,
+    opts: &Options,
+    fixed_step: bool,
+) -> Result<Vec<f64>, SolveError> {
+    let bad = |s: String| Err(SolveError::InvalidInput(s));
+    if n == 0 {
+        return bad("the system has no states (dim() = 0)".into());
+    }
+    if x0.len() != n {
+        return bad(format!(
+            "x0 has {} entries but the system has {n} states",
+            x0.len()
+        ));
+    }
+    if let Some(i) = x0.iter().position(|v| !v.is_finite()) {
+        return bad(format!("x0[{i}] = {} is not finite", x0[i]));
+    }
+    if !t0.is_finite() || !t_end.is_finite() {
+        return bad(format!("t0 = {t0} and t_end = {t_end} must be finite"));
+    }
+    if t_end < t0 {
+        return bad(format!(
+            "t_end = {t_end} s is before t0 = {t0} s (only forward integration is supported)"
+        ));
+    }
+    if !(opts.rtol.is_finite() && opts.rtol >= 0.0) {
+        return bad(format!(
+            "Options::rtol = {} must be finite and >= 0",
+            opts.rtol
+        ));
+    }
+    let atol = expand_atol(opts, n)?;
+    if let Some(h0) = opts.h0 {
+        if !(h0.is_finite() && h0 > 0.0) {
+            return bad(format!("Options::h0 = {h0} must be finite and > 0"));
+        }
+    } else if fixed_step {
+        return bad("RK4 is a fixed-step method: set Options::h0 to the step size".into());
+    }
+    if opts.h_max.is_nan() || opts.h_max <= 0.0 {
+        return bad(format!("Options::h_max = {} must be > 0", opts.h_max));
+    }
+    if !(opts.h_min.is_finite() && opts.h_min >= 0.0 && opts.h_min <= opts.h_max) {
+        return bad(format!(
+            "Options::h_min = {} must be finite, >= 0 and <= h_max = {}",
+            opts.h_min, opts.h_max
+        ));
+    }
+    if opts.max_steps == 0 {
+        return bad("Options::max_steps must be at least 1".into());
+    }
+    if !(opts.event_tol.is_finite() && opts.event_tol > 0.0) {
+        return bad(format!(
+            "Options::event_tol = {} must be finite and > 0",
+            opts.event_tol
+        ));
+    }
+    if let Some(te) = &opts.t_eval {
+        for (k, &tk) in te.iter().enumerate() {
+            if !tk.is_finite() || tk < t0 || tk > t_end {
+                return bad(format!(
+                    "Options::t_eval[{k}] = {tk} is not within [t0, t_end] = [{t0}, {t_end}]"
+                ));
+            }
+            if k > 0 && tk < te[k - 1] {
+                return bad(format!(
+                    "Options::t_eval is not sorted: t_eval[{k}] = {tk} < t_eval[{}] = {}",
+                    k - 1,
+                    te[k - 1]
+                ));
+            }
+        }
+    }
+    Ok(atol)
+}
+
+/// Hairer's starting-step heuristic (Hairer, Nørsett & Wanner I, §II.4):
+/// a step such that an explicit Euler step has a local error of about the
+/// tolerance, refined with one extra right-hand-side evaluation.
+#[allow(clippy::too_many_arguments)]
+fn initial_step<S: OdeSystem + ?Sized>(
+    sys: &S,
+    t: f64,
+    x: &[f64],
+    f0: &[f64],
+    order: f64,
+    atol: &[f64],
+    rtol: f64,
+    h_max: f64,
+    work_x: &mut [f64],
+    work_f: &mut [f64],
+    stats: &mut Stats,
+) -> f64 {
+    let n = x.len();
+    let sc = |i: usize| (atol[i] + rtol * x[i].abs()).max(f64::MIN_POSITIVE);
+    let (mut d0, mut d1) = (0.0, 0.0);
+    for i in 0..n {
+        d0 += (x[i] / sc(i)).powi(2);
+        d1 += (f0[i] / sc(i)).powi(2);
+    }
+    let d0 = (d0 / n as f64).sqrt();
+    let d1 = (d1 / n as f64).sqrt();
+    let mut h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    h0 = h0.min(h_max);
+    for i in 0..n {
+        work_x[i] = x[i] + h0 * f0[i];
+    }
+    sys.rhs(t + h0, work_x, work_f);
+    stats.rhs_evals += 1;
+    let mut d2 = 0.0;
+    for i in 0..n {
+        d2 += ((work_f[i] - f0[i]) / sc(i)).powi(2);
+    }
+    let d2 = (d2 / n as f64).sqrt() / h0;
+    let dmax = d1.max(d2);
+    let h1 = if !dmax.is_finite() {
+        h0
+    } else if dmax <= 1e-15 {
+        (h0 * 1e-3).max(1e-6)
+    } else {
+        (0.01 / dmax).powf(1.0 / order)
+    };
+    (100.0 * h0).min(h1).min(h_max)
+}
+
+/// Sign of a switching-function value: -1, 0 or +1.
+fn sgn(v: f64) -> i8 {
+    if v > 0.0 {
+        1
+    } else if v < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+/// Event bookkeeping: values at the start of the current step and whether
+/// each function is armed (its last value was a trustworthy non-zero sign).
+struct EventState {
+    g_prev: Vec<f64>,
+    g_new: Vec<f64>,
+    g_tmp: Vec<f64>,
+    armed: Vec<bool>,
+    /// `|g|` at the ends of the final bracket of each triggered function.
+    bracket_mag: Vec<f64>,
+    triggered: Vec<bool>,
+    x_tmp: Vec<f64>,
+}
+
+/// Writes the states at the output times in `(t_from, t_to]` (all of them
+/// when `include_start`) from the stepper's dense output.
+#[allow(clippy::too_many_arguments)]
+fn emit_t_eval<St: Stepper>(
+    stepper: &St,
+    t_eval: &[f64],
+    next_out: &mut usize,
+    t_step: f64,
+    h: f64,
+    t_to: f64,
+    x_to: &[f64],
+    buf: &mut [f64],
+    sol: &mut Solution,
+) {
+    while *next_out < t_eval.len() && t_eval[*next_out] <= t_to {
+        let tk = t_eval[*next_out];
+        if tk == t_to {
+            sol.x.extend_from_slice(x_to);
+        } else {
+            let theta = ((tk - t_step) / h).clamp(0.0, 1.0);
+            stepper.dense(theta, buf);
+            sol.x.extend_from_slice(buf);
+        }
+        sol.t.push(tk);
+        *next_out += 1;
+    }
+}
+
+/// Runs one solve with the given stepper.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn run<S: OdeSystem + ?Sized, St: Stepper>(
+    mut stepper: St,
+    controller: Controller,
+    start_order: f64,
+    sys: &mut S,
+    t0: f64,
+    x0: &[f64],
+    t_end: f64,
+    opts: &Options,
+) -> Result<Solution, SolveError> {
+    let n = sys.dim();
+    let adaptive = stepper.adaptive();
+    let atol = check_inputs(n, t0, x0, t_end, opts, !adaptive)?;
+    let rtol = opts.rtol;
+    stepper.set_scale(&atol, rtol);
+    let n_ev = sys.n_events();
+
+    let mut sol = Solution {
+        dim: n,
+        ..Solution::default()
+    };
+    let mut stats = Stats::default();
+    if let Some(te) = &opts.t_eval {
+        sol.t.reserve(te.len());
+        sol.x.reserve(te.len() * n);
+    }
+
+    let mut t = t0;
+    let mut x = x0.to_vec();
+    let mut x_new = vec![0.0; n];
+    let mut err = vec![0.0; n];
+    let mut buf = vec![0.0; n];
+    let mut work_f = vec![0.0; n];
+    let mut work_f0 = vec![0.0; n];
+    let mut x_ev = vec![0.0; n];
+    let mut ev = EventState {
+        g_prev: vec![0.0; n_ev],
+        g_new: vec![0.0; n_ev],
+        g_tmp: vec![0.0; n_ev],
+        armed: vec![false; n_ev],
+        bracket_mag: vec![0.0; n_ev],
+        triggered: vec![false; n_ev],
+        x_tmp: vec![0.0; n],
+    };
+    if n_ev > 0 {
+        sys.events(t, &x, &mut ev.g_prev);
+        for i in 0..n_ev {
+            ev.armed[i] = ev.g_prev[i] != 0.0 && ev.g_prev[i].is_finite();
+        }
+    }
+
+    // Output at t0.
+    let t_eval: &[f64] = opts.t_eval.as_deref().unwrap_or(&[]);
+    let mut next_out = 0usize;
+    if opts.t_eval.is_some() {
+        while next_out < t_eval.len() && t_eval[next_out] <= t0 {
+            sol.t.push(t_eval[next_out]);
+            sol.x.extend_from_slice(&x);
+            next_out += 1;
+        }
+    } else {
+        sol.t.push(t0);
+        sol.x.extend_from_slice(&x);
+    }
+
+    let mut ctrl = ControlState::new(controller);
+    let mut fresh = true; // a fresh step-size estimate is needed
+    let mut h = opts.h0.unwrap_or(0.0);
+    let mut singular_retries = 0usize;
+
+    // Times closer than this to t_end count as t_end.
+    let t_close = |t: f64| 4.0 * f64::EPSILON * t.abs().max(t_end.abs()).max(1e-300);
+
+    while t_end - t > t_close(t) {
+        if stats.steps + stats.rejected >= opts.max_steps {
+            sol.stats = stats;
+            return Err(SolveError::TooManySteps {
+                t,
+                max: opts.max_steps,
+            });
+        }
+        if fresh {
+            stepper.restart();
+            ctrl.reset();
+            if adaptive && (opts.h0.is_none() || stats.steps + stats.rejected > 0) {
+                // f(t, x) for the estimate; the stepper recomputes its own.
+                sys.rhs(t, &x, &mut work_f);
+                stats.rhs_evals += 1;
+                if let Some(i) = work_f.iter().position(|v| !v.is_finite()) {
+                    return Err(SolveError::NonFinite { t, index: i });
+                }
+                work_f0.copy_from_slice(&work_f);
+                h = initial_step(
+                    sys,
+                    t,
+                    &x,
+                    &work_f0,
+                    start_order,
+                    &atol,
+                    rtol,
+                    opts.h_max,
+                    &mut buf,
+                    &mut work_f,
+                    &mut stats,
+                );
+            } else if let Some(h0) = opts.h0 {
+                h = if adaptive { h0.min(opts.h_max) } else { h0 };
+            }
+            fresh = false;
+        }
+        if adaptive {
+            h = h.min(opts.h_max);
+            // A step that does not move t in floating point is as bad as h < h_min.
+            if h < opts.h_min || t + h <= t {
+                sol.stats = stats;
+                return Err(SolveError::StepTooSmall { t, h });
+            }
+        }
+        // Land exactly on t_end; avoid a sliver of a last step.
+        let mut last = false;
+        let remaining = t_end - t;
+        let stretch = if adaptive { 1.01 } else { 1.0 + 1e-9 };
+        if h * stretch >= remaining {
+            h = remaining;
+            last = true;
+        }
+
+        if stepper.attempt(&*sys, t, &x, h, &mut x_new, &mut err, &mut stats) == Attempt::Singular {
+            singular_retries += 1;
+            stats.rejected += 1;
+            if singular_retries > MAX_SINGULAR_RETRIES || h * 0.5 < opts.h_min {
+                sol.stats = stats;
+                return Err(SolveError::Singular { t });
+            }
+            h *= 0.5;
+            ctrl.last_rejected = true;
+            continue;
+        }
+        if let Some(i) = stepper.f_start().iter().position(|v| !v.is_finite()) {
+            sol.stats = stats;
+            return Err(SolveError::NonFinite { t, index: i });
+        }
+        if let Some(i) = x_new.iter().position(|v| !v.is_finite()) {
+            let i = stepper.nonfinite_hint().unwrap_or(i);
+            // A too-large step can overflow; shrink and retry, give up at h_min.
+            stats.rejected += 1;
+            let h_try = h * 0.25;
+            if !adaptive || h_try < opts.h_min.max(f64::EPSILON * t.abs()) {
+                sol.stats = stats;
+                return Err(SolveError::NonFinite { t: t + h, index: i });
+            }
+            h = h_try;
+            ctrl.last_rejected = true;
+            continue;
+        }
+        let err_norm = if adaptive {
+            error_norm(&err, &x, &x_new, &atol, rtol)
+        } else {
+            0.0
+        };
+        // A NaN norm counts as a failed step.
+        if err_norm.is_nan() || err_norm > 1.0 {
+            stats.rejected += 1;
+            h = ctrl.rejected(h, err_norm);
+            continue;
+        }
+        singular_retries = 0;
+
+        // Accepted.
+        stats.steps += 1;
+        stepper.accept(&*sys, t, &x, h, &x_new, &mut stats);
+        let t_new = if last { t_end } else { t + h };
+        let h_next = if adaptive {
+            ctrl.accepted(h, err_norm)
+        } else {
+            h
+        };
+
+        // Event detection over [t, t_new].
+        let mut event_at: Option<f64> = None;
+        if n_ev > 0 {
+            sys.events(t_new, &x_new, &mut ev.g_new);
+            let mut t_stop = f64::INFINITY;
+            let tol = opts.event_tol.max(4.0 * f64::EPSILON * t_new.abs());
+            for i in 0..n_ev {
+                ev.triggered[i] = false;
+                let (gp, gn) = (ev.g_prev[i], ev.g_new[i]);
+                if !(ev.armed[i] && sgn(gp) != 0 && sgn(gn) != sgn(gp)) {
+                    continue;
+                }
+                let br = if gn == 0.0 {
+                    Bracket {
+                        a: t_new,
+                        ga: 0.0,
+                        b: t_new,
+                        gb: 0.0,
+                    }
+                } else {
+                    let stepper_ref = &stepper;
+                    let sys_ref = &*sys;
+                    let (x_tmp, g_tmp) = (&mut ev.x_tmp, &mut ev.g_tmp);
+                    locate_root(
+                        Bracket {
+                            a: t,
+                            ga: gp,
+                            b: t_new,
+                            gb: gn,
+                        },
+                        tol,
+                        |tau| {
+                            let theta = ((tau - t) / h).clamp(0.0, 1.0);
+                            stepper_ref.dense(theta, x_tmp);
+                            sys_ref.events(tau, x_tmp, g_tmp);
+                            g_tmp[i]
+                        },
+                    )
+                };
+                ev.bracket_mag[i] = br.ga.abs().max(br.gb.abs());
+                t_stop = t_stop.min(br.b);
+            }
+            if t_stop.is_finite() {
+                event_at = Some(t_stop);
+            }
+        }
+
+        match event_at {
+            None => {
+                if opts.t_eval.is_some() {
+                    emit_t_eval(
+                        &stepper,
+                        t_eval,
+                        &mut next_out,
+                        t,
+                        h,
+                        t_new,
+                        &x_new,
+                        &mut buf,
+                        &mut sol,
+                    );
+                } else {
+                    sol.t.push(t_new);
+                    sol.x.extend_from_slice(&x_new);
+                }
+                t = t_new;
+                std::mem::swap(&mut x, &mut x_new);
+                if n_ev > 0 {
+                    std::mem::swap(&mut ev.g_prev, &mut ev.g_new);
+                    for i in 0..n_ev {
+                        ev.armed[i] = ev.g_prev[i] != 0.0;
+                    }
+                }
+                h = h_next;
+            }
+            Some(t_ev) => {
+                // State at the event from the dense output (exact step end if t_ev = t_new).
+                if t_ev >= t_new {
+                    x_ev.copy_from_slice(&x_new);
+                } else {
+                    stepper.dense(((t_ev - t) / h).clamp(0.0, 1.0), &mut x_ev);
+                }
+                if opts.t_eval.is_some() {
+                    emit_t_eval(
+                        &stepper,
+                        t_eval,
+                        &mut next_out,
+                        t,
+                        h,
+                        t_ev,
+                        &x_ev,
+                        &mut buf,
+                        &mut sol,
+                    );
+                } else {
+                    sol.t.push(t_ev);
+                    sol.x.extend_from_slice(&x_ev);
+                }
+                // Which functions have crossed by t_ev.
+                sys.events(t_ev, &x_ev, &mut ev.g_tmp);
+                let mut stop = false;
+                x.copy_from_slice(&x_ev);
+                for i in 0..n_ev {
+                    let gp = ev.g_prev[i];
+                    let crossed = ev.armed[i]
+                        && sgn(gp) != 0
+                        && sgn(ev.g_new[i]) != sgn(gp)
+                        && sgn(ev.g_tmp[i]) != sgn(gp);
+                    ev.triggered[i] = crossed;
+                    if crossed {
+                        let dir = if gp < 0.0 {
+                            Crossing::Rising
+                        } else {
+                            Crossing::Falling
+                        };
+                        sol.events.push(EventRecord {
+                            t: t_ev,
+                            which: i,
+                            dir,
+                        });
+                        stats.events += 1;
+                        if sys.on_event(t_ev, &mut x, i, dir) == EventAction::Stop {
+                            stop = true;
+                        }
+                    }
+                }
+                if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+                    sol.stats = stats;
+                    return Err(SolveError::NonFinite { t: t_ev, index: i });
+                }
+                let edited = x.iter().zip(x_ev.iter()).any(|(a, b)| a != b);
+                if edited && opts.t_eval.is_none() {
+                    sol.t.push(t_ev);
+                    sol.x.extend_from_slice(&x);
+                }
+                t = t_ev;
+                if stop {
+                    break;
+                }
+                // Re-arm: a triggered function still within its bracket's
+                // magnitude sits on its root; it is armed again once it has
+                // left zero, so the restart cannot re-detect the same event.
+                sys.events(t, &x, &mut ev.g_prev);
+                for i in 0..n_ev {
+                    let g = ev.g_prev[i];
+                    ev.armed[i] = g != 0.0 && !(ev.triggered[i] && g.abs() <= ev.bracket_mag[i]);
+                }
+                fresh = true;
+            }
+        }
+    }
+    // Output times at t_end not yet written (t reached t_end within rounding).
+    if opts.t_eval.is_some() {
+        while next_out < t_eval.len() && t_eval[next_out] <= t_end && t >= t_end - t_close(t) {
+            sol.t.push(t_eval[next_out]);
+            sol.x.extend_from_slice(&x);
+            next_out += 1;
+        }
+    }
+    sol.stats = stats;
+    Ok(sol)
+}

@@ -1,0 +1,314 @@
+//! Rodas4: the stiffly accurate, L-stable, six-stage Rosenbrock method of
+//! order 4 with an embedded order-3 solution and an order-3 continuous
+//! extension (Hairer & Wanner II, §IV.7, the coefficients of `RODAS`,
+//! method 1).
+//!
+//! One step from `(t, x)` with step `h`, `E = I/(hγ) − J`, `J = ∂f/∂x(t, x)`,
+//! `f_t = ∂f/∂t(t, x)`:
+//!
+//! ```text
+//! E k_i = f(t + c_i h, x + Σ_{j<i} a_ij k_j) + Σ_{j<i} (c_ij / h) k_j + h d_i f_t ,  i = 1..6
+//! x_new = x + Σ_{j≤4} a_5j k_j + k_5 + k_6 ,   error estimate = k_6
+//! ```
+//!
+//! The Jacobian is the model's ([`OdeSystem::jacobian`]) or a column-wise
+//! forward difference with increments `δ_j = sqrt(ε) · max(|x_j|, atol_j/rtol)`
+//! (`atol_j/rtol` is the magnitude below which the error norm treats state j
+//! as absolute, a natural scale for it); `f_t` is always a forward difference
+//! in `t` with `δ_t = sqrt(ε) · max(|t|, h)`. After a rejected step the
+//! Jacobian is reused and only `E` is refactorised.
+// The stage loops index several vectors in step; iterators would hide that.
+#![allow(clippy::needless_range_loop)]
+
+use crate::api::{OdeSystem, Stats};
+use crate::driver::{Attempt, Stepper};
+use crate::linalg::{DenseLu, SolverLu};
+
+const GAMMA: f64 = 0.25;
+const C2: f64 = 0.386;
+const C3: f64 = 0.21;
+const C4: f64 = 0.63;
+const D1: f64 = 0.25;
+const D2: f64 = -0.1043;
+const D3: f64 = 0.1035;
+const D4: f64 = -0.362e-1;
+const A21: f64 = 0.1544e+01;
+const A31: f64 = 0.946_678_528_081_582_6;
+const A32: f64 = 0.255_701_169_898_328_4;
+const A41: f64 = 0.331_482_518_706_852_1e+01;
+const A42: f64 = 0.289_612_401_597_220_1e+01;
+const A43: f64 = 0.998_641_913_997_781_7;
+const A51: f64 = 0.122_122_450_922_664_1e+01;
+const A52: f64 = 0.601_913_448_128_862_9e+01;
+const A53: f64 = 0.125_370_833_293_208_7e+02;
+const A54: f64 = -0.687_886_036_105_895;
+const C21: f64 = -0.56688e+01;
+const C31: f64 = -0.243_009_335_683_387_5e+01;
+const C32: f64 = -0.206_359_915_709_191_5;
+const C41: f64 = -0.107_352_905_815_137_5;
+const C42: f64 = -0.959_456_225_102_335_5e+01;
+const C43: f64 = -0.204_702_861_480_961_6e+02;
+const C51: f64 = 0.749_644_331_396_764_7e+01;
+const C52: f64 = -0.102_468_043_146_435_2e+02;
+const C53: f64 = -0.339_999_035_281_990_5e+02;
+const C54: f64 = 0.117_089_089_320_616e+02;
+const C61: f64 = 0.808_324_679_592_152_2e+01;
+const C62: f64 = -0.798_113_298_806_489_3e+01;
+const C63: f64 = -0.315_215_943_287_437_1e+02;
+const C64: f64 = 0.163_193_054_312_313_6e+02;
+const C65: f64 = -0.605_881_823_883_405_4e+01;
+// Dense output.
+const DD21: f64 = 0.101_262_350_834_458_6e+02;
+const DD22: f64 = -0.748_799_587_761_016_7e+01;
+const DD23: f64 = -0.348_009_186_155_574_7e+02;
+const DD24: f64 = -0.799_277_170_756_882_3e+01;
+const DD25: f64 = 0.102_513_772_329_566_2e+01;
+const DD31: f64 = -0.676_280_339_280_125_3;
+const DD32: f64 = 0.608_771_465_168_001_5e+01;
+const DD33: f64 = 0.164_308_432_089_247_8e+02;
+const DD34: f64 = 0.247_672_251_141_838_6e+02;
+const DD35: f64 = -0.659_438_912_571_687_2e+01;
+
+/// Rodas4 stepper; all work vectors and the LU buffer allocated once.
+pub(crate) struct Rodas4 {
+    n: usize,
+    k: [Vec<f64>; 6],
+    f0: Vec<f64>,
+    ft: Vec<f64>,
+    y: Vec<f64>,
+    fy: Vec<f64>,
+    jac: Vec<f64>,
+    /// `f0`, `ft` and `jac` belong to the current step start.
+    jac_valid: bool,
+    lu: SolverLu,
+    cont: [Vec<f64>; 4],
+    /// Magnitude scale of each state for finite-difference increments.
+    scale: Vec<f64>,
+    /// A state whose derivative was non-finite in the last attempt.
+    bad: Option<usize>,
+    /// A state whose derivative was non-finite while linearising.
+    lin_bad: Option<usize>,
+}
+
+/// First index of a non-finite entry.
+fn first_nonfinite(v: &[f64]) -> Option<usize> {
+    v.iter().position(|x| !x.is_finite())
+}
+
+impl Rodas4 {
+    pub(crate) fn new(n: usize) -> Self {
+        Self {
+            n,
+            k: std::array::from_fn(|_| vec![0.0; n]),
+            f0: vec![0.0; n],
+            ft: vec![0.0; n],
+            y: vec![0.0; n],
+            fy: vec![0.0; n],
+            jac: vec![0.0; n * n],
+            jac_valid: false,
+            lu: SolverLu::new(n),
+            cont: std::array::from_fn(|_| vec![0.0; n]),
+            scale: vec![1e-5; n],
+            bad: None,
+            lin_bad: None,
+        }
+    }
+
+    /// `f(t, x)`, `∂f/∂t` and `∂f/∂x` at the step start.
+    fn linearise<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        x: &[f64],
+        h: f64,
+        stats: &mut Stats,
+    ) {
+        let n = self.n;
+        let sqrt_eps = f64::EPSILON.sqrt();
+        sys.rhs(t, x, &mut self.f0);
+        stats.rhs_evals += 1;
+        self.lin_bad = first_nonfinite(&self.f0);
+        // ∂f/∂t by a forward difference.
+        let t_plus = t + sqrt_eps * t.abs().max(h);
+        let dt = t_plus - t;
+        sys.rhs(t_plus, x, &mut self.fy);
+        stats.rhs_evals += 1;
+        self.lin_bad = self.lin_bad.or(first_nonfinite(&self.fy));
+        for i in 0..n {
+            self.ft[i] = (self.fy[i] - self.f0[i]) / dt;
+        }
+        stats.jac_evals += 1;
+        if !sys.jacobian(t, x, &mut self.jac) {
+            self.y.copy_from_slice(x);
+            for j in 0..n {
+                let xj = x[j];
+                self.y[j] = xj + sqrt_eps * xj.abs().max(self.scale[j]);
+                sys.rhs(t, &self.y, &mut self.fy);
+                stats.rhs_evals += 1;
+                self.lin_bad = self.lin_bad.or(first_nonfinite(&self.fy));
+                let dx = self.y[j] - xj;
+                for i in 0..n {
+                    self.jac[i * n + j] = (self.fy[i] - self.f0[i]) / dx;
+                }
+                self.y[j] = xj;
+            }
+        }
+    }
+}
+
+impl Stepper for Rodas4 {
+    fn adaptive(&self) -> bool {
+        true
+    }
+
+    fn restart(&mut self) {
+        self.jac_valid = false;
+    }
+
+    fn attempt<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        x: &[f64],
+        h: f64,
+        x_new: &mut [f64],
+        err: &mut [f64],
+        stats: &mut Stats,
+    ) -> Attempt {
+        let n = self.n;
+        if !self.jac_valid {
+            self.linearise(sys, t, x, h, stats);
+            self.jac_valid = true;
+        }
+        self.bad = self.lin_bad;
+        if self.f0.iter().any(|v| !v.is_finite()) {
+            // The driver reports the offending state from f_start().
+            return Attempt::Done;
+        }
+        // E = I/(hγ) − J.
+        let fac = 1.0 / (h * GAMMA);
+        {
+            let e = self.lu.matrix_mut();
+            for i in 0..n {
+                for j in 0..n {
+                    e[i * n + j] = -self.jac[i * n + j];
+                }
+                e[i * n + i] += fac;
+            }
+        }
+        stats.lu_decomps += 1;
+        if !self.lu.factor() {
+            return Attempt::Singular;
+        }
+        let [k1, k2, k3, k4, k5, k6] = &mut self.k;
+        let (y, fy, f0, ft) = (&mut self.y, &mut self.fy, &self.f0, &self.ft);
+        let lu = &self.lu;
+        let inv_h = 1.0 / h;
+
+        for i in 0..n {
+            k1[i] = f0[i] + h * D1 * ft[i];
+        }
+        lu.solve(k1);
+
+        for i in 0..n {
+            y[i] = x[i] + A21 * k1[i];
+        }
+        sys.rhs(t + C2 * h, y, fy);
+        let mut bad = first_nonfinite(fy);
+        for i in 0..n {
+            k2[i] = fy[i] + C21 * inv_h * k1[i] + h * D2 * ft[i];
+        }
+        lu.solve(k2);
+
+        for i in 0..n {
+            y[i] = x[i] + A31 * k1[i] + A32 * k2[i];
+        }
+        sys.rhs(t + C3 * h, y, fy);
+        bad = bad.or(first_nonfinite(fy));
+        for i in 0..n {
+            k3[i] = fy[i] + inv_h * (C31 * k1[i] + C32 * k2[i]) + h * D3 * ft[i];
+        }
+        lu.solve(k3);
+
+        for i in 0..n {
+            y[i] = x[i] + A41 * k1[i] + A42 * k2[i] + A43 * k3[i];
+        }
+        sys.rhs(t + C4 * h, y, fy);
+        bad = bad.or(first_nonfinite(fy));
+        for i in 0..n {
+            k4[i] = fy[i] + inv_h * (C41 * k1[i] + C42 * k2[i] + C43 * k3[i]) + h * D4 * ft[i];
+        }
+        lu.solve(k4);
+
+        for i in 0..n {
+            y[i] = x[i] + A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i];
+        }
+        sys.rhs(t + h, y, fy);
+        bad = bad.or(first_nonfinite(fy));
+        for i in 0..n {
+            k5[i] = fy[i] + inv_h * (C51 * k1[i] + C52 * k2[i] + C53 * k3[i] + C54 * k4[i]);
+        }
+        lu.solve(k5);
+
+        for i in 0..n {
+            y[i] += k5[i];
+        }
+        sys.rhs(t + h, y, fy);
+        bad = bad.or(first_nonfinite(fy));
+        for i in 0..n {
+            k6[i] = fy[i]
+                + inv_h * (C61 * k1[i] + C62 * k2[i] + C63 * k3[i] + C64 * k4[i] + C65 * k5[i]);
+        }
+        lu.solve(k6);
+        stats.rhs_evals += 5;
+        self.bad = self.bad.or(bad);
+
+        for i in 0..n {
+            x_new[i] = y[i] + k6[i];
+            err[i] = k6[i];
+        }
+        Attempt::Done
+    }
+
+    fn f_start(&self) -> &[f64] {
+        &self.f0
+    }
+
+    fn nonfinite_hint(&self) -> Option<usize> {
+        self.bad
+    }
+
+    fn set_scale(&mut self, atol: &[f64], rtol: f64) {
+        for (s, &a) in self.scale.iter_mut().zip(atol) {
+            *s = if rtol > 0.0 { a / rtol } else { a }.max(f64::MIN_POSITIVE);
+        }
+    }
+
+    fn accept<S: OdeSystem + ?Sized>(
+        &mut self,
+        _sys: &S,
+        _t: f64,
+        x: &[f64],
+        _h: f64,
+        x_new: &[f64],
+        _stats: &mut Stats,
+    ) {
+        let [k1, k2, k3, k4, k5, _] = &self.k;
+        let [c1, c2, c3, c4] = &mut self.cont;
+        for i in 0..self.n {
+            c1[i] = x[i];
+            c2[i] = x_new[i] - x[i];
+            c3[i] = DD21 * k1[i] + DD22 * k2[i] + DD23 * k3[i] + DD24 * k4[i] + DD25 * k5[i];
+            c4[i] = DD31 * k1[i] + DD32 * k2[i] + DD33 * k3[i] + DD34 * k4[i] + DD35 * k5[i];
+        }
+        self.jac_valid = false;
+    }
+
+    fn dense(&self, theta: f64, out: &mut [f64]) {
+        let s1 = 1.0 - theta;
+        let [c1, c2, c3, c4] = &self.cont;
+        for i in 0..out.len() {
+            out[i] = c1[i] + theta * (c2[i] + s1 * (c3[i] + theta * c4[i]));
+        }
+    }
+}

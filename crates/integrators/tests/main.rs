@@ -1,0 +1,10 @@
+//! hydrocyl-integrators' integration tests, in one binary to save link time.
+
+mod common;
+mod convergence;
+mod dense;
+mod errors;
+mod events;
+mod linalg;
+mod stats;
+mod stiff;

@@ -1,0 +1,135 @@
+//! Stiff problems: the Rosenbrock method needs few steps where the explicit
+//! method exceeds a step budget.
+
+use hydrocyl_integrators::problems::{Robertson, VanDerPol};
+use hydrocyl_integrators::{solve, Method, Options, SolveError};
+
+#[test]
+fn van_der_pol_mu_1000_rosenbrock_few_steps_dp45_over_budget() {
+    let opts = Options {
+        rtol: 1e-6,
+        atol: vec![1e-6],
+        max_steps: 50_000,
+        ..Options::default()
+    };
+    let mut sys = VanDerPol { mu: 1000.0 };
+    let sol = solve(
+        Method::Rosenbrock,
+        &mut sys,
+        0.0,
+        &[2.0, 0.0],
+        3000.0,
+        &opts,
+    )
+    .unwrap();
+    let s = sol.stats;
+    assert!(s.steps + s.rejected < 3000, "Rodas4 took {s:?}");
+    // One period is about (3 − 2 ln 2) μ ≈ 1614 s: by 3000 s x1 has been through −2.
+    let min_x1 = (0..sol.t.len())
+        .map(|k| sol.state(k)[0])
+        .fold(f64::INFINITY, f64::min);
+    assert!(min_x1 < -1.9 && min_x1 > -2.1, "min x1 = {min_x1}");
+
+    let e = solve(
+        Method::DormandPrince45,
+        &mut sys,
+        0.0,
+        &[2.0, 0.0],
+        3000.0,
+        &opts,
+    )
+    .unwrap_err();
+    match e {
+        SolveError::TooManySteps { t, max } => {
+            assert_eq!(max, 50_000);
+            assert!(t < 3000.0);
+        }
+        other => panic!("expected TooManySteps, got {other:?}"),
+    }
+}
+
+#[test]
+fn robertson_to_1e5_conserves_mass_in_few_steps() {
+    let opts = Options {
+        rtol: 1e-6,
+        atol: vec![1e-10],
+        max_steps: 20_000,
+        ..Options::default()
+    };
+    let sol = solve(
+        Method::Rosenbrock,
+        &mut Robertson,
+        0.0,
+        &[1.0, 0.0, 0.0],
+        1e5,
+        &opts,
+    )
+    .unwrap();
+    assert!(sol.stats.steps < 500, "{:?}", sol.stats);
+    for k in 0..sol.t.len() {
+        let x = sol.state(k);
+        let sum: f64 = x.iter().sum();
+        assert!((sum - 1.0).abs() < 1e-12, "mass {sum} at t = {}", sol.t[k]);
+        assert!(
+            x.iter().all(|v| *v > -1e-10),
+            "negative concentration {x:?}"
+        );
+    }
+    // Reference values at t = 1e5 (Hairer & Wanner's tables): x1 ≈ 0.0179, x3 ≈ 0.982.
+    let x = sol.last().unwrap();
+    assert!((x[0] - 1.7832e-2).abs() < 2e-4, "x1 = {}", x[0]);
+    let e = solve(
+        Method::DormandPrince45,
+        &mut Robertson,
+        0.0,
+        &[1.0, 0.0, 0.0],
+        1e5,
+        &opts,
+    )
+    .unwrap_err();
+    assert!(matches!(e, SolveError::TooManySteps { .. }), "{e:?}");
+}
+
+#[test]
+fn fd_jacobian_matches_analytic_jacobian_results() {
+    // The same stiff solve with the Jacobian from finite differences.
+    use hydrocyl_integrators::OdeSystem;
+    struct NoJac(VanDerPol);
+    impl OdeSystem for NoJac {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
+            self.0.rhs(t, x, dx)
+        }
+    }
+    let opts = Options {
+        rtol: 1e-8,
+        atol: vec![1e-8],
+        ..Options::default()
+    };
+    let a = solve(
+        Method::Rosenbrock,
+        &mut VanDerPol { mu: 50.0 },
+        0.0,
+        &[2.0, 0.0],
+        100.0,
+        &opts,
+    )
+    .unwrap();
+    let b = solve(
+        Method::Rosenbrock,
+        &mut NoJac(VanDerPol { mu: 50.0 }),
+        0.0,
+        &[2.0, 0.0],
+        100.0,
+        &opts,
+    )
+    .unwrap();
+    let (xa, xb) = (a.last().unwrap(), b.last().unwrap());
+    assert!((xa[0] - xb[0]).abs() < 1e-4, "{xa:?} vs {xb:?}");
+    assert_eq!(
+        b.stats.rhs_evals,
+        2 + 4 * b.stats.jac_evals + 5 * (b.stats.steps + b.stats.rejected)
+    );
+}

@@ -1,0 +1,942 @@
+//! The assembler core: components, the netlist they bind to, and the
+//! [`Circuit`] that flattens them into one [`OdeSystem`].
+//!
+//! See the crate docs for the causality rules and how to add a component.
+
+use hydrocyl_integrators::{Crossing, EventAction, OdeSystem};
+use std::cell::RefCell;
+use std::collections::HashMap;
+use thiserror::Error;
+
+/// Index of one scalar in the circuit's wire table (a pressure, an
+/// accumulated flow, a position, a signal, ...).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Wire(usize);
+
+impl Wire {
+    /// A placeholder for a component's wire fields before
+    /// [`Component::bind`] sets them (never read: [`Circuit::build`] binds
+    /// every component before anything is evaluated).
+    pub const UNBOUND: Wire = Wire(usize::MAX);
+}
+
+/// The wires of a hydraulic node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HydraulicNode {
+    /// The node pressure \[Pa\] (the effort), written by the node's one owner.
+    pub pressure: Wire,
+    /// Accumulator of the volume flow **into** the node from every component
+    /// except its owner \[m³·s⁻¹\]; zeroed at the start of each evaluation.
+    pub inflow: Wire,
+}
+
+/// The wires of a mechanical (translational) node: a rigid body.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MechanicalNode {
+    /// Position, + extending \[m\] (written by the owner, a mass).
+    pub position: Wire,
+    /// Velocity \[m·s⁻¹\] (written by the owner).
+    pub velocity: Wire,
+    /// Accumulator of the forces on the body from every component except its
+    /// owner, + in the + direction \[N\]; zeroed at each evaluation.
+    pub force: Wire,
+    /// Accumulator of masses added by acceleration-proportional terms
+    /// (`c a` friction terms moved to the mass side) \[kg\].
+    pub added_mass: Wire,
+    /// Accumulator of hold requests: a component that sticks the body (a
+    /// friction law in its stick mode) adds 1; while it is positive the owner
+    /// holds the body at rest (`dv/dt = 0`, and `v = 0` after the event).
+    pub hold: Wire,
+}
+
+/// When a component writes a wire it owns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Causality {
+    /// From its own state and time only, in [`Component::publish`] (volumes,
+    /// masses, spools, command sources). Readers need no ordering.
+    Stored,
+    /// Algebraically from other wires, in [`Component::evaluate`] (a pilot
+    /// spool travel from line pressures; the generalised actuator's chamber
+    /// pressures). Readers are evaluated after the writer.
+    Algebraic,
+}
+
+/// The wire table, read and written by components during one evaluation.
+#[derive(Clone, Debug, Default)]
+pub struct Wires {
+    v: Vec<f64>,
+}
+
+impl Wires {
+    /// Value of a wire.
+    #[inline(always)]
+    pub fn get(&self, w: Wire) -> f64 {
+        self.v[w.0]
+    }
+    /// Sets a wire (only its owner should).
+    #[inline(always)]
+    pub fn set(&mut self, w: Wire, value: f64) {
+        self.v[w.0] = value;
+    }
+    /// Adds to an accumulator wire (flows into a node, forces on a body).
+    #[inline(always)]
+    pub fn add(&mut self, w: Wire, value: f64) {
+        self.v[w.0] += value;
+    }
+}
+
+/// A failure to assemble a circuit; names the component and the node.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum BuildError {
+    /// Two components claim to set the same effort.
+    #[error(
+        "{kind} `{node}` is set by both `{first}` and `{second}`: a node has exactly one owner"
+    )]
+    TwoOwners {
+        /// "hydraulic node", "mechanical node" or "signal".
+        kind: &'static str,
+        /// The node name.
+        node: String,
+        /// The first owner.
+        first: String,
+        /// The second claimant.
+        second: String,
+    },
+    /// A node is used but nothing sets its effort.
+    #[error("{kind} `{node}` is used by `{user}` but no component sets it (add a volume, chamber, pressure source, mass or signal source)")]
+    NoOwner {
+        /// "hydraulic node", "mechanical node" or "signal".
+        kind: &'static str,
+        /// The node name.
+        node: String,
+        /// A component that uses it.
+        user: String,
+    },
+    /// Algebraic components depend on each other in a cycle.
+    #[error("algebraic loop between components: {0}")]
+    AlgebraicLoop(String),
+    /// A component rejected its parameters or connections.
+    #[error("component `{component}`: {message}")]
+    Component {
+        /// The component.
+        component: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Power bookkeeping of one component at one instant (the energy ledger's
+/// input). Each component must balance on its own:
+/// `power in at its ports + source = dissipated + storage + load + power out at its ports`,
+/// so that summed over a circuit (port powers cancel pairwise at each node)
+/// `Σ source = Σ dissipated + Σ storage + Σ load`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PowerTerms {
+    /// Power brought into the circuit from outside: a fixed-pressure supply
+    /// delivering flow, a pump's shaft \[W\].
+    pub source: f64,
+    /// Power turned into heat: orifices, leakage, friction \[W\].
+    pub dissipated: f64,
+    /// Rate of change of energy stored in the component: fluid compression
+    /// `p V/B dp/dt`, kinetic `m v a`, bristle `σ0 z ż` \[W\].
+    pub storage: f64,
+    /// Power delivered as work to the outside (an external load force) \[W\].
+    pub load: f64,
+    /// Energy stored now (`½ V p²/B`, `½ m v²`, `½ σ0 z²`) \[J\] — for reports;
+    /// the ledger integrates `storage`, which is exact for the model used.
+    pub stored: f64,
+}
+
+/// A named output of a component, read from a wire after a solve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Probe {
+    /// Column name, e.g. `p1`, `position`, `spool` (the measured-data names).
+    pub name: String,
+    /// SI unit, e.g. `Pa`.
+    pub unit: &'static str,
+    /// The wire it reads.
+    pub wire: Wire,
+}
+
+/// A component of a circuit. Implement this to add a new component type: it
+/// lives in its own file, and [`Circuit::build`] joins it to the others
+/// through named nodes — no change to the assembler.
+///
+/// The assembler calls, for each evaluation of `rhs(t, x)`:
+/// 1. [`publish`](Component::publish) on every component (efforts from own state);
+/// 2. [`evaluate`](Component::evaluate) in dependency order (flows, forces,
+///    algebraic signals, accumulated into node wires);
+/// 3. [`derivatives`](Component::derivatives) on every stateful component.
+///
+/// Each component sees only its own slice of the state vector.
+pub trait Component {
+    /// Instance name (unique in a circuit), used in errors and reports.
+    fn name(&self) -> &str;
+
+    /// Declares the nodes and signals this component reads and owns, and
+    /// stores the returned wire handles.
+    fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError>;
+
+    /// Number of states this component owns.
+    fn n_states(&self) -> usize {
+        0
+    }
+
+    /// Names of the states (for reports), `n_states` long.
+    fn state_names(&self) -> Vec<String> {
+        (0..self.n_states())
+            .map(|i| format!("{}.x{i}", self.name()))
+            .collect()
+    }
+
+    /// Typical magnitude of each state \[its SI unit\]; the absolute
+    /// tolerance of state i is `rtol · scale_i`.
+    fn state_scales(&self, scales: &mut [f64]) {
+        scales.fill(1.0);
+    }
+
+    /// The component's default initial state.
+    fn initial_state(&self, _x: &mut [f64]) {}
+
+    /// Writes the efforts this component owns with [`Causality::Stored`].
+    fn publish(&self, _t: f64, _x: &[f64], _w: &mut Wires) {}
+
+    /// Computes flows and forces from the efforts at its ports and adds them
+    /// to the node accumulators; writes [`Causality::Algebraic`] wires.
+    fn evaluate(&self, _t: f64, _x: &[f64], _w: &mut Wires) {}
+
+    /// Time derivatives of its states (all accumulators are complete here).
+    fn derivatives(&self, _t: f64, _x: &[f64], _w: &Wires, _dx: &mut [f64]) {}
+
+    /// Number of switching functions.
+    fn n_events(&self) -> usize {
+        0
+    }
+
+    /// Switching functions (an event is a sign change of one).
+    fn events(&self, _t: f64, _x: &[f64], _w: &Wires, _g: &mut [f64]) {}
+
+    /// Handles a located event: change mode, edit own state.
+    fn on_event(
+        &mut self,
+        _t: f64,
+        _x: &mut [f64],
+        _w: &Wires,
+        _which: usize,
+        _dir: Crossing,
+    ) -> EventAction {
+        EventAction::Continue
+    }
+
+    /// Called on every component after any component handled an event, with
+    /// the wires re-evaluated at the edited state: a chance to edit its own
+    /// state in response (a mass sets v = 0 when a friction law starts to stick).
+    fn after_event(&mut self, _t: f64, _x: &mut [f64], _w: &Wires) {}
+
+    /// Power bookkeeping at this instant (see [`PowerTerms`]).
+    fn power(&self, _t: f64, _x: &[f64], _w: &Wires, _dx: &[f64], _p: &mut PowerTerms) {}
+
+    /// Number of extra quadratures this component asks for (integrated
+    /// alongside the states when [`Circuit::set_quadratures`] is on).
+    fn n_quadratures(&self) -> usize {
+        0
+    }
+
+    /// Names of the quadratures.
+    fn quadrature_names(&self) -> Vec<String> {
+        Vec::new()
+    }
+
+    /// Integrands of the quadratures.
+    fn quadratures(&self, _t: f64, _x: &[f64], _w: &Wires, _dx: &[f64], _q: &mut [f64]) {}
+
+    /// Named outputs.
+    fn probes(&self) -> Vec<Probe> {
+        Vec::new()
+    }
+
+    /// Counters and flags of the last run (cavitation entries, stop impacts).
+    fn diagnostics(&self) -> Vec<(String, f64)> {
+        Vec::new()
+    }
+
+    /// Called once before a run from a given state (reset counters, set modes).
+    fn reset(&mut self, _t: f64, _x: &[f64], _w: &Wires) {}
+}
+
+#[derive(Clone, Debug)]
+struct Owned {
+    owner: usize,
+    causality: Causality,
+}
+
+/// The registry components bind to: it turns node and signal names into
+/// wires and records who owns (sets) and who reads each.
+#[derive(Debug, Default)]
+pub struct Netlist {
+    names: Vec<String>,
+    index: HashMap<String, Wire>,
+    owners: HashMap<usize, Owned>,
+    accumulators: Vec<Wire>,
+    reads: Vec<(usize, Wire, &'static str, String)>,
+    current: usize,
+    component_names: Vec<String>,
+}
+
+impl Netlist {
+    fn wire(&mut self, key: String) -> Wire {
+        if let Some(w) = self.index.get(&key) {
+            return *w;
+        }
+        let w = Wire(self.names.len());
+        self.names.push(key.clone());
+        self.index.insert(key, w);
+        w
+    }
+
+    fn own(
+        &mut self,
+        w: Wire,
+        kind: &'static str,
+        node: &str,
+        c: Causality,
+    ) -> Result<(), BuildError> {
+        if let Some(o) = self.owners.get(&w.0) {
+            return Err(BuildError::TwoOwners {
+                kind,
+                node: node.to_string(),
+                first: self.component_names[o.owner].clone(),
+                second: self.component_names[self.current].clone(),
+            });
+        }
+        self.owners.insert(
+            w.0,
+            Owned {
+                owner: self.current,
+                causality: c,
+            },
+        );
+        Ok(())
+    }
+
+    fn read(&mut self, w: Wire, kind: &'static str, node: &str) {
+        self.reads.push((self.current, w, kind, node.to_string()));
+    }
+
+    fn accumulator(&mut self, key: String) -> Wire {
+        let w = self.wire(key);
+        if !self.accumulators.contains(&w) {
+            self.accumulators.push(w);
+        }
+        w
+    }
+
+    fn hyd(&mut self, node: &str) -> HydraulicNode {
+        let pressure = self.wire(format!("hyd:{node}:p"));
+        let inflow = self.accumulator(format!("hyd:{node}:q"));
+        HydraulicNode { pressure, inflow }
+    }
+
+    /// Connects to hydraulic node `node`: read its pressure, add flows into it.
+    pub fn hydraulic(&mut self, node: &str) -> HydraulicNode {
+        let h = self.hyd(node);
+        self.read(h.pressure, "hydraulic node", node);
+        h
+    }
+
+    /// Becomes the owner of hydraulic node `node` (sets its pressure); every
+    /// hydraulic node has exactly one owner.
+    pub fn own_hydraulic(&mut self, node: &str, c: Causality) -> Result<HydraulicNode, BuildError> {
+        let h = self.hyd(node);
+        self.own(h.pressure, "hydraulic node", node, c)?;
+        Ok(h)
+    }
+
+    fn mech(&mut self, node: &str) -> MechanicalNode {
+        MechanicalNode {
+            position: self.wire(format!("mech:{node}:x")),
+            velocity: self.wire(format!("mech:{node}:v")),
+            force: self.accumulator(format!("mech:{node}:f")),
+            added_mass: self.accumulator(format!("mech:{node}:m")),
+            hold: self.accumulator(format!("mech:{node}:hold")),
+        }
+    }
+
+    /// Connects to mechanical node `node`: read position and velocity, add forces.
+    pub fn mechanical(&mut self, node: &str) -> MechanicalNode {
+        let m = self.mech(node);
+        self.read(m.position, "mechanical node", node);
+        self.read(m.velocity, "mechanical node", node);
+        m
+    }
+
+    /// Becomes the owner of mechanical node `node` (sets position and velocity).
+    pub fn own_mechanical(&mut self, node: &str) -> Result<MechanicalNode, BuildError> {
+        let m = self.mech(node);
+        self.own(m.position, "mechanical node", node, Causality::Stored)?;
+        self.own(m.velocity, "mechanical node", node, Causality::Stored)?;
+        Ok(m)
+    }
+
+    /// Reads signal `name` (a command, a spool position, a pilot travel).
+    pub fn signal(&mut self, name: &str) -> Wire {
+        let w = self.wire(format!("sig:{name}"));
+        self.read(w, "signal", name);
+        w
+    }
+
+    /// Becomes the writer of signal `name`.
+    pub fn own_signal(&mut self, name: &str, c: Causality) -> Result<Wire, BuildError> {
+        let w = self.wire(format!("sig:{name}"));
+        self.own(w, "signal", name, c)?;
+        Ok(w)
+    }
+
+    /// A wire private to the calling component (scratch values passed from
+    /// `evaluate` to `derivatives`); `key` need only be unique per component.
+    pub fn private(&mut self, key: &str) -> Wire {
+        let name = format!("priv:{}:{key}", self.component_names[self.current]);
+        let w = self.wire(name.clone());
+        self.owners.insert(
+            w.0,
+            Owned {
+                owner: self.current,
+                causality: Causality::Algebraic,
+            },
+        );
+        w
+    }
+}
+
+/// The assembled circuit: one ODE system over all component states, plus
+/// optional quadratures (component quadratures, the energy ledger).
+pub struct Circuit {
+    comps: Vec<Box<dyn Component>>,
+    offsets: Vec<usize>,
+    ev_offsets: Vec<usize>,
+    order: Vec<usize>,
+    accumulators: Vec<Wire>,
+    wires: RefCell<Wires>,
+    n_states: usize,
+    n_events: usize,
+    quad: bool,
+    ledger: bool,
+    q_offsets: Vec<usize>,
+    n_quad: usize,
+    wire_names: Vec<String>,
+}
+
+impl std::fmt::Debug for Circuit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Circuit")
+            .field(
+                "components",
+                &self
+                    .comps
+                    .iter()
+                    .map(|c| c.name().to_string())
+                    .collect::<Vec<_>>(),
+            )
+            .field("n_states", &self.n_states)
+            .finish()
+    }
+}
+
+/// Number of ledger quadratures per component: ∫source, ∫dissipated, ∫storage, ∫load.
+pub const LEDGER_TERMS: usize = 4;
+
+impl Circuit {
+    /// Assembles components: binds each to the netlist, checks that every
+    /// node has one owner, orders the algebraic evaluations, and lays out one
+    /// state vector (each component's slice in the order given).
+    pub fn build(mut comps: Vec<Box<dyn Component>>) -> Result<Self, BuildError> {
+        let mut net = Netlist {
+            component_names: comps.iter().map(|c| c.name().to_string()).collect(),
+            ..Netlist::default()
+        };
+        for (i, n) in net.component_names.iter().enumerate() {
+            if net.component_names[..i].contains(n) {
+                return Err(BuildError::Component {
+                    component: n.clone(),
+                    message: "two components have this name".into(),
+                });
+            }
+        }
+        for (i, c) in comps.iter_mut().enumerate() {
+            net.current = i;
+            c.bind(&mut net)?;
+        }
+        // every read wire has an owner; dependencies on algebraic owners
+        let n = comps.len();
+        let mut deps: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for (reader, w, kind, node) in &net.reads {
+            match net.owners.get(&w.0) {
+                None => {
+                    return Err(BuildError::NoOwner {
+                        kind,
+                        node: node.clone(),
+                        user: net.component_names[*reader].clone(),
+                    })
+                }
+                Some(o) => {
+                    if o.causality == Causality::Algebraic
+                        && o.owner != *reader
+                        && !deps[*reader].contains(&o.owner)
+                    {
+                        deps[*reader].push(o.owner);
+                    }
+                }
+            }
+        }
+        // Kahn's order, stable in the given component order
+        let mut order = Vec::with_capacity(n);
+        let mut done = vec![false; n];
+        while order.len() < n {
+            let next = (0..n).find(|&i| !done[i] && deps[i].iter().all(|&d| done[d]));
+            match next {
+                Some(i) => {
+                    done[i] = true;
+                    order.push(i);
+                }
+                None => {
+                    let left: Vec<String> = (0..n)
+                        .filter(|&i| !done[i])
+                        .map(|i| net.component_names[i].clone())
+                        .collect();
+                    return Err(BuildError::AlgebraicLoop(left.join(", ")));
+                }
+            }
+        }
+        let mut offsets = Vec::with_capacity(n + 1);
+        let mut ev_offsets = Vec::with_capacity(n + 1);
+        let mut q_offsets = Vec::with_capacity(n + 1);
+        let (mut s, mut e, mut q) = (0, 0, 0);
+        for c in &comps {
+            offsets.push(s);
+            ev_offsets.push(e);
+            q_offsets.push(q);
+            s += c.n_states();
+            e += c.n_events();
+            q += c.n_quadratures();
+        }
+        offsets.push(s);
+        ev_offsets.push(e);
+        q_offsets.push(q);
+        Ok(Self {
+            comps,
+            offsets,
+            ev_offsets,
+            order,
+            accumulators: net.accumulators,
+            wires: RefCell::new(Wires {
+                v: vec![0.0; net.names.len()],
+            }),
+            n_states: s,
+            n_events: e,
+            quad: false,
+            ledger: false,
+            q_offsets,
+            n_quad: q,
+            wire_names: net.names,
+        })
+    }
+
+    /// Number of component states (without quadratures).
+    pub fn n_states(&self) -> usize {
+        self.n_states
+    }
+
+    /// Turns the component quadratures on or off (appended after the states).
+    pub fn set_quadratures(&mut self, on: bool) {
+        self.quad = on;
+    }
+
+    /// Turns the energy ledger on or off: [`LEDGER_TERMS`] quadratures per
+    /// component (∫source, ∫dissipated, ∫storage, ∫load dt \[J\]) appended
+    /// after the component quadratures.
+    pub fn set_ledger(&mut self, on: bool) {
+        self.ledger = on;
+    }
+
+    fn quad_len(&self) -> usize {
+        if self.quad {
+            self.n_quad
+        } else {
+            0
+        }
+    }
+
+    /// Index of the first component quadrature in the full state vector.
+    pub fn quadrature_offset(&self) -> usize {
+        self.n_states
+    }
+
+    /// Index of the first ledger quadrature in the full state vector.
+    pub fn ledger_offset(&self) -> usize {
+        self.n_states + self.quad_len()
+    }
+
+    /// The components, in the order given to [`Circuit::build`].
+    pub fn components(&self) -> impl Iterator<Item = &dyn Component> {
+        self.comps.iter().map(|c| c.as_ref())
+    }
+
+    /// Index of the component named `name`.
+    pub fn component_index(&self, name: &str) -> Option<usize> {
+        self.comps.iter().position(|c| c.name() == name)
+    }
+
+    /// The state range of component `i`.
+    pub fn state_range(&self, i: usize) -> std::ops::Range<usize> {
+        self.offsets[i]..self.offsets[i + 1]
+    }
+
+    /// The quadrature range of component `i` in the full vector (when on).
+    pub fn quadrature_range(&self, i: usize) -> std::ops::Range<usize> {
+        let o = self.quadrature_offset();
+        o + self.q_offsets[i]..o + self.q_offsets[i + 1]
+    }
+
+    /// Names of all entries of the full state vector.
+    pub fn state_names(&self) -> Vec<String> {
+        let mut v: Vec<String> = self.comps.iter().flat_map(|c| c.state_names()).collect();
+        if self.quad {
+            v.extend(self.comps.iter().flat_map(|c| c.quadrature_names()));
+        }
+        if self.ledger {
+            for c in &self.comps {
+                for t in ["source", "dissipated", "storage", "load"] {
+                    v.push(format!("{}.energy_{t}", c.name()));
+                }
+            }
+        }
+        v
+    }
+
+    /// The default initial state of every component (quadratures zero).
+    pub fn initial_state(&self) -> Vec<f64> {
+        let mut x = vec![0.0; self.dim()];
+        for (i, c) in self.comps.iter().enumerate() {
+            c.initial_state(&mut x[self.offsets[i]..self.offsets[i + 1]]);
+        }
+        x
+    }
+
+    /// Absolute tolerances, `rtol · scale` per state; quadratures are
+    /// loosely weighted (scale 1e6 of their unit) so they never limit the step.
+    pub fn atol(&self, rtol: f64) -> Vec<f64> {
+        let mut a = vec![1.0e6; self.dim()];
+        for (i, c) in self.comps.iter().enumerate() {
+            c.state_scales(&mut a[self.offsets[i]..self.offsets[i + 1]]);
+        }
+        a.iter().map(|s| rtol * s).collect()
+    }
+
+    /// The probes of every component, in component order.
+    pub fn probes(&self) -> Vec<Probe> {
+        self.comps.iter().flat_map(|c| c.probes()).collect()
+    }
+
+    /// Diagnostics of every component, names prefixed by the component's.
+    pub fn diagnostics(&self) -> Vec<(String, f64)> {
+        self.comps
+            .iter()
+            .flat_map(|c| {
+                let n = c.name().to_string();
+                c.diagnostics()
+                    .into_iter()
+                    .map(move |(k, v)| (format!("{n}.{k}"), v))
+            })
+            .collect()
+    }
+
+    /// Evaluates every wire at `(t, x)` and returns a copy of the table.
+    pub fn wires_at(&self, t: f64, x: &[f64]) -> Wires {
+        self.fill(t, x);
+        self.wires.borrow().clone()
+    }
+
+    /// Evaluates every wire at `(t, x)` and copies the values of `wires` into `out`.
+    pub fn read_wires(&self, t: f64, x: &[f64], wires: &[Wire], out: &mut [f64]) {
+        self.fill(t, x);
+        let w = self.wires.borrow();
+        for (o, wire) in out.iter_mut().zip(wires) {
+            *o = w.get(*wire);
+        }
+    }
+
+    /// Name of a wire (`hyd:<node>:p`, `mech:<node>:v`, `sig:<name>`, ...).
+    pub fn wire_name(&self, w: Wire) -> &str {
+        &self.wire_names[w.0]
+    }
+
+    /// Finds a wire by its name.
+    pub fn find_wire(&self, name: &str) -> Option<Wire> {
+        self.wire_names.iter().position(|n| n == name).map(Wire)
+    }
+
+    /// Per-component power terms at `(t, x)` (the ledger's integrands), in component order.
+    pub fn power_terms(&self, t: f64, x: &[f64]) -> Vec<PowerTerms> {
+        let mut dx = vec![0.0; self.dim()];
+        self.rhs(t, x, &mut dx);
+        let w = self.wires.borrow();
+        self.comps
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let r = self.offsets[i]..self.offsets[i + 1];
+                let mut p = PowerTerms::default();
+                c.power(t, &x[r.clone()], &w, &dx[r], &mut p);
+                p
+            })
+            .collect()
+    }
+
+    /// Calls [`Component::reset`] on every component at `(t, x)`.
+    pub fn reset(&mut self, t: f64, x: &[f64]) {
+        self.fill(t, x);
+        let w = self.wires.borrow().clone();
+        for (i, c) in self.comps.iter_mut().enumerate() {
+            c.reset(t, &x[self.offsets[i]..self.offsets[i + 1]], &w);
+        }
+    }
+
+    /// Publish + evaluate: every wire is current for `(t, x)`.
+    fn fill(&self, t: f64, x: &[f64]) {
+        let mut w = self.wires.borrow_mut();
+        for a in &self.accumulators {
+            w.set(*a, 0.0);
+        }
+        for (i, c) in self.comps.iter().enumerate() {
+            c.publish(t, &x[self.offsets[i]..self.offsets[i + 1]], &mut w);
+        }
+        for &i in &self.order {
+            self.comps[i].evaluate(t, &x[self.offsets[i]..self.offsets[i + 1]], &mut w);
+        }
+    }
+}
+
+impl OdeSystem for Circuit {
+    fn dim(&self) -> usize {
+        self.n_states
+            + self.quad_len()
+            + if self.ledger {
+                LEDGER_TERMS * self.comps.len()
+            } else {
+                0
+            }
+    }
+
+    fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
+        self.fill(t, x);
+        let w = self.wires.borrow();
+        for (i, c) in self.comps.iter().enumerate() {
+            let r = self.offsets[i]..self.offsets[i + 1];
+            c.derivatives(t, &x[r.clone()], &w, &mut dx[r]);
+        }
+        if self.quad {
+            let o = self.quadrature_offset();
+            for (i, c) in self.comps.iter().enumerate() {
+                let r = self.offsets[i]..self.offsets[i + 1];
+                let (ds, dq) = dx.split_at_mut(o);
+                c.quadratures(
+                    t,
+                    &x[r.clone()],
+                    &w,
+                    &ds[r],
+                    &mut dq[self.q_offsets[i]..self.q_offsets[i + 1]],
+                );
+            }
+        }
+        if self.ledger {
+            let o = self.ledger_offset();
+            for (i, c) in self.comps.iter().enumerate() {
+                let r = self.offsets[i]..self.offsets[i + 1];
+                let mut p = PowerTerms::default();
+                c.power(t, &x[r.clone()], &w, &dx[r], &mut p);
+                let k = o + LEDGER_TERMS * i;
+                dx[k] = p.source;
+                dx[k + 1] = p.dissipated;
+                dx[k + 2] = p.storage;
+                dx[k + 3] = p.load;
+            }
+        }
+    }
+
+    fn n_events(&self) -> usize {
+        self.n_events
+    }
+
+    fn events(&self, t: f64, x: &[f64], g: &mut [f64]) {
+        self.fill(t, x);
+        let w = self.wires.borrow();
+        for (i, c) in self.comps.iter().enumerate() {
+            c.events(
+                t,
+                &x[self.offsets[i]..self.offsets[i + 1]],
+                &w,
+                &mut g[self.ev_offsets[i]..self.ev_offsets[i + 1]],
+            );
+        }
+    }
+
+    fn on_event(&mut self, t: f64, x: &mut [f64], which: usize, dir: Crossing) -> EventAction {
+        self.fill(t, x);
+        let w = self.wires.borrow().clone();
+        let i = (0..self.comps.len())
+            .find(|&i| which >= self.ev_offsets[i] && which < self.ev_offsets[i + 1])
+            .unwrap_or(0);
+        let r = self.offsets[i]..self.offsets[i + 1];
+        let action = self.comps[i].on_event(t, &mut x[r], &w, which - self.ev_offsets[i], dir);
+        self.fill(t, x);
+        let w = self.wires.borrow().clone();
+        for (i, c) in self.comps.iter_mut().enumerate() {
+            c.after_event(t, &mut x[self.offsets[i]..self.offsets[i + 1]], &w);
+        }
+        action
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::components::{FixedOrifice, PressureSource, Volume};
+    use hydrocyl_integrators::{solve, Method, Options};
+    use hydrocyl_ports::{Area, Density, Pressure};
+    use hydrocyl_valves::orifice::Orifice;
+
+    /// A test component that writes signal `out` algebraically from signal `inp`.
+    struct Gain {
+        name: String,
+        inp: String,
+        out: String,
+        w: (Wire, Wire),
+    }
+
+    impl Component for Gain {
+        fn name(&self) -> &str {
+            &self.name
+        }
+        fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
+            self.w = (
+                net.signal(&self.inp),
+                net.own_signal(&self.out, Causality::Algebraic)?,
+            );
+            Ok(())
+        }
+        fn evaluate(&self, _t: f64, _x: &[f64], w: &mut Wires) {
+            w.set(self.w.1, 2.0 * w.get(self.w.0));
+        }
+    }
+
+    fn gain(name: &str, inp: &str, out: &str) -> Box<dyn Component> {
+        Box::new(Gain {
+            name: name.into(),
+            inp: inp.into(),
+            out: out.into(),
+            w: (Wire::UNBOUND, Wire::UNBOUND),
+        })
+    }
+
+    fn orifice() -> Orifice {
+        Orifice::new(0.65, Density::new(870.0))
+    }
+
+    #[test]
+    fn causality_errors_name_components_and_nodes() {
+        let two = Circuit::build(vec![
+            Box::new(PressureSource::new(
+                "supply",
+                "P",
+                Pressure::from_bar(70.0),
+                None,
+            )),
+            Box::new(Volume::new("line", "P", 1e-4, 7e8, 0.0, None)),
+        ])
+        .unwrap_err();
+        assert!(matches!(two, BuildError::TwoOwners { .. }));
+        assert!(
+            two.to_string().contains("`P`")
+                && two.to_string().contains("supply")
+                && two.to_string().contains("line")
+        );
+
+        let none = Circuit::build(vec![
+            Box::new(PressureSource::new(
+                "supply",
+                "P",
+                Pressure::from_bar(70.0),
+                None,
+            )),
+            Box::new(FixedOrifice::new("o", "P", "A", Area::new(1e-6), orifice())),
+        ])
+        .unwrap_err();
+        assert!(
+            none.to_string().contains("`A`") && none.to_string().contains("`o`"),
+            "{none}"
+        );
+
+        let looped = Circuit::build(vec![gain("g1", "a", "b"), gain("g2", "b", "a")]).unwrap_err();
+        assert!(matches!(looped, BuildError::AlgebraicLoop(_)), "{looped}");
+
+        let dup = Circuit::build(vec![gain("g", "a", "b"), gain("g", "b", "c")]).unwrap_err();
+        assert!(dup.to_string().contains("two components"), "{dup}");
+    }
+
+    #[test]
+    fn algebraic_components_are_ordered_by_dependency() {
+        // given in reverse order: g2 reads what g1 writes; g1 reads a stored signal
+        let mut c = Circuit::build(vec![
+            gain("g2", "b", "c"),
+            gain("g1", "a", "b"),
+            Box::new(crate::components::CommandInput::new(
+                "cmd",
+                "a",
+                crate::signal::Signal::Constant { value: 1.5 },
+            )),
+        ])
+        .unwrap();
+        let w = c.wires_at(0.0, &[]);
+        let cw = c.find_wire("sig:c").unwrap();
+        assert_eq!(w.get(cw), 6.0);
+        c.reset(0.0, &[]);
+    }
+
+    #[test]
+    fn volume_filled_through_an_orifice_conserves_mass_and_reaches_supply() {
+        // supply → orifice → volume: V/B (p(T) − p(0)) = ∫Q dt, p → Ps
+        let (v, b) = (1e-4, 7e8);
+        let mut c = Circuit::build(vec![
+            Box::new(PressureSource::new(
+                "supply",
+                "P",
+                Pressure::from_bar(70.0),
+                Some("ps"),
+            )),
+            Box::new(FixedOrifice::new("o", "P", "A", Area::new(1e-7), orifice())),
+            Box::new(Volume::new("vol", "A", v, b, 0.0, Some("pa"))),
+        ])
+        .unwrap();
+        c.set_ledger(true);
+        let x0 = c.initial_state();
+        let opts = Options {
+            rtol: 1e-9,
+            atol: c.atol(1e-9),
+            ..Options::default()
+        };
+        let sol = solve(Method::DormandPrince45, &mut c, 0.0, &x0, 2.0, &opts).unwrap();
+        let last = sol.last().unwrap();
+        assert!((last[0] - 7e6).abs() < 1e3, "p = {}", last[0]);
+        // energy: source = dissipated + storage (volume), each integrated
+        let o = c.ledger_offset();
+        let src = last[o];
+        let diss = last[o + 4 + 1];
+        let stored = last[o + 8 + 2];
+        assert!(
+            (src - diss - stored).abs() < 1e-6 * src,
+            "{src} {diss} {stored}"
+        );
+        // stored = V p²/(2B) for a constant volume
+        assert!((stored - v * last[0] * last[0] / (2.0 * b)).abs() < 1e-6 * stored);
+    }
+}

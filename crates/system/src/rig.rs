@@ -1,0 +1,250 @@
+//! Rig files and presets: JSON in, checked rig out; `--set path=value`
+//! overrides on the JSON before it is checked.
+//!
+//! A rig file is a JSON object with a `kind` field that selects the rig
+//! type ([`RIG_KINDS`]); a preset is a named built-in rig ([`PRESETS`]).
+//! Overrides act on the JSON value, so they work for every rig kind.
+
+use crate::circuit::BuildError;
+use crate::run::{Run, RunOptions};
+use crate::signal::Signal;
+use crate::valve_rig::{self, ValveRig};
+use serde_json::Value;
+use thiserror::Error;
+
+/// A bad rig: names the JSON path (or file) and what is wrong.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum RigError {
+    /// A parameter outside its range.
+    #[error("rig parameter `{path}` = {value}: {why}")]
+    OutOfRange {
+        /// JSON path, e.g. `cylinder.area_1_m2`.
+        path: String,
+        /// The value given.
+        value: f64,
+        /// The rule it breaks.
+        why: String,
+    },
+    /// Another problem with a parameter or the file's shape.
+    #[error("rig `{path}`: {why}")]
+    Invalid {
+        /// JSON path or file.
+        path: String,
+        /// What is wrong.
+        why: String,
+    },
+    /// A `--set` path that the rig does not have.
+    #[error("unknown rig parameter `{path}`{hint}")]
+    UnknownPath {
+        /// The path given.
+        path: String,
+        /// The keys that exist there, formatted.
+        hint: String,
+    },
+    /// Assembly failed.
+    #[error("assembling the rig: {0}")]
+    Build(#[from] BuildError),
+    /// The simulation failed.
+    #[error("simulation: {0}")]
+    Sim(String),
+}
+
+/// A built-in rig.
+pub struct Preset {
+    /// Name (`--rig <name>`).
+    pub name: &'static str,
+    /// Its JSON value (equal to `fixtures/rigs/<name>.json`).
+    pub json: fn() -> Value,
+}
+
+/// The built-in presets. Other rig kinds add their presets here (one line each).
+pub const PRESETS: &[Preset] = &[
+    Preset {
+        name: "leaney-moog",
+        json: || serde_json::to_value(ValveRig::leaney_moog()).unwrap_or(Value::Null),
+    },
+    Preset {
+        name: "wang-valve-c10",
+        json: || {
+            serde_json::from_str(include_str!("../../../fixtures/rigs/wang-valve-c10.json"))
+                .unwrap_or(Value::Null)
+        },
+    },
+    Preset {
+        name: "wang-hybrid",
+        json: || serde_json::to_value(crate::hybrid::WangHybrid::preset()).unwrap_or(Value::Null),
+    },
+];
+
+/// A rig kind: how a checked JSON value of that kind is simulated.
+pub struct RigKind {
+    /// The `kind` field's value.
+    pub kind: &'static str,
+    /// Deserialises and validates the rig (errors name the JSON path).
+    pub check: fn(&Value) -> Result<(), RigError>,
+    /// Simulates the rig on a command, output at the given times.
+    pub simulate: fn(&Value, Signal, &[f64], &RunOptions) -> Result<Run, RigError>,
+}
+
+/// The rig kinds hydrocyl knows. Other rig kinds add an entry here.
+pub const RIG_KINDS: &[RigKind] = &[
+    RigKind {
+        kind: valve_rig::KIND,
+        check: |v| valve_rig_from(v).map(|_| ()),
+        simulate: |v, cmd, t, o| valve_rig_from(v)?.simulate(cmd, t, o),
+    },
+    RigKind {
+        kind: crate::hybrid::KIND,
+        check: |v| crate::hybrid::WangHybrid::from_value(v).map(|_| ()),
+        simulate: |v, cmd, t, o| crate::hybrid::WangHybrid::from_value(v)?.simulate(cmd, t, o),
+    },
+];
+
+/// Deserialises and validates a `valve-cylinder` rig.
+pub fn valve_rig_from(v: &Value) -> Result<ValveRig, RigError> {
+    let r: ValveRig = serde_json::from_value(v.clone()).map_err(|e| RigError::Invalid {
+        path: "rig".into(),
+        why: e.to_string(),
+    })?;
+    r.validate()?;
+    Ok(r)
+}
+
+/// The JSON of preset `name`, if there is one.
+pub fn preset(name: &str) -> Option<Value> {
+    PRESETS.iter().find(|p| p.name == name).map(|p| (p.json)())
+}
+
+/// A preset by name, or else a rig file by path.
+pub fn load(name_or_path: &str) -> Result<Value, RigError> {
+    if let Some(v) = preset(name_or_path) {
+        return Ok(v);
+    }
+    let text = std::fs::read_to_string(name_or_path).map_err(|e| RigError::Invalid {
+        path: name_or_path.into(),
+        why: format!(
+            "not a preset ({}) and not a readable file: {e}",
+            PRESETS
+                .iter()
+                .map(|p| p.name)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    })?;
+    serde_json::from_str(&text).map_err(|e| RigError::Invalid {
+        path: name_or_path.into(),
+        why: format!("not valid JSON: {e}"),
+    })
+}
+
+/// The kind entry of a rig value.
+pub fn kind_of(v: &Value) -> Result<&'static RigKind, RigError> {
+    let k = v
+        .get("kind")
+        .and_then(Value::as_str)
+        .ok_or_else(|| RigError::Invalid {
+            path: "kind".into(),
+            why: "missing (a rig file names its kind)".into(),
+        })?;
+    RIG_KINDS
+        .iter()
+        .find(|r| r.kind == k)
+        .ok_or_else(|| RigError::Invalid {
+            path: "kind".into(),
+            why: format!(
+                "unknown rig kind `{k}` (known: {})",
+                RIG_KINDS
+                    .iter()
+                    .map(|r| r.kind)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        })
+}
+
+/// Checks a rig value of any kind.
+pub fn check(v: &Value) -> Result<(), RigError> {
+    (kind_of(v)?.check)(v)
+}
+
+/// Simulates a rig value of any kind.
+pub fn simulate(
+    v: &Value,
+    command: Signal,
+    t_eval: &[f64],
+    opts: &RunOptions,
+) -> Result<Run, RigError> {
+    (kind_of(v)?.simulate)(v, command, t_eval, opts)
+}
+
+/// Applies one `path=value` override (`cylinder.area_1_m2=1.2e-3`,
+/// `initial.p1=3e6`, `valve.dynamics.order="second"`). The path must exist in
+/// the rig (a `null` entry such as `initial.p1` exists); the value is parsed
+/// as JSON, else taken as a string; a number may only replace a number (or a
+/// `null`), a string a string.
+pub fn apply_set(rig: &mut Value, assignment: &str) -> Result<(), RigError> {
+    let (path, text) = assignment
+        .split_once('=')
+        .ok_or_else(|| RigError::Invalid {
+            path: assignment.into(),
+            why: "an override is `path=value`".into(),
+        })?;
+    let path = path.trim();
+    let new: Value = serde_json::from_str(text.trim())
+        .unwrap_or_else(|_| Value::String(text.trim().to_string()));
+    let mut cur = rig;
+    let mut walked = String::new();
+    for seg in path.split('.') {
+        let keys = |v: &Value| match v {
+            Value::Object(m) => format!(
+                " (at `{}` the keys are: {})",
+                if walked.is_empty() { "." } else { &walked },
+                m.keys().cloned().collect::<Vec<_>>().join(", ")
+            ),
+            _ => String::new(),
+        };
+        let hint = keys(cur);
+        let next = match cur {
+            Value::Object(m) => m.get_mut(seg),
+            Value::Array(a) => seg.parse::<usize>().ok().and_then(|i| a.get_mut(i)),
+            _ => None,
+        };
+        cur = next.ok_or_else(|| RigError::UnknownPath {
+            path: path.to_string(),
+            hint,
+        })?;
+        if !walked.is_empty() {
+            walked.push('.');
+        }
+        walked.push_str(seg);
+    }
+    let compatible = match (&*cur, &new) {
+        (Value::Number(_), Value::Number(_)) => true,
+        (Value::Null, Value::Number(_) | Value::Null) => true,
+        (Value::Number(_), Value::Null) => path.starts_with("initial."),
+        (Value::String(_), Value::String(_)) => true,
+        (Value::Bool(_), Value::Bool(_)) => true,
+        (Value::Object(_), Value::Object(_)) => true,
+        (Value::Array(_), Value::Array(_)) => true,
+        _ => false,
+    };
+    if !compatible {
+        return Err(RigError::Invalid {
+            path: path.to_string(),
+            why: format!("cannot replace {} with `{}`", describe(cur), text.trim()),
+        });
+    }
+    *cur = new;
+    Ok(())
+}
+
+fn describe(v: &Value) -> &'static str {
+    match v {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    }
+}

@@ -1,0 +1,288 @@
+//! Running an assembled circuit: solver choice, output sampling at given
+//! times, probes turned into named channels, cavitation and stop reports.
+
+use crate::circuit::{BuildError, Circuit};
+use hydrocyl_integrators::{solve, Method, OdeSystem, Options, SolveError, Stats};
+use std::time::{Duration, Instant};
+use thiserror::Error;
+
+/// Why a run failed.
+#[derive(Debug, Error)]
+pub enum SimError {
+    /// The circuit could not be assembled.
+    #[error(transparent)]
+    Build(#[from] BuildError),
+    /// The integrator failed (tolerance not met, non-finite state, ...).
+    #[error("solver {method}: {source}")]
+    Solve {
+        /// The method used.
+        method: &'static str,
+        /// The solver's error.
+        source: SolveError,
+    },
+    /// Bad run settings.
+    #[error("run settings: {0}")]
+    Settings(String),
+}
+
+/// The integration method, by the names the CLI accepts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Solver {
+    /// Dormand–Prince 5(4) (default; Simulink's ode45, the thesis's solver).
+    Dp45,
+    /// Stiff Rosenbrock.
+    Rosenbrock,
+    /// Fixed-step RK4 (step `RunOptions::rk4_step`).
+    Rk4,
+}
+
+impl Solver {
+    /// The integrator crate's method.
+    pub fn method(self) -> Method {
+        match self {
+            Solver::Dp45 => Method::DormandPrince45,
+            Solver::Rosenbrock => Method::Rosenbrock,
+            Solver::Rk4 => Method::Rk4,
+        }
+    }
+    /// The CLI name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Solver::Dp45 => "dp45",
+            Solver::Rosenbrock => "rosenbrock",
+            Solver::Rk4 => "rk4",
+        }
+    }
+    /// Parses a CLI name (`dp45`, `rosenbrock`, `rk4`).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "dp45" => Some(Solver::Dp45),
+            "rosenbrock" => Some(Solver::Rosenbrock),
+            "rk4" => Some(Solver::Rk4),
+            _ => None,
+        }
+    }
+}
+
+/// Settings of a run.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// The integration method.
+    pub solver: Solver,
+    /// Relative tolerance (absolute tolerances are `rtol ·` each state's scale).
+    pub rtol: f64,
+    /// Largest step \[s\] (adaptive methods).
+    pub h_max: f64,
+    /// Fixed step of RK4 \[s\].
+    pub rk4_step: f64,
+    /// Integrate the component quadratures (mass balance).
+    pub quadratures: bool,
+    /// Integrate the energy ledger.
+    pub ledger: bool,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        Self {
+            solver: Solver::Dp45,
+            rtol: 1e-6,
+            h_max: 1e-2,
+            rk4_step: 2e-5,
+            quadratures: false,
+            ledger: false,
+        }
+    }
+}
+
+/// One output column.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Channel {
+    /// Name (measured-data signal names: `position`, `velocity`, `p1`, ...).
+    pub name: String,
+    /// SI unit.
+    pub unit: &'static str,
+    /// Values at [`Run::time`].
+    pub values: Vec<f64>,
+}
+
+/// The result of a run.
+#[derive(Clone, Debug)]
+pub struct Run {
+    /// Output times \[s\].
+    pub time: Vec<f64>,
+    /// Output channels, in the measured-data order (command, position,
+    /// velocity, p1, p2, then the rig's others).
+    pub channels: Vec<Channel>,
+    /// Full state vectors at the output times, row-major (`dim` each).
+    pub states: Vec<f64>,
+    /// Length of one state vector.
+    pub dim: usize,
+    /// Integrator work counters.
+    pub stats: Stats,
+    /// Component counters (`<component>.<counter>`): cavitation entries,
+    /// stop impacts, X-factor evaluations.
+    pub diagnostics: Vec<(String, f64)>,
+    /// Wall-clock time of the solve.
+    pub wall: Duration,
+}
+
+impl Run {
+    /// A channel's values by name.
+    pub fn channel(&self, name: &str) -> Option<&[f64]> {
+        self.channels
+            .iter()
+            .find(|c| c.name == name)
+            .map(|c| c.values.as_slice())
+    }
+
+    /// A diagnostic counter by its full name.
+    pub fn diagnostic(&self, name: &str) -> Option<f64> {
+        self.diagnostics
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| *v)
+    }
+
+    /// The state vector at output `k`.
+    pub fn state(&self, k: usize) -> &[f64] {
+        &self.states[k * self.dim..(k + 1) * self.dim]
+    }
+
+    /// Number of cavitation entries of all chambers (0 = none).
+    pub fn cavitation_entries(&self) -> usize {
+        self.diagnostics
+            .iter()
+            .filter(|(n, _)| n.contains("cavitation_entries"))
+            .map(|(_, v)| *v as usize)
+            .sum()
+    }
+
+    /// Lowest value of the chamber pressure channels `p1`, `p2` \[Pa\].
+    pub fn min_chamber_pressure(&self) -> f64 {
+        ["p1", "p2"]
+            .iter()
+            .filter_map(|n| self.channel(n))
+            .flat_map(|v| v.iter().copied())
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
+const ORDER: [&str; 5] = ["command", "position", "velocity", "p1", "p2"];
+
+/// Integrates `circuit` from `x0` at `t_eval[0]` to the last of `t_eval`,
+/// sampling at every `t_eval` time (sorted, strictly increasing, ≥ 2 points).
+pub fn run(
+    circuit: &mut Circuit,
+    x0: &[f64],
+    t_eval: &[f64],
+    opts: &RunOptions,
+) -> Result<Run, SimError> {
+    if t_eval.len() < 2 {
+        return Err(SimError::Settings("need at least two output times".into()));
+    }
+    if let Some(i) =
+        (1..t_eval.len()).find(|&i| !(t_eval[i] > t_eval[i - 1]) || !t_eval[i].is_finite())
+    {
+        return Err(SimError::Settings(format!(
+            "output time {} (sample {i}) does not increase",
+            t_eval[i]
+        )));
+    }
+    if !(opts.rtol > 0.0 && opts.rtol < 1.0) {
+        return Err(SimError::Settings(format!(
+            "rtol must be in (0, 1), got {}",
+            opts.rtol
+        )));
+    }
+    circuit.set_quadratures(opts.quadratures);
+    circuit.set_ledger(opts.ledger);
+    let n = circuit.n_states();
+    if x0.len() != n {
+        return Err(SimError::Settings(format!(
+            "initial state has {} entries, the circuit {n}",
+            x0.len()
+        )));
+    }
+    let mut x = vec![0.0; circuit.dim()];
+    x[..n].copy_from_slice(x0);
+    if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+        return Err(SimError::Settings(format!(
+            "initial state {} is not finite",
+            circuit.state_names()[i]
+        )));
+    }
+    let (t0, t_end) = (t_eval[0], t_eval[t_eval.len() - 1]);
+    circuit.reset(t0, &x);
+    let sopts = Options {
+        rtol: opts.rtol,
+        atol: circuit.atol(opts.rtol),
+        h0: if opts.solver == Solver::Rk4 {
+            Some(opts.rk4_step)
+        } else {
+            None
+        },
+        h_max: opts.h_max,
+        t_eval: Some(t_eval.to_vec()),
+        ..Options::default()
+    };
+    let start = Instant::now();
+    let sol = solve(opts.solver.method(), circuit, t0, &x, t_end, &sopts).map_err(|source| {
+        SimError::Solve {
+            method: opts.solver.name(),
+            source,
+        }
+    })?;
+    let wall = start.elapsed();
+    // probes → channels
+    let probes = circuit.probes();
+    let mut channels: Vec<Channel> = probes
+        .iter()
+        .map(|p| Channel {
+            name: p.name.clone(),
+            unit: p.unit,
+            values: Vec::with_capacity(sol.t.len()),
+        })
+        .collect();
+    let wires: Vec<_> = probes.iter().map(|p| p.wire).collect();
+    let mut row = vec![0.0; wires.len()];
+    for k in 0..sol.t.len() {
+        circuit.read_wires(sol.t[k], sol.state(k), &wires, &mut row);
+        for (c, v) in channels.iter_mut().zip(&row) {
+            c.values.push(*v);
+        }
+    }
+    channels.sort_by_key(|c| {
+        ORDER
+            .iter()
+            .position(|o| *o == c.name)
+            .unwrap_or(ORDER.len())
+    });
+    Ok(Run {
+        time: sol.t.clone(),
+        channels,
+        dim: sol.dim,
+        states: sol.x,
+        stats: sol.stats,
+        diagnostics: circuit.diagnostics(),
+        wall,
+    })
+}
+
+/// Normalised RMS error `RMSE(a − b) / (max b − min b)` (the measured-data
+/// spec's NRMSE, `b` the reference). `NaN` when lengths differ or `b` is flat.
+pub fn nrmse(a: &[f64], b: &[f64]) -> f64 {
+    if a.len() != b.len() || a.is_empty() {
+        return f64::NAN;
+    }
+    let (lo, hi) = b
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+            (l.min(*v), h.max(*v))
+        });
+    let mse = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>() / a.len() as f64;
+    if hi > lo {
+        mse.sqrt() / (hi - lo)
+    } else {
+        f64::NAN
+    }
+}

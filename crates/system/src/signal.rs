@@ -1,0 +1,374 @@
+//! Command signals: square with bias, sine, sawtooth, step, ramp and a
+//! sampled table with first-order hold (the CSV-given command).
+
+use serde::{Deserialize, Serialize};
+use std::cell::Cell;
+use thiserror::Error;
+
+/// A bad signal definition; names the field and the value.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum SignalError {
+    /// A parameter out of range.
+    #[error("signal parameter `{what}` = {value}: {why}")]
+    Parameter {
+        /// The parameter.
+        what: &'static str,
+        /// Its value.
+        value: f64,
+        /// What is wrong.
+        why: &'static str,
+    },
+    /// A table sample is bad.
+    #[error("command sample {row}: {why}")]
+    Table {
+        /// 0-based sample index.
+        row: usize,
+        /// What is wrong.
+        why: String,
+    },
+}
+
+/// A scalar signal of time (a normalised valve command, a drive voltage).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Signal {
+    /// `value` for all t.
+    Constant {
+        /// The value.
+        value: f64,
+    },
+    /// `before` for t < `time_s`, `after` from then on.
+    Step {
+        /// Switching time \[s\].
+        time_s: f64,
+        /// Value before.
+        before: f64,
+        /// Value after.
+        after: f64,
+    },
+    /// Square wave: `bias + amplitude` for the first half of each period,
+    /// `bias − amplitude` for the second (the open-loop test of §3.1.3).
+    Square {
+        /// Half the peak-to-peak value.
+        amplitude: f64,
+        /// Period \[s\].
+        period_s: f64,
+        /// Offset (the bias that makes an asymmetric cylinder's velocity symmetric).
+        bias: f64,
+    },
+    /// `bias + amplitude sin(2π t/period + phase)`.
+    Sine {
+        /// Amplitude.
+        amplitude: f64,
+        /// Period \[s\].
+        period_s: f64,
+        /// Offset.
+        bias: f64,
+        /// Phase \[rad\].
+        phase_rad: f64,
+    },
+    /// Sawtooth: rises linearly from `bias − amplitude` to `bias + amplitude`
+    /// over each period, then drops back.
+    Sawtooth {
+        /// Half the peak-to-peak value.
+        amplitude: f64,
+        /// Period \[s\].
+        period_s: f64,
+        /// Offset.
+        bias: f64,
+    },
+    /// `from` until `t0_s`, linear to `to` at `t1_s`, `to` after.
+    Ramp {
+        /// Start value.
+        from: f64,
+        /// End value.
+        to: f64,
+        /// Ramp start \[s\].
+        t0_s: f64,
+        /// Ramp end \[s\].
+        t1_s: f64,
+    },
+    /// Samples with first-order hold (linear between samples), held constant
+    /// outside the sampled range.
+    Table {
+        /// Sample times, strictly increasing \[s\].
+        time_s: Vec<f64>,
+        /// Sample values.
+        value: Vec<f64>,
+    },
+}
+
+impl Signal {
+    /// A table signal, checked: equal lengths, at least one sample, finite
+    /// values, strictly increasing times.
+    pub fn table(time_s: Vec<f64>, value: Vec<f64>) -> Result<Self, SignalError> {
+        let s = Signal::Table { time_s, value };
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// Checks the parameters.
+    pub fn validate(&self) -> Result<(), SignalError> {
+        let fin = |what, v: f64| {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(SignalError::Parameter {
+                    what,
+                    value: v,
+                    why: "must be finite",
+                })
+            }
+        };
+        let period = |v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(SignalError::Parameter {
+                    what: "period_s",
+                    value: v,
+                    why: "must be positive",
+                })
+            }
+        };
+        match self {
+            Signal::Constant { value } => fin("value", *value),
+            Signal::Step {
+                time_s,
+                before,
+                after,
+            } => {
+                fin("time_s", *time_s)?;
+                fin("before", *before)?;
+                fin("after", *after)
+            }
+            Signal::Square {
+                amplitude,
+                period_s,
+                bias,
+            }
+            | Signal::Sawtooth {
+                amplitude,
+                period_s,
+                bias,
+            } => {
+                fin("amplitude", *amplitude)?;
+                fin("bias", *bias)?;
+                period(*period_s)
+            }
+            Signal::Sine {
+                amplitude,
+                period_s,
+                bias,
+                phase_rad,
+            } => {
+                fin("amplitude", *amplitude)?;
+                fin("bias", *bias)?;
+                fin("phase_rad", *phase_rad)?;
+                period(*period_s)
+            }
+            Signal::Ramp {
+                from,
+                to,
+                t0_s,
+                t1_s,
+            } => {
+                fin("from", *from)?;
+                fin("to", *to)?;
+                fin("t0_s", *t0_s)?;
+                fin("t1_s", *t1_s)?;
+                if t1_s <= t0_s {
+                    return Err(SignalError::Parameter {
+                        what: "t1_s",
+                        value: *t1_s,
+                        why: "must be after t0_s",
+                    });
+                }
+                Ok(())
+            }
+            Signal::Table { time_s, value } => {
+                if time_s.len() != value.len() {
+                    return Err(SignalError::Table {
+                        row: time_s.len().min(value.len()),
+                        why: format!("{} times but {} values", time_s.len(), value.len()),
+                    });
+                }
+                if time_s.is_empty() {
+                    return Err(SignalError::Table {
+                        row: 0,
+                        why: "no samples".into(),
+                    });
+                }
+                for (i, (t, v)) in time_s.iter().zip(value).enumerate() {
+                    if !t.is_finite() || !v.is_finite() {
+                        return Err(SignalError::Table {
+                            row: i,
+                            why: format!("time {t} / value {v} is not finite"),
+                        });
+                    }
+                    if i > 0 && *t <= time_s[i - 1] {
+                        return Err(SignalError::Table {
+                            row: i,
+                            why: format!(
+                                "time {t} s does not increase (previous {} s)",
+                                time_s[i - 1]
+                            ),
+                        });
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// The value at time `t`.
+    pub fn value(&self, t: f64) -> f64 {
+        self.value_hinted(t, &Cell::new(0))
+    }
+
+    /// The value at time `t`; `hint` caches the table interval last used so
+    /// that the integrator's nearby calls need no search.
+    #[inline]
+    pub fn value_hinted(&self, t: f64, hint: &Cell<usize>) -> f64 {
+        match self {
+            Signal::Constant { value } => *value,
+            Signal::Step {
+                time_s,
+                before,
+                after,
+            } => {
+                if t < *time_s {
+                    *before
+                } else {
+                    *after
+                }
+            }
+            Signal::Square {
+                amplitude,
+                period_s,
+                bias,
+            } => {
+                let ph = (t / period_s).rem_euclid(1.0);
+                if ph < 0.5 {
+                    bias + amplitude
+                } else {
+                    bias - amplitude
+                }
+            }
+            Signal::Sine {
+                amplitude,
+                period_s,
+                bias,
+                phase_rad,
+            } => bias + amplitude * (std::f64::consts::TAU * t / period_s + phase_rad).sin(),
+            Signal::Sawtooth {
+                amplitude,
+                period_s,
+                bias,
+            } => {
+                let ph = (t / period_s).rem_euclid(1.0);
+                bias + amplitude * (2.0 * ph - 1.0)
+            }
+            Signal::Ramp {
+                from,
+                to,
+                t0_s,
+                t1_s,
+            } => {
+                if t <= *t0_s {
+                    *from
+                } else if t >= *t1_s {
+                    *to
+                } else {
+                    from + (to - from) * (t - t0_s) / (t1_s - t0_s)
+                }
+            }
+            Signal::Table { time_s, value } => {
+                let n = time_s.len();
+                if t <= time_s[0] {
+                    return value[0];
+                }
+                if t >= time_s[n - 1] {
+                    return value[n - 1];
+                }
+                let mut i = hint.get().min(n - 2);
+                if !(time_s[i] <= t && t < time_s[i + 1]) {
+                    // binary search: largest i with time_s[i] <= t
+                    i = time_s.partition_point(|&s| s <= t) - 1;
+                    hint.set(i);
+                }
+                let (t0, t1) = (time_s[i], time_s[i + 1]);
+                value[i] + (value[i + 1] - value[i]) * (t - t0) / (t1 - t0)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn shapes() {
+        let sq = Signal::Square {
+            amplitude: 0.2,
+            period_s: 2.0,
+            bias: -0.05,
+        };
+        assert!((sq.value(0.5) - 0.15).abs() < 1e-15);
+        assert!((sq.value(1.5) + 0.25).abs() < 1e-15);
+        let saw = Signal::Sawtooth {
+            amplitude: 1.0,
+            period_s: 4.0,
+            bias: 0.0,
+        };
+        assert_eq!(saw.value(0.0), -1.0);
+        assert_eq!(saw.value(2.0), 0.0);
+        assert_eq!(saw.value(5.0), -0.5);
+        let step = Signal::Step {
+            time_s: 1.0,
+            before: 0.0,
+            after: 2.0,
+        };
+        assert_eq!(step.value(0.999), 0.0);
+        assert_eq!(step.value(1.0), 2.0);
+        let r = Signal::Ramp {
+            from: 1.0,
+            to: -1.0,
+            t0_s: 0.0,
+            t1_s: 2.0,
+        };
+        assert_eq!(r.value(1.0), 0.0);
+    }
+
+    #[test]
+    fn table_rejects_bad_samples() {
+        let e = Signal::table(vec![0.0, 1.0, 1.0], vec![0.0; 3]).unwrap_err();
+        assert!(e.to_string().contains("sample 2"), "{e}");
+        assert!(Signal::table(vec![0.0, f64::NAN], vec![0.0; 2]).is_err());
+        assert!(Signal::table(vec![], vec![]).is_err());
+        let e = Signal::Square {
+            amplitude: 1.0,
+            period_s: 0.0,
+            bias: 0.0,
+        }
+        .validate()
+        .unwrap_err();
+        assert!(e.to_string().contains("period_s"));
+    }
+
+    proptest! {
+        /// First-order hold: exact at the samples and linear in between,
+        /// whatever the hint says.
+        #[test]
+        fn table_is_first_order_hold(t in -1.0f64..12.0, h in 0usize..20) {
+            let ts: Vec<f64> = (0..11).map(|i| i as f64 + 0.1 * (i % 3) as f64).collect();
+            let vs: Vec<f64> = ts.iter().map(|t| 3.0 * t - 2.0).collect();
+            let s = Signal::table(ts.clone(), vs).unwrap();
+            let hint = Cell::new(h);
+            let expect = 3.0 * t.clamp(ts[0], ts[10]) - 2.0;
+            prop_assert!((s.value_hinted(t, &hint) - expect).abs() < 1e-12);
+        }
+    }
+}

@@ -1,0 +1,622 @@
+//! The valve-controlled rig (`kind = "valve-cylinder"`), preset
+//! `leaney-moog`: a servovalve driving an asymmetric cylinder and a mass on a
+//! slideway (thesis chapter 3; rigs.md). Every parameter is a field of
+//! [`ValveRig`], which is also the JSON rig file (`fixtures/rigs/leaney-moog.json`).
+
+use crate::circuit::{Circuit, Component};
+use crate::components::*;
+use crate::rig::RigError;
+use crate::run::{run, Run, RunOptions, SimError};
+use crate::signal::Signal;
+use hydrocyl_actuator::Cylinder;
+use hydrocyl_friction::{CoulombViscous, FrictionInput, FrictionLaw, FrictionModel};
+use hydrocyl_ports::{Area, Density, Force, Position, Pressure, Velocity};
+use hydrocyl_valves::orifice::Orifice;
+use hydrocyl_valves::servovalve::{Metering, Spool, SpoolDynamics};
+use serde::{Deserialize, Serialize};
+
+/// The JSON `kind` of this rig.
+pub const KIND: &str = "valve-cylinder";
+
+/// Fluid properties.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FluidSpec {
+    /// Density ρ \[kg·m⁻³\].
+    pub density_kg_per_m3: f64,
+    /// Effective bulk modulus B \[Pa\].
+    pub bulk_modulus_pa: f64,
+}
+
+/// Constant-pressure supply and tank.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SupplySpec {
+    /// Supply pressure Ps \[Pa\].
+    pub pressure_pa: f64,
+    /// Tank (return) pressure \[Pa\].
+    pub tank_pressure_pa: f64,
+}
+
+/// The servovalve.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ValveSpec {
+    /// Spool stroke x_max: saturation, and the demand `x_ref = u · x_max` \[m\].
+    pub stroke_m: f64,
+    /// Equivalent underlap u0 \[m\] (eq 3.2).
+    pub underlap_m: f64,
+    /// Spool diameter D; area gradient `w = π D` \[m\].
+    pub spool_diameter_m: f64,
+    /// Discharge coefficient Cd \[-\].
+    pub discharge_coefficient: f64,
+    /// Transition pressure of the regularised orifice root \[Pa\].
+    pub regularisation_pa: f64,
+    /// Spool null bias x_b added to the spool position \[m\] (catalog `valve_null_bias`).
+    pub null_bias_m: f64,
+    /// Scale on the area gradient \[-\] (catalog `flow_gain_error`, 1 = nominal).
+    pub flow_gain: f64,
+    /// Spool dynamics: `{"order": "first", "time_constant_s": τ}` or
+    /// `{"order": "second", "natural_frequency_rad_per_s": ω, "damping_ratio": ζ}`.
+    pub dynamics: SpoolDynamics,
+}
+
+/// Which actuator formulation to assemble.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Formulation {
+    /// Two chamber pressures (eqs 2.8, 2.9, 2.10–2.15).
+    Fundamental,
+    /// One load pressure, X by a bracketing root finder (eq 3.4).
+    GeneralisedNumerical,
+    /// One load pressure, X from the exact quartic root.
+    GeneralisedAnalytical,
+}
+
+impl Formulation {
+    /// All three, in the order of the thesis's Table 3-5 columns.
+    pub const ALL: [Formulation; 3] = [
+        Formulation::GeneralisedNumerical,
+        Formulation::GeneralisedAnalytical,
+        Formulation::Fundamental,
+    ];
+    /// The JSON name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Formulation::Fundamental => "fundamental",
+            Formulation::GeneralisedNumerical => "generalised-numerical",
+            Formulation::GeneralisedAnalytical => "generalised-analytical",
+        }
+    }
+}
+
+/// The cylinder.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CylinderSpec {
+    /// Cap-side area A1 \[m²\].
+    pub area_1_m2: f64,
+    /// Rod-side area A2 \[m²\].
+    pub area_2_m2: f64,
+    /// Stroke \[m\]; the piston moves in ±stroke/2 (hard stops).
+    pub stroke_m: f64,
+    /// `V1 = A1 (l1 + x)` \[m\] (vt.m: 0.31).
+    pub chamber_length_1_m: f64,
+    /// `V2 = A2 (l2 − x)` \[m\].
+    pub chamber_length_2_m: f64,
+    /// Internal leakage coefficient Cl \[m³·s⁻¹·Pa⁻¹\].
+    pub internal_leakage_m3_per_s_pa: f64,
+    /// External leakage coefficient of chamber 1 \[m³·s⁻¹·Pa⁻¹\].
+    pub external_leakage_1_m3_per_s_pa: f64,
+    /// External leakage coefficient of chamber 2 \[m³·s⁻¹·Pa⁻¹\].
+    pub external_leakage_2_m3_per_s_pa: f64,
+    /// Chamber pressure below which cavitation is reported \[Pa\].
+    pub cavitation_pressure_pa: f64,
+    /// `fundamental`, `generalised-numerical` or `generalised-analytical`.
+    pub formulation: Formulation,
+    /// Absolute tolerance of the numerical X root \[-\].
+    pub x_tolerance: f64,
+}
+
+/// The moving load.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// Moving mass m \[kg\].
+    pub mass_kg: f64,
+    /// External force opposing extension \[N\].
+    pub external_force_n: f64,
+}
+
+/// The initial state (SI: m, m/s, Pa, m). `p1`/`p2` `null`: the steady
+/// pressures of the rig at rest for the initial spool position (X factor,
+/// section 3.3.4).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// Piston position from mid-stroke \[m\].
+    pub position: f64,
+    /// Piston velocity \[m·s⁻¹\].
+    pub velocity: f64,
+    /// Spool position \[m\].
+    pub spool: f64,
+    /// Chamber 1 pressure \[Pa\] or `null` (steady state).
+    pub p1: Option<f64>,
+    /// Chamber 2 pressure \[Pa\] or `null` (steady state).
+    pub p2: Option<f64>,
+}
+
+/// A valve-controlled asymmetric-cylinder rig: the JSON rig file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ValveRig {
+    /// Always `valve-cylinder`.
+    pub kind: String,
+    /// Rig name.
+    pub name: String,
+    /// Free text: source of the parameters.
+    pub description: String,
+    /// Fluid.
+    pub fluid: FluidSpec,
+    /// Supply and tank.
+    pub supply: SupplySpec,
+    /// Servovalve.
+    pub valve: ValveSpec,
+    /// Cylinder.
+    pub cylinder: CylinderSpec,
+    /// Load.
+    pub load: LoadSpec,
+    /// Friction: any law of the friction crate, tagged by `model`
+    /// (`coulomb-viscous`, `stribeck`, `karnopp`, `dahl`, `lugre`, `wang`).
+    pub friction: FrictionLaw,
+    /// Initial state.
+    pub initial: InitialSpec,
+}
+
+fn check(path: &str, value: f64, ok: bool, why: &str) -> Result<(), RigError> {
+    if ok && value.is_finite() {
+        Ok(())
+    } else {
+        Err(RigError::OutOfRange {
+            path: path.to_string(),
+            value,
+            why: why.to_string(),
+        })
+    }
+}
+
+impl ValveRig {
+    /// The `leaney-moog` preset: exactly the values of rigs.md.
+    pub fn leaney_moog() -> Self {
+        Self {
+            kind: KIND.into(),
+            name: "leaney-moog".into(),
+            description: "Moog 76-102 servovalve and 88533-002 asymmetric cylinder (Wang 2019, ch. 3, Tables 3-1/3-2, Appendix II); mass and friction assumed (rigs.md)".into(),
+            fluid: FluidSpec {
+                density_kg_per_m3: 870.0,
+                bulk_modulus_pa: 7.0e8,
+            },
+            supply: SupplySpec {
+                pressure_pa: 7.0e6,
+                tank_pressure_pa: 0.0,
+            },
+            valve: ValveSpec {
+                stroke_m: 0.375e-3,
+                underlap_m: 0.0045e-3,
+                spool_diameter_m: 7.938e-3,
+                discharge_coefficient: 0.625,
+                regularisation_pa: hydrocyl_valves::orifice::DEFAULT_DP_TRANSITION.si(),
+                null_bias_m: 0.0,
+                flow_gain: 1.0,
+                dynamics: SpoolDynamics::First { time_constant_s: 0.004 },
+            },
+            cylinder: CylinderSpec {
+                area_1_m2: 11.43e-4,
+                area_2_m2: 5.8e-4,
+                stroke_m: 0.52,
+                chamber_length_1_m: 0.31,
+                chamber_length_2_m: 0.31,
+                internal_leakage_m3_per_s_pa: 0.0,
+                external_leakage_1_m3_per_s_pa: 0.0,
+                external_leakage_2_m3_per_s_pa: 0.0,
+                cavitation_pressure_pa: 0.0,
+                formulation: Formulation::Fundamental,
+                x_tolerance: 1e-12,
+            },
+            load: LoadSpec {
+                mass_kg: 100.0,
+                external_force_n: 0.0,
+            },
+            friction: FrictionLaw::CoulombViscous(CoulombViscous::leaney_moog()),
+            initial: InitialSpec {
+                position: 0.0,
+                velocity: 0.0,
+                spool: 0.0,
+                p1: None,
+                p2: None,
+            },
+        }
+    }
+
+    /// Checks every parameter; the error names its JSON path.
+    pub fn validate(&self) -> Result<(), RigError> {
+        if self.kind != KIND {
+            return Err(RigError::Invalid {
+                path: "kind".into(),
+                why: format!("expected `{KIND}`, got `{}`", self.kind),
+            });
+        }
+        let pos = |p: &str, v: f64| check(p, v, v > 0.0, "must be positive");
+        let nonneg = |p: &str, v: f64| check(p, v, v >= 0.0, "must be non-negative");
+        let fin = |p: &str, v: f64| check(p, v, true, "must be finite");
+        pos("fluid.density_kg_per_m3", self.fluid.density_kg_per_m3)?;
+        pos("fluid.bulk_modulus_pa", self.fluid.bulk_modulus_pa)?;
+        fin("supply.tank_pressure_pa", self.supply.tank_pressure_pa)?;
+        check(
+            "supply.pressure_pa",
+            self.supply.pressure_pa,
+            self.supply.pressure_pa > 0.0 && self.supply.pressure_pa > self.supply.tank_pressure_pa,
+            "must be positive and above the tank pressure",
+        )?;
+        let v = &self.valve;
+        pos("valve.stroke_m", v.stroke_m)?;
+        nonneg("valve.underlap_m", v.underlap_m)?;
+        pos("valve.spool_diameter_m", v.spool_diameter_m)?;
+        check(
+            "valve.discharge_coefficient",
+            v.discharge_coefficient,
+            v.discharge_coefficient > 0.0 && v.discharge_coefficient <= 1.0,
+            "must be in (0, 1]",
+        )?;
+        pos("valve.regularisation_pa", v.regularisation_pa)?;
+        fin("valve.null_bias_m", v.null_bias_m)?;
+        pos("valve.flow_gain", v.flow_gain)?;
+        match v.dynamics {
+            SpoolDynamics::First { time_constant_s } => {
+                pos("valve.dynamics.time_constant_s", time_constant_s)?
+            }
+            SpoolDynamics::Second {
+                natural_frequency_rad_per_s,
+                damping_ratio,
+            } => {
+                pos(
+                    "valve.dynamics.natural_frequency_rad_per_s",
+                    natural_frequency_rad_per_s,
+                )?;
+                pos("valve.dynamics.damping_ratio", damping_ratio)?;
+            }
+        }
+        let c = &self.cylinder;
+        pos("cylinder.area_1_m2", c.area_1_m2)?;
+        check(
+            "cylinder.area_2_m2",
+            c.area_2_m2,
+            c.area_2_m2 > 0.0 && c.area_2_m2 <= c.area_1_m2,
+            "must be positive and not above area_1_m2",
+        )?;
+        pos("cylinder.stroke_m", c.stroke_m)?;
+        check(
+            "cylinder.chamber_length_1_m",
+            c.chamber_length_1_m,
+            c.chamber_length_1_m > 0.5 * c.stroke_m,
+            "must exceed half the stroke (chamber 1 keeps a volume at the retracted end)",
+        )?;
+        check(
+            "cylinder.chamber_length_2_m",
+            c.chamber_length_2_m,
+            c.chamber_length_2_m > 0.5 * c.stroke_m,
+            "must exceed half the stroke (chamber 2 keeps a volume at the extended end)",
+        )?;
+        nonneg(
+            "cylinder.internal_leakage_m3_per_s_pa",
+            c.internal_leakage_m3_per_s_pa,
+        )?;
+        nonneg(
+            "cylinder.external_leakage_1_m3_per_s_pa",
+            c.external_leakage_1_m3_per_s_pa,
+        )?;
+        nonneg(
+            "cylinder.external_leakage_2_m3_per_s_pa",
+            c.external_leakage_2_m3_per_s_pa,
+        )?;
+        fin("cylinder.cavitation_pressure_pa", c.cavitation_pressure_pa)?;
+        check(
+            "cylinder.x_tolerance",
+            c.x_tolerance,
+            c.x_tolerance > 0.0 && c.x_tolerance < 1e-3,
+            "must be in (0, 1e-3)",
+        )?;
+        pos("load.mass_kg", self.load.mass_kg)?;
+        fin("load.external_force_n", self.load.external_force_n)?;
+        self.friction.validate().map_err(|e| RigError::Invalid {
+            path: "friction".into(),
+            why: e.to_string(),
+        })?;
+        let i = &self.initial;
+        check(
+            "initial.position",
+            i.position,
+            i.position.abs() <= 0.5 * c.stroke_m,
+            "must be within the stroke (±stroke/2)",
+        )?;
+        fin("initial.velocity", i.velocity)?;
+        check(
+            "initial.spool",
+            i.spool,
+            i.spool.abs() <= v.stroke_m,
+            "must be within the spool stroke",
+        )?;
+        if let Some(p) = i.p1 {
+            fin("initial.p1", p)?;
+        }
+        if let Some(p) = i.p2 {
+            fin("initial.p2", p)?;
+        }
+        Ok(())
+    }
+
+    /// The friction model.
+    pub fn friction_model(&self) -> Box<dyn FrictionModel> {
+        Box::new(self.friction)
+    }
+
+    /// The cylinder model.
+    pub fn cylinder_model(&self) -> Cylinder {
+        let c = &self.cylinder;
+        Cylinder {
+            area_1: Area::new(c.area_1_m2),
+            area_2: Area::new(c.area_2_m2),
+            stroke: Position::new(c.stroke_m),
+            chamber_length_1: Position::new(c.chamber_length_1_m),
+            chamber_length_2: Position::new(c.chamber_length_2_m),
+            bulk_modulus: Pressure::new(self.fluid.bulk_modulus_pa),
+            internal_leakage: c.internal_leakage_m3_per_s_pa,
+            external_leakage_1: c.external_leakage_1_m3_per_s_pa,
+            external_leakage_2: c.external_leakage_2_m3_per_s_pa,
+        }
+    }
+
+    /// The metering model.
+    pub fn metering(&self) -> Metering {
+        let v = &self.valve;
+        Metering {
+            underlap: Position::new(v.underlap_m),
+            spool_diameter: Position::new(v.spool_diameter_m),
+            orifice: Orifice {
+                cd: v.discharge_coefficient,
+                density: Density::new(self.fluid.density_kg_per_m3),
+                dp_transition: Pressure::new(v.regularisation_pa),
+            },
+            null_bias: Position::new(v.null_bias_m),
+            flow_gain: v.flow_gain,
+        }
+    }
+
+    /// The spool model.
+    pub fn spool(&self) -> Spool {
+        Spool {
+            stroke: Position::new(self.valve.stroke_m),
+            dynamics: self.valve.dynamics,
+        }
+    }
+
+    /// Normalised travel `(x_s + x_b)/u0` of spool position `xs` \[-\].
+    fn travel(&self, xs: f64) -> f64 {
+        let u0 = self.valve.underlap_m;
+        let x = xs + self.valve.null_bias_m;
+        if u0 > 0.0 {
+            x / u0
+        } else if x >= 0.0 {
+            1.0
+        } else {
+            -1.0
+        }
+    }
+
+    /// The initial chamber pressures `(p1, p2)` \[Pa\]: those given, else the
+    /// steady pressures at rest for the initial spool position (section
+    /// 3.3.4: X factor at the spool's travel, `P_LE = (F_ext + F_friction(v0))/A_E`).
+    pub fn initial_pressures(&self) -> Result<(f64, f64), RigError> {
+        let pt = self.supply.tank_pressure_pa;
+        let ps = self.supply.pressure_pa - pt;
+        let cyl = self.cylinder_model();
+        let fric = self
+            .friction_model()
+            .steady_force(&FrictionInput::at_velocity(Velocity::new(
+                self.initial.velocity,
+            )))
+            .si();
+        let load = Force::new(self.load.external_force_n + fric);
+        let steady = hydrocyl_xfactor::steady_pressures(
+            self.travel(self.initial.spool),
+            Pressure::new(ps),
+            cyl.gamma(),
+            cyl.area_1,
+            load,
+        );
+        let (s1, s2) = match (self.initial.p1, self.initial.p2) {
+            (Some(a), Some(b)) => return Ok((a, b)),
+            _ => match steady {
+                Ok(s) => (s.p1.si() + pt, s.p2.si() + pt),
+                Err(e) => {
+                    return Err(RigError::Invalid {
+                        path: "initial.p1".into(),
+                        why: format!(
+                            "no steady state to start from ({e}); give initial.p1 and initial.p2"
+                        ),
+                    })
+                }
+            },
+        };
+        Ok((self.initial.p1.unwrap_or(s1), self.initial.p2.unwrap_or(s2)))
+    }
+
+    /// Assembles the rig's circuit driven by `command` (normalised spool
+    /// demand), with the formulation of `cylinder.formulation`.
+    pub fn circuit(&self, command: Signal) -> Result<Circuit, RigError> {
+        self.validate()?;
+        command.validate().map_err(|e| RigError::Invalid {
+            path: "command".into(),
+            why: e.to_string(),
+        })?;
+        let (p1, p2) = self.initial_pressures()?;
+        let cyl = self.cylinder_model();
+        let metering = self.metering();
+        let mut comps: Vec<Box<dyn Component>> = vec![
+            Box::new(PressureSource::new(
+                "supply",
+                "P",
+                Pressure::new(self.supply.pressure_pa),
+                Some("ps"),
+            )),
+            Box::new(PressureSource::new(
+                "tank",
+                "T",
+                Pressure::new(self.supply.tank_pressure_pa),
+                None,
+            )),
+            Box::new(CommandInput::new("command", "command", command)),
+            Box::new(ServoSpool::new(
+                "spool",
+                "command",
+                "spool",
+                self.spool(),
+                self.initial.spool,
+            )),
+        ];
+        match self.cylinder.formulation {
+            Formulation::Fundamental => {
+                comps.push(Box::new(FourWayValve::new(
+                    "valve", "spool", "P", "T", "A", "B", metering,
+                )));
+                let mut c = TwoChamberCylinder::new("cylinder", "A", "B", "rod", cyl, (p1, p2));
+                c.cavitation_pressure = self.cylinder.cavitation_pressure_pa;
+                comps.push(Box::new(c));
+            }
+            f => {
+                let x_method = if f == Formulation::GeneralisedAnalytical {
+                    XMethod::Analytical
+                } else {
+                    XMethod::Numerical {
+                        tol: self.cylinder.x_tolerance,
+                    }
+                };
+                let p_le = cyl.force(Pressure::new(p1), Pressure::new(p2)).si()
+                    / cyl.effective_area().si();
+                let mut g = GeneralisedCylinder::new(
+                    "cylinder", "spool", "P", "T", "A", "B", "rod", cyl, metering, x_method, p_le,
+                );
+                g.cavitation_pressure = self.cylinder.cavitation_pressure_pa;
+                comps.push(Box::new(g));
+            }
+        }
+        comps.push(Box::new(Mass::new(
+            "load",
+            "rod",
+            self.load.mass_kg,
+            self.load.external_force_n,
+            Some(cyl.stroke_ends()),
+            (self.initial.position, self.initial.velocity),
+        )));
+        comps.push(Box::new(Friction::new(
+            "friction",
+            "rod",
+            Some(("A", "B")),
+            self.friction_model(),
+        )));
+        Circuit::build(comps).map_err(RigError::from)
+    }
+
+    /// Simulates the rig on `command`, output at `t_eval`.
+    pub fn simulate(
+        &self,
+        command: Signal,
+        t_eval: &[f64],
+        opts: &RunOptions,
+    ) -> Result<Run, RigError> {
+        let mut c = self.circuit(command)?;
+        let x0 = c.initial_state();
+        run(&mut c, &x0, t_eval, opts).map_err(|e| match e {
+            SimError::Build(b) => RigError::from(b),
+            other => RigError::Sim(other.to_string()),
+        })
+    }
+
+    /// Steady piston velocity at spool position `xs` \[m·s⁻¹\]: the exact
+    /// two-chamber steady state (`Q1 = A1 v`, `Q2 = A2 v`, force balance with
+    /// the friction at `v` and the external force), solved by fixed-point
+    /// iteration on the load force.
+    pub fn steady_velocity(&self, xs: f64) -> Result<f64, RigError> {
+        let cyl = self.cylinder_model();
+        let m = self.metering();
+        let ps = self.supply.pressure_pa - self.supply.tank_pressure_pa;
+        let fric = self.friction_model();
+        let travel = self.travel(xs);
+        let c = m.orifice.coefficient() * m.area_gradient() * self.valve.underlap_m.max(1e-12);
+        let (a, b) = ((1.0 + travel).max(0.0), (1.0 - travel).max(0.0));
+        let mut v = 0.0;
+        for _ in 0..200 {
+            let f = self.load.external_force_n
+                + fric
+                    .steady_force(&FrictionInput::at_velocity(Velocity::new(v)))
+                    .si();
+            let s = hydrocyl_xfactor::steady_pressures_two_chamber(
+                travel,
+                Pressure::new(ps),
+                cyl.gamma(),
+                cyl.area_1,
+                Force::new(f),
+            )
+            .map_err(|e| RigError::Invalid {
+                path: "load".into(),
+                why: format!("no steady state at spool {xs} m: {e}"),
+            })?;
+            let p1 = s.p1.si();
+            let q1 = c * (a * (ps - p1).max(0.0).sqrt() - b * p1.max(0.0).sqrt());
+            let vn = q1 / cyl.area_1.si();
+            // damped update: the friction slope near v = 0 is steep
+            let next = 0.5 * (v + vn);
+            if (next - v).abs() < 1e-12 {
+                return Ok(next);
+            }
+            v = next;
+        }
+        Ok(v)
+    }
+
+    /// Spool position \[m\] whose steady velocity is `v` (bisection over the
+    /// spool stroke on [`ValveRig::steady_velocity`], monotone in `xs`).
+    pub fn spool_for_velocity(&self, v: f64) -> Result<f64, RigError> {
+        let xm = self.valve.stroke_m;
+        let (mut lo, mut hi) = (-xm, xm);
+        let (vlo, vhi) = (self.steady_velocity(lo)?, self.steady_velocity(hi)?);
+        if !(vlo <= v && v <= vhi) {
+            return Err(RigError::Invalid {
+                path: "command".into(),
+                why: format!(
+                    "velocity {v} m/s is outside the valve's range [{vlo:.4}, {vhi:.4}] m/s"
+                ),
+            });
+        }
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if self.steady_velocity(mid)? < v {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Ok(0.5 * (lo + hi))
+    }
+
+    /// The open-loop bias of section 3.1.3: the normalised square-wave
+    /// `(bias, amplitude)` whose two levels give steady velocities `+v` and
+    /// `−v` on this asymmetric cylinder (a symmetric command would retract
+    /// faster than it extends).
+    pub fn open_loop_square(&self, v: f64) -> Result<(f64, f64), RigError> {
+        let xm = self.valve.stroke_m;
+        let ue = self.spool_for_velocity(v.abs())? / xm;
+        let ur = self.spool_for_velocity(-v.abs())? / xm;
+        Ok((0.5 * (ue + ur), 0.5 * (ue - ur)))
+    }
+}

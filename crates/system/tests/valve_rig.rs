@@ -1,0 +1,391 @@
+//! The `leaney-moog` rig through the assembler: preset = fixture, rig-file
+//! errors, steady initial state, open-loop bias, conservation, formulation
+//! agreement, component swaps, stops and cavitation.
+
+use hydrocyl_friction::{CoulombViscous, FrictionLaw, LuGre};
+use hydrocyl_integrators::OdeSystem;
+use hydrocyl_system::chapter3;
+use hydrocyl_system::rig::{self, RigError};
+use hydrocyl_system::run::{nrmse, run, RunOptions, Solver};
+use hydrocyl_system::signal::Signal;
+use hydrocyl_system::valve_rig::{Formulation, ValveRig};
+use hydrocyl_valves::servovalve::SpoolDynamics;
+
+fn times(t_end: f64, dt: f64) -> Vec<f64> {
+    let n = (t_end / dt).round() as usize;
+    (0..=n).map(|k| k as f64 * dt).collect()
+}
+
+fn fixture() -> serde_json::Value {
+    let text = include_str!("../../../fixtures/rigs/leaney-moog.json");
+    serde_json::from_str(text).unwrap()
+}
+
+#[test]
+fn preset_equals_fixture_file() {
+    let preset = rig::preset("leaney-moog").unwrap();
+    assert_eq!(preset, fixture());
+    let from_file = rig::valve_rig_from(&fixture()).unwrap();
+    assert_eq!(from_file, ValveRig::leaney_moog());
+}
+
+#[test]
+fn preset_has_the_values_of_rigs_md() {
+    let r = ValveRig::leaney_moog();
+    assert_eq!(r.valve.stroke_m, 0.375e-3);
+    assert_eq!(r.valve.underlap_m, 0.0045e-3);
+    assert_eq!(r.valve.spool_diameter_m, 7.938e-3);
+    assert_eq!(
+        r.valve.dynamics,
+        SpoolDynamics::First {
+            time_constant_s: 0.004
+        }
+    );
+    assert_eq!(r.valve.discharge_coefficient, 0.625);
+    assert_eq!(
+        (r.cylinder.area_1_m2, r.cylinder.area_2_m2),
+        (11.43e-4, 5.8e-4)
+    );
+    assert_eq!(r.cylinder.stroke_m, 0.52);
+    assert_eq!(
+        (r.cylinder.chamber_length_1_m, r.cylinder.chamber_length_2_m),
+        (0.31, 0.31)
+    );
+    assert_eq!(
+        (r.fluid.density_kg_per_m3, r.fluid.bulk_modulus_pa),
+        (870.0, 7.0e8)
+    );
+    assert_eq!(
+        (r.supply.pressure_pa, r.supply.tank_pressure_pa),
+        (7.0e6, 0.0)
+    );
+    assert_eq!(r.load.mass_kg, 100.0);
+    assert_eq!(
+        r.friction,
+        FrictionLaw::CoulombViscous(CoulombViscous::leaney_moog())
+    );
+    assert_eq!(r.cylinder.internal_leakage_m3_per_s_pa, 0.0);
+}
+
+#[test]
+fn overrides_reach_every_parameter_and_bad_ones_are_named() {
+    let mut v = fixture();
+    rig::apply_set(&mut v, "initial.p1=2.5e6").unwrap();
+    rig::apply_set(&mut v, "initial.p2=4e6").unwrap();
+    rig::apply_set(&mut v, "cylinder.formulation=generalised-analytical").unwrap();
+    rig::apply_set(&mut v, "friction.coulomb=80").unwrap();
+    rig::apply_set(
+        &mut v,
+        r#"valve.dynamics={"order":"second","natural_frequency_rad_per_s":350,"damping_ratio":0.7}"#,
+    )
+    .unwrap();
+    let r = rig::valve_rig_from(&v).unwrap();
+    assert_eq!(r.initial.p1, Some(2.5e6));
+    assert_eq!(r.cylinder.formulation, Formulation::GeneralisedAnalytical);
+    assert_eq!(r.initial_pressures().unwrap(), (2.5e6, 4e6));
+    assert_eq!(r.valve.dynamics.n_states(), 2);
+
+    let e = rig::apply_set(&mut fixture(), "cylinder.area_3_m2=1").unwrap_err();
+    assert!(matches!(e, RigError::UnknownPath { .. }), "{e}");
+    assert!(e.to_string().contains("cylinder.area_3_m2") && e.to_string().contains("area_1_m2"));
+    let e = rig::apply_set(&mut fixture(), "load.mass_kg=heavy").unwrap_err();
+    assert!(e.to_string().contains("load.mass_kg"), "{e}");
+    assert!(rig::apply_set(&mut fixture(), "no_equals_sign").is_err());
+
+    for (set, path) in [
+        ("cylinder.area_1_m2=-1", "cylinder.area_1_m2"),
+        ("cylinder.area_2_m2=2e-3", "cylinder.area_2_m2"),
+        ("supply.pressure_pa=0", "supply.pressure_pa"),
+        ("fluid.bulk_modulus_pa=0", "fluid.bulk_modulus_pa"),
+        (
+            "cylinder.chamber_length_2_m=0.2",
+            "cylinder.chamber_length_2_m",
+        ),
+        ("initial.position=0.3", "initial.position"),
+        ("initial.spool=1e-3", "initial.spool"),
+        (
+            "valve.discharge_coefficient=1.5",
+            "valve.discharge_coefficient",
+        ),
+        ("friction.viscous=-1", "friction"),
+    ] {
+        let mut v = fixture();
+        rig::apply_set(&mut v, set).unwrap();
+        let e = rig::check(&v).unwrap_err();
+        assert!(e.to_string().contains(path), "{set}: {e}");
+    }
+    let mut v = fixture();
+    v.as_object_mut()
+        .unwrap()
+        .insert("colour".into(), "red".into());
+    assert!(rig::check(&v).unwrap_err().to_string().contains("colour"));
+}
+
+#[test]
+fn initial_pressures_are_the_x_factor_steady_state_at_null() {
+    // section 3.3.4 at rest (no friction at v = 0, no external force):
+    // P_LE = 0, p1 = X Ps/(1+γ³), p2 = γ p1, X(0) = 2.637188916 (Table 3-3)
+    let r = ValveRig::leaney_moog();
+    let (p1, p2) = r.initial_pressures().unwrap();
+    let g: f64 = 11.43 / 5.8;
+    let p1_thesis = 2.637188916 * 7.0e6 / (1.0 + g.powi(3));
+    assert!((p1 / p1_thesis - 1.0).abs() < 1e-6, "{p1} vs {p1_thesis}");
+    assert!((p2 / (g * p1) - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn open_loop_bias_gives_symmetric_velocity() {
+    let case = chapter3::square_wave().unwrap();
+    let Signal::Square { bias, .. } = case.command else {
+        panic!("square wave expected")
+    };
+    assert!(
+        bias < 0.0,
+        "retraction needs less spool: the bias is negative ({bias})"
+    );
+    let r = case
+        .rig
+        .simulate(case.command.clone(), &case.times, &RunOptions::default())
+        .unwrap();
+    let v = r.channel("velocity").unwrap();
+    // end of each half period: steady ±90 mm/s
+    for (k, want) in [(990, 0.09), (1990, -0.09), (2990, 0.09), (3990, -0.09)] {
+        assert!(
+            (v[k] - want).abs() < 2e-4,
+            "v({}) = {}",
+            case.times[k],
+            v[k]
+        );
+    }
+}
+
+#[test]
+fn chamber_mass_balance_closes() {
+    let case = chapter3::square_wave().unwrap();
+    let mut c = case.rig.circuit(case.command.clone()).unwrap();
+    let x0 = c.initial_state();
+    let opts = RunOptions {
+        quadratures: true,
+        ..RunOptions::default()
+    };
+    let r = run(&mut c, &x0, &case.times, &opts).unwrap();
+    let cyl = case.rig.cylinder_model();
+    let (q, st) = (
+        c.quadrature_range(c.component_index("cylinder").unwrap()),
+        c.state_range(c.component_index("cylinder").unwrap()),
+    );
+    let ls = c.state_range(c.component_index("load").unwrap());
+    let (a, b) = (r.state(0), r.state(r.time.len() - 1));
+    let bm = case.rig.fluid.bulk_modulus_pa;
+    let vol = |x: f64| cyl.volumes(hydrocyl_ports::Position::new(x));
+    let ((v10, v20), (v11, v21)) = (vol(a[ls.start]), vol(b[ls.start]));
+    let dx = b[ls.start] - a[ls.start];
+    let res1 = b[q.start]
+        - cyl.area_1.si() * dx
+        - ((v11.si() * b[st.start] - v10.si() * a[st.start]) / bm - b[q.start + 2]);
+    let res2 = b[q.start + 1] + cyl.area_2.si() * dx
+        - ((v21.si() * b[st.start + 1] - v20.si() * a[st.start + 1]) / bm + b[q.start + 3]);
+    let xs: Vec<f64> = (0..r.time.len()).map(|k| r.state(k)[ls.start]).collect();
+    let swept = cyl.area_1.si() * xs.windows(2).map(|w| (w[1] - w[0]).abs()).sum::<f64>();
+    assert!(swept > 1e-4);
+    assert!(res1.abs() / swept < 1e-6, "chamber 1: {}", res1 / swept);
+    assert!(res2.abs() / swept < 1e-6, "chamber 2: {}", res2 / swept);
+}
+
+#[test]
+fn power_terms_balance_at_every_state_of_a_run() {
+    // Σ source = Σ (dissipated + storage + load) pointwise, with leakage on
+    let mut rig = ValveRig::leaney_moog();
+    rig.cylinder.internal_leakage_m3_per_s_pa = 1e-12;
+    rig.cylinder.external_leakage_1_m3_per_s_pa = 2e-13;
+    rig.load.external_force_n = 300.0;
+    let cmd = Signal::Sine {
+        amplitude: 0.3,
+        period_s: 1.0,
+        bias: 0.0,
+        phase_rad: 0.0,
+    };
+    let t = times(2.0, 0.05);
+    let mut c = rig.circuit(cmd.clone()).unwrap();
+    let x0 = c.initial_state();
+    let r = run(&mut c, &x0, &t, &RunOptions::default()).unwrap();
+    for k in 0..r.time.len() {
+        let p = c.power_terms(r.time[k], r.state(k));
+        let src: f64 = p.iter().map(|p| p.source).sum();
+        let out: f64 = p.iter().map(|p| p.dissipated + p.storage + p.load).sum();
+        assert!(
+            (src - out).abs() <= 1e-9 * src.abs().max(1.0),
+            "t = {}: {src} vs {out}",
+            r.time[k]
+        );
+    }
+}
+
+#[test]
+fn formulations_agree_on_the_square_wave() {
+    let case = chapter3::square_wave().unwrap();
+    let opts = RunOptions {
+        rtol: 1e-8,
+        ..RunOptions::default()
+    };
+    let cmp = chapter3::Comparison::run(&case, &opts).unwrap();
+    for ch in chapter3::COMPARED {
+        let e = cmp.nrmse(0, 1, ch, &case.rig);
+        assert!(e < 1e-6, "numerical vs analytical X, {ch}: {e}");
+    }
+    assert!(cmp.nrmse(1, 2, "velocity", &case.rig) < 0.02);
+    assert!(cmp.nrmse(1, 2, "p_le", &case.rig) < 0.05);
+}
+
+#[test]
+fn swapping_spool_order_and_friction_keeps_the_steady_velocity() {
+    // a second-order spool and another friction law change the transient,
+    // not the steady velocity of a constant command (same static friction curve)
+    let t = times(1.5, 0.01);
+    let cmd = Signal::Constant { value: 0.2 };
+    let base = ValveRig::leaney_moog();
+    let v0 = *base
+        .simulate(cmd.clone(), &t, &RunOptions::default())
+        .unwrap()
+        .channel("velocity")
+        .unwrap()
+        .last()
+        .unwrap();
+    let mut second = base.clone();
+    second.valve.dynamics = SpoolDynamics::Second {
+        natural_frequency_rad_per_s: 350.0,
+        damping_ratio: 0.7,
+    };
+    let r2 = second
+        .simulate(cmd.clone(), &t, &RunOptions::default())
+        .unwrap();
+    assert!(
+        (r2.channel("velocity").unwrap().last().unwrap() - v0).abs() < 1e-6 * v0.abs().max(1.0)
+    );
+    let spool = r2.channel("spool").unwrap();
+    assert!(spool.iter().all(|x| x.abs() <= base.valve.stroke_m));
+    // the simulated steady velocity is the rig's steady state for each law
+    let xs = 0.2 * base.valve.stroke_m;
+    assert!(
+        (v0 / base.steady_velocity(xs).unwrap() - 1.0).abs() < 1e-4,
+        "{v0}"
+    );
+    let mut lugre = base.clone();
+    lugre.friction = FrictionLaw::LuGre(LuGre::table_5_11());
+    let r3 = lugre.simulate(cmd, &t, &RunOptions::default()).unwrap();
+    let v3 = *r3.channel("velocity").unwrap().last().unwrap();
+    let vs = lugre.steady_velocity(xs).unwrap();
+    assert!((v3 / vs - 1.0).abs() < 1e-3, "LuGre: {v3} vs steady {vs}");
+    assert!(
+        (v3 - v0).abs() > 1e-4,
+        "a different law gives a different speed"
+    );
+}
+
+#[test]
+fn stop_holds_the_piston_for_every_solver() {
+    let case = chapter3::end_stop();
+    for solver in [Solver::Dp45, Solver::Rosenbrock, Solver::Rk4] {
+        let opts = RunOptions {
+            solver,
+            rk4_step: 5e-5,
+            ..RunOptions::default()
+        };
+        let r = case
+            .rig
+            .simulate(case.command.clone(), &case.times, &opts)
+            .unwrap();
+        let x = r.channel("position").unwrap();
+        let xmax = x.iter().cloned().fold(f64::MIN, f64::max);
+        assert!(xmax <= 0.26, "{}: {xmax}", solver.name());
+        assert!(xmax > 0.2599, "{}: reaches the stop", solver.name());
+        assert_eq!(
+            r.diagnostic("load.stop_impacts"),
+            Some(1.0),
+            "{}",
+            solver.name()
+        );
+        // held at the stop at 2.4 s, moving back at 3.4 s
+        assert_eq!(x[2400], 0.26, "{}", solver.name());
+        assert!(x[3400] < 0.2, "{}", solver.name());
+        // chamber volumes stayed positive: the fundamental state is finite
+        assert!(r.channel("p2").unwrap().iter().all(|p| p.is_finite()));
+    }
+}
+
+#[test]
+fn cavitation_is_reported() {
+    // a heavy load coasting at 0.5 m/s with the spool at null pulls chamber 1 below zero
+    let mut rig = ValveRig::leaney_moog();
+    rig.load.mass_kg = 2000.0;
+    rig.initial.velocity = 0.5;
+    rig.initial.p1 = Some(2.0e6);
+    rig.initial.p2 = Some(4.0e6);
+    let r = rig
+        .simulate(
+            Signal::Constant { value: 0.0 },
+            &times(0.3, 1e-3),
+            &RunOptions::default(),
+        )
+        .unwrap();
+    assert!(r.min_chamber_pressure() < 0.0);
+    assert!(r.diagnostic("cylinder.cavitation_entries_1").unwrap() >= 1.0);
+    // and a quiet run reports none
+    let q = ValveRig::leaney_moog()
+        .simulate(
+            Signal::Constant { value: 0.1 },
+            &times(0.3, 1e-3),
+            &RunOptions::default(),
+        )
+        .unwrap();
+    assert_eq!(q.cavitation_entries(), 0);
+}
+
+#[test]
+fn generalised_form_is_exact_outside_the_underlap_at_steady_state() {
+    // constant extension: after the transient, generalised and fundamental
+    // pressures coincide (X = 1 is exact for Q1 = γ Q2)
+    let t = times(1.0, 0.01);
+    let cmd = Signal::Constant { value: 0.15 };
+    let mut rig = ValveRig::leaney_moog();
+    let f = rig
+        .simulate(cmd.clone(), &t, &RunOptions::default())
+        .unwrap();
+    rig.cylinder.formulation = Formulation::GeneralisedAnalytical;
+    let g = rig.simulate(cmd, &t, &RunOptions::default()).unwrap();
+    let n = t.len() - 1;
+    for ch in ["p1", "p2", "velocity"] {
+        let (a, b) = (f.channel(ch).unwrap()[n], g.channel(ch).unwrap()[n]);
+        assert!((a - b).abs() <= 1e-5 * a.abs().max(1.0), "{ch}: {a} vs {b}");
+    }
+    assert!(
+        nrmse(
+            g.channel("velocity").unwrap(),
+            f.channel("velocity").unwrap()
+        ) < 0.05
+    );
+}
+
+#[test]
+fn bad_run_inputs_are_errors_not_panics() {
+    let rig = ValveRig::leaney_moog();
+    let cmd = Signal::Constant { value: 0.1 };
+    assert!(rig
+        .simulate(cmd.clone(), &[0.0], &RunOptions::default())
+        .is_err());
+    assert!(rig
+        .simulate(cmd.clone(), &[0.0, 0.1, 0.1], &RunOptions::default())
+        .is_err());
+    let e = rig
+        .simulate(
+            Signal::Constant { value: f64::NAN },
+            &[0.0, 0.1],
+            &RunOptions::default(),
+        )
+        .unwrap_err();
+    assert!(e.to_string().contains("command"), "{e}");
+    let mut c = rig.circuit(cmd).unwrap();
+    assert_eq!(c.dim(), c.n_states());
+    let x0 = vec![0.0; 2];
+    assert!(run(&mut c, &x0, &[0.0, 1.0], &RunOptions::default()).is_err());
+}

@@ -79,7 +79,9 @@ fn xfactor_analytical_vs_brent() {
             (g, t)
         })
         .collect();
-    let ana = ns_per_call(n, || pts.iter().map(|&(g, t)| x_factor(black_box(g), t)).sum());
+    let ana = ns_per_call(n, || {
+        pts.iter().map(|&(g, t)| x_factor(black_box(g), t)).sum()
+    });
     let num = ns_per_call(n, || {
         pts.iter()
             .map(|&(g, t)| x_factor_numerical(black_box(g), t, 1e-12))

@@ -18,8 +18,9 @@
 //!   `Q_DE = A_E v`, `Q_KE = Ql + (Qe1 − Qe2)/2`.
 //!
 //! X is Leaney's factor (eq 3.4), 1 when extending, γ² when retracting and the
-//! root of eq 3.4 in the underlap; this module takes it as an input (the
-//! caller gets it from `hydrocyl-xfactor`, numerically or analytically).
+//! root of eq 3.4 in the underlap; [`evaluate`] takes it as an input, and
+//! [`XMethod`] obtains it from `hydrocyl-xfactor` numerically (Brent) or
+//! analytically (the exact quartic root).
 //!
 //! ## What the form assumes (why it differs from the fundamental form)
 //! 1. The pressure pair is constrained to the line of eqs 2.21/2.22 for the
@@ -35,6 +36,30 @@
 
 use crate::Cylinder;
 use hydrocyl_ports::{Area, Pressure, Velocity, VolumeFlow};
+
+/// How the generalised form obtains Leaney's X factor (eq 3.4) from the
+/// normalised spool travel `x_s/u0` (`hydrocyl-xfactor`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum XMethod {
+    /// The exact analytical quartic root (root picked by the unsquared eq 3.4).
+    Analytical,
+    /// A bracketing (Brent) solve of eq 3.4 in `[1, γ²]`.
+    Numerical {
+        /// Absolute tolerance on X \[-\].
+        tol: f64,
+    },
+}
+
+impl XMethod {
+    /// X at area ratio `gamma` and travel `travel` (1 for travel ≥ 1, γ² for ≤ −1).
+    #[inline]
+    pub fn x_factor(self, gamma: f64, travel: f64) -> f64 {
+        match self {
+            XMethod::Analytical => hydrocyl_xfactor::x_factor(gamma, travel),
+            XMethod::Numerical { tol } => hydrocyl_xfactor::x_factor_numerical(gamma, travel, tol),
+        }
+    }
+}
 
 /// Chamber pressures `(p1, p2)` above tank from `P_LE`, X and the supply
 /// pressure `ps` above tank (eqs 2.21, 2.22) \[Pa\].
@@ -196,6 +221,16 @@ mod tests {
             s.q_le.si(),
             printed
         );
+    }
+
+    #[test]
+    fn both_x_methods_give_table_3_3() {
+        let g = 11.43 / 5.8;
+        for m in [XMethod::Analytical, XMethod::Numerical { tol: 1e-13 }] {
+            assert!((m.x_factor(g, 0.0) / 2.637188916 - 1.0).abs() < 1e-6);
+            assert_eq!(m.x_factor(g, 1.5), 1.0);
+            assert!((m.x_factor(g, -1.0) - g * g).abs() < 1e-12);
+        }
     }
 
     proptest! {

@@ -12,7 +12,8 @@
 //! * [`generalised`] — Leaney's **generalised one-pressure** form
 //!   (eqs 2.16–2.26, 3.3): one effective load pressure `P_LE` with
 //!   `dP_LE/dt = 4B/V_TE (Q_LE − Q_DE − Q_KE)`, the chamber pressures recovered
-//!   from `P_LE` and the X factor (eqs 2.21, 2.22). It needs the valve's port
+//!   from `P_LE` and the X factor (eqs 2.21, 2.22), X obtained numerically or
+//!   analytically ([`generalised::XMethod`]). It needs the valve's port
 //!   areas, so it merges valve and cylinder hydraulics into one subsystem.
 //! * [`StrokeEnds`] — the hard stroke-end stops (positions and the switching
 //!   functions of the event-based stop used by the assembler).

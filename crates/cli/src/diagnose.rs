@@ -8,16 +8,20 @@ use std::path::{Path, PathBuf};
 
 use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_identify::catalog::EffectId;
-use hydrocyl_identify::data::{write_atomic, Record};
+use hydrocyl_identify::data::{write_atomic, ColumnMap, Record};
 use hydrocyl_identify::diagnose::{diagnose_bench, DiagnoseOptions, Outcome, RecordTrace};
+use hydrocyl_identify::valve::diagnose_valve;
+use hydrocyl_system::rig::valve_rig_from;
+use hydrocyl_system::valve_rig::ValveRig;
 
 use crate::error::CliError;
 
 /// Arguments of this subcommand.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Rig: a preset name (friction benches: tudelft-seal-25,
-    /// tudelft-seal-257, emps) or a rig JSON file.
+    /// Rig: a preset name (valve rig: leaney-moog; friction benches:
+    /// tudelft-seal-25, tudelft-seal-257, emps) or a rig JSON file
+    /// (kind valve-cylinder or friction-bench).
     #[arg(long)]
     pub rig: String,
     /// Measured record(s) (CSV); repeat for several records of one rig
@@ -47,15 +51,31 @@ pub struct Args {
     pub quiet: bool,
 }
 
-fn load_rig(spec: &str) -> Result<FrictionBench, CliError> {
+/// A rig `diagnose` can run.
+enum Rig {
+    Bench(FrictionBench),
+    Valve(Box<ValveRig>),
+}
+
+fn load_rig(spec: &str) -> Result<Rig, CliError> {
     if let Some(r) = bench::preset(spec) {
-        return Ok(r);
+        return Ok(Rig::Bench(r));
+    }
+    if let Some(v) = hydrocyl_system::rig::preset(spec) {
+        return valve_rig_from(&v)
+            .map(|r| Rig::Valve(Box::new(r)))
+            .map_err(|e| CliError::Input(format!("--rig {spec}: {e}")));
     }
     let path = Path::new(spec);
     if !path.exists() {
         return Err(CliError::Input(format!(
-            "--rig '{spec}': neither a preset ({}) nor an existing rig file",
-            bench::PRESETS.join(", ")
+            "--rig '{spec}': neither a preset ({}, {}) nor an existing rig file",
+            bench::PRESETS.join(", "),
+            hydrocyl_system::rig::PRESETS
+                .iter()
+                .map(|p| p.name)
+                .collect::<Vec<_>>()
+                .join(", ")
         )));
     }
     let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
@@ -64,14 +84,19 @@ fn load_rig(spec: &str) -> Result<FrictionBench, CliError> {
     })?;
     let v: serde_json::Value = serde_json::from_str(&text)
         .map_err(|e| CliError::Input(format!("{spec}: not valid JSON: {e}")))?;
-    let kind = v.get("kind").and_then(|k| k.as_str()).unwrap_or("");
-    if kind != bench::KIND {
-        return Err(CliError::Input(format!(
-            "{spec}: rig kind '{kind}' cannot be diagnosed yet (only '{}'); hydraulic rigs wait for the assembler's effect switches",
-            bench::KIND
-        )));
+    match v.get("kind").and_then(|k| k.as_str()).unwrap_or("") {
+        k if k == bench::KIND => FrictionBench::from_json(&text)
+            .map(Rig::Bench)
+            .map_err(|e| CliError::Input(format!("{spec}: {e}"))),
+        k if k == hydrocyl_system::valve_rig::KIND => valve_rig_from(&v)
+            .map(|r| Rig::Valve(Box::new(r)))
+            .map_err(|e| CliError::Input(format!("{spec}: {e}"))),
+        k => Err(CliError::Input(format!(
+            "{spec}: rig kind '{k}' cannot be diagnosed (kinds: {}, {})",
+            bench::KIND,
+            hydrocyl_system::valve_rig::KIND
+        ))),
     }
-    FrictionBench::from_json(&text).map_err(|e| CliError::Input(format!("{spec}: {e}")))
 }
 
 /// Runs the subcommand.
@@ -103,10 +128,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ),
     };
     let rig = load_rig(&args.rig)?;
+    let columns = match &rig {
+        Rig::Bench(b) => b.columns.clone(),
+        Rig::Valve(_) => ColumnMap::default(),
+    };
     let records = args
         .data
         .iter()
-        .map(|p| Record::read_mapped(p, &rig.columns))
+        .map(|p| Record::read_mapped(p, &columns))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| CliError::Input(e.to_string()))?;
     let opts = DiagnoseOptions {
@@ -132,17 +161,33 @@ pub fn run(args: Args) -> Result<(), CliError> {
             b.set_message(stage.to_string());
         }
     };
-    let outcome = diagnose_bench(&rig, &records, &opts, &mut progress)
-        .map_err(|e| CliError::Input(e.to_string()))?;
+    let (report, outcome) = match &rig {
+        Rig::Bench(b) => {
+            let o = diagnose_bench(b, &records, &opts, &mut progress)
+                .map_err(|e| CliError::Input(e.to_string()))?;
+            (o.report.clone(), Some(o))
+        }
+        Rig::Valve(v) => {
+            if records.len() != 1 {
+                return Err(CliError::Input(format!(
+                    "--data: the valve rig is diagnosed on one record at a time ({} given)",
+                    records.len()
+                )));
+            }
+            let r = diagnose_valve(v, &records[0], &opts, &mut progress)
+                .map_err(|e| CliError::Input(e.to_string()))?;
+            (r, None)
+        }
+    };
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
     // Everything computed: now write, plots first, the report last.
-    if let Some(dir) = &args.plots {
-        write_plots(dir, &outcome)?;
+    if let (Some(dir), Some(o)) = (&args.plots, &outcome) {
+        write_plots(dir, o)?;
     }
     if let Some(path) = &args.report {
-        let json = serde_json::to_string_pretty(&outcome.report)
+        let json = serde_json::to_string_pretty(&report)
             .map_err(|e| CliError::Input(format!("report: {e}")))?;
         write_atomic(path, json.as_bytes()).map_err(|e| CliError::Io {
             path: path.display().to_string(),
@@ -150,7 +195,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
         })?;
     }
     if !args.quiet {
-        print!("{}", outcome.report.human());
+        print!("{}", report.human());
+        if args.plots.is_some() && outcome.is_none() {
+            println!("(plots are drawn for friction benches only so far)");
+        }
     }
     Ok(())
 }
@@ -262,7 +310,7 @@ fn plot_residual(path: &Path, tr: &RecordTrace) -> Result<(), Box<dyn std::error
         .x_desc(format!("{name} regressor [SI]"))
         .y_desc("residual before [SI]")
         .draw()?;
-    let step = (phi.len() / 4000).max(1);
+    let step = (phi.len() / 1500).max(1);
     ch.draw_series(
         phi.iter()
             .zip(&resid)

@@ -176,3 +176,30 @@ fn unknown_rig_is_an_error() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no-such-rig"));
 }
+
+#[test]
+fn valve_rig_finds_the_planted_leak() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("r.json");
+    let out = bin()
+        .args(["diagnose", "--rig", "leaney-moog", "--quiet", "--data"])
+        .arg(fixtures().join("valve-internal_leakage.csv"))
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.stdout.is_empty(), "--quiet printed");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["rig_kind"], "valve-cylinder");
+    assert_eq!(json["effects_added"][0]["id"], "internal_leakage");
+    for ch in ["position", "velocity", "p1", "p2"] {
+        assert!(json["nrmse_before"][ch].is_number(), "{ch}");
+        assert!(json["nrmse_after"][ch].is_number(), "{ch}");
+    }
+}

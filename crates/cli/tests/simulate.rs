@@ -72,11 +72,19 @@ fn writes_the_measured_data_format_at_the_command_times() {
     for (r, (t, u)) in data.iter().zip(&rows) {
         assert_eq!(r[0], *t);
         assert_eq!(r[1], *u);
-        assert!(r[4] >= 0.0 && r[4] <= 7e6 && r[5] >= 0.0 && r[5] <= 7e6);
+        // an abrupt reversal may push a chamber briefly above Ps (the load's
+        // momentum compresses it); it may not go below tank without a report
+        assert!(r[4].is_finite() && r[5].is_finite() && r[4] <= 1.5e7 && r[5] <= 1.5e7);
         assert!(r[2].abs() <= 0.26);
     }
     // the piston moves out in the first half second
     assert!(data[99][3] > 0.05, "velocity {}", data[99][3]);
+    let min_p = data
+        .iter()
+        .map(|r| r[4].min(r[5]))
+        .fold(f64::INFINITY, f64::min);
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(min_p >= 0.0 || err.contains("CAVITATION"), "{min_p}: {err}");
 }
 
 #[test]

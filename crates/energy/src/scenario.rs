@@ -220,9 +220,10 @@ pub enum FrictionCase {
     AsRig,
     /// Eq 5.14 with the pressure-energised seal gain K = 0 (which also
     /// removes the acceleration term `K H a`): the bristle and Stribeck curve
-    /// only. With K of Table 5-8 neither drive has a steady state at
-    /// 100 mm/s (the fold of `hydrocyl_system::hybrid::chapter7`); see
-    /// docs/energy.md.
+    /// only. With K of Table 5-8 the valve drive has no steady retraction
+    /// above ≈ 19 mm/s and the hybrid's extension reserve is a few newtons
+    /// (the fold of `hydrocyl_system::hybrid::chapter7`), so a transient
+    /// locks it; see docs/energy.md.
     WithoutSealTerm,
 }
 
@@ -308,6 +309,15 @@ pub struct Outcome {
 }
 
 impl Outcome {
+    /// Number of chamber cavitation entries in the run.
+    pub fn cavitation_entries(&self) -> f64 {
+        self.diagnostics
+            .iter()
+            .filter(|(n, _)| n.contains("cavitation_entries"))
+            .map(|(_, v)| *v)
+            .sum()
+    }
+
     /// Number of stroke-end impacts in the run.
     pub fn stop_impacts(&self) -> f64 {
         self.diagnostics
@@ -328,7 +338,7 @@ fn rig_err(rig: &str) -> impl Fn(RigError) -> EnergyError + '_ {
 /// Runs scenario `sc` on `drive`.
 pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome, EnergyError> {
     sc.check()?;
-    if plan.measured_periods == 0 || !(plan.sample_s > 0.0) {
+    if plan.measured_periods == 0 || plan.sample_s.is_nan() || plan.sample_s <= 0.0 {
         return Err(EnergyError::Scenario {
             scenario: sc.label(),
             why: "the plan needs at least one measured period and a positive sample interval"
@@ -416,7 +426,9 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
         trace.time_s.push(out.time[k] - out.time[k0]);
         trace.power_in_w.push(p_in);
         trace.power_out_w.push(p_out);
-        trace.velocity_m_s.push(vel.get(k).copied().unwrap_or(f64::NAN));
+        trace
+            .velocity_m_s
+            .push(vel.get(k).copied().unwrap_or(f64::NAN));
     }
     let efficiency = led.efficiency();
     let peak = |sign: f64| {

@@ -90,6 +90,11 @@ impl FrictionModel for Dahl {
         }
     }
 
+    /// The largest steady deflection, max(Fs)/σ0 \[m\].
+    fn state_scales(&self, scales: &mut [f64]) {
+        scales[0] = self.coulomb.si() / self.sigma0;
+    }
+
     fn stored_energy(&self, state: &[f64]) -> Energy {
         Energy::new(0.5 * self.sigma0 * state[0] * state[0])
     }

@@ -91,6 +91,9 @@ impl FrictionModel for FrictionLaw {
     fn validate(&self) -> Result<(), FrictionError> {
         each!(self, m => m.validate())
     }
+    fn state_scales(&self, scales: &mut [f64]) {
+        each!(self, m => m.state_scales(scales))
+    }
     fn jacobian(&self, input: &FrictionInput, state: &[f64]) -> FrictionJacobian {
         each!(self, m => m.jacobian(input, state))
     }

@@ -70,6 +70,10 @@ pub struct FrictionJacobian {
 /// them to the mass side of the balance and solve it explicitly:
 /// `(m + c) a = p1 A1 − p2 A2 − force(..) − F_ext`.
 ///
+/// `state` slices passed to every method have exactly
+/// [`n_states`](FrictionModel::n_states) entries (the assembler's slice of its
+/// state vector); the hot-path methods do not re-check it.
+///
 /// # How an assembler uses a model
 ///
 /// * **States**: it reserves [`n_states`](FrictionModel::n_states) entries of
@@ -77,7 +81,8 @@ pub struct FrictionJacobian {
 ///   [`steady_state`](FrictionModel::steady_state) (or zeros) at t0, and
 ///   writes [`state_derivative`](FrictionModel::state_derivative) into its
 ///   right-hand side. The bristle deflection z is of order Fs/σ0 ≈ 6 µm: give
-///   it an absolute tolerance near 1e-10 m.
+///   it an absolute tolerance near 1e-10 m
+///   ([`state_scales`](FrictionModel::state_scales) gives the scale).
 /// * **Stiffness**: its analytic Jacobian takes
 ///   [`jacobian`](FrictionModel::jacobian) (analytic for every model here;
 ///   the default is finite differences).
@@ -118,6 +123,13 @@ pub trait FrictionModel {
         let mut z = vec![0.0; self.n_states()];
         self.steady_state(input, &mut z);
         self.force(input, &z)
+    }
+
+    /// Typical magnitude of each internal state, for the integrator's absolute
+    /// tolerances (the bristle deflection is of order Fs/σ0 ≈ 6e-6 m for the
+    /// thesis's parameters). The default fills 1.
+    fn state_scales(&self, scales: &mut [f64]) {
+        scales.fill(1.0);
     }
 
     /// Checks the parameters (finite, in range); call after deserialising.

@@ -197,6 +197,17 @@ impl FrictionModel for Wang {
         }
     }
 
+    /// The largest steady deflection, max(Fs)/σ0 \[m\].
+    fn state_scales(&self, scales: &mut [f64]) {
+        scales[0] = self
+            .extending
+            .curve
+            .stiction
+            .si()
+            .max(self.retracting.curve.stiction.si())
+            / self.sigma0;
+    }
+
     fn stored_energy(&self, state: &[f64]) -> Energy {
         Energy::new(0.5 * self.sigma0 * state[0] * state[0])
     }

@@ -8,7 +8,8 @@
 
 use std::path::PathBuf;
 
-use hydrocyl_identify::data::write_atomic;
+use hydrocyl_identify::catalog::EffectId;
+use hydrocyl_identify::data::{write_atomic, Signal};
 use hydrocyl_identify::synth::{self, Noise};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -29,9 +30,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             case.seed,
         );
         let mut csv = String::from("time [s],position [mm],p2 [bar],force [N]\n");
-        let x = &rec.signals[&hydrocyl_identify::data::Signal::Position];
-        let p = &rec.signals[&hydrocyl_identify::data::Signal::P2];
-        let f = &rec.signals[&hydrocyl_identify::data::Signal::Force];
+        let x = &rec.signals[&Signal::Position];
+        let p = &rec.signals[&Signal::P2];
+        let f = &rec.signals[&Signal::Force];
         for i in 0..rec.time.len() {
             csv.push_str(&format!(
                 "{:.3},{:.5},{:.5},{:.3}\n",
@@ -53,6 +54,32 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "{}: planted {:?}, foreign {:?}",
             case.name, case.planted, case.foreign
         );
+    }
+    // Valve rig (leaney-moog): nothing missing, and an internal leak.
+    for (name, planted) in [
+        ("valve-none", None),
+        ("valve-internal_leakage", Some(EffectId::InternalLeakage)),
+    ] {
+        let mut truth = hydrocyl_system::valve_rig::ValveRig::leaney_moog();
+        if let Some(id) = planted {
+            let (p, v) = synth::valve_planted(id).ok_or("no planted value")?;
+            hydrocyl_identify::valve::set(&mut truth, id, p, v);
+        }
+        let rec = synth::valve_record(&truth, 2000, 1e-3, 40)?;
+        let mut csv = String::from("time [s],command,position [mm],p1 [bar],p2 [bar]\n");
+        let g = |s: Signal| &rec.signals[&s];
+        for i in 0..rec.time.len() {
+            csv.push_str(&format!(
+                "{:.3},{:.6},{:.4},{:.4},{:.4}\n",
+                rec.time[i],
+                g(Signal::Command)[i],
+                g(Signal::Position)[i] * 1e3,
+                g(Signal::P1)[i] * 1e-5,
+                g(Signal::P2)[i] * 1e-5
+            ));
+        }
+        write_atomic(&dir.join(format!("{name}.csv")), csv.as_bytes())?;
+        println!("{name}: planted {planted:?} on leaney-moog");
     }
     Ok(())
 }

@@ -152,6 +152,8 @@ pub struct Report {
     /// An out-of-catalog shape the unexplained residual resembles, if a probe
     /// explains more of it than any catalog effect.
     pub unexplained_resembles: Option<Probe>,
+    /// What did not go as planned (a refit that did not converge, ...).
+    pub warnings: Vec<String>,
     /// Share of what is left that sensor noise accounts for (1 = all noise).
     pub noise_share: f64,
     /// The selection rule, in words.
@@ -611,11 +613,13 @@ pub fn diagnose_bench(
             }
             last_scores.insert(id, rep);
         }
-        let probe = (!rig.steady_state)
-            .then(|| probes(&model, &sigs))
-            .unwrap_or_default()
-            .into_iter()
-            .max_by(|a, b| a.explained_share.total_cmp(&b.explained_share));
+        let probe = if rig.steady_state {
+            Vec::new()
+        } else {
+            probes(&model, &sigs)
+        }
+        .into_iter()
+        .max_by(|a, b| a.explained_share.total_cmp(&b.explained_share));
         if let Some(p) = &probe {
             if p.explained_share >= opts.min_share
                 && best
@@ -785,6 +789,7 @@ pub fn diagnose_bench(
             .collect(),
         unexplained_share: rss_after / rss_before.max(1e-300),
         unexplained_resembles: resembles,
+        warnings: Vec::new(),
         noise_share: if noise_ss.is_nan() {
             f64::NAN
         } else {
@@ -895,6 +900,9 @@ impl Report {
                 p.value,
                 100.0 * p.explained_share
             );
+        }
+        for w in &self.warnings {
+            let _ = writeln!(s, "warning: {w}");
         }
         let _ = writeln!(s, "time: {:.2} s", self.elapsed_s);
         s

@@ -8,7 +8,8 @@
 //! solver's interval is `s² (JᵀJ)⁻¹`-based, which assumes independent
 //! residuals; samples of a measured record are not independent, so the
 //! interval is widened by `√((1 + ρ)/(1 − ρ))` where ρ is the residual's
-//! lag-1 autocorrelation (the AR(1) variance-inflation factor).
+//! lag-1 autocorrelation (the AR(1) variance-inflation factor), taken per
+//! channel block and the largest used.
 
 use std::cell::RefCell;
 
@@ -26,6 +27,9 @@ pub struct LmOptions {
     /// Models integrated by an adaptive solver need a step well above the
     /// solver's tolerance, or the Jacobian measures the solver's noise.
     pub fd_step: f64,
+    /// The residual vector is this many equal-length blocks (channels); the
+    /// interval is widened by the largest of the blocks' AR(1) factors.
+    pub blocks: usize,
 }
 
 impl Default for LmOptions {
@@ -34,6 +38,7 @@ impl Default for LmOptions {
             max_evaluations: 800,
             ftol: 1e-8,
             fd_step: 1e-7,
+            blocks: 1,
         }
     }
 }
@@ -126,8 +131,15 @@ where
             ..Options::default()
         })
         .solve(&scaled(x0))?;
-    let rho = lag1_autocorrelation(&report.residuals).clamp(0.0, 0.999);
-    let widen = ((1.0 + rho) / (1.0 - rho)).sqrt();
+    let nb = opts.blocks.max(1);
+    let len = report.residuals.len() / nb;
+    let widen = (0..nb)
+        .map(|b| {
+            let block = &report.residuals[b * len..((b + 1) * len).min(report.residuals.len())];
+            let rho = lag1_autocorrelation(block).clamp(0.0, 0.999);
+            ((1.0 + rho) / (1.0 - rho)).sqrt()
+        })
+        .fold(1.0, f64::max);
     let ci95 = report
         .parameters
         .iter()

@@ -290,10 +290,26 @@ pub fn valve_record(
     dt: f64,
     seed: u64,
 ) -> Result<Record, String> {
+    valve_record_delayed(truth, n, dt, seed, 0.0)
+}
+
+/// As [`valve_record`], but the rig receives the command `delay` seconds
+/// late (a transport delay the catalog does not have); the record holds the
+/// command as sent.
+pub fn valve_record_delayed(
+    truth: &hydrocyl_system::valve_rig::ValveRig,
+    n: usize,
+    dt: f64,
+    seed: u64,
+    delay: f64,
+) -> Result<Record, String> {
     let t: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
     let u: Vec<f64> = t.iter().map(|&t| valve_command(t)).collect();
-    let cmd =
-        hydrocyl_system::signal::Signal::table(t.clone(), u.clone()).map_err(|e| e.to_string())?;
+    let late: Vec<f64> = t
+        .iter()
+        .map(|&t| valve_command((t - delay).max(0.0)))
+        .collect();
+    let cmd = hydrocyl_system::signal::Signal::table(t.clone(), late).map_err(|e| e.to_string())?;
     let run = truth
         .simulate(
             cmd,

@@ -18,8 +18,8 @@
 //! means refitting B away from the declared value.
 //!
 //! Tracing here is by output error, not equation error: each candidate's
-//! parameters are fitted on the training part of the record by simulating the
-//! whole rig, and scored by the share of the output-error sum of squares they
+//! parameters are estimated on the training part of the record by two
+//! Gauss–Newton steps of the simulated whole rig, and scored by the share of the output-error sum of squares they
 //! remove, each channel weighted by the inverse of its noise level (the
 //! maximum-likelihood weighting for Gaussian sensor noise) (whole record, held-out part, ΔBIC). The valve rig
 //! simulates 3 s in about 20 ms, so this is affordable and avoids the
@@ -36,7 +36,7 @@ use hydrocyl_system::valve_rig::ValveRig;
 
 use crate::catalog::EffectId;
 use crate::data::{Record, Signal};
-use crate::diagnose::{nrmse, DiagnoseError, DiagnoseOptions, EffectReport, Report};
+use crate::diagnose::{nrmse, DiagnoseError, DiagnoseOptions, EffectReport, Probe, Report};
 use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, smooth_gcv, smooth_with};
 
@@ -146,7 +146,10 @@ fn bounds(id: EffectId, name: &str, rig: &ValveRig) -> (f64, f64) {
     }
 }
 
+#[derive(Clone)]
 struct Prepared {
+    /// Relative tolerance of the simulations (looser while tracing).
+    rtol: f64,
     t: Vec<f64>,
     command: Vec<f64>,
     /// Measured channels present (velocity: measured, else smoothed derivative).
@@ -208,6 +211,7 @@ fn prepare(
     let (p10, p20) = (p0(Signal::P1), p0(Signal::P2));
     Ok((
         Prepared {
+            rtol: 1e-7,
             x0: s.value[0],
             p10,
             p20,
@@ -239,7 +243,7 @@ fn with_initial(rig: &ValveRig, p: &Prepared) -> ValveRig {
 fn simulate(rig: &ValveRig, p: &Prepared) -> Result<Vec<Vec<f64>>, String> {
     let cmd = CmdSignal::table(p.t.clone(), p.command.clone()).map_err(|e| e.to_string())?;
     let opts = RunOptions {
-        rtol: 1e-7,
+        rtol: p.rtol,
         ..RunOptions::default()
     };
     let run = rig.simulate(cmd, &p.t, &opts).map_err(|e| e.to_string())?;
@@ -340,9 +344,10 @@ fn fit(
         &hi,
         &typ,
         &LmOptions {
-            max_evaluations: 200,
+            max_evaluations: 600,
             ftol: 1e-6,
             fd_step: 1e-3,
+            blocks: p.weights.iter().filter(|w| **w > 0.0).count(),
         },
     )?;
     for ((id, n), v) in params.iter().zip(&res.x) {
@@ -350,6 +355,112 @@ fn fit(
     }
     rig.initial.position = res.x[k];
     Ok(res)
+}
+
+/// Traces a candidate cheaply: up to three backtracking Gauss–Newton steps on `part` from the
+/// current values, with a finite-difference Jacobian (step 10 % of each
+/// parameter's typical size) and the initial position as a nuisance column,
+/// then clamped to the bounds. A handful of simulations per candidate instead
+/// of a full Levenberg–Marquardt fit; the effect that is added is refitted
+/// properly afterwards.
+fn gauss_newton_trace(
+    rig: &mut ValveRig,
+    params: &ParamList,
+    p: &Prepared,
+    holdout: f64,
+    part: Part,
+) -> Result<(), String> {
+    let k = params.len() + 1;
+    for _ in 0..3 {
+        let mut r0 = Vec::new();
+        residual(rig, p, holdout, part, &mut r0)?;
+        let m = r0.len();
+        let mut jac = nalgebra::DMatrix::<f64>::zeros(m, k);
+        for j in 0..k {
+            let mut t = rig.clone();
+            let h = if j < params.len() {
+                let (id, n) = params[j];
+                let h = 0.1 * typical(id, n, rig);
+                set(&mut t, id, n, get(rig, id, n).unwrap_or(0.0) + h);
+                h
+            } else {
+                t.initial.position += 1e-5;
+                1e-5
+            };
+            let mut r1 = Vec::new();
+            residual(&t, p, holdout, part, &mut r1)?;
+            for i in 0..m {
+                jac[(i, j)] = (r1[i] - r0[i]) / h;
+            }
+        }
+        let rhs = jac.transpose() * nalgebra::DVector::from_column_slice(&r0);
+        let mut a = jac.transpose() * &jac;
+        for j in 0..k {
+            a[(j, j)] *= 1.0 + 1e-9;
+        }
+        let delta = a
+            .cholesky()
+            .ok_or("singular trace Jacobian")?
+            .solve(&(-rhs));
+        // Backtrack: take the largest of 1, 1/2, 1/4, 1/8 of the step that
+        // lowers the sum of squares (keep the point if none does).
+        let rss0: f64 = r0.iter().map(|v| v * v).sum();
+        let mut accepted = None;
+        for alpha in [1.0, 0.5, 0.25, 0.125] {
+            let mut t = rig.clone();
+            for (j, (id, n)) in params.iter().enumerate() {
+                let (lo, hi) = bounds(*id, n, rig);
+                let v = (get(rig, *id, n).unwrap_or(0.0) + alpha * delta[j]).clamp(lo, hi);
+                set(&mut t, *id, n, v);
+            }
+            t.initial.position += alpha * delta[k - 1];
+            if rss(&t, p, holdout, part) < rss0 {
+                accepted = Some(t);
+                break;
+            }
+        }
+        match accepted {
+            Some(t) => *rig = t,
+            None => break,
+        }
+    }
+    Ok(())
+}
+
+/// Out-of-catalog probe: the command reaching the rig late by τ (a
+/// transport delay), τ on a grid up to 60 ms, initial position refitted.
+fn delay_probe(rig: &ValveRig, p: &Prepared, holdout: f64) -> Option<Probe> {
+    let rss0 = rss(rig, p, holdout, Part::All);
+    let mut best = (0.0, rss0);
+    for tau in [0.002, 0.005, 0.01, 0.015, 0.02, 0.03, 0.045, 0.06] {
+        let mut q = Prepared {
+            rtol: p.rtol,
+            command: p
+                .t
+                .iter()
+                .map(|&t| crate::data::interp_linear(&p.t, &p.command, t - tau))
+                .collect(),
+            t: p.t.clone(),
+            meas: p.meas.clone(),
+            ranges: p.ranges.clone(),
+            weights: p.weights.clone(),
+            x0: p.x0,
+            v0: p.v0,
+            p10: p.p10,
+            p20: p.p20,
+        };
+        q.command[0] = p.command[0];
+        let r = rss(rig, &q, holdout, Part::All);
+        if r < best.1 {
+            best = (tau, r);
+        }
+    }
+    (best.0 > 0.0).then(|| Probe {
+        kind: "delay".into(),
+        what: "transport delay of the command".into(),
+        value: best.0,
+        explained_share: 1.0 - best.1 / rss0.max(1e-300),
+    })
 }
 
 fn channel_nrmse(rig: &ValveRig, p: &Prepared) -> BTreeMap<String, f64> {
@@ -389,14 +500,22 @@ pub fn diagnose_valve(
     let mut free: ParamList = Vec::new();
     let mut added: Vec<EffectReport> = Vec::new();
     let mut last: BTreeMap<EffectId, EffectReport> = BTreeMap::new();
+    let mut resembles: Option<Probe> = None;
+    let mut warnings: Vec<String> = Vec::new();
     let total = opts.max_effects + 1;
+    // Tracing compares candidates with each other: a looser integration
+    // tolerance is enough there; refits use the tight one.
+    let pt = Prepared {
+        rtol: 1e-6,
+        ..p.clone()
+    };
     for round in 0..opts.max_effects {
         progress("tracing", round, total);
         let mut r0 = Vec::new();
-        residual(&model, &p, opts.holdout, Part::All, &mut r0)
+        residual(&model, &pt, opts.holdout, Part::All, &mut r0)
             .map_err(|e| DiagnoseError::Rig(e.to_string()))?;
         let rss0: f64 = r0.iter().map(|v| v * v).sum();
-        let rss0_held = rss(&model, &p, opts.holdout, Part::Held);
+        let rss0_held = rss(&model, &pt, opts.holdout, Part::Held);
         let rho = lm::lag1_autocorrelation(&r0).clamp(0.0, 0.999);
         let neff = (r0.len() as f64 * (1.0 - rho) / (1.0 + rho)).max(2.0);
         let mut best: Option<(EffectId, ValveRig, EffectReport)> = None;
@@ -409,17 +528,13 @@ pub fn diagnose_valve(
             }
             let params: ParamList = id.params().iter().map(|q| (id, q.name)).collect();
             let mut trial = model.clone();
-            // Start a little away from neutral so the first Jacobian sees the effect.
-            for (eid, n) in &params {
-                let cur = get(&trial, *eid, n).unwrap_or(0.0);
-                if cur == 0.0 {
-                    let start = 0.1 * typical(*eid, n, &trial);
-                    set(&mut trial, *eid, n, start);
-                }
-            }
-            let res = fit(&mut trial, &params, &p, opts.holdout, Part::Train);
-            let rss1 = rss(&trial, &p, opts.holdout, Part::All);
-            let held = 1.0 - rss(&trial, &p, opts.holdout, Part::Held) / rss0_held.max(1e-300);
+            // The candidate is traced together with the effects already added
+            // (refitted jointly), so that an earlier effect that was standing
+            // in for this one can give way.
+            let joint: ParamList = free.iter().chain(params.iter()).copied().collect();
+            let res = gauss_newton_trace(&mut trial, &joint, &pt, opts.holdout, Part::Train);
+            let rss1 = rss(&trial, &pt, opts.holdout, Part::All);
+            let held = 1.0 - rss(&trial, &pt, opts.holdout, Part::Held) / rss0_held.max(1e-300);
             let share = 1.0 - rss1 / rss0.max(1e-300);
             let dbic = neff * (rss1 / rss0.max(1e-300)).ln() + params.len() as f64 * neff.ln();
             let mut rep = EffectReport {
@@ -462,22 +577,116 @@ pub fn diagnose_valve(
             }
             last.insert(id, rep);
         }
+        if let Some(pr) = delay_probe(&model, &pt, opts.holdout) {
+            if pr.explained_share >= opts.min_share
+                && best
+                    .as_ref()
+                    .is_none_or(|(_, _, r)| pr.explained_share > r.explained_share + opts.min_share)
+            {
+                if let Some((id, _, _)) = &best {
+                    if let Some(r) = last.get_mut(id) {
+                        r.reason = Some(format!(
+                            "the residual is better explained by a {} ({:.1} %), which is not in the catalog",
+                            pr.what,
+                            100.0 * pr.explained_share
+                        ));
+                    }
+                }
+                resembles = Some(pr);
+                break;
+            }
+        }
         let Some((id, trial, rep)) = best else { break };
         model = trial;
         free.extend(id.params().iter().map(|q| (id, q.name)));
         progress("refit", round + 1, total);
-        let res = fit(&mut model, &free, &p, opts.holdout, Part::All).map_err(|e| {
-            DiagnoseError::Fit {
-                what: id.id().into(),
-                reason: e.to_string(),
+        // A refit that does not converge keeps the traced values (no
+        // intervals) and says so, rather than losing the whole diagnosis.
+        let mut refit = model.clone();
+        let res = match fit(&mut refit, &free, &p, opts.holdout, Part::All) {
+            Ok(res) => {
+                model = refit;
+                res
             }
-        })?;
+            Err(e) => {
+                warnings.push(format!(
+                    "refit after adding {}: {e}; the traced values are kept, without intervals",
+                    id.id()
+                ));
+                lm::LmResult {
+                    x: free
+                        .iter()
+                        .map(|(eid, n)| get(&model, *eid, n).unwrap_or(f64::NAN))
+                        .collect(),
+                    ci95: vec![f64::NAN; free.len()],
+                    rss: f64::NAN,
+                    m: 0,
+                    iterations: 0,
+                    evaluations: 0,
+                    at_bound: vec![false; free.len()],
+                }
+            }
+        };
         last.remove(&id);
         added.push(rep);
         for ((eid, n), (x, ci)) in free.iter().zip(res.x.iter().zip(&res.ci95)) {
             if let Some(a) = added.iter_mut().find(|a| a.id == eid.id()) {
                 a.params.insert(n.to_string(), *x);
                 a.ci95.insert(n.to_string(), ci.is_finite().then_some(*ci));
+            }
+        }
+    }
+    // Backward step: an effect whose refitted size became negligible once
+    // later effects were added was standing in for them; drop it and refit.
+    let stale: Vec<EffectId> = added
+        .iter()
+        .filter_map(|a| EffectId::from_id(&a.id))
+        .filter(|id| negligible(*id, &model, declared))
+        .collect();
+    if !stale.is_empty() {
+        for id in &stale {
+            for q in id.params() {
+                let neutral = if *id == EffectId::FlowGainError {
+                    1.0
+                } else {
+                    0.0
+                };
+                let v = if *id == EffectId::BulkModulus {
+                    declared.fluid.bulk_modulus_pa
+                } else {
+                    neutral
+                };
+                set(&mut model, *id, q.name, v);
+            }
+            free.retain(|(e, _)| e != id);
+            if let Some(pos) = added.iter().position(|a| a.id == id.id()) {
+                let mut rep = added.remove(pos);
+                rep.reason = Some(
+                    "added, then gave way: its refitted size became negligible once later effects were added".into(),
+                );
+                last.insert(*id, rep);
+            }
+        }
+        if !free.is_empty() {
+            let mut refit = model.clone();
+            let res = match fit(&mut refit, &free, &p, opts.holdout, Part::All) {
+                Ok(r) => {
+                    model = refit;
+                    r
+                }
+                Err(e) => {
+                    warnings.push(format!("refit after the backward step: {e}"));
+                    return Err(DiagnoseError::Fit {
+                        what: "refit after the backward step".into(),
+                        reason: e.to_string(),
+                    });
+                }
+            };
+            for ((eid, n), (x, ci)) in free.iter().zip(res.x.iter().zip(&res.ci95)) {
+                if let Some(a) = added.iter_mut().find(|a| a.id == eid.id()) {
+                    a.params.insert(n.to_string(), *x);
+                    a.ci95.insert(n.to_string(), ci.is_finite().then_some(*ci));
+                }
             }
         }
     }
@@ -515,7 +724,8 @@ pub fn diagnose_valve(
             .map(|e| e.id().to_string())
             .collect(),
         unexplained_share: rss_after / rss_before.max(1e-300),
-        unexplained_resembles: None,
+        unexplained_resembles: resembles,
+        warnings,
         noise_share: (noise_ss / rss_after.max(1e-300)).min(1.0),
         selection: format!(
             "output-error tracing: add the effect removing the largest share of the noise-weighted output-error SS if share >= {:.0} %, held-out share >= {:.1} % and BIC falls; refit all added parameters on the output error",

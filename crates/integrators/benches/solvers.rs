@@ -13,10 +13,52 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use faer::linalg::solvers::Solve;
-use hydrocyl_integrators::linalg::{DenseLu, InPlaceLu, NalgebraLu};
+use hydrocyl_integrators::linalg::{DenseLu, InPlaceLu};
 use hydrocyl_integrators::problems::{Robertson, VanDerPol};
 use hydrocyl_integrators::{solve, Method, OdeSystem, Options};
+use nalgebra::{DMatrix, DVectorViewMut, Dyn, LU};
 use std::hint::black_box;
+
+/// nalgebra's LU with partial pivoting (copies the matrix per factorisation).
+pub struct NalgebraLu {
+    n: usize,
+    a: Vec<f64>,
+    lu: Option<LU<f64, Dyn, Dyn>>,
+}
+
+impl DenseLu for NalgebraLu {
+    fn new(n: usize) -> Self {
+        Self {
+            n,
+            a: vec![0.0; n * n],
+            lu: None,
+        }
+    }
+
+    fn matrix_mut(&mut self) -> &mut [f64] {
+        &mut self.a
+    }
+
+    fn factor(&mut self) -> bool {
+        let m = DMatrix::from_row_slice(self.n, self.n, &self.a);
+        let lu = m.lu();
+        let u = lu.u();
+        let ok = (0..self.n).all(|i| {
+            let d = u[(i, i)];
+            d != 0.0 && d.is_finite()
+        });
+        self.lu = if ok { Some(lu) } else { None };
+        ok
+    }
+
+    fn solve(&self, b: &mut [f64]) {
+        if let Some(lu) = &self.lu {
+            let n = self.n;
+            let mut v = DVectorViewMut::from_slice(b, n);
+            lu.solve_mut(&mut v);
+        }
+    }
+}
 
 fn run(method: Method, sys: &mut dyn OdeSystem, x0: &[f64], t_end: f64, opts: &Options) -> usize {
     solve(method, sys, 0.0, x0, t_end, opts)

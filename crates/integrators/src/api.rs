@@ -67,21 +67,22 @@ pub enum Method {
 /// Solver settings.
 #[derive(Clone, Debug)]
 pub struct Options {
-    /// Relative tolerance.
+    /// Relative tolerance (dimensionless).
     pub rtol: f64,
-    /// Absolute tolerance, one per state; a single entry applies to all states.
+    /// Absolute tolerance in the unit of each state (Pa, m, m/s, ...), one per
+    /// state; a single entry applies to all states.
     pub atol: Vec<f64>,
-    /// Initial step (adaptive methods; `None` = estimated); the fixed step for RK4.
+    /// Initial step \[s\] (adaptive methods; `None` = estimated); the fixed step for RK4.
     pub h0: Option<f64>,
-    /// Largest step allowed.
+    /// Largest step allowed \[s\].
     pub h_max: f64,
-    /// Step below which the solver gives up with [`SolveError::StepTooSmall`].
+    /// Step \[s\] below which the solver gives up with [`SolveError::StepTooSmall`].
     pub h_min: f64,
     /// Most steps (accepted + rejected) before [`SolveError::TooManySteps`].
     pub max_steps: usize,
-    /// Time tolerance to which event times are located.
+    /// Time tolerance \[s\] to which event times are located.
     pub event_tol: f64,
-    /// Output times (sorted, within `[t0, t_end]`); `None` = every accepted step.
+    /// Output times \[s\] (sorted, within `[t0, t_end]`); `None` = every accepted step.
     pub t_eval: Option<Vec<f64>>,
 }
 
@@ -120,7 +121,7 @@ pub struct Stats {
 /// One located event.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EventRecord {
-    /// Time of the event.
+    /// Time of the event \[s\].
     pub t: f64,
     /// Index of the switching function.
     pub which: usize,
@@ -131,7 +132,7 @@ pub struct EventRecord {
 /// The result of a solve.
 #[derive(Clone, Debug, Default)]
 pub struct Solution {
-    /// Output times.
+    /// Output times \[s\].
     pub t: Vec<f64>,
     /// States at the output times, row-major: `x[k * dim + i]` is state `i` at `t[k]`.
     pub x: Vec<f64>,

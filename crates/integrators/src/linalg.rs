@@ -1,17 +1,13 @@
 //! Small dense LU factorisations for the Rosenbrock method's iteration matrix
 //! `E = I/(hγ) − J` (n ≤ 16 in hydrocyl's models).
 //!
-//! Two implementations of the same [`DenseLu`] contract are kept so that the
-//! choice can be measured (`cargo bench -p hydrocyl-integrators -- lu`):
-//!
-//! * [`NalgebraLu`] — nalgebra's partial-pivoting `LU` on a `DMatrix`;
-//! * [`InPlaceLu`] — partial-pivoting Doolittle elimination in a buffer
-//!   allocated once, with no allocation per factorisation.
-//!
-//! The bench also runs faer's `PartialPivLu` (as a dev-dependency only).
-//! The solver uses [`SolverLu`], the faster of the two on this crate's sizes.
-
-use nalgebra::{DMatrix, DVectorViewMut, Dyn, LU};
+//! The solver uses [`InPlaceLu`]: partial-pivoting Doolittle elimination in
+//! a row-major buffer allocated once per solve, so a factorisation allocates
+//! nothing. `cargo bench -p hydrocyl-integrators -- lu` measures it against
+//! nalgebra's `LU` on a `DMatrix` and faer's `PartialPivLu` behind the same
+//! [`DenseLu`] contract (both as dev-dependencies only) for n = 2..16; the
+//! in-place version was the fastest at every size measured, so the library
+//! itself depends on neither.
 
 /// A dense LU factorisation with partial pivoting, reusable across steps.
 pub trait DenseLu {
@@ -25,47 +21,6 @@ pub trait DenseLu {
     fn factor(&mut self) -> bool;
     /// Overwrites `b` with the solution of `A y = b` for the last factorised `A`.
     fn solve(&self, b: &mut [f64]);
-}
-
-/// nalgebra's LU with partial pivoting (copies the matrix per factorisation).
-pub struct NalgebraLu {
-    n: usize,
-    a: Vec<f64>,
-    lu: Option<LU<f64, Dyn, Dyn>>,
-}
-
-impl DenseLu for NalgebraLu {
-    fn new(n: usize) -> Self {
-        Self {
-            n,
-            a: vec![0.0; n * n],
-            lu: None,
-        }
-    }
-
-    fn matrix_mut(&mut self) -> &mut [f64] {
-        &mut self.a
-    }
-
-    fn factor(&mut self) -> bool {
-        let m = DMatrix::from_row_slice(self.n, self.n, &self.a);
-        let lu = m.lu();
-        let u = lu.u();
-        let ok = (0..self.n).all(|i| {
-            let d = u[(i, i)];
-            d != 0.0 && d.is_finite()
-        });
-        self.lu = if ok { Some(lu) } else { None };
-        ok
-    }
-
-    fn solve(&self, b: &mut [f64]) {
-        if let Some(lu) = &self.lu {
-            let n = self.n;
-            let mut v = DVectorViewMut::from_slice(b, n);
-            lu.solve_mut(&mut v);
-        }
-    }
 }
 
 /// Partial-pivoting LU in a preallocated row-major buffer.
@@ -148,5 +103,5 @@ impl DenseLu for InPlaceLu {
     }
 }
 
-/// The LU the Rosenbrock solver uses.
+/// The LU the Rosenbrock solver uses (the fastest in `benches/solvers.rs`).
 pub type SolverLu = InPlaceLu;

@@ -18,7 +18,7 @@ use crate::api::{Crossing, EventAction, OdeSystem};
 /// `dx/dt = −k x`.
 #[derive(Clone, Copy, Debug)]
 pub struct ExponentialDecay {
-    /// Rate constant `k` [1/s].
+    /// Rate constant `k` \[1/s\].
     pub k: f64,
 }
 
@@ -45,7 +45,7 @@ impl OdeSystem for ExponentialDecay {
 /// `x'' = −ω² x` as `[x, v]`.
 #[derive(Clone, Copy, Debug)]
 pub struct HarmonicOscillator {
-    /// Angular frequency `ω` [rad/s].
+    /// Angular frequency `ω` \[rad/s\].
     pub omega: f64,
 }
 
@@ -155,12 +155,12 @@ impl OdeSystem for Robertson {
 }
 
 /// A ball falling under gravity onto a floor at height 0, state `[y, v]`
-/// ([m], [m/s]). Switching function `y`; at a falling crossing the velocity
+/// (\[m\], \[m/s\]). Switching function `y`; at a falling crossing the velocity
 /// is reversed and scaled by the restitution `e`. The solve stops after
 /// `max_bounces` bounces (the bounce times accumulate: Zeno).
 #[derive(Clone, Copy, Debug)]
 pub struct BouncingBall {
-    /// Gravitational acceleration `g` [m/s²].
+    /// Gravitational acceleration `g` \[m/s²\].
     pub gravity: f64,
     /// Coefficient of restitution `e` (0..1).
     pub restitution: f64,
@@ -171,7 +171,7 @@ pub struct BouncingBall {
 }
 
 impl BouncingBall {
-    /// A ball with gravity `g` [m/s²] and restitution `e`, stopping after `max_bounces`.
+    /// A ball with gravity `g` \[m/s²\] and restitution `e`, stopping after `max_bounces`.
     pub fn new(gravity: f64, restitution: f64, max_bounces: usize) -> Self {
         Self {
             gravity,
@@ -181,7 +181,7 @@ impl BouncingBall {
         }
     }
 
-    /// The first `n` bounce times [s] for a drop from rest at height `h0` [m]
+    /// The first `n` bounce times \[s\] for a drop from rest at height `h0` \[m\]
     /// at time 0: `t_1 = sqrt(2 h0 / g)`, `t_{k+1} = t_k + 2 e^k v_1 / g` with
     /// `v_1 = sqrt(2 g h0)`.
     pub fn bounce_times(&self, h0: f64, n: usize) -> Vec<f64> {

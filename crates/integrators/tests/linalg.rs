@@ -1,6 +1,7 @@
 //! The small dense LU factorisations agree and detect singular matrices.
 
-use hydrocyl_integrators::linalg::{DenseLu, InPlaceLu, NalgebraLu};
+use hydrocyl_integrators::linalg::{DenseLu, InPlaceLu};
+use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
 
 fn residual(a: &[f64], x: &[f64], b: &[f64]) -> f64 {
@@ -33,7 +34,11 @@ proptest! {
         }
         let b: Vec<f64> = seed[n * n..n * n + n].to_vec();
         let x1 = solve_with::<InPlaceLu>(n, &a, &b).expect("non-singular");
-        let x2 = solve_with::<NalgebraLu>(n, &a, &b).expect("non-singular");
+        // Reference: nalgebra's LU.
+        let x2 = DMatrix::from_row_slice(n, n, &a)
+            .lu()
+            .solve(&DVector::from_column_slice(&b))
+            .expect("non-singular");
         let scale = 1.0 + x1.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         prop_assert!(residual(&a, &x1, &b) < 1e-10 * scale * n as f64);
         for (p, q) in x1.iter().zip(&x2) {
@@ -53,7 +58,6 @@ fn pivoting_handles_a_zero_leading_entry() {
 fn singular_matrices_are_reported() {
     let a = [1.0, 2.0, 2.0, 4.0];
     assert!(solve_with::<InPlaceLu>(2, &a, &[1.0, 1.0]).is_none());
-    assert!(solve_with::<NalgebraLu>(2, &a, &[1.0, 1.0]).is_none());
     let nan = [f64::NAN, 0.0, 0.0, 1.0];
     assert!(solve_with::<InPlaceLu>(2, &nan, &[1.0, 1.0]).is_none());
 }

@@ -74,3 +74,32 @@ fn rodas4_counts_jacobians_and_factorisations() {
         "{s:?}"
     );
 }
+
+#[test]
+fn each_event_restart_costs_a_fresh_start() {
+    use hydrocyl_integrators::problems::BouncingBall;
+    let mut ball = BouncingBall::new(9.81, 0.8, 5);
+    let opts = Options {
+        rtol: 1e-8,
+        atol: vec![1e-10],
+        ..Options::default()
+    };
+    let s = solve(
+        Method::DormandPrince45,
+        &mut ball,
+        0.0,
+        &[2.0, 0.0],
+        10.0,
+        &opts,
+    )
+    .unwrap()
+    .stats;
+    assert_eq!(s.events, 5);
+    // Start: f(t0) and one probe for the step estimate, plus the first stage;
+    // the same again after each of the four events that continue (the fifth stops).
+    assert_eq!(
+        s.rhs_evals,
+        3 + 3 * (s.events - 1) + 6 * (s.steps + s.rejected),
+        "{s:?}"
+    );
+}

@@ -783,9 +783,11 @@ impl OdeSystem for Circuit {
     fn on_event(&mut self, t: f64, x: &mut [f64], which: usize, dir: Crossing) -> EventAction {
         self.fill(t, x);
         let w = self.wires.borrow().clone();
-        let i = (0..self.comps.len())
+        let Some(i) = (0..self.comps.len())
             .find(|&i| which >= self.ev_offsets[i] && which < self.ev_offsets[i + 1])
-            .unwrap_or(0);
+        else {
+            return EventAction::Continue;
+        };
         let r = self.offsets[i]..self.offsets[i + 1];
         let action = self.comps[i].on_event(t, &mut x[r], &w, which - self.ev_offsets[i], dir);
         self.fill(t, x);

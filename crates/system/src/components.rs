@@ -513,7 +513,7 @@ impl TwoChamberCylinder {
         }
     }
 
-    /// `(dp1, dp2, v, x)` at this instant.
+    /// `(dp1/dt, dp2/dt)` at this instant \[Pa·s⁻¹\].
     fn rates(&self, x: &[f64], w: &Wires) -> (f64, f64) {
         self.cylinder.pressure_rates(
             Position::new(w.get(self.rod.position)),
@@ -653,17 +653,7 @@ impl Component for TwoChamberCylinder {
     }
 }
 
-/// How the generalised form obtains Leaney's X factor.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum XMethod {
-    /// The exact analytical quartic root of `hydrocyl-xfactor`.
-    Analytical,
-    /// A bracketing (Brent) solve of eq 3.4 in `[1, γ²]` to tolerance `tol`.
-    Numerical {
-        /// Absolute tolerance on X.
-        tol: f64,
-    },
-}
+pub use hydrocyl_actuator::generalised::XMethod;
 
 /// Leaney's generalised one-pressure actuator (eqs 2.16–2.26, 3.3) with the
 /// servovalve metering folded in: it owns the chamber nodes A and B but sets
@@ -756,10 +746,7 @@ impl GeneralisedCylinder {
             -1.0
         };
         self.x_calls.set(self.x_calls.get() + 1);
-        match self.x_method {
-            XMethod::Analytical => hydrocyl_xfactor::x_factor(g, travel),
-            XMethod::Numerical { tol } => hydrocyl_xfactor::x_factor_numerical(g, travel, tol),
-        }
+        self.x_method.x_factor(g, travel)
     }
 
     fn state(&self, x: &[f64], w: &Wires) -> gen::GeneralisedState {
@@ -1053,7 +1040,7 @@ impl Component for Mass {
         &mut self,
         _t: f64,
         x: &mut [f64],
-        w: &Wires,
+        _w: &Wires,
         which: usize,
         dir: Crossing,
     ) -> EventAction {
@@ -1063,7 +1050,6 @@ impl Component for Mass {
         if dir != Crossing::Falling {
             return EventAction::Continue;
         }
-        let _ = w;
         match self.mode {
             StopMode::Free => {
                 // plastic impact: clamp to the end and stop; `after_event`

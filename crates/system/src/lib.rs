@@ -67,6 +67,29 @@
 //!   [`Circuit::set_ledger`] appends four quadratures per component to the
 //!   state vector (loosely weighted in the error norm by [`Circuit::atol`]).
 //!
+//! A circuit from components, by hand (what a rig kind's builder does):
+//!
+//! ```
+//! use hydrocyl_integrators::{solve, Method, OdeSystem, Options};
+//! use hydrocyl_ports::{Area, Density, Pressure};
+//! use hydrocyl_system::components::{FixedOrifice, PressureSource, Volume};
+//! use hydrocyl_system::{Circuit, Component};
+//! use hydrocyl_valves::orifice::Orifice;
+//!
+//! // supply ──[orifice 0.1 mm²]── line volume 0.1 l (B = 7000 bar)
+//! let parts: Vec<Box<dyn Component>> = vec![
+//!     Box::new(PressureSource::new("supply", "P", Pressure::from_bar(70.0), None)),
+//!     Box::new(FixedOrifice::new("restrictor", "P", "L", Area::from_mm2(0.1),
+//!                                Orifice::new(0.65, Density::new(870.0)))),
+//!     Box::new(Volume::new("line", "L", 1e-4, 7e8, 0.0, Some("pl"))),
+//! ];
+//! let mut c = Circuit::build(parts).unwrap();
+//! let x0 = c.initial_state();
+//! let opts = Options { atol: c.atol(1e-8), rtol: 1e-8, ..Options::default() };
+//! let sol = solve(Method::DormandPrince45, &mut c, 0.0, &x0, 2.0, &opts).unwrap();
+//! assert!((sol.last().unwrap()[0] - 7.0e6).abs() < 1e3); // the line fills to supply pressure
+//! ```
+//!
 //! ## Thesis equations
 //! The components implement eqs 2.2, 2.3/3.1 (spool), 3.2, 2.8, 2.9 (metering),
 //! 2.10–2.15 (chambers), 2.16–2.26 and 3.3 (generalised form), 2.27 (load),

@@ -180,8 +180,14 @@ pub fn run(
     if t_eval.len() < 2 {
         return Err(SimError::Settings("need at least two output times".into()));
     }
+    if !t_eval[0].is_finite() {
+        return Err(SimError::Settings(format!(
+            "output time {} is not finite",
+            t_eval[0]
+        )));
+    }
     if let Some(i) =
-        (1..t_eval.len()).find(|&i| !(t_eval[i] > t_eval[i - 1]) || !t_eval[i].is_finite())
+        (1..t_eval.len()).find(|&i| t_eval[i] <= t_eval[i - 1] || !t_eval[i].is_finite())
     {
         return Err(SimError::Settings(format!(
             "output time {} (sample {i}) does not increase",

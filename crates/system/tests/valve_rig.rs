@@ -134,6 +134,43 @@ fn initial_pressures_are_the_x_factor_steady_state_at_null() {
 }
 
 #[test]
+fn closed_form_rest_state_in_the_underlap_is_stationary() {
+    // At rest (v = 0, no friction, no load) both valve flows vanish and
+    // p1 A1 = p2 A2: Av1/Av2 = 1/sqrt(γ), p1 = Ps/(1+γ), p2 = γ Ps/(1+γ).
+    let mut rig = ValveRig::leaney_moog();
+    let g = rig.cylinder.area_1_m2 / rig.cylinder.area_2_m2;
+    let u0 = rig.valve.underlap_m;
+    let r = 1.0 / g.sqrt();
+    let xs = u0 * (r - 1.0) / (r + 1.0);
+    assert!((rig.spool_for_velocity(0.0).unwrap() - xs).abs() < 1e-6 * u0);
+    let ps = rig.supply.pressure_pa;
+    rig.initial.spool = xs;
+    rig.initial.p1 = Some(ps / (1.0 + g));
+    rig.initial.p2 = Some(g * ps / (1.0 + g));
+    let u = xs / rig.valve.stroke_m;
+    let run = rig
+        .simulate(
+            Signal::Constant { value: u },
+            &times(1.0, 0.01),
+            &RunOptions::default(),
+        )
+        .unwrap();
+    let v = run.channel("velocity").unwrap();
+    let p1 = run.channel("p1").unwrap();
+    // stationary to the integration tolerance (rtol 1e-6 of a 0.1 m/s scale)
+    assert!(
+        v.iter().all(|v| v.abs() < 1e-6),
+        "max |v| {}",
+        v.iter().fold(0.0f64, |a, b| a.max(b.abs()))
+    );
+    assert!(
+        p1.iter().all(|p| (p - ps / (1.0 + g)).abs() < 1e-6 * ps),
+        "{:?}",
+        p1.last()
+    );
+}
+
+#[test]
 fn open_loop_bias_gives_symmetric_velocity() {
     let case = chapter3::square_wave().unwrap();
     let Signal::Square { bias, .. } = case.command else {
@@ -388,4 +425,48 @@ fn bad_run_inputs_are_errors_not_panics() {
     assert_eq!(c.dim(), c.n_states());
     let x0 = vec![0.0; 2];
     assert!(run(&mut c, &x0, &[0.0, 1.0], &RunOptions::default()).is_err());
+}
+
+mod invariants {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// At any state of the assembled rig (spool, pressures, piston), the
+        /// per-component power terms balance: Σ source = Σ (dissipated + storage + load).
+        #[test]
+        fn power_balances_at_any_state(
+            xs in -0.4e-3f64..0.4e-3, p1 in -1e5f64..9e6, p2 in -1e5f64..9e6,
+            x in -0.25f64..0.25, v in -0.5f64..0.5, leak in 0.0f64..1e-11, f_ext in -2e3f64..2e3,
+        ) {
+            let mut rig = ValveRig::leaney_moog();
+            rig.cylinder.internal_leakage_m3_per_s_pa = leak;
+            rig.cylinder.external_leakage_2_m3_per_s_pa = leak;
+            rig.load.external_force_n = f_ext;
+            let c = rig.circuit(Signal::Constant { value: 0.3 }).unwrap();
+            let names = c.state_names();
+            let mut state = c.initial_state();
+            for (i, n) in names.iter().enumerate() {
+                state[i] = match n.as_str() {
+                    "spool.x" => xs, "cylinder.p1" => p1, "cylinder.p2" => p2,
+                    "load.x" => x, "load.v" => v, _ => state[i],
+                };
+            }
+            let p = c.power_terms(0.0, &state);
+            let src: f64 = p.iter().map(|p| p.source).sum();
+            let out: f64 = p.iter().map(|p| p.dissipated + p.storage + p.load).sum();
+            let scale = p.iter().map(|p| p.source.abs() + p.dissipated.abs() + p.storage.abs() + p.load.abs()).sum::<f64>();
+            prop_assert!((src - out).abs() <= 1e-9 * scale.max(1.0), "{} vs {}", src, out);
+        }
+
+        /// The steady velocity rises with the spool opening (the bias and the
+        /// bisections of `spool_for_velocity` rely on it).
+        #[test]
+        fn steady_velocity_is_monotone_in_the_spool(a in -0.35e-3f64..0.35e-3, d in 1e-7f64..2e-5) {
+            let rig = ValveRig::leaney_moog();
+            let (va, vb) = (rig.steady_velocity(a).unwrap(), rig.steady_velocity(a + d).unwrap());
+            prop_assert!(vb >= va - 1e-9, "{} {}", va, vb);
+        }
+    }
 }

@@ -23,8 +23,8 @@
 //!   `Q_A = Cd√(2/ρ) [A_v1 √(p_P − p_A) − A_v2 √(p_A − p_T)]` into port A,
 //!   `Q_B = Cd√(2/ρ) [A_v1 √(p_B − p_T) − A_v2 √(p_P − p_B)]` out of port B,
 //!   each square root signed and regularised through
-//!   [`Orifice`](crate::orifice::Orifice) (C¹, Lipschitz, error bounded by
-//!   `0.2 Cd A √(2Δp_t/ρ)` and vanishing as `√Δp_t`).
+//!   [`Orifice`] (C¹, Lipschitz, error bounded by
+//!   `0.2011 Cd A √(2Δp_t/ρ)` and vanishing as `√Δp_t`).
 //!
 //! Two effects of the measured-data catalog are parameters here, off by
 //! default: `valve_null_bias` ([`Metering::null_bias`], a spool offset added

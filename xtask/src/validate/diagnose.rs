@@ -124,13 +124,95 @@ pub fn section() -> Section {
     let ok = run(&synth::declared_for(&[EffectId::PressureViscous]), &[rec]).is_ok();
     let el = t0.elapsed().as_secs_f64();
     s.check(
-        "12 s at 1 kHz diagnosed (wall time)",
+        "friction bench: 12 s at 1 kHz diagnosed (wall time)",
         format!("{el:.2} s"),
         "< 10 s".into(),
         ok && el < 10.0,
     );
+    valve(&mut s, &dir);
     real_data(&mut s);
     s
+}
+
+/// The valve rig (`leaney-moog`): the generated fixtures and the speed goal.
+fn valve(s: &mut Section, dir: &Path) {
+    use hydrocyl_identify::valve::{diagnose_valve, set};
+    use hydrocyl_system::valve_rig::ValveRig;
+    for (name, planted) in [
+        ("valve-none", "none"),
+        ("valve-internal_leakage", "internal_leakage"),
+    ] {
+        let res = Record::read(&dir.join(format!("{name}.csv")))
+            .map_err(|e| e.to_string())
+            .and_then(|r| {
+                diagnose_valve(
+                    &ValveRig::leaney_moog(),
+                    &r,
+                    &DiagnoseOptions::default(),
+                    &mut |_, _, _| {},
+                )
+                .map_err(|e| e.to_string())
+            });
+        match res {
+            Ok(r) => {
+                let found: Vec<&str> = r.effects_added.iter().map(|e| e.id.as_str()).collect();
+                let found = if found.is_empty() {
+                    "none".to_string()
+                } else {
+                    found.join("+")
+                };
+                let within = ["position", "p1", "p2"]
+                    .iter()
+                    .all(|c| r.nrmse_after[*c] <= 1.5 * r.noise_floor[*c]);
+                s.note(&format!(
+                    "{name:<40} {planted:<38} {found:<38} p1 {:.5}->{:.5} (floor {:.5}), position {:.2e}->{:.2e} (floor {:.2e})",
+                    r.nrmse_before["p1"], r.nrmse_after["p1"], r.noise_floor["p1"],
+                    r.nrmse_before["position"], r.nrmse_after["position"], r.noise_floor["position"]
+                ));
+                s.check(
+                    &format!("{name}: found / NRMSE"),
+                    format!("{found}, {}", if within { "within" } else { "above" }),
+                    format!("{planted}, every channel <= 1.5 x floor"),
+                    found == planted && within,
+                );
+            }
+            Err(e) => s.check(&format!("{name}: diagnosed"), e, "a report".into(), false),
+        }
+    }
+    // Speed: 12 s at 1 kHz on the valve rig, one planted leak.
+    let mut truth = ValveRig::leaney_moog();
+    if let Some((p, v)) = synth::valve_planted(EffectId::InternalLeakage) {
+        set(&mut truth, EffectId::InternalLeakage, p, v);
+    }
+    match synth::valve_record(&truth, 12_000, 1e-3, 9) {
+        Ok(rec) => {
+            let t0 = Instant::now();
+            let ok = diagnose_valve(
+                &ValveRig::leaney_moog(),
+                &rec,
+                &DiagnoseOptions::default(),
+                &mut |_, _, _| {},
+            )
+            .is_ok_and(|r| {
+                r.effects_added
+                    .first()
+                    .is_some_and(|e| e.id == "internal_leakage")
+            });
+            let el = t0.elapsed().as_secs_f64();
+            s.check(
+                "valve rig: 12 s at 1 kHz diagnosed (wall time)",
+                format!("{el:.2} s"),
+                "< 10 s".into(),
+                ok && el < 10.0,
+            );
+        }
+        Err(e) => s.check(
+            "valve rig: 12 s record generated",
+            e,
+            "a record".into(),
+            false,
+        ),
+    }
 }
 
 fn real_data(s: &mut Section) {

@@ -9,13 +9,16 @@
 //!   and 5-11;
 //! * the pressure dependence of real seal friction (TU Delft records,
 //!   `fixtures/measured/tudelft-seal-strokes.csv`): linear (eq 5.2) against
-//!   quadratic (eq 5.3) laws.
+//!   quadratic (eq 5.3) laws;
+//! * the inverse model (mass, offset, friction curve) of the EMPS
+//!   electromechanical axis (`fixtures/measured/emps-inverse-model.csv`).
 
 use std::path::{Path, PathBuf};
 
 use hydrocyl_friction::ident::{
-    fit_seal_friction, fit_steady_curve, read_seal_strokes, read_steady_points, Direction,
-    FitReport, PressureLaw, SealStroke, SteadyCurveFit, SteadyFitSpec, SteadyPoint,
+    fit_inverse_model, fit_seal_friction, fit_steady_curve, read_inverse_samples,
+    read_seal_strokes, read_steady_points, Direction, FitReport, InverseLaw, PressureLaw,
+    SealStroke, SteadyCurveFit, SteadyFitSpec, SteadyPoint,
 };
 use hydrocyl_friction::{
     CoulombViscous, Dahl, FrictionInput, FrictionLaw, FrictionModel, Karnopp, LuGre, Stribeck, Wang,

@@ -78,7 +78,11 @@ fn worst_bounce_error(method: Method) -> Result<(f64, usize), SolveError> {
     let opts = Options {
         rtol: 1e-10,
         atol: vec![1e-12],
-        h0: if method == Method::Rk4 { Some(0.01) } else { None },
+        h0: if method == Method::Rk4 {
+            Some(0.01)
+        } else {
+            None
+        },
         event_tol: 1e-12,
         ..Options::default()
     };
@@ -116,7 +120,10 @@ pub fn section() -> Section {
         match observed_order(method, ns) {
             Ok((p, e_last)) => s.check(
                 &check,
-                format!("{p:.2} (error {e_last:.1e} at h = {:.4})", 3.0 / ns[ns.len() - 1] as f64),
+                format!(
+                    "{p:.2} (error {e_last:.1e} at h = {:.4})",
+                    3.0 / ns[ns.len() - 1] as f64
+                ),
                 format!("{order} (theory), pass within 0.3"),
                 (p - order).abs() < 0.3,
             ),

@@ -111,6 +111,9 @@ fn stored_energy_is_half_sigma0_z_squared() {
     let m = LuGre::table_5_11();
     let z = 5e-6;
     assert!((m.stored_energy(&[z]).si() - 0.5 * 3e7 * z * z).abs() < 1e-15);
+    let mut scale = [0.0];
+    hydrocyl_friction::FrictionLaw::LuGre(m).state_scales(&mut scale);
+    assert!((scale[0] - 188.0 / 3e7).abs() < 1e-15);
 }
 
 /// The bristle released from a deflection with v = 0 neither gains nor loses

@@ -29,7 +29,7 @@
 //! rises further and the drive **locks** with p1 at the safety valve's 200 bar
 //! and `v = A1/(K p1)` ≈ 1.5 mm/s. With Table 5-8 (K = 2.5e-8 m³·s/N) the reserve
 //! at 50 mm/s is only 18 N (no load), 5 N (25 kg set) and 2 N (38 kg set), and
-//! the steady Δp of ≈ 2 bar lies 2.3, 1.3 and 0.9 bar below `Δp*`. A square-wave step must
+//! the steady Δp (2.0, 2.6, 2.8 bar) lies 2.4, 1.3 and 0.9 bar below `Δp*`. A square-wave step must
 //! accelerate the moving mass while breaking stiction; the acceleration term
 //! `K H a` of eq 5.14 adds `K H` = 76 kg to the 10 kg moved, and with it even
 //! the no-load square wave crosses `Δp*` and locks (measured by validate with
@@ -65,6 +65,56 @@ pub fn extend_force_reserve(rig: &WangHybrid, wang: &Wang, v: f64) -> f64 {
     let p2 = (a2 * v / k_ret).powi(2);
     let k = wang.extending.k_pressure;
     a1 * a1 / (4.0 * k * v) + p2 * (a1 - a2) - wang.extending.curve.g(v)
+}
+
+/// The lowest force reserve of steady extension between 1 mm/s and 1 m/s
+/// under `wang` on `rig`, as `(speed [m/s], reserve [N])`: a scan of
+/// [`extend_force_reserve`] in 1 mm/s steps refined by golden-section search.
+/// A negative reserve means a band of speeds without steady extension.
+pub fn extend_reserve_minimum(rig: &WangHybrid, wang: &Wang) -> (f64, f64) {
+    let f = |v: f64| extend_force_reserve(rig, wang, v);
+    let (mut v_best, mut r_best) = (1e-3, f(1e-3));
+    for k in 2..=1000 {
+        let v = k as f64 * 1e-3;
+        let r = f(v);
+        if r < r_best {
+            (v_best, r_best) = (v, r);
+        }
+    }
+    let (mut lo, mut hi) = ((v_best - 1e-3).max(1e-3), (v_best + 1e-3).min(1.0));
+    let phi = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..60 {
+        let (a, b) = (hi - phi * (hi - lo), lo + phi * (hi - lo));
+        if f(a) < f(b) {
+            hi = b;
+        } else {
+            lo = a;
+        }
+    }
+    let v = 0.5 * (lo + hi);
+    (v, f(v).min(r_best))
+}
+
+/// The fold speed: the lowest speed in (1 mm/s, 1 m/s) at which
+/// [`extend_force_reserve`] reaches zero \[m/s\] (scan in 1 mm/s steps, then
+/// bisection to 1e-12 m/s); `None` when K = 0 or the reserve stays positive
+/// (see [`extend_reserve_minimum`] for how close it comes).
+pub fn extend_fold_speed(rig: &WangHybrid, wang: &Wang) -> Option<f64> {
+    if wang.extending.k_pressure <= 0.0 {
+        return None;
+    }
+    let f = |v: f64| extend_force_reserve(rig, wang, v);
+    let hi = (1..=1000).map(|k| k as f64 * 1e-3).find(|&v| f(v) <= 0.0)?;
+    let (mut lo, mut hi) = ((hi - 1e-3).max(1e-4), hi);
+    while hi - lo > 1e-12 {
+        let m = 0.5 * (lo + hi);
+        if f(m) > 0.0 {
+            lo = m;
+        } else {
+            hi = m;
+        }
+    }
+    Some(0.5 * (lo + hi))
 }
 
 /// The two roots `(Δp_s, Δp*)` of the steady extension balance at speed `v`

@@ -442,8 +442,35 @@ pub struct ReturnPath {
 }
 
 impl ReturnPath {
-    /// The return path `name` joined to `nodes`.
+    /// The return path `name`, piloted by `pilot_1`, `pilot_2`, opening
+    /// chambers `a`, `b` to `tank` (the same as [`ReturnPath::with_nodes`]).
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
+        name: &str,
+        four_way: PilotFourWay,
+        needle: NeedleValve,
+        pilot_1: &str,
+        pilot_2: &str,
+        a: &str,
+        b: &str,
+        tank: &str,
+    ) -> Self {
+        Self::with_nodes(
+            name,
+            four_way,
+            needle,
+            ReturnNodes {
+                pilot_1,
+                pilot_2,
+                a,
+                b,
+                tank,
+            },
+        )
+    }
+
+    /// The return path `name` joined to `nodes`.
+    pub fn with_nodes(
         name: &str,
         four_way: PilotFourWay,
         needle: NeedleValve,
@@ -658,7 +685,7 @@ mod tests {
     use super::*;
 
     fn path() -> ReturnPath {
-        ReturnPath::new(
+        ReturnPath::with_nodes(
             "return",
             PilotFourWay::dddc(),
             NeedleValve::nccc(),

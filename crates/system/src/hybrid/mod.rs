@@ -319,7 +319,7 @@ impl WangHybrid {
             )),
             Box::new(CheckComponent::new("check_1", self.check, TANK, LINE_1)),
             Box::new(CheckComponent::new("check_2", self.check, TANK, LINE_2)),
-            Box::new(ReturnPath::new(
+            Box::new(ReturnPath::with_nodes(
                 "return",
                 self.four_way,
                 self.needle,

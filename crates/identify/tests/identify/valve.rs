@@ -74,3 +74,65 @@ fn nothing_missing_adds_nothing_on_the_valve_rig() {
     let r = run(&[], 33);
     assert!(r.effects_added.is_empty(), "{}", r.human());
 }
+
+#[test]
+fn flow_gain_error_is_found() {
+    check(EffectId::FlowGainError, 34);
+}
+
+#[test]
+fn external_force_is_found() {
+    check(EffectId::ExternalForce, 35);
+}
+
+#[test]
+fn bulk_modulus_is_found() {
+    check(EffectId::BulkModulus, 36);
+}
+
+#[test]
+fn flow_gain_and_external_force_together_are_both_found() {
+    let r = run(&[EffectId::FlowGainError, EffectId::ExternalForce], 37);
+    let mut ids: Vec<&str> = r.effects_added.iter().map(|e| e.id.as_str()).collect();
+    ids.sort();
+    assert_eq!(ids, ["external_force", "flow_gain_error"], "{}", r.human());
+}
+
+#[test]
+fn leak_and_bias_together_are_both_found() {
+    let r = run(&[EffectId::InternalLeakage, EffectId::ValveNullBias], 38);
+    let mut ids: Vec<&str> = r.effects_added.iter().map(|e| e.id.as_str()).collect();
+    ids.sort();
+    assert_eq!(
+        ids,
+        ["internal_leakage", "valve_null_bias"],
+        "{}",
+        r.human()
+    );
+}
+
+#[test]
+fn command_delay_is_reported_unexplained() {
+    // A 15 ms transport delay on the command: not a catalog effect.
+    let truth = ValveRig::leaney_moog();
+    let rec =
+        hydrocyl_identify::synth::valve_record_delayed(&truth, 2000, 1e-3, 39, 0.015).unwrap();
+    let r = diagnose_valve(
+        &ValveRig::leaney_moog(),
+        &rec,
+        &DiagnoseOptions::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    assert!(r.effects_added.is_empty(), "{}", r.human());
+    assert!(r.noise_share < 0.5, "{}", r.human());
+    let p = r
+        .unexplained_resembles
+        .as_ref()
+        .expect("a probe names the shape");
+    assert!(
+        p.kind == "delay" && (p.value - 0.015).abs() < 2.5e-3,
+        "{}",
+        r.human()
+    );
+}

@@ -1,0 +1,6 @@
+//! hydrocyl-identify's integration tests, one binary (link time on 2 cores):
+//! the loop on generated records with planted effects, on the friction bench
+//! and on the valve rig.
+
+mod planted;
+mod valve;

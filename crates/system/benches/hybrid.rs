@@ -1,0 +1,44 @@
+//! Criterion bench of the `wang-hybrid` rig: simulated seconds per wall
+//! second for the chapter-7 square-wave test (±50 mm/s, 0.2 Hz, no added
+//! load, one 5 s period, Rosenbrock, rtol 1e-6), output every 1 ms, with
+//! and without the mass-balance quadratures. The goal is 500× real time.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use hydrocyl_system::hybrid::chapter7::{Chapter7Test, Load, Shape};
+use hydrocyl_system::run::{run, RunOptions, Solver};
+use std::hint::black_box;
+
+fn square_period(c: &mut Criterion) {
+    let test = Chapter7Test::new(Shape::Square, Load::None);
+    let rig = test.rig();
+    let t: Vec<f64> = (0..=5000).map(|k| k as f64 * 1e-3).collect();
+    let mut g = c.benchmark_group("wang-hybrid square 0.2 Hz, 5 simulated s");
+    // throughput in simulated milliseconds: criterion's "elements/s" reads as
+    // simulated ms per wall second, i.e. 1000 x the real-time factor
+    g.throughput(Throughput::Elements(5000));
+    g.sample_size(10);
+    for quadratures in [false, true] {
+        let opts = RunOptions {
+            solver: Solver::Rosenbrock,
+            quadratures,
+            ..RunOptions::default()
+        };
+        let name = if quadratures {
+            "with mass balance"
+        } else {
+            "plain"
+        };
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let mut circ = rig.build(test.command(&rig)).expect("rig");
+                let x0 = circ.initial_state();
+                circ.reset(0.0, &x0);
+                black_box(run(&mut circ, &x0, &t, &opts).expect("run").stats.steps)
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, square_period);
+criterion_main!(benches);

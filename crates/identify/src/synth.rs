@@ -268,6 +268,7 @@ pub fn valve_planted(id: EffectId) -> Option<(&'static str, f64)> {
         EffectId::ValveNullBias => ("xb", 0.03 * 0.375e-3),
         EffectId::FlowGainError => ("kw", 0.85),
         EffectId::InternalLeakage => ("Cl", 1e-11),
+        EffectId::ExternalLeakage => ("Ce1", 1e-11),
         EffectId::BulkModulus => ("B", 3.5e8),
         EffectId::ExternalForce => ("F0", 800.0),
         _ => return None,

@@ -81,8 +81,9 @@ pub fn run() -> bool {
         let rig = hydrocyl_system::hybrid::WangHybrid::preset();
         let w = hydrocyl_friction::Wang::table_5_8();
         let (v, r) = extend_reserve_minimum(&rig, &w);
-        let fold = extend_fold_speed(&rig, &w)
-            .map_or("no fold".to_string(), |f| format!("a fold at {:.1} mm/s", 1e3 * f));
+        let fold = extend_fold_speed(&rig, &w).map_or("no fold".to_string(), |f| {
+            format!("a fold at {:.1} mm/s", 1e3 * f)
+        });
         println!(
             "with Table 5-8's seal gain K the hybrid drive's steady-extension force reserve falls to \
              {r:.2} N at {:.1} mm/s ({fold}; hydrocyl_system::hybrid::chapter7), so a transient \

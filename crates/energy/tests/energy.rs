@@ -408,7 +408,7 @@ mod tables {
     #[test]
     fn seal_term_fold_lies_between_50_and_100_mm_s() {
         use hydrocyl_system::hybrid::chapter7::{
-            extend_force_reserve, extend_fold_speed, extend_reserve_minimum,
+            extend_fold_speed, extend_force_reserve, extend_reserve_minimum,
         };
         let rig = hydrocyl_system::hybrid::WangHybrid::preset();
         let w = hydrocyl_friction::Wang::table_5_8();

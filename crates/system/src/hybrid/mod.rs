@@ -231,8 +231,20 @@ impl WangHybrid {
                 });
             }
         }
-        self.friction.validate().map_err(|e| BuildError::Component {
-            component: "friction".into(),
+        self.friction
+            .validate()
+            .map_err(|e| BuildError::Component {
+                component: "friction".into(),
+                message: e.to_string(),
+            })?;
+        self.cylinder
+            .validate()
+            .map_err(|e| BuildError::Component {
+                component: "cylinder".into(),
+                message: e.to_string(),
+            })?;
+        self.four_way.validate().map_err(|e| BuildError::Component {
+            component: "four_way".into(),
             message: e.to_string(),
         })
     }

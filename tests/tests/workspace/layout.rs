@@ -1,0 +1,77 @@
+//! The README's promises about the tree: the layout table names exactly the
+//! crate folders that exist, the design card's top level is there, and the
+//! set-up commands are the ones CI runs.
+
+use super::root;
+
+fn readme() -> String {
+    std::fs::read_to_string(root().join("README.md")).unwrap()
+}
+
+#[test]
+fn top_level_is_the_design_cards() {
+    for p in [
+        "Cargo.toml",
+        "crates",
+        "xtask",
+        "tests",
+        "fixtures",
+        "docs",
+        "README.md",
+    ] {
+        assert!(root().join(p).exists(), "missing top-level `{p}`");
+    }
+}
+
+#[test]
+fn readme_layout_table_names_every_crate_folder_and_no_other() {
+    let text = readme();
+    let listed: Vec<String> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("| `crates/"))
+        .map(|l| l.split('`').next().unwrap().to_string())
+        .collect();
+    let mut present: Vec<String> = std::fs::read_dir(root().join("crates"))
+        .unwrap()
+        .map(|e| e.unwrap())
+        .filter(|e| e.path().join("Cargo.toml").exists())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    present.sort();
+    let mut listed_sorted = listed.clone();
+    listed_sorted.sort();
+    assert_eq!(listed_sorted, present, "README layout table vs crates/");
+}
+
+#[test]
+fn ci_runs_the_readme_commands() {
+    let text = readme();
+    let ci = std::fs::read_to_string(root().join(".ci/run")).unwrap();
+    for cmd in ["cargo xtask validate", "cargo test --workspace"] {
+        assert!(text.contains(cmd), "README lacks `{cmd}`");
+        assert!(ci.contains(cmd), ".ci/run lacks `{cmd}`");
+    }
+}
+
+#[test]
+fn every_crate_opens_its_docs_with_a_title_and_a_compiled_example() {
+    for e in std::fs::read_dir(root().join("crates")).unwrap() {
+        let dir = e.unwrap().path();
+        let lib = dir.join("src/lib.rs");
+        if !lib.exists() {
+            continue; // the CLI crate is a binary
+        }
+        let text = std::fs::read_to_string(&lib).unwrap();
+        assert!(
+            text.starts_with("//! # hydrocyl-"),
+            "{} does not open with its crate title",
+            lib.display()
+        );
+        let examples = text
+            .lines()
+            .filter(|l| l.trim_end() == "//! ```" || l.trim_end() == "//! ```rust")
+            .count();
+        // an opening and a closing fence at least; `text` diagrams are not examples
+        assert!(examples >= 2, "{} has no compiled example", lib.display());
+    }
+}

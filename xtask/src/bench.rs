@@ -93,10 +93,87 @@ fn xfactor_analytical_vs_brent() {
     );
 }
 
-/// Runs the benchmarks; returns `true` (a benchmark has no pass/fail).
+/// Best-of-`reps` wall time \[s\] of `f`, which returns its own measured
+/// solve time (so that set-up is not counted), or the first error.
+fn best_of(reps: usize, mut f: impl FnMut() -> Result<f64, String>) -> Result<f64, String> {
+    let mut best = f64::INFINITY;
+    for _ in 0..reps {
+        best = best.min(f()?);
+    }
+    Ok(best)
+}
+
+/// The chapter-3 square wave (6 s simulated) on each actuator formulation:
+/// simulated seconds per wall second, and each formulation's time as a ratio
+/// to the fundamental model's in the same run.
+fn valve_rig_real_time() -> Result<(), String> {
+    use hydrocyl_system::chapter3;
+    use hydrocyl_system::run::RunOptions;
+    use hydrocyl_system::valve_rig::Formulation;
+    let case = chapter3::square_wave().map_err(|e| e.to_string())?;
+    let span = case.times[case.times.len() - 1] - case.times[0];
+    let mut walls = Vec::new();
+    for f in Formulation::ALL {
+        let mut rig = case.rig.clone();
+        rig.cylinder.formulation = f;
+        let wall = best_of(5, || {
+            rig.simulate(case.command.clone(), &case.times, &RunOptions::default())
+                .map(|r| r.wall.as_secs_f64())
+                .map_err(|e| e.to_string())
+        })?;
+        walls.push((f, wall));
+    }
+    let reference = walls
+        .iter()
+        .find(|(f, _)| *f == Formulation::Fundamental)
+        .map_or(f64::NAN, |w| w.1);
+    for (f, wall) in walls {
+        println!(
+            "valve rig square wave, {:<23} DP45: {:7.1}x real time ({:.2} ms for {span} s)  time / fundamental {:.2}",
+            f.name(),
+            span / wall,
+            wall * 1e3,
+            wall / reference
+        );
+    }
+    Ok(())
+}
+
+/// The chapter-7 0.2 Hz square test of the hybrid rig (no load, Rosenbrock):
+/// simulated seconds per wall second.
+fn hybrid_real_time() -> Result<(), String> {
+    use hydrocyl_system::hybrid::chapter7::{Chapter7Test, Load, Shape};
+    let test = Chapter7Test::new(Shape::Square, Load::None);
+    let mut span = 0.0;
+    let wall = best_of(3, || {
+        let t0 = Instant::now();
+        let r = test.run().map_err(|e| e.to_string())?;
+        span = r.trace.t.last().copied().unwrap_or(0.0) - r.trace.t.first().copied().unwrap_or(0.0);
+        Ok(t0.elapsed().as_secs_f64())
+    })?;
+    println!(
+        "hybrid rig 0.2 Hz square, Rosenbrock:                {:7.1}x real time ({:.1} ms for {span:.0} s, incl. measuring the phenomena)",
+        span / wall,
+        wall * 1e3
+    );
+    Ok(())
+}
+
+/// Runs the benchmarks; returns `false` only when a benchmark could not run
+/// (a benchmark has no pass/fail threshold).
 pub fn run() -> bool {
     println!("cargo xtask bench: ratios against a reference in the same run on this machine");
     orifice_typed_vs_raw();
     xfactor_analytical_vs_brent();
-    true
+    let mut ok = true;
+    for (name, r) in [
+        ("valve rig", valve_rig_real_time()),
+        ("hybrid rig", hybrid_real_time()),
+    ] {
+        if let Err(e) = r {
+            eprintln!("cargo xtask bench: {name}: {e}");
+            ok = false;
+        }
+    }
+    ok
 }

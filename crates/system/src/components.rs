@@ -381,11 +381,17 @@ pub struct FourWayValve {
     spool_name: String,
     /// Metering geometry and orifice law.
     pub metering: Metering,
+    /// Supply droop resistance Rs \[Pa·s·m⁻³\]: the valve sees
+    /// `Ps = P − Rs Q_P` ([`Metering::drooped_supply`]); 0 = off.
+    pub supply_resistance: f64,
+    /// Output name of the supply pressure the valve sees (with droop on).
+    pub supply_probe: Option<String>,
     spool: Wire,
     p: HydraulicNode,
     t: HydraulicNode,
     a: HydraulicNode,
     b: HydraulicNode,
+    ps: Wire,
 }
 
 impl FourWayValve {
@@ -404,23 +410,30 @@ impl FourWayValve {
             ports: [p.into(), t.into(), a.into(), b.into()],
             spool_name: spool.into(),
             metering,
+            supply_resistance: 0.0,
+            supply_probe: None,
             spool: UNBOUND,
             p: unbound_h(),
             t: unbound_h(),
             a: unbound_h(),
             b: unbound_h(),
+            ps: UNBOUND,
         }
     }
 
-    fn flows(&self, w: &Wires) -> hydrocyl_valves::servovalve::MeteringFlows {
+    /// The flows and the supply pressure the valve sees (drooped when
+    /// `supply_resistance > 0`).
+    fn flows(&self, w: &Wires) -> (hydrocyl_valves::servovalve::MeteringFlows, f64) {
         let g = |n: &HydraulicNode| Pressure::new(w.get(n.pressure));
-        self.metering.flows(
+        let (f, ps) = self.metering.flows_drooped(
             Position::new(w.get(self.spool)),
             g(&self.p),
+            self.supply_resistance,
             g(&self.t),
             g(&self.a),
             g(&self.b),
-        )
+        );
+        (f, ps.si())
     }
 }
 
@@ -440,17 +453,38 @@ impl Component for FourWayValve {
         self.t = net.hydraulic(&self.ports[1]);
         self.a = net.hydraulic(&self.ports[2]);
         self.b = net.hydraulic(&self.ports[3]);
+        if !(self.supply_resistance.is_finite() && self.supply_resistance >= 0.0) {
+            return Err(BuildError::Component {
+                component: self.name.clone(),
+                message: format!(
+                    "supply_resistance must be finite and non-negative, got {}",
+                    self.supply_resistance
+                ),
+            });
+        }
+        self.ps = net.private("ps");
         Ok(())
     }
     fn evaluate(&self, _t: f64, _x: &[f64], w: &mut Wires) {
-        let f = self.flows(w);
+        let (f, ps) = self.flows(w);
         w.add(self.p.inflow, -f.qp.si());
         w.add(self.t.inflow, f.qt.si());
         w.add(self.a.inflow, f.qa.si());
         w.add(self.b.inflow, -f.qb.si());
+        w.set(self.ps, ps);
     }
     fn power(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
-        p.dissipated = self.flows(w).dissipated;
+        p.dissipated = self.flows(w).0.dissipated;
+    }
+    fn probes(&self) -> Vec<Probe> {
+        self.supply_probe
+            .iter()
+            .map(|n| Probe {
+                name: n.clone(),
+                unit: "Pa",
+                wire: self.ps,
+            })
+            .collect()
     }
 }
 

@@ -116,6 +116,7 @@ pub mod components;
 pub mod hybrid;
 pub mod rig;
 pub mod run;
+pub mod sensor;
 pub mod signal;
 pub mod valve_rig;
 

@@ -7,6 +7,7 @@ use crate::circuit::{Circuit, Component};
 use crate::components::*;
 use crate::rig::RigError;
 use crate::run::{run, Run, RunOptions, SimError};
+use crate::sensor::LaggedPressureSensor;
 use crate::signal::Signal;
 use hydrocyl_actuator::Cylinder;
 use hydrocyl_friction::{CoulombViscous, FrictionInput, FrictionLaw, FrictionModel};
@@ -28,14 +29,35 @@ pub struct FluidSpec {
     pub bulk_modulus_pa: f64,
 }
 
-/// Constant-pressure supply and tank.
+/// Supply and tank: a constant source pressure, optionally drooping with
+/// the flow drawn (catalog `supply_droop`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SupplySpec {
-    /// Supply pressure Ps \[Pa\].
+    /// Supply (source) pressure Ps0 \[Pa\].
     pub pressure_pa: f64,
     /// Tank (return) pressure \[Pa\].
     pub tank_pressure_pa: f64,
+    /// Supply droop resistance Rs \[Pa·s·m⁻³\]: the valve's supply port sees
+    /// `Ps = Ps0 − Rs Q_s`, `Q_s` the flow it draws (solved exactly at every
+    /// instant, see `Metering::drooped_supply`). 0 (the default, and the value
+    /// when the field is absent) = a stiff supply. Needs the `fundamental`
+    /// formulation.
+    #[serde(default)]
+    pub droop_resistance_pa_s_per_m3: f64,
+}
+
+/// The measurement chain (catalog `sensor_lag`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorSpec {
+    /// First-order lag τ of the p1/p2 pressure transducers \[s\]; 0 (the
+    /// default, and the value when the section is absent) = ideal sensors.
+    /// With τ > 0 the output columns `p1`, `p2` are the sensor readings
+    /// (what the rig logs) and `p1_chamber`, `p2_chamber` the chamber
+    /// pressures themselves.
+    #[serde(default)]
+    pub pressure_lag_s: f64,
 }
 
 /// The servovalve.
@@ -171,6 +193,9 @@ pub struct ValveRig {
     pub friction: FrictionLaw,
     /// Initial state.
     pub initial: InitialSpec,
+    /// Sensors (absent = ideal).
+    #[serde(default)]
+    pub sensors: SensorSpec,
 }
 
 fn check(path: &str, value: f64, ok: bool, why: &str) -> Result<(), RigError> {
@@ -199,6 +224,7 @@ impl ValveRig {
             supply: SupplySpec {
                 pressure_pa: 7.0e6,
                 tank_pressure_pa: 0.0,
+                droop_resistance_pa_s_per_m3: 0.0,
             },
             valve: ValveSpec {
                 stroke_m: 0.375e-3,
@@ -235,6 +261,7 @@ impl ValveRig {
                 p1: None,
                 p2: None,
             },
+            sensors: SensorSpec::default(),
         }
     }
 
@@ -258,6 +285,22 @@ impl ValveRig {
             self.supply.pressure_pa > 0.0 && self.supply.pressure_pa > self.supply.tank_pressure_pa,
             "must be positive and above the tank pressure",
         )?;
+        nonneg(
+            "supply.droop_resistance_pa_s_per_m3",
+            self.supply.droop_resistance_pa_s_per_m3,
+        )?;
+        if self.supply.droop_resistance_pa_s_per_m3 > 0.0
+            && self.cylinder.formulation != Formulation::Fundamental
+        {
+            return Err(RigError::Invalid {
+                path: "supply.droop_resistance_pa_s_per_m3".into(),
+                why: format!(
+                    "supply droop needs the `fundamental` formulation (cylinder.formulation is `{}`)",
+                    self.cylinder.formulation.name()
+                ),
+            });
+        }
+        nonneg("sensors.pressure_lag_s", self.sensors.pressure_lag_s)?;
         let v = &self.valve;
         pos("valve.stroke_m", v.stroke_m)?;
         nonneg("valve.underlap_m", v.underlap_m)?;
@@ -427,26 +470,61 @@ impl ValveRig {
             )))
             .si();
         let load = Force::new(self.load.external_force_n + fric);
-        let steady = hydrocyl_xfactor::steady_pressures(
-            self.travel(self.initial.spool),
-            Pressure::new(ps),
-            cyl.gamma(),
-            cyl.area_1,
-            load,
-        );
-        let (s1, s2) = match (self.initial.p1, self.initial.p2) {
-            (Some(a), Some(b)) => return Ok((a, b)),
-            _ => match steady {
-                Ok(s) => (s.p1.si() + pt, s.p2.si() + pt),
-                Err(e) => {
-                    return Err(RigError::Invalid {
-                        path: "initial.p1".into(),
-                        why: format!(
-                            "no steady state to start from ({e}); give initial.p1 and initial.p2"
-                        ),
-                    })
+        if let (Some(a), Some(b)) = (self.initial.p1, self.initial.p2) {
+            return Ok((a, b));
+        }
+        // steady (p1, p2) for a supply `ps` above tank
+        let steady = |ps: f64| {
+            hydrocyl_xfactor::steady_pressures(
+                self.travel(self.initial.spool),
+                Pressure::new(ps),
+                cyl.gamma(),
+                cyl.area_1,
+                load,
+            )
+            .map(|s| (s.p1.si() + pt, s.p2.si() + pt))
+            .map_err(|e| RigError::Invalid {
+                path: "initial.p1".into(),
+                why: format!("no steady state to start from ({e}); give initial.p1 and initial.p2"),
+            })
+        };
+        let rs = self.supply.droop_resistance_pa_s_per_m3;
+        let (s1, s2) = if rs > 0.0 {
+            // With droop the valve sees Ps0 − Rs Q_s, and Q_s (the underlap's
+            // flow at rest) depends on the steady pressures: bisection on the
+            // supply above tank, h(ps) = ps + Rs Q_s(ps) − (Ps0 − pt), which
+            // rises with ps (h < 0 near 0 where nothing flows, h ≥ 0 at Ps0).
+            let ps_source = ps;
+            let m = self.metering();
+            let xs = Position::new(self.initial.spool);
+            let h = |ps: f64| -> Result<f64, RigError> {
+                let (a, b) = steady(ps)?;
+                let q = m
+                    .flows(
+                        xs,
+                        Pressure::new(ps + pt),
+                        Pressure::new(pt),
+                        Pressure::new(a),
+                        Pressure::new(b),
+                    )
+                    .qp
+                    .si();
+                Ok(ps + rs * q - ps_source)
+            };
+            let (mut lo, mut hi) = (1e-9 * ps_source, ps_source);
+            if h(hi)? > 0.0 {
+                for _ in 0..80 {
+                    let mid = 0.5 * (lo + hi);
+                    if h(mid)? < 0.0 {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
                 }
-            },
+            }
+            steady(hi)?
+        } else {
+            steady(ps)?
         };
         Ok((self.initial.p1.unwrap_or(s1), self.initial.p2.unwrap_or(s2)))
     }
@@ -462,12 +540,14 @@ impl ValveRig {
         let (p1, p2) = self.initial_pressures()?;
         let cyl = self.cylinder_model();
         let metering = self.metering();
+        let droop = self.supply.droop_resistance_pa_s_per_m3 > 0.0;
         let mut comps: Vec<Box<dyn Component>> = vec![
             Box::new(PressureSource::new(
                 "supply",
                 "P",
                 Pressure::new(self.supply.pressure_pa),
-                Some("ps"),
+                // with droop, `ps` is the pressure the valve sees (below)
+                (!droop).then_some("ps"),
             )),
             Box::new(PressureSource::new(
                 "tank",
@@ -486,9 +566,10 @@ impl ValveRig {
         ];
         match self.cylinder.formulation {
             Formulation::Fundamental => {
-                comps.push(Box::new(FourWayValve::new(
-                    "valve", "spool", "P", "T", "A", "B", metering,
-                )));
+                let mut valve = FourWayValve::new("valve", "spool", "P", "T", "A", "B", metering);
+                valve.supply_resistance = self.supply.droop_resistance_pa_s_per_m3;
+                valve.supply_probe = droop.then(|| "ps".to_string());
+                comps.push(Box::new(valve));
                 let mut c = TwoChamberCylinder::new("cylinder", "A", "B", "rod", cyl, (p1, p2));
                 c.cavitation_pressure = self.cylinder.cavitation_pressure_pa;
                 comps.push(Box::new(c));
@@ -524,6 +605,18 @@ impl ValveRig {
             Some(("A", "B")),
             self.friction_model(),
         )));
+        let tau = self.sensors.pressure_lag_s;
+        if tau > 0.0 {
+            for (node, probe, p0) in [("A", "p1_sensor", p1), ("B", "p2_sensor", p2)] {
+                comps.push(Box::new(LaggedPressureSensor::new(
+                    &format!("sensor_{node}"),
+                    node,
+                    probe,
+                    tau,
+                    p0,
+                )));
+            }
+        }
         Circuit::build(comps).map_err(RigError::from)
     }
 
@@ -536,17 +629,44 @@ impl ValveRig {
     ) -> Result<Run, RigError> {
         let mut c = self.circuit(command)?;
         let x0 = c.initial_state();
-        run(&mut c, &x0, t_eval, opts).map_err(|e| match e {
+        let mut r = run(&mut c, &x0, t_eval, opts).map_err(|e| match e {
             SimError::Build(b) => RigError::from(b),
             other => RigError::Sim(other.to_string()),
-        })
+        })?;
+        if self.sensors.pressure_lag_s > 0.0 {
+            // `p1`/`p2` become what the sensors read, the chamber pressures
+            // move to `p1_chamber`/`p2_chamber` (column order kept).
+            for k in ["p1", "p2"] {
+                let sensor = r
+                    .channels
+                    .iter()
+                    .position(|c| c.name == format!("{k}_sensor"));
+                let chamber = r.channels.iter().position(|c| c.name == k);
+                if let (Some(s), Some(c)) = (sensor, chamber) {
+                    let (lo, hi) = (s.min(c), s.max(c));
+                    let (a, b) = r.channels.split_at_mut(hi);
+                    std::mem::swap(&mut a[lo].values, &mut b[0].values);
+                    r.channels[s].name = format!("{k}_chamber");
+                }
+            }
+        }
+        Ok(r)
     }
 
     /// Steady piston velocity at spool position `xs` \[m·s⁻¹\]: the exact
     /// two-chamber steady state (`Q1 = A1 v`, `Q2 = A2 v`, force balance with
     /// the friction at `v` and the external force), solved by fixed-point
     /// iteration on the load force.
+    /// Not available with supply droop on (an error says so).
     pub fn steady_velocity(&self, xs: f64) -> Result<f64, RigError> {
+        if self.supply.droop_resistance_pa_s_per_m3 > 0.0 {
+            return Err(RigError::Invalid {
+                path: "supply.droop_resistance_pa_s_per_m3".into(),
+                why:
+                    "the steady-velocity helpers assume a stiff supply; set the droop to 0 for them"
+                        .into(),
+            });
+        }
         let cyl = self.cylinder_model();
         let m = self.metering();
         let ps = self.supply.pressure_pa - self.supply.tank_pressure_pa;

@@ -470,3 +470,142 @@ mod invariants {
         }
     }
 }
+
+#[test]
+fn rig_files_without_droop_or_sensors_still_load() {
+    // rig files written before `supply.droop_resistance_pa_s_per_m3` and
+    // `sensors` existed: the fields default to off
+    let mut v = fixture();
+    v["supply"]
+        .as_object_mut()
+        .unwrap()
+        .remove("droop_resistance_pa_s_per_m3");
+    v.as_object_mut().unwrap().remove("sensors");
+    assert_eq!(rig::valve_rig_from(&v).unwrap(), ValveRig::leaney_moog());
+    // and bad values are named
+    let mut bad = fixture();
+    bad["supply"]["droop_resistance_pa_s_per_m3"] = (-1.0).into();
+    let e = rig::valve_rig_from(&bad).unwrap_err().to_string();
+    assert!(e.contains("supply.droop_resistance_pa_s_per_m3"), "{e}");
+    let mut bad = fixture();
+    bad["sensors"]["pressure_lag_s"] = (-0.01).into();
+    let e = rig::valve_rig_from(&bad).unwrap_err().to_string();
+    assert!(e.contains("sensors.pressure_lag_s"), "{e}");
+    let mut bad = fixture();
+    bad["supply"]["droop_resistance_pa_s_per_m3"] = 1e9.into();
+    bad["cylinder"]["formulation"] = "generalised-analytical".into();
+    let e = rig::valve_rig_from(&bad).unwrap_err().to_string();
+    assert!(e.contains("fundamental"), "{e}");
+}
+
+fn sine_run(rig: &ValveRig) -> hydrocyl_system::run::Run {
+    let cmd = Signal::Sine {
+        amplitude: 0.5,
+        period_s: 1.0,
+        bias: 0.0,
+        phase_rad: 0.0,
+    };
+    rig.simulate(cmd, &times(1.0, 1e-3), &RunOptions::default())
+        .unwrap()
+}
+
+#[test]
+fn supply_droop_lowers_the_supply_with_the_flow_drawn() {
+    let stiff = ValveRig::leaney_moog();
+    let mut rig = stiff.clone();
+    let rs = 3e9;
+    rig.supply.droop_resistance_pa_s_per_m3 = rs;
+    let (a, b) = (sine_run(&stiff), sine_run(&rig));
+    let ps0 = rig.supply.pressure_pa;
+    let ps = b.channel("ps").unwrap();
+    assert!(a.channel("ps").unwrap().iter().all(|p| *p == ps0));
+    // the valve sees less than Ps0 all along (the underlap draws flow even at null) ...
+    assert!(ps.iter().all(|p| *p < ps0));
+    // ... and most when the piston moves fastest: the supply flow is then
+    // at least A2 |v| (retracting) and about A1 v (extending)
+    let v = b.channel("velocity").unwrap();
+    let k = (0..v.len())
+        .max_by(|&i, &j| v[i].abs().total_cmp(&v[j].abs()))
+        .unwrap();
+    let a2 = rig.cylinder.area_2_m2;
+    assert!(
+        ps0 - ps[k] >= rs * a2 * v[k].abs(),
+        "{} at v {}",
+        ps0 - ps[k],
+        v[k]
+    );
+    // the piston is slower than on a stiff supply
+    let peak = |r: &hydrocyl_system::run::Run| {
+        r.channel("velocity")
+            .unwrap()
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+    };
+    assert!(peak(&b) < 0.99 * peak(&a), "{} vs {}", peak(&b), peak(&a));
+    // the initial steady state accounts for the droop: it is the stiff
+    // rig's at the supply the valve sees there (a fixed point: that supply
+    // depends on the flow the underlap draws at those pressures)
+    let (p1, p2) = rig.initial_pressures().unwrap();
+    let mut at_drooped = stiff.clone();
+    at_drooped.supply.pressure_pa = ps[0];
+    let (q1, q2) = at_drooped.initial_pressures().unwrap();
+    assert!((p1 / q1 - 1.0).abs() < 1e-9 && (p2 / q2 - 1.0).abs() < 1e-9);
+    assert!(p1 < stiff.initial_pressures().unwrap().0);
+}
+
+#[test]
+fn power_terms_balance_with_supply_droop() {
+    // the droop's loss Rs Qs^2 is booked: source = dissipated + storage + load
+    let mut rig = ValveRig::leaney_moog();
+    rig.supply.droop_resistance_pa_s_per_m3 = 5e9;
+    let cmd = Signal::Sine {
+        amplitude: 0.3,
+        period_s: 1.0,
+        bias: 0.0,
+        phase_rad: 0.0,
+    };
+    let t = times(1.0, 0.05);
+    let mut c = rig.circuit(cmd).unwrap();
+    let x0 = c.initial_state();
+    let r = run(&mut c, &x0, &t, &RunOptions::default()).unwrap();
+    for k in 0..r.time.len() {
+        let p = c.power_terms(r.time[k], r.state(k));
+        let src: f64 = p.iter().map(|p| p.source).sum();
+        let out: f64 = p.iter().map(|p| p.dissipated + p.storage + p.load).sum();
+        assert!(
+            (src - out).abs() <= 1e-9 * src.abs().max(1.0),
+            "t = {}: {src} vs {out}",
+            r.time[k]
+        );
+    }
+}
+
+#[test]
+fn sensor_lag_is_a_first_order_lag_of_the_chamber_pressure() {
+    let ideal = ValveRig::leaney_moog();
+    let mut rig = ideal.clone();
+    let tau = 0.01;
+    rig.sensors.pressure_lag_s = tau;
+    let (a, b) = (sine_run(&ideal), sine_run(&rig));
+    for k in ["p1", "p2"] {
+        // the physics is unchanged: the chambers are the ideal run's pressures
+        let chamber = b.channel(&format!("{k}_chamber")).unwrap();
+        assert!(nrmse(chamber, a.channel(k).unwrap()) < 1e-4, "{k}");
+        // and the reading obeys tau dy/dt = p - y (central differences)
+        let y = b.channel(k).unwrap();
+        let h = 1e-3;
+        let range = y.iter().fold(f64::NEG_INFINITY, |m, v| m.max(*v))
+            - y.iter().fold(f64::INFINITY, |m, v| m.min(*v));
+        let mut worst: f64 = 0.0;
+        for i in 1..y.len() - 1 {
+            let dy = (y[i + 1] - y[i - 1]) / (2.0 * h);
+            worst = worst.max((tau * dy + y[i] - chamber[i]).abs());
+        }
+        assert!(worst < 5e-3 * range, "{k}: {worst} of {range}");
+        // it lags: the reading differs visibly from the chamber
+        assert!(nrmse(y, chamber) > 1e-2, "{k}");
+    }
+    // column order kept: command, position, velocity, p1, p2 first
+    let names: Vec<&str> = b.channels.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(&names[..5], ["command", "position", "velocity", "p1", "p2"]);
+}

@@ -299,6 +299,101 @@ impl Metering {
     }
 }
 
+/// Supply droop (catalog `supply_droop`): the supply port sees
+/// `Ps = Ps0 − Rs Q_P`, a source pressure `Ps0` behind a linear resistance
+/// `Rs` (a pressure-compensated pump that sags with flow, hoses, a filter).
+///
+/// `Q_P` depends on `Ps` through the two metering edges P→A and P→B, so `Ps`
+/// is the root of `g(Ps) = Ps + Rs Q_P(Ps) − Ps0`. `Q_P` is non-decreasing in
+/// `Ps` (each edge's flow rises with its upstream pressure), so `g' ≥ 1`:
+/// the root is unique, and `|Ps − root| ≤ |g(Ps)|` gives a guaranteed error
+/// bound. It is bracketed by `[min(Ps0, pa, pb), max(Ps0, pa, pb)]` (at the
+/// lower end no edge can draw from P, at the upper end none can push into
+/// it). A Newton step on the analytic `g'` is taken when it stays inside the
+/// current bracket, a bisection otherwise (a safeguarded Newton), so the
+/// iteration cannot leave the bracket or stall.
+///
+/// The solution is Lipschitz in the chamber pressures and the spool
+/// position: by the implicit function theorem `∂Ps/∂pa = Rs G_a / (1 + Rs
+/// (G_a + G_b))` with `G` the edges' (finite, regularised) conductances, so
+/// `0 ≤ ∂Ps/∂pa < 1`; the right-hand side of an integrator stays Lipschitz.
+/// A negative `Q_P` (flow pushed back into the supply) raises `Ps` above
+/// `Ps0`: the law is used as written, no check valve is assumed.
+impl Metering {
+    /// The supply pressure at port P: the root of `Ps = ps0 − rs Q_P(Ps)`
+    /// (see the block above), to within `1e-12` of the pressure scale.
+    /// `rs = 0` returns `ps0`; a non-finite input gives `NaN` (never a
+    /// clamped value), which the integrator reports.
+    pub fn drooped_supply(
+        &self,
+        xs: Position,
+        ps0: Pressure,
+        rs: f64,
+        pa: Pressure,
+        pb: Pressure,
+    ) -> Pressure {
+        let (p0, a, b) = (ps0.si(), pa.si(), pb.si());
+        if rs == 0.0 {
+            return ps0;
+        }
+        if !(rs.is_finite() && rs > 0.0 && p0.is_finite() && a.is_finite() && b.is_finite()) {
+            return Pressure::new(f64::NAN);
+        }
+        let areas = self.areas(xs);
+        let o = &self.orifice;
+        let g = |ps: f64| -> (f64, f64) {
+            let (pp, pa, pb) = (Pressure::new(ps), Pressure::new(a), Pressure::new(b));
+            let q = o.flow(areas.av1, pp, pa).si() + o.flow(areas.av2, pp, pb).si();
+            let dq = o.conductance(areas.av1, pp, pa) + o.conductance(areas.av2, pp, pb);
+            (ps + rs * q - p0, 1.0 + rs * dq)
+        };
+        let (mut lo, mut hi) = (p0.min(a).min(b), p0.max(a).max(b));
+        let tol = 1e-12 * (p0.abs() + a.abs() + b.abs()).max(1.0);
+        let mut x = p0.clamp(lo, hi);
+        for _ in 0..200 {
+            let (gx, dg) = g(x);
+            if gx.abs() <= tol {
+                break;
+            }
+            if gx < 0.0 {
+                lo = x;
+            } else {
+                hi = x;
+            }
+            if hi - lo <= tol {
+                x = 0.5 * (lo + hi);
+                break;
+            }
+            let newton = x - gx / dg;
+            x = if newton > lo && newton < hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+        }
+        Pressure::new(x)
+    }
+
+    /// [`Metering::flows`] with the supply drooping behind resistance `rs`
+    /// \[Pa·s·m⁻³\] from source pressure `ps0`: the flows at the drooped
+    /// supply pressure (returned alongside), with the droop's loss
+    /// `rs Q_P²` added to `dissipated`.
+    pub fn flows_drooped(
+        &self,
+        xs: Position,
+        ps0: Pressure,
+        rs: f64,
+        pt: Pressure,
+        pa: Pressure,
+        pb: Pressure,
+    ) -> (MeteringFlows, Pressure) {
+        let ps = self.drooped_supply(xs, ps0, rs, pa, pb);
+        let mut f = self.flows(xs, ps, pt, pa, pb);
+        f.dissipated += rs * f.qp.si() * f.qp.si();
+        (f, ps)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -332,6 +427,79 @@ mod tests {
         // leakage flow through the underlap: P→A→T and P→B→T
         assert!(f.qp.si() > 0.0);
         assert!((f.qp.si() - f.qt.si()).abs() < 1e-18);
+    }
+
+    #[test]
+    fn drooped_supply_solves_the_implicit_law() {
+        let v = valve();
+        let ps0 = Pressure::new(7.0e6);
+        let rs = 3.0e9;
+        for &(xs, pa, pb) in &[
+            (0.2e-3, 3.0e6, 1.0e6),
+            (-0.3e-3, 2.0e6, 5.0e6),
+            (0.0, 3.5e6, 3.5e6),
+            (1e-6, 6.9995e6, 0.5e6),
+            (0.375e-3, 7.5e6, 0.0),
+        ] {
+            let (xs, pa, pb) = (Position::new(xs), Pressure::new(pa), Pressure::new(pb));
+            let (f, ps) = v.flows_drooped(xs, ps0, rs, Pressure::ZERO, pa, pb);
+            // the law holds at the root, to the solver's tolerance
+            let resid = ps.si() - (ps0.si() - rs * f.qp.si());
+            assert!(resid.abs() < 1e-4, "{xs:?} {pa:?} {pb:?}: {resid}");
+            // and the flows are those of the plain valve at that supply
+            assert_eq!(f.qa, v.flows(xs, ps, Pressure::ZERO, pa, pb).qa);
+        }
+        // no resistance: the source pressure
+        let p = v.drooped_supply(Position::ZERO, ps0, 0.0, ps0 * 0.5, ps0 * 0.5);
+        assert_eq!(p, ps0);
+        // more resistance, more droop, while the valve draws flow
+        let at = |rs: f64| {
+            v.drooped_supply(
+                Position::new(0.2e-3),
+                ps0,
+                rs,
+                Pressure::new(3e6),
+                Pressure::new(1e6),
+            )
+            .si()
+        };
+        assert!(at(1e9) < ps0.si() && at(1e10) < at(1e9));
+        // one edge open and outside the regularisation: the closed form
+        // s² + k s − (Ps0 − pa) = 0 with s = √(Ps − pa), k = rs Cd √(2/ρ) Av1
+        let xs = Position::new(0.375e-3);
+        let a = v.areas(xs).av1.si();
+        let k = 1e10 * v.orifice.coefficient() * a;
+        let s = 0.5 * (-k + (k * k + 4.0 * (7.0e6 - 3.0e6)).sqrt());
+        let want = 3.0e6 + s * s;
+        let got = v.drooped_supply(xs, ps0, 1e10, Pressure::new(3e6), Pressure::new(1e6));
+        assert!((got.si() - want).abs() < 1e-3, "{got:?} vs {want}");
+        // non-finite input: NaN, not a clamped number
+        let nan = v.drooped_supply(xs, ps0, rs, Pressure::new(f64::NAN), Pressure::ZERO);
+        assert!(nan.si().is_nan());
+    }
+
+    #[test]
+    fn drooped_supply_moves_less_than_the_chamber_pressure() {
+        // the Lipschitz bound 0 <= dPs/dpa < 1 of the docs, by finite differences
+        let v = valve();
+        let ps0 = Pressure::new(7.0e6);
+        for &xs in &[0.0, 0.1e-3, -0.1e-3, 0.375e-3] {
+            for k in 0..20 {
+                let pa = 0.35e6 * k as f64;
+                let f = |pa: f64| {
+                    v.drooped_supply(
+                        Position::new(xs),
+                        ps0,
+                        5e9,
+                        Pressure::new(pa),
+                        Pressure::new(2e6),
+                    )
+                    .si()
+                };
+                let d = (f(pa + 10.0) - f(pa)) / 10.0;
+                assert!((-1e-6..1.0).contains(&d), "xs {xs} pa {pa}: {d}");
+            }
+        }
     }
 
     #[test]

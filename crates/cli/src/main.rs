@@ -3,6 +3,7 @@
 //! Subcommands live one per module; each returns `Result<(), CliError>` and
 //! `main` turns an error into one line on stderr and exit code 2.
 
+mod bench_sim;
 mod diagnose;
 mod error;
 mod simulate;

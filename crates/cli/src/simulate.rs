@@ -12,10 +12,12 @@
 //! valve rig, the drive voltage of a pump rig); other columns are ignored.
 //! The output has one row per command sample: `time, command, position,
 //! velocity, p1, p2`, then the rig's other outputs (`ps`, `spool`, `p_le`,
-//! ...), all SI without unit suffixes. It is written to a temporary file in
+//! ...), all SI without unit suffixes. A `friction-bench` rig is driven by
+//! its motion instead: see [`crate::bench_sim`]. It is written to a temporary file in
 //! the output's folder and renamed into place, so a failed run leaves no file.
 
 use crate::error::CliError;
+use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
@@ -172,12 +174,43 @@ fn write_atomic(path: &Path, text: &str) -> Result<(), CliError> {
     Ok(())
 }
 
+/// `hydrocyl simulate` on a friction bench: the `--command` file carries the
+/// imposed motion (see [`crate::bench_sim`]).
+fn run_bench(args: &Args, value: &serde_json::Value) -> Result<(), CliError> {
+    let bench = FrictionBench::from_json(&value.to_string())
+        .map_err(|e| CliError::Input(format!("rig {}: {e}", args.rig)))?;
+    if args.print_rig {
+        let text = serde_json::to_string_pretty(value)
+            .map_err(|e| CliError::Input(format!("rig: {e}")))?;
+        println!("{text}");
+        return Ok(());
+    }
+    let (Some(input), Some(out)) = (&args.command, &args.out) else {
+        return Err(CliError::Input("--command and --out are required".into()));
+    };
+    let text = crate::bench_sim::simulate(&bench, input)?;
+    write_atomic(out, &text)?;
+    eprintln!(
+        "hydrocyl: simulated the friction bench on {} samples of {}",
+        text.lines().count() - 1,
+        input.display()
+    );
+    Ok(())
+}
+
 /// Runs `hydrocyl simulate`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let rig_err = |e: rig::RigError| CliError::Input(e.to_string());
-    let mut value = rig::load(&args.rig).map_err(rig_err)?;
+    let mut value = match bench::preset(&args.rig) {
+        Some(b) => serde_json::to_value(b)
+            .map_err(|e| CliError::Input(format!("--rig {}: {e}", args.rig)))?,
+        None => rig::load(&args.rig).map_err(rig_err)?,
+    };
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(rig_err)?;
+    }
+    if value.get("kind").and_then(|k| k.as_str()) == Some(bench::KIND) {
+        return run_bench(&args, &value);
     }
     rig::check(&value).map_err(rig_err)?;
     if args.print_rig {

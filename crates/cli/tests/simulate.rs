@@ -255,3 +255,94 @@ fn rig_files_and_print_rig_round_trip() {
         .unwrap();
     assert!(st.status.success());
 }
+
+/// A friction bench is driven by its motion: simulated on the generated
+/// record whose truth is its declared model, the predicted load-cell force
+/// matches the measured one to the record's sensor noise (σ = 0.5 N on the
+/// force, plus what the pressure noise carries through the piston area);
+/// the same record under a rig that lacks a planted effect does not.
+#[test]
+fn friction_bench_is_simulated_from_its_motion() {
+    let dir = tempfile::tempdir().unwrap();
+    let fx = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/measured");
+    let rms = |rig: &str, rec: &str| {
+        let out = dir.path().join(format!("{rec}.out.csv"));
+        let st = hydrocyl()
+            .args(["simulate", "--rig"])
+            .arg(fx.join(rig))
+            .arg("--command")
+            .arg(fx.join(rec))
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(
+            st.status.success(),
+            "{}",
+            String::from_utf8_lossy(&st.stderr)
+        );
+        let (h, sim) = read_csv(&out);
+        assert_eq!(h, ["time", "position", "velocity", "p1", "p2", "force"]);
+        let text = std::fs::read_to_string(fx.join(rec)).unwrap();
+        let col = text
+            .lines()
+            .next()
+            .unwrap()
+            .split(',')
+            .position(|c| c.starts_with("force"))
+            .unwrap();
+        let measured: Vec<f64> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(measured.len(), sim.len());
+        let ss: f64 = measured
+            .iter()
+            .zip(&sim)
+            .map(|(m, r)| (m - r[5]).powi(2))
+            .sum();
+        (ss / sim.len() as f64).sqrt()
+    };
+    // the prediction uses the measured (noisy) pressure, so its error floor is
+    // √(σ_F² + (σ_p A2)²) with the noise of fixtures/measured/README.md
+    let rig: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fx.join("bench-none.rig.json")).unwrap())
+            .unwrap();
+    let area = rig["area2"].as_f64().unwrap();
+    let floor = (0.5f64.powi(2) + (2e3 * area).powi(2)).sqrt();
+    let truth = rms("bench-none.rig.json", "bench-none.csv");
+    assert!(
+        truth > 0.8 * floor && truth < 1.2 * floor,
+        "declared = truth: rms {truth} N, noise floor {floor} N"
+    );
+    let lacking = rms("bench-viscous.rig.json", "bench-viscous.csv");
+    assert!(lacking > 4.0 * floor, "viscous missing: rms {lacking} N");
+}
+
+#[test]
+fn friction_bench_needs_motion_and_writes_nothing_without_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let fx = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/measured");
+    let input = dir.path().join("p.csv");
+    let mut s = String::from("time,p2\n");
+    for k in 0..20 {
+        s.push_str(&format!("{},{}\n", k as f64 * 0.01, 3e5));
+    }
+    std::fs::write(&input, s).unwrap();
+    let out = dir.path().join("o.csv");
+    let st = hydrocyl()
+        .args(["simulate", "--rig"])
+        .arg(fx.join("bench-none.rig.json"))
+        .arg("--command")
+        .arg(&input)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("position") && err.contains("p.csv"), "{err}");
+    assert!(!out.exists());
+}

@@ -377,6 +377,17 @@ impl FrictionBench {
     /// every sample. The bristle state starts from the value that explains
     /// the first five samples' force (limited to the steady range).
     pub fn simulate(&self, s: &BenchSignals) -> Vec<f64> {
+        self.simulate_from(s, false)
+    }
+
+    /// Simulates the bench with the bristle deflection starting at zero (at
+    /// rest) instead of from the measured force: what `hydrocyl simulate`
+    /// does for a record that has no force to start from.
+    pub fn simulate_from_rest(&self, s: &BenchSignals) -> Vec<f64> {
+        self.simulate_from(s, true)
+    }
+
+    fn simulate_from(&self, s: &BenchSignals, at_rest: bool) -> Vec<f64> {
         let c = self.coeffs();
         let n = s.t.len();
         let mut out = vec![0.0; n];
@@ -384,7 +395,7 @@ impl FrictionBench {
         let sg = self.force_sign;
         let pres = |i: usize| s.p1[i] * self.area1 - s.p2[i] * self.area2;
         let mut z = 0.0;
-        if let Some((s0, _)) = c.lugre {
+        if let (Some((s0, _)), false) = (c.lugre, at_rest) {
             // s F = m a + F_f + F0 − pA  →  F_f = s F − m a − F0 + pA.
             let k = n.min(5);
             let ff: f64 = (0..k)

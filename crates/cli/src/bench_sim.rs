@@ -1,0 +1,53 @@
+//! `hydrocyl simulate` on a `friction-bench` rig (`spec/measured-data.md`,
+//! the rig kind of `hydrocyl-identify`): the drive imposes the motion, so the
+//! bench's input is not a command but the motion itself. The `--command` file
+//! is a record in the measured-data format (through the rig's column map) with
+//! `time`, `position` or `velocity`, and `p1`/`p2` where the bench has
+//! pressures; the output adds the predicted load-cell `force`:
+//! `time, position, velocity, p1, p2, force` (SI). Velocity and acceleration
+//! come from the same smoother `diagnose` uses; the bristle starts from the
+//! record's measured force when it has one, else at rest.
+
+use crate::error::CliError;
+use hydrocyl_identify::bench::{bench_signals, FrictionBench};
+use hydrocyl_identify::data::{Record, Signal};
+use std::path::Path;
+
+/// Simulates `bench` on the motion in `input`; returns the output CSV text.
+pub fn simulate(bench: &FrictionBench, input: &Path) -> Result<String, CliError> {
+    let mut rec =
+        Record::read_mapped(input, &bench.columns).map_err(|e| CliError::Input(e.to_string()))?;
+    if rec.get(Signal::Position).is_none() && rec.get(Signal::Velocity).is_none() {
+        return Err(CliError::Input(format!(
+            "{}: a friction bench is driven by its motion: the file needs a `position` or `velocity` column",
+            input.display()
+        )));
+    }
+    let measured_force = rec.get(Signal::Force).is_some();
+    if !measured_force {
+        rec.signals.insert(Signal::Force, vec![0.0; rec.len()]);
+    }
+    let (s, _) = bench_signals(&rec, None, bench.steady_state)
+        .map_err(|e| CliError::Input(e.to_string()))?;
+    let force = if measured_force {
+        bench.simulate(&s)
+    } else {
+        bench.simulate_from_rest(&s)
+    };
+    if let Some(i) = force.iter().position(|f| !f.is_finite()) {
+        return Err(CliError::Input(format!(
+            "{}: the bench model gave a non-finite force at row {} (t = {} s)",
+            input.display(),
+            i + 2,
+            s.t[i]
+        )));
+    }
+    let mut out = String::from("time,position,velocity,p1,p2,force\n");
+    for (i, f) in force.iter().enumerate() {
+        out.push_str(&format!(
+            "{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{f:.9e}\n",
+            s.t[i], s.x[i], s.v[i], s.p1[i], s.p2[i]
+        ));
+    }
+    Ok(out)
+}

@@ -13,14 +13,19 @@
 //! The output has one row per command sample: `time, command, position,
 //! velocity, p1, p2`, then the rig's other outputs (`ps`, `spool`, `p_le`,
 //! ...), all SI without unit suffixes. A `friction-bench` rig is driven by
-//! its motion instead: see [`crate::bench_sim`]. It is written to a temporary file in
+//! its motion instead: see [`crate::bench_sim`]. A `hybrid-variant` rig file
+//! (chapter 8's circuit improvements) runs on its base rig with the variant's
+//! components swapped in. It is written to a temporary file in
 //! the output's folder and renamed into place, so a failed run leaves no file.
 
 use crate::error::CliError;
+use hydrocyl_energy::variant::{self, HybridVariant};
 use hydrocyl_identify::bench::{self, FrictionBench};
+use hydrocyl_system::hybrid::WangHybrid;
 use hydrocyl_system::rig;
-use hydrocyl_system::run::{Run, RunOptions, Solver};
+use hydrocyl_system::run::{self as runner, Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
+use hydrocyl_system::Circuit;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -174,6 +179,47 @@ fn write_atomic(path: &Path, text: &str) -> Result<(), CliError> {
     Ok(())
 }
 
+/// A `hybrid-variant` rig (`hydrocyl-energy`): the variant (after `--set`)
+/// and its base rig, resolved relative to the variant file.
+fn load_variant(
+    spec: &str,
+    value: &serde_json::Value,
+) -> Result<(WangHybrid, HybridVariant), CliError> {
+    let input = |e: hydrocyl_energy::EnergyError| CliError::Input(e.to_string());
+    let v = HybridVariant::from_json(&value.to_string(), spec).map_err(input)?;
+    let base = v.base_rig(Path::new(spec).parent()).map_err(input)?;
+    Ok((base, v))
+}
+
+/// Simulates a circuit variant of the hybrid drive on `command` \[V\]. A
+/// variant that sets the needle opening per speed gets the entry for the
+/// command's peak speed, `K max(u_max / A1, −u_min / A2)` (K the pump's
+/// flow gain), the speed the chapter-8 scenarios command.
+fn simulate_variant(
+    base: &WangHybrid,
+    v: &HybridVariant,
+    command: Signal,
+    t: &[f64],
+    opts: &RunOptions,
+) -> Result<Run, CliError> {
+    let mut r = base.clone();
+    let (u_max, u_min) = match &command {
+        Signal::Table { value, .. } => value
+            .iter()
+            .fold((0.0f64, 0.0f64), |(hi, lo), &u| (hi.max(u), lo.min(u))),
+        _ => (0.0, 0.0),
+    };
+    let speed = r.pump.gain * (u_max / r.cylinder.area_1.si()).max(-u_min / r.cylinder.area_2.si());
+    v.apply_to_rig(&mut r, Some(1e3 * speed));
+    let build = |e: hydrocyl_system::BuildError| CliError::Input(format!("rig {}: {e}", v.name));
+    let mut comps = r.components(command).map_err(build)?;
+    v.swap_components(&mut comps);
+    let mut c = Circuit::build(comps).map_err(build)?;
+    let x0 = c.initial_state();
+    c.reset(t.first().copied().unwrap_or(0.0), &x0);
+    runner::run(&mut c, &x0, t, opts).map_err(|e| CliError::Input(format!("rig {}: {e}", v.name)))
+}
+
 /// `hydrocyl simulate` on a friction bench: the `--command` file carries the
 /// imposed motion (see [`crate::bench_sim`]).
 fn run_bench(args: &Args, value: &serde_json::Value) -> Result<(), CliError> {
@@ -209,10 +255,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(rig_err)?;
     }
-    if value.get("kind").and_then(|k| k.as_str()) == Some(bench::KIND) {
+    let kind = value.get("kind").and_then(|k| k.as_str());
+    if kind == Some(bench::KIND) {
         return run_bench(&args, &value);
     }
-    rig::check(&value).map_err(rig_err)?;
+    let variant = if kind == Some(variant::KIND) {
+        Some(load_variant(&args.rig, &value)?)
+    } else {
+        rig::check(&value).map_err(rig_err)?;
+        None
+    };
     if args.print_rig {
         let text = serde_json::to_string_pretty(&value)
             .map_err(|e| CliError::Input(format!("rig: {e}")))?;
@@ -249,7 +301,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
         rk4_step: args.rk4_step,
         ..RunOptions::default()
     };
-    let run = rig::simulate(&value, signal, &t, &opts).map_err(rig_err)?;
+    let run = match variant {
+        None => rig::simulate(&value, signal, &t, &opts).map_err(rig_err)?,
+        Some((base, v)) => simulate_variant(&base, &v, signal, &t, &opts)?,
+    };
     write_atomic(&out, &to_csv(&run))?;
     let cav = run.cavitation_entries();
     eprintln!(

@@ -346,3 +346,71 @@ fn friction_bench_needs_motion_and_writes_nothing_without_it() {
     assert!(err.contains("position") && err.contains("p.csv"), "{err}");
     assert!(!out.exists());
 }
+
+/// A `hybrid-variant` rig file (chapter 8's improvements) simulates through
+/// its base rig: the needle variant with every opening set to the base's
+/// 4.0e-6 m² is the base rig to the digit, and the solenoid variant removes
+/// the relief valves' cracking drop between pump line and chamber.
+#[test]
+fn hybrid_variants_are_simulated_on_their_base_rig() {
+    let dir = tempfile::tempdir().unwrap();
+    let rigs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/rigs");
+    let rows: Vec<(f64, f64)> = (0..=300)
+        .map(|k| {
+            let t = k as f64 * 0.005;
+            (t, if t > 0.2 { 2.0 } else { 0.0 })
+        })
+        .collect();
+    let cmd = write_command(dir.path(), "cmd.csv", &rows);
+    let sim = |rig: &Path, sets: &[&str], name: &str| {
+        let out = dir.path().join(name);
+        let mut c = hydrocyl();
+        c.args(["simulate", "--solver", "rosenbrock", "--rig"])
+            .arg(rig)
+            .arg("--command")
+            .arg(&cmd)
+            .arg("--out")
+            .arg(&out);
+        for s in sets {
+            c.args(["--set", s]);
+        }
+        let st = c.output().unwrap();
+        assert!(
+            st.status.success(),
+            "{}",
+            String::from_utf8_lossy(&st.stderr)
+        );
+        read_csv(&out)
+    };
+    let (h, base) = sim(&rigs.join("wang-hybrid.json"), &[], "base.csv");
+    let (h2, same) = sim(
+        &rigs.join("wang-hybrid-needle.json"),
+        &[
+            "needle_area_by_speed.0.area_m2=4.0e-6",
+            "needle_area_by_speed.1.area_m2=4.0e-6",
+        ],
+        "needle.csv",
+    );
+    assert_eq!(h, h2);
+    assert_eq!(
+        base, same,
+        "the needle variant at the base opening is the base rig"
+    );
+    let (h3, sol) = sim(&rigs.join("wang-hybrid-solenoid.json"), &[], "sol.csv");
+    // the relief valves' flow channels are gone with the relief valves
+    assert!(h3.contains(&"pp1".to_string()) && !h3.contains(&"relief_1_flow".to_string()));
+    let col = |h: &[String], n: &str| h.iter().position(|c| c == n).unwrap();
+    // one second into the extending command
+    let k = rows.iter().position(|r| r.0 >= 1.2).unwrap();
+    let drop = |h: &[String], d: &[Vec<f64>]| d[k][col(h, "pp1")] - d[k][col(h, "p1")];
+    assert!(
+        drop(&h, &base) > 10.34e5,
+        "relief 1 cracking: {}",
+        drop(&h, &base)
+    );
+    assert!(
+        drop(&h3, &sol) < 1e5,
+        "solenoid valve open: {}",
+        drop(&h3, &sol)
+    );
+}

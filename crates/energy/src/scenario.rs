@@ -17,16 +17,15 @@
 
 use crate::error::EnergyError;
 use crate::ledger::{ledger, trapezoid, Ledger, RodSide};
-use crate::switched::SwitchedOrifice;
 use crate::variant::HybridVariant;
 use hydrocyl_friction::FrictionLaw;
-use hydrocyl_ports::{Area, Pressure};
+use hydrocyl_ports::Pressure;
 use hydrocyl_system::hybrid::{nodes, ReturnPath, WangHybrid};
 use hydrocyl_system::rig::RigError;
 use hydrocyl_system::run::{run, RunOptions, SimError, Solver};
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::valve_rig::ValveRig;
-use hydrocyl_system::{Circuit, Component};
+use hydrocyl_system::Circuit;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -365,9 +364,7 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
             plan.friction.apply(&mut r.friction);
             r.initial_position = sc.start_position();
             if let Some(var) = variant {
-                if let Some(a) = var.needle_area_for(sc.speed_mm_s) {
-                    r.needle.area = Area::new(a);
-                }
+                var.apply_to_rig(&mut r, Some(sc.speed_mm_s));
             }
             let (a1, a2) = (r.cylinder.area_1.si(), r.cylinder.area_2.si());
             let k = r.pump.gain;
@@ -377,8 +374,8 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
             let mut comps = r
                 .components(cmd)
                 .map_err(|e| rig_err(&label)(RigError::Build(e)))?;
-            if let Some(s) = variant.as_ref().and_then(|v| v.solenoid_valves) {
-                replace_reliefs(&mut comps, s.area_m2, s.orifice);
+            if let Some(var) = variant {
+                var.swap_components(&mut comps);
             }
             let c = Circuit::build(comps).map_err(|e| rig_err(&label)(RigError::Build(e)))?;
             (c, Solver::Rosenbrock, Some(r))
@@ -463,31 +460,6 @@ fn wave_signal(wave: Wave, amplitude: f64, period_s: f64, bias: f64) -> Signal {
             bias,
             phase_rad: 0.0,
         },
-    }
-}
-
-/// Replaces relief valves 1 and 2 of the hybrid rig by solenoid valves
-/// switched by the pump command's sign (variant (a)).
-fn replace_reliefs(
-    comps: &mut [Box<dyn Component>],
-    area_m2: f64,
-    orifice: hydrocyl_valves::orifice::Orifice,
-) {
-    for c in comps.iter_mut() {
-        let (name, line, chamber, dir) = match c.name() {
-            "relief_1" => ("solenoid_1", nodes::LINE_1, nodes::CHAMBER_1, 1.0),
-            "relief_2" => ("solenoid_2", nodes::LINE_2, nodes::CHAMBER_2, -1.0),
-            _ => continue,
-        };
-        *c = Box::new(SwitchedOrifice::new(
-            name,
-            nodes::COMMAND,
-            line,
-            chamber,
-            Area::new(area_m2),
-            orifice,
-            dir,
-        ));
     }
 }
 

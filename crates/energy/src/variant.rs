@@ -19,7 +19,10 @@
 //!   \[m²\] per speed; a scenario takes the entry of the nearest speed.
 
 use crate::error::EnergyError;
-use hydrocyl_system::hybrid::WangHybrid;
+use crate::switched::SwitchedOrifice;
+use hydrocyl_ports::Area;
+use hydrocyl_system::hybrid::{nodes, WangHybrid};
+use hydrocyl_system::Component;
 use hydrocyl_valves::orifice::Orifice;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -131,6 +134,40 @@ impl HybridVariant {
                 })
                 .map(|s| s.area_m2)
         })
+    }
+
+    /// Changes the variant makes to the base rig's parameters: the needle
+    /// opening for `speed_mm_s` (the entry of the nearest speed) when the
+    /// variant sets one per speed and a speed is given.
+    pub fn apply_to_rig(&self, rig: &mut WangHybrid, speed_mm_s: Option<f64>) {
+        if let Some(a) = speed_mm_s.and_then(|v| self.needle_area_for(v)) {
+            rig.needle.area = Area::new(a);
+        }
+    }
+
+    /// Changes the variant makes to the assembled components: relief valves
+    /// 1 and 2 replaced by solenoid valves switched by the pump command's sign
+    /// (variant (a)); nothing otherwise.
+    pub fn swap_components(&self, comps: &mut [Box<dyn Component>]) {
+        let Some(spec) = self.solenoid_valves else {
+            return;
+        };
+        for c in comps.iter_mut() {
+            let (name, line, chamber, dir) = match c.name() {
+                "relief_1" => ("solenoid_1", nodes::LINE_1, nodes::CHAMBER_1, 1.0),
+                "relief_2" => ("solenoid_2", nodes::LINE_2, nodes::CHAMBER_2, -1.0),
+                _ => continue,
+            };
+            *c = Box::new(SwitchedOrifice::new(
+                name,
+                nodes::COMMAND,
+                line,
+                chamber,
+                Area::new(spec.area_m2),
+                spec.orifice,
+                dir,
+            ));
+        }
     }
 
     /// Parses and checks a variant from JSON text; `origin` names it in errors.

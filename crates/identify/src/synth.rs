@@ -269,6 +269,10 @@ pub fn valve_planted(id: EffectId) -> Option<(&'static str, f64)> {
         EffectId::FlowGainError => ("kw", 0.85),
         EffectId::InternalLeakage => ("Cl", 1e-11),
         EffectId::ExternalLeakage => ("Ce1", 1e-11),
+        // 2e9 Pa s/m^3: about 4 bar of droop at the 12 l/min the records draw at most
+        EffectId::SupplyDroop => ("Rs", 2e9),
+        // a transducer with its line and anti-alias filter
+        EffectId::SensorLag => ("tau", 5e-3),
         EffectId::BulkModulus => ("B", 3.5e8),
         EffectId::ExternalForce => ("F0", 800.0),
         _ => return None,

@@ -12,8 +12,11 @@
 //! by those parameters: `valve_null_bias` (valve.null_bias_m), `flow_gain_error`
 //! (valve.flow_gain), `internal_leakage` and `external_leakage`
 //! (cylinder.*_leakage), `bulk_modulus` (fluid.bulk_modulus_pa),
-//! `external_force` (load.external_force_n, + opposing extension) and
-//! `viscous` (the coulomb-viscous law's b). An effect is "off" at its neutral
+//! `external_force` (load.external_force_n, + opposing extension),
+//! `viscous` (the coulomb-viscous law's b), `supply_droop`
+//! (supply.droop_resistance_pa_s_per_m3) and `sensor_lag`
+//! (sensors.pressure_lag_s: the simulated p1/p2 are then the lagged sensor
+//! readings the record is compared with). An effect is "off" at its neutral
 //! value (0, or kw = 1); `bulk_modulus` is always declared, so tracing it
 //! means refitting B away from the declared value.
 //!
@@ -41,7 +44,7 @@ use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, smooth_gcv, smooth_with};
 
 /// Effects the valve rig exposes as parameters.
-pub const VALVE_EFFECTS: [EffectId; 7] = [
+pub const VALVE_EFFECTS: [EffectId; 9] = [
     EffectId::ValveNullBias,
     EffectId::FlowGainError,
     EffectId::InternalLeakage,
@@ -49,6 +52,8 @@ pub const VALVE_EFFECTS: [EffectId; 7] = [
     EffectId::BulkModulus,
     EffectId::ExternalForce,
     EffectId::Viscous,
+    EffectId::SupplyDroop,
+    EffectId::SensorLag,
 ];
 
 /// The channels compared, in report order.
@@ -64,6 +69,8 @@ pub fn get(rig: &ValveRig, id: EffectId, name: &str) -> Option<f64> {
         (EffectId::ExternalLeakage, "Ce2") => rig.cylinder.external_leakage_2_m3_per_s_pa,
         (EffectId::BulkModulus, "B") => rig.fluid.bulk_modulus_pa,
         (EffectId::ExternalForce, "F0") => rig.load.external_force_n,
+        (EffectId::SupplyDroop, "Rs") => rig.supply.droop_resistance_pa_s_per_m3,
+        (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s,
         (EffectId::Viscous, "b") => match &rig.friction {
             FrictionLaw::CoulombViscous(c) => c.viscous,
             _ => return None,
@@ -82,6 +89,8 @@ pub fn set(rig: &mut ValveRig, id: EffectId, name: &str, v: f64) {
         (EffectId::ExternalLeakage, "Ce2") => rig.cylinder.external_leakage_2_m3_per_s_pa = v,
         (EffectId::BulkModulus, "B") => rig.fluid.bulk_modulus_pa = v,
         (EffectId::ExternalForce, "F0") => rig.load.external_force_n = v,
+        (EffectId::SupplyDroop, "Rs") => rig.supply.droop_resistance_pa_s_per_m3 = v,
+        (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s = v,
         (EffectId::Viscous, "b") => {
             if let FrictionLaw::CoulombViscous(c) = &mut rig.friction {
                 c.viscous = v;
@@ -110,6 +119,9 @@ fn typical(id: EffectId, name: &str, rig: &ValveRig) -> f64 {
         (EffectId::BulkModulus, _) => rig.fluid.bulk_modulus_pa,
         (EffectId::ExternalForce, _) => 100.0,
         (EffectId::Viscous, _) => 1000.0,
+        // a droop of 1 bar at 6 l/min
+        (EffectId::SupplyDroop, _) => 1e9,
+        (EffectId::SensorLag, _) => 5e-3,
         _ => 1.0,
     }
 }
@@ -128,6 +140,18 @@ fn negligible(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> bool {
         EffectId::BulkModulus => (v("B") / declared.fluid.bulk_modulus_pa - 1.0).abs() < 0.02,
         EffectId::ExternalForce => v("F0").abs() < 5.0,
         EffectId::Viscous => v("b").abs() < 10.0,
+        // droop below 0.5 % of the supply at the valve's full-opening flow
+        // (half the supply across each edge)
+        EffectId::SupplyDroop => {
+            let m = rig.metering();
+            let q_full = m.orifice.coefficient()
+                * m.area_gradient()
+                * (rig.valve.stroke_m + rig.valve.underlap_m)
+                * (0.5 * rig.supply.pressure_pa).max(0.0).sqrt();
+            v("Rs") * q_full < 5e-3 * rig.supply.pressure_pa
+        }
+        // a lag under 0.1 ms is below any record's resolution here
+        EffectId::SensorLag => v("tau") < 1e-4,
         _ => false,
     }
 }
@@ -302,10 +326,13 @@ fn rss(rig: &ValveRig, p: &Prepared, holdout: f64, part: Part) -> f64 {
 type ParamList = Vec<(EffectId, &'static str)>;
 
 /// Fits `params` of `rig` in place on `part`, together with the initial
-/// piston position (a nuisance parameter: the rig integrates flow into
-/// position, so a few micrometres of initial offset would otherwise be
-/// absorbed by whichever effect shifts the position). The result's last
-/// entry is the initial position.
+/// piston position and velocity (nuisance parameters: the rig integrates
+/// flow into position, so a few micrometres of initial offset would
+/// otherwise be absorbed by whichever effect shifts the position; and the
+/// smoother's derivative at the record's first sample is one-sided and
+/// noisy, and an initial velocity a few cm/s off rings the chambers for a
+/// tenth of a second). The result's last two entries are the initial
+/// position and velocity.
 fn fit(
     rig: &mut ValveRig,
     params: &ParamList,
@@ -329,6 +356,11 @@ fn fit(
     lo.push(xi - 0.01);
     hi.push(xi + 0.01);
     typ.push(1e-3);
+    let vi = rig.initial.velocity;
+    x0.push(vi);
+    lo.push(vi - 0.2);
+    hi.push(vi + 0.2);
+    typ.push(1e-2);
     let k = params.len();
     let mut work = rig.clone();
     let res = lm::fit(
@@ -337,6 +369,7 @@ fn fit(
                 set(&mut work, *id, n, *v);
             }
             work.initial.position = x[k];
+            work.initial.velocity = x[k + 1];
             residual(&work, p, holdout, part, r)
         },
         &x0,
@@ -354,12 +387,13 @@ fn fit(
         set(rig, *id, n, *v);
     }
     rig.initial.position = res.x[k];
+    rig.initial.velocity = res.x[k + 1];
     Ok(res)
 }
 
 /// Traces a candidate cheaply: up to three backtracking Gauss–Newton steps on `part` from the
 /// current values, with a finite-difference Jacobian (step 10 % of each
-/// parameter's typical size) and the initial position as a nuisance column,
+/// parameter's typical size) and the initial position and velocity as nuisance columns,
 /// then clamped to the bounds. A handful of simulations per candidate instead
 /// of a full Levenberg–Marquardt fit; the effect that is added is refitted
 /// properly afterwards.
@@ -370,7 +404,7 @@ fn gauss_newton_trace(
     holdout: f64,
     part: Part,
 ) -> Result<(), String> {
-    let k = params.len() + 1;
+    let k = params.len() + 2;
     for _ in 0..3 {
         let mut r0 = Vec::new();
         residual(rig, p, holdout, part, &mut r0)?;
@@ -383,9 +417,12 @@ fn gauss_newton_trace(
                 let h = 0.1 * typical(id, n, rig);
                 set(&mut t, id, n, get(rig, id, n).unwrap_or(0.0) + h);
                 h
-            } else {
+            } else if j == params.len() {
                 t.initial.position += 1e-5;
                 1e-5
+            } else {
+                t.initial.velocity += 1e-4;
+                1e-4
             };
             let mut r1 = Vec::new();
             residual(&t, p, holdout, part, &mut r1)?;
@@ -413,7 +450,8 @@ fn gauss_newton_trace(
                 let v = (get(rig, *id, n).unwrap_or(0.0) + alpha * delta[j]).clamp(lo, hi);
                 set(&mut t, *id, n, v);
             }
-            t.initial.position += alpha * delta[k - 1];
+            t.initial.position += alpha * delta[k - 2];
+            t.initial.velocity += alpha * delta[k - 1];
             if rss(&t, p, holdout, part) < rss0 {
                 accepted = Some(t);
                 break;
@@ -483,9 +521,23 @@ pub fn diagnose_valve(
 ) -> Result<Report, DiagnoseError> {
     let start = Instant::now();
     let (p, info) = prepare(rec, opts.half_window)?;
-    let rig0 = with_initial(declared, &p);
+    let mut rig0 = with_initial(declared, &p);
     simulate(&rig0, &p)
         .map_err(|e| DiagnoseError::Rig(format!("declared model does not simulate: {e}")))?;
+    let nrmse_declared = channel_nrmse(&rig0, &p);
+    let mut warnings: Vec<String> = Vec::new();
+    // The declared model's own refit: the initial position and velocity
+    // only (the nuisance parameters of every later fit), so that what the
+    // effects are scored against is not an initial transient.
+    {
+        let mut r = rig0.clone();
+        match fit(&mut r, &Vec::new(), &p, opts.holdout, Part::All) {
+            Ok(_) => rig0 = r,
+            Err(e) => warnings.push(format!(
+                "initial-state fit: {e}; the smoother's initial position and velocity are kept"
+            )),
+        }
+    }
     let nrmse_before = channel_nrmse(&rig0, &p);
     let rss_before = rss(&rig0, &p, opts.holdout, Part::All);
     let candidates: Vec<EffectId> = opts
@@ -501,7 +553,6 @@ pub fn diagnose_valve(
     let mut added: Vec<EffectReport> = Vec::new();
     let mut last: BTreeMap<EffectId, EffectReport> = BTreeMap::new();
     let mut resembles: Option<Probe> = None;
-    let mut warnings: Vec<String> = Vec::new();
     let total = opts.max_effects + 1;
     // Tracing compares candidates with each other: a looser integration
     // tolerance is enough there; refits use the tight one.
@@ -710,8 +761,8 @@ pub fn diagnose_valve(
         samples: rec.len(),
         smoother: info.clone(),
         smoother_windows: vec![info.half_window],
-        initial_state: "velocity and chamber pressures at the first sample from the smoother's local cubic fit (not the raw noisy sample), initial position fitted with every refit (the rig integrates flow into position); spool at the first command; the rig's steady pressures where p1/p2 are not measured".into(),
-        nrmse_declared: nrmse_before.clone(),
+        initial_state: "velocity and chamber pressures at the first sample from the smoother's local cubic fit (not the raw noisy sample), initial position and velocity fitted first on the declared model and again with every refit (the rig integrates flow into position; the smoother's one-sided derivative at the first sample is noisy); spool at the first command; the rig's steady pressures where p1/p2 are not measured".into(),
+        nrmse_declared,
         nrmse_before,
         nrmse_after,
         noise_floor,

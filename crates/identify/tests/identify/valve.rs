@@ -64,6 +64,16 @@ fn external_leakage_is_found() {
 }
 
 #[test]
+fn supply_droop_is_found() {
+    check(EffectId::SupplyDroop, 41);
+}
+
+#[test]
+fn sensor_lag_is_found() {
+    check(EffectId::SensorLag, 42);
+}
+
+#[test]
 fn valve_null_bias_is_found() {
     // Found first and to within 0.05 % here, but its interval comes out about
     // 4x too narrow (see docs/diagnose.md), so the check is on the value only.

@@ -51,7 +51,7 @@ pub struct Args {
     /// Relative tolerance of the adaptive methods.
     #[arg(long, default_value_t = 1e-6)]
     rtol: f64,
-    /// Fixed step of rk4 [s].
+    /// Fixed step of rk4 \[s\].
     #[arg(long, default_value_t = 2e-5)]
     rk4_step: f64,
     /// Print the rig (after --set) as JSON and exit.

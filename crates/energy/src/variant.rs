@@ -13,7 +13,7 @@
 //! * `base`: a preset name or the path of a `hybrid-pump` rig file (relative
 //!   to the variant file);
 //! * `solenoid_valves` (variant (a)): relief valves 1 and 2 replaced by on/off
-//!   valves ([`SwitchedOrifice`](crate::switched::SwitchedOrifice)) open while
+//!   valves ([`SwitchedOrifice`]) open while
 //!   the pump command feeds their line (valve 1 for a positive command);
 //! * `needle_area_by_speed` (variant (b)): the needle valve's opening area
 //!   \[m²\] per speed; a scenario takes the entry of the nearest speed.

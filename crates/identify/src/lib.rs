@@ -22,7 +22,7 @@
 //!   force \[N\]); errors name file, row and column; first-order hold.
 //! * [`smooth`] — Savitzky–Golay on uneven steps, window by GCV.
 //! * [`catalog`] — the effect catalog as data (ids, balances, parameters).
-//! * [`bench`] — the `friction-bench` rig: force balance
+//! * [`bench`](mod@bench) — the `friction-bench` rig: force balance
 //!   `m a = s F + p1 A1 − p2 A2 − F_f − F0` (thesis eq 5.9 with the drive
 //!   force), friction per eq 5.1 (LuGre, g(v) with Stribeck), eq 5.4
 //!   (`K (p1 − p2)² v`) and eq 5.12 (`K H a`).

@@ -5,10 +5,14 @@
 //! the planted effects at realistic magnitude) on [`synth::motion`], 8 s at
 //! 500 Hz, with the default sensor noise, and the declared rig (the truth
 //! without the planted effects) as `<case>.rig.json`.
+//!
+//! The valve-rig records `valve-<effect>.csv` ([`synth::valve_fixture_cases`])
+//! are `leaney-moog` with one effect on at [`synth::valve_planted`]'s
+//! magnitude, simulated by [`synth::valve_record`] (2 s at 1 kHz, seed
+//! [`synth::VALVE_FIXTURE_SEED`]); their declared rig is the preset itself.
 
 use std::path::PathBuf;
 
-use hydrocyl_identify::catalog::EffectId;
 use hydrocyl_identify::data::{write_atomic, Signal};
 use hydrocyl_identify::synth::{self, Noise};
 
@@ -55,17 +59,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             case.name, case.planted, case.foreign
         );
     }
-    // Valve rig (leaney-moog): nothing missing, and an internal leak.
-    for (name, planted) in [
-        ("valve-none", None),
-        ("valve-internal_leakage", Some(EffectId::InternalLeakage)),
-    ] {
+    // Valve rig (leaney-moog): nothing missing, and each valve-rig effect alone.
+    for (name, planted) in synth::valve_fixture_cases() {
         let mut truth = hydrocyl_system::valve_rig::ValveRig::leaney_moog();
         if let Some(id) = planted {
             let (p, v) = synth::valve_planted(id).ok_or("no planted value")?;
             hydrocyl_identify::valve::set(&mut truth, id, p, v);
         }
-        let rec = synth::valve_record(&truth, 2000, 1e-3, 40)?;
+        let rec = synth::valve_record(&truth, 2000, 1e-3, synth::VALVE_FIXTURE_SEED)?;
         let mut csv = String::from("time [s],command,position [mm],p1 [bar],p2 [bar]\n");
         let g = |s: Signal| &rec.signals[&s];
         for i in 0..rec.time.len() {

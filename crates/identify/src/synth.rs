@@ -279,6 +279,23 @@ pub fn valve_planted(id: EffectId) -> Option<(&'static str, f64)> {
     })
 }
 
+/// Noise seed of the generated valve-rig fixtures (`fixtures/measured/valve-*.csv`).
+pub const VALVE_FIXTURE_SEED: u64 = 40;
+
+/// The generated valve-rig fixtures: file stem and the planted effect
+/// (`None`: nothing missing) — every effect [`valve_planted`] knows, each on
+/// `leaney-moog` alone at its planted magnitude; the declared rig is the
+/// preset itself.
+pub fn valve_fixture_cases() -> Vec<(String, Option<EffectId>)> {
+    let mut v = vec![("valve-none".to_string(), None)];
+    for id in EffectId::ALL {
+        if valve_planted(id).is_some() {
+            v.push((format!("valve-{}", id.id()), Some(id)));
+        }
+    }
+    v
+}
+
 /// The command of generated valve-rig records: two sines (1 Hz, 0.3 and
 /// 3.3 Hz, 0.1 of full spool demand).
 pub fn valve_command(t: f64) -> f64 {

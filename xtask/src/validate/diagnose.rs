@@ -138,10 +138,8 @@ pub fn section() -> Section {
 fn valve(s: &mut Section, dir: &Path) {
     use hydrocyl_identify::valve::{diagnose_valve, set};
     use hydrocyl_system::valve_rig::ValveRig;
-    for (name, planted) in [
-        ("valve-none", "none"),
-        ("valve-internal_leakage", "internal_leakage"),
-    ] {
+    for (name, planted_id) in synth::valve_fixture_cases() {
+        let planted = planted_id.map_or("none", |id| id.id());
         let res = Record::read(&dir.join(format!("{name}.csv")))
             .map_err(|e| e.to_string())
             .and_then(|r| {
@@ -164,10 +162,21 @@ fn valve(s: &mut Section, dir: &Path) {
                 let within = ["position", "p1", "p2"]
                     .iter()
                     .all(|c| r.nrmse_after[*c] <= 1.5 * r.noise_floor[*c]);
+                // the planted parameter: fitted ± 95 % interval vs planted
+                let param = planted_id
+                    .and_then(|id| synth::valve_planted(id).map(|(n, v)| (id, n, v)))
+                    .and_then(|(id, n, v)| {
+                        let e = r.effects_added.iter().find(|e| e.id == id.id())?;
+                        let got = e.params.get(n).copied()?;
+                        let ci = e.ci95.get(n).copied().flatten().unwrap_or(f64::NAN);
+                        Some(format!("; {n} {got:.4e} ± {ci:.1e} (planted {v:.4e})"))
+                    })
+                    .unwrap_or_default();
                 s.note(&format!(
-                    "{name:<40} {planted:<38} {found:<38} p1 {:.5}->{:.5} (floor {:.5}), position {:.2e}->{:.2e} (floor {:.2e})",
+                    "{name:<40} {planted:<38} {found:<38} NRMSE before -> after (floor): position {:.2e}->{:.2e} ({:.2e}), p1 {:.5}->{:.5} ({:.5}), p2 {:.5}->{:.5} ({:.5}){param}",
+                    r.nrmse_before["position"], r.nrmse_after["position"], r.noise_floor["position"],
                     r.nrmse_before["p1"], r.nrmse_after["p1"], r.noise_floor["p1"],
-                    r.nrmse_before["position"], r.nrmse_after["position"], r.noise_floor["position"]
+                    r.nrmse_before["p2"], r.nrmse_after["p2"], r.noise_floor["p2"],
                 ));
                 s.check(
                     &format!("{name}: found / NRMSE"),

@@ -63,8 +63,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (name, planted) in synth::valve_fixture_cases() {
         let mut truth = hydrocyl_system::valve_rig::ValveRig::leaney_moog();
         if let Some(id) = planted {
-            let (p, v) = synth::valve_planted(id).ok_or("no planted value")?;
-            hydrocyl_identify::valve::set(&mut truth, id, p, v);
+            for (p, v) in synth::valve_planted_all(id) {
+                hydrocyl_identify::valve::set(&mut truth, id, p, v);
+            }
         }
         let rec = synth::valve_record(&truth, 2000, 1e-3, synth::VALVE_FIXTURE_SEED)?;
         let mut csv = String::from("time [s],command,position [mm],p1 [bar],p2 [bar]\n");

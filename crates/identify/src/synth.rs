@@ -261,22 +261,34 @@ pub fn fixture_cases() -> Vec<FixtureCase> {
     v
 }
 
-/// A realistic magnitude of each valve-rig effect on `leaney-moog`
-/// (`None` for effects the valve rig does not expose).
+/// A realistic magnitude of each valve-rig effect on `leaney-moog`: its
+/// first parameter (the one the tests check against its interval); see
+/// [`valve_planted_all`] for every parameter planted. `None` for effects
+/// the valve rig does not expose.
 pub fn valve_planted(id: EffectId) -> Option<(&'static str, f64)> {
-    Some(match id {
-        EffectId::ValveNullBias => ("xb", 0.03 * 0.375e-3),
-        EffectId::FlowGainError => ("kw", 0.85),
-        EffectId::InternalLeakage => ("Cl", 1e-11),
-        EffectId::ExternalLeakage => ("Ce1", 1e-11),
+    valve_planted_all(id).first().copied()
+}
+
+/// Every parameter planted for effect `id` on `leaney-moog` (empty for
+/// effects the valve rig does not expose), in the order to set them.
+pub fn valve_planted_all(id: EffectId) -> Vec<(&'static str, f64)> {
+    match id {
+        EffectId::ValveNullBias => vec![("xb", 0.03 * 0.375e-3)],
+        EffectId::FlowGainError => vec![("kw", 0.85)],
+        EffectId::InternalLeakage => vec![("Cl", 1e-11)],
+        EffectId::ExternalLeakage => vec![("Ce1", 1e-11)],
         // 2e9 Pa s/m^3: about 4 bar of droop at the 12 l/min the records draw at most
-        EffectId::SupplyDroop => ("Rs", 2e9),
+        EffectId::SupplyDroop => vec![("Rs", 2e9)],
         // a transducer with its line and anti-alias filter
-        EffectId::SensorLag => ("tau", 5e-3),
-        EffectId::BulkModulus => ("B", 3.5e8),
-        EffectId::ExternalForce => ("F0", 800.0),
-        _ => return None,
-    })
+        EffectId::SensorLag => vec![("tau", 5e-3)],
+        EffectId::BulkModulus => vec![("B", 3.5e8)],
+        EffectId::ExternalForce => vec![("F0", 800.0)],
+        // declared Fc = 50 N: extending 70 N, retracting 30 N
+        EffectId::CoulombAsymmetry => vec![("dFc", 40.0)],
+        // a break-away level three times the Coulomb level, fading over ~20 mm/s
+        EffectId::Stribeck => vec![("Fs", 150.0), ("vs", 0.02), ("alpha", 0.7)],
+        _ => vec![],
+    }
 }
 
 /// Noise seed of the generated valve-rig fixtures (`fixtures/measured/valve-*.csv`).

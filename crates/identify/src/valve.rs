@@ -32,7 +32,8 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use hydrocyl_friction::FrictionLaw;
+use hydrocyl_friction::{FrictionLaw, SteadySet, Stribeck, StribeckCurve};
+use hydrocyl_ports::{Force, Velocity};
 use hydrocyl_system::run::RunOptions;
 use hydrocyl_system::signal::Signal as CmdSignal;
 use hydrocyl_system::valve_rig::ValveRig;
@@ -44,7 +45,9 @@ use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, smooth_gcv, smooth_with};
 
 /// Effects the valve rig exposes as parameters.
-pub const VALVE_EFFECTS: [EffectId; 9] = [
+pub const VALVE_EFFECTS: [EffectId; 11] = [
+    EffectId::CoulombAsymmetry,
+    EffectId::Stribeck,
     EffectId::ValveNullBias,
     EffectId::FlowGainError,
     EffectId::InternalLeakage,
@@ -73,10 +76,77 @@ pub fn get(rig: &ValveRig, id: EffectId, name: &str) -> Option<f64> {
         (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s,
         (EffectId::Viscous, "b") => match &rig.friction {
             FrictionLaw::CoulombViscous(c) => c.viscous,
+            FrictionLaw::Stribeck(s) => s.extending.sigma2,
+            _ => return None,
+        },
+        (EffectId::CoulombAsymmetry, "dFc") => match &rig.friction {
+            FrictionLaw::CoulombViscous(_) => 0.0,
+            FrictionLaw::Stribeck(s) => {
+                s.extending.curve.coulomb.si() - s.retracting.curve.coulomb.si()
+            }
+            _ => return None,
+        },
+        (EffectId::Stribeck, n) => match &rig.friction {
+            FrictionLaw::CoulombViscous(_) => 0.0,
+            FrictionLaw::Stribeck(s) if !has_hump(s) => 0.0,
+            FrictionLaw::Stribeck(s) => match n {
+                // the mean stiction level: Fc (mean) + the hump, which both
+                // directions share
+                "Fs" => 0.5 * (s.extending.curve.stiction.si() + s.retracting.curve.stiction.si()),
+                "vs" => s.extending.curve.stribeck_velocity.si(),
+                "alpha" => s.extending.curve.stribeck_exponent,
+                _ => return None,
+            },
             _ => return None,
         },
         _ => return None,
     })
+}
+
+/// `true` when a Stribeck law has a hump (stiction level away from the
+/// Coulomb level in either direction).
+fn has_hump(s: &Stribeck) -> bool {
+    s.extending.curve.stiction != s.extending.curve.coulomb
+        || s.retracting.curve.stiction != s.retracting.curve.coulomb
+}
+
+/// The valve rig's friction law as a [`Stribeck`] law (two direction sets),
+/// converting the declared coulomb-viscous law exactly: `Fc tanh(v/v_t) + b v`
+/// is the Stribeck law with `Fs = Fc` (no hump) and `σ2 = b` in both
+/// directions (its `vs` = 10 mm/s and `α` = 1 are then inert). Other laws:
+/// `None` (their friction effects are not switchable here).
+fn as_stribeck(law: &FrictionLaw) -> Option<Stribeck> {
+    match law {
+        FrictionLaw::Stribeck(s) => Some(*s),
+        FrictionLaw::CoulombViscous(c) => {
+            let set = SteadySet {
+                curve: StribeckCurve {
+                    coulomb: c.coulomb,
+                    stiction: c.coulomb,
+                    stribeck_velocity: Velocity::new(0.01),
+                    stribeck_exponent: 1.0,
+                },
+                sigma2: c.viscous,
+            };
+            Some(Stribeck {
+                extending: set,
+                retracting: set,
+                smoothing_velocity: c.smoothing_velocity,
+            })
+        }
+        _ => None,
+    }
+}
+
+/// Mean Coulomb level of the two directions \[N\] (the declared Fc).
+fn mean_coulomb(rig: &ValveRig) -> f64 {
+    match &rig.friction {
+        FrictionLaw::CoulombViscous(c) => c.coulomb.si(),
+        FrictionLaw::Stribeck(s) => {
+            0.5 * (s.extending.curve.coulomb.si() + s.retracting.curve.coulomb.si())
+        }
+        _ => 0.0,
+    }
 }
 
 /// Sets catalog parameter `name` of effect `id` in the rig.
@@ -91,12 +161,71 @@ pub fn set(rig: &mut ValveRig, id: EffectId, name: &str, v: f64) {
         (EffectId::ExternalForce, "F0") => rig.load.external_force_n = v,
         (EffectId::SupplyDroop, "Rs") => rig.supply.droop_resistance_pa_s_per_m3 = v,
         (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s = v,
-        (EffectId::Viscous, "b") => {
-            if let FrictionLaw::CoulombViscous(c) = &mut rig.friction {
-                c.viscous = v;
+        (EffectId::Viscous, "b") => match &mut rig.friction {
+            FrictionLaw::CoulombViscous(c) => c.viscous = v,
+            FrictionLaw::Stribeck(s) => {
+                s.extending.sigma2 = v;
+                s.retracting.sigma2 = v;
+            }
+            _ => {}
+        },
+        (EffectId::CoulombAsymmetry, "dFc") => {
+            if let Some(mut s) = as_stribeck(&rig.friction) {
+                // extending Fc + dFc/2, retracting Fc − dFc/2 (as on the
+                // friction bench), each direction's hump kept
+                let mean = 0.5 * (s.extending.curve.coulomb.si() + s.retracting.curve.coulomb.si());
+                for (set, level) in [
+                    (&mut s.extending, mean + 0.5 * v),
+                    (&mut s.retracting, mean - 0.5 * v),
+                ] {
+                    let hump = set.curve.stiction.si() - set.curve.coulomb.si();
+                    set.curve.coulomb = Force::new(level);
+                    set.curve.stiction = Force::new(level + hump);
+                }
+                rig.friction = FrictionLaw::Stribeck(s);
+            }
+        }
+        (EffectId::Stribeck, n) => {
+            if let Some(mut s) = as_stribeck(&rig.friction) {
+                let on = has_hump(&s);
+                match n {
+                    // Fs = 0 is the catalog's "off": no hump
+                    "Fs" => {
+                        let mean = 0.5
+                            * (s.extending.curve.coulomb.si() + s.retracting.curve.coulomb.si());
+                        let hump = if v == 0.0 { 0.0 } else { v - mean };
+                        for set in [&mut s.extending, &mut s.retracting] {
+                            set.curve.stiction = Force::new(set.curve.coulomb.si() + hump);
+                        }
+                    }
+                    // vs and alpha are inert without a hump; 0 (off) leaves them
+                    "vs" if on || v != 0.0 => {
+                        s.extending.curve.stribeck_velocity = Velocity::new(v);
+                        s.retracting.curve.stribeck_velocity = Velocity::new(v);
+                    }
+                    "alpha" if on || v != 0.0 => {
+                        s.extending.curve.stribeck_exponent = v;
+                        s.retracting.curve.stribeck_exponent = v;
+                    }
+                    _ => {}
+                }
+                rig.friction = FrictionLaw::Stribeck(s);
             }
         }
         _ => {}
+    }
+}
+
+/// Where the trace of an effect that is off starts: its neutral values,
+/// except `stribeck`, whose hump must exist for vs and α to be seen at all
+/// (at Fs = Fc their Jacobian columns vanish): Fs = 2 Fc, vs = 10 mm/s,
+/// α = 1 — generic values, not the planted ones.
+fn start_trace(rig: &mut ValveRig, id: EffectId) {
+    if id == EffectId::Stribeck && !is_on(rig, id) {
+        let fc = mean_coulomb(rig);
+        set(rig, id, "Fs", 2.0 * fc);
+        set(rig, id, "vs", 0.01);
+        set(rig, id, "alpha", 1.0);
     }
 }
 
@@ -119,6 +248,9 @@ fn typical(id: EffectId, name: &str, rig: &ValveRig) -> f64 {
         (EffectId::BulkModulus, _) => rig.fluid.bulk_modulus_pa,
         (EffectId::ExternalForce, _) => 100.0,
         (EffectId::Viscous, _) => 1000.0,
+        (EffectId::CoulombAsymmetry, _) | (EffectId::Stribeck, "Fs") => mean_coulomb(rig).max(1.0),
+        (EffectId::Stribeck, "vs") => 0.01,
+        (EffectId::Stribeck, _) => 1.0,
         // a droop of 1 bar at 6 l/min
         (EffectId::SupplyDroop, _) => 1e9,
         (EffectId::SensorLag, _) => 5e-3,
@@ -152,6 +284,11 @@ fn negligible(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> bool {
         }
         // a lag under 0.1 ms is below any record's resolution here
         EffectId::SensorLag => v("tau") < 1e-4,
+        // friction terms under 5 % of the declared Coulomb level
+        EffectId::CoulombAsymmetry => v("dFc").abs() < 0.05 * mean_coulomb(declared),
+        EffectId::Stribeck => {
+            v("Fs") == 0.0 || (v("Fs") - mean_coulomb(rig)).abs() < 0.05 * mean_coulomb(declared)
+        }
         _ => false,
     }
 }
@@ -161,6 +298,22 @@ fn negligible(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> bool {
 fn bounds(id: EffectId, name: &str, rig: &ValveRig) -> (f64, f64) {
     match id {
         EffectId::ValveNullBias => (-rig.valve.stroke_m, rig.valve.stroke_m),
+        // both directions keep a positive Coulomb level
+        EffectId::CoulombAsymmetry => {
+            let fc = mean_coulomb(rig);
+            (-1.9 * fc, 1.9 * fc)
+        }
+        // A break-away level beyond 10x the Coulomb level would say the
+        // declared friction is wrong altogether, not that it lacks a hump; α
+        // down to 0.1 (the thesis's Table 5-8 has 0.11) and vs from 0.1 mm/s.
+        // Without these limits a Gauss-Newton step from the generic start
+        // went to Fs = 17 kN, α = 0.07, where the curve is so steep at v = 0
+        // that one simulation took seconds.
+        EffectId::Stribeck => match name {
+            "Fs" => (0.0, 10.0 * mean_coulomb(rig)),
+            "vs" => (1e-4, 1.0),
+            _ => (0.1, 4.0),
+        },
         EffectId::ExternalForce => (-1e6, 1e6),
         _ => id
             .params()
@@ -685,6 +838,7 @@ pub fn diagnose_valve(
         let trace_one = |id: EffectId| -> (ValveRig, EffectReport) {
             let params: ParamList = id.params().iter().map(|q| (id, q.name)).collect();
             let mut trial = model.clone();
+            start_trace(&mut trial, id);
             // The candidate is traced together with the effects already added
             // (refitted jointly), so that an earlier effect that was standing
             // in for this one can give way.
@@ -902,7 +1056,60 @@ pub fn diagnose_valve(
 
 #[cfg(test)]
 mod tests {
-    use super::lag_samples;
+    use super::{as_stribeck, get, is_on, lag_samples, set};
+    use crate::catalog::EffectId;
+    use hydrocyl_friction::{FrictionInput, FrictionLaw, FrictionModel};
+    use hydrocyl_ports::Velocity;
+    use hydrocyl_system::valve_rig::ValveRig;
+
+    fn force(law: &FrictionLaw, v: f64) -> f64 {
+        law.force(&FrictionInput::at_velocity(Velocity::new(v)), &[])
+            .si()
+    }
+
+    #[test]
+    fn friction_effects_map_onto_a_stribeck_law() {
+        let rig = ValveRig::leaney_moog();
+        let cv = rig.friction;
+        let st = FrictionLaw::Stribeck(as_stribeck(&cv).unwrap());
+        let vs = [-0.2, -0.01, -1e-3, -1e-5, 0.0, 1e-5, 1e-3, 0.01, 0.2];
+        // the conversion of the declared coulomb-viscous law is exact
+        for v in vs {
+            assert!((force(&cv, v) - force(&st, v)).abs() < 1e-12, "v {v}");
+        }
+        // off: both effects read 0; setting them to 0 changes nothing
+        let mut r = rig.clone();
+        assert!(!is_on(&r, EffectId::CoulombAsymmetry) && !is_on(&r, EffectId::Stribeck));
+        set(&mut r, EffectId::CoulombAsymmetry, "dFc", 0.0);
+        set(&mut r, EffectId::Stribeck, "Fs", 0.0);
+        for v in vs {
+            assert!(
+                (force(&cv, v) - force(&r.friction, v)).abs() < 1e-12,
+                "v {v}"
+            );
+        }
+        // asymmetry: extending Fc + dFc/2, retracting Fc − dFc/2, read back
+        set(&mut r, EffectId::CoulombAsymmetry, "dFc", 40.0);
+        assert_eq!(get(&r, EffectId::CoulombAsymmetry, "dFc"), Some(40.0));
+        let b = 500.0;
+        assert!((force(&r.friction, 0.2) - (70.0 + b * 0.2)).abs() < 1e-9);
+        assert!((force(&r.friction, -0.2) - (-30.0 - b * 0.2)).abs() < 1e-9);
+        // a hump on top keeps the asymmetry: g(0+) = Fs + dFc/2
+        set(&mut r, EffectId::Stribeck, "Fs", 150.0);
+        assert!(is_on(&r, EffectId::Stribeck));
+        assert_eq!(get(&r, EffectId::Stribeck, "Fs"), Some(150.0));
+        // (vs = 10 mm/s and α = 1 from the conversion, v_t = 1 mm/s)
+        for v in [5e-3, -5e-3] {
+            let level = if v > 0.0 { 70.0 } else { 30.0 };
+            let g = level + 100.0 * (-(v / 0.01f64).abs()).exp();
+            let want = (v / 1e-3f64).tanh() * g + b * v;
+            assert!((force(&r.friction, v) - want).abs() < 1e-9, "v {v}");
+        }
+        // and the hump switches off again at Fs = 0
+        set(&mut r, EffectId::Stribeck, "Fs", 0.0);
+        assert!(!is_on(&r, EffectId::Stribeck));
+        assert!((force(&r.friction, 0.2) - (70.0 + b * 0.2)).abs() < 1e-9);
+    }
 
     #[test]
     fn lag_of_samples_is_exact_for_a_ramp_and_identity_at_zero() {

@@ -2,15 +2,16 @@
 
 use hydrocyl_identify::catalog::EffectId;
 use hydrocyl_identify::diagnose::{DiagnoseOptions, Report};
-use hydrocyl_identify::synth::{valve_planted, valve_record};
+use hydrocyl_identify::synth::{valve_planted, valve_planted_all, valve_record};
 use hydrocyl_identify::valve::{diagnose_valve, set};
 use hydrocyl_system::valve_rig::ValveRig;
 
 fn run(planted: &[EffectId], seed: u64) -> Report {
     let mut truth = ValveRig::leaney_moog();
     for id in planted {
-        let (name, v) = valve_planted(*id).unwrap();
-        set(&mut truth, *id, name, v);
+        for (name, v) in valve_planted_all(*id) {
+            set(&mut truth, *id, name, v);
+        }
     }
     let rec = valve_record(&truth, 2000, 1e-3, seed).unwrap();
     diagnose_valve(
@@ -71,6 +72,21 @@ fn supply_droop_is_found() {
 #[test]
 fn sensor_lag_is_found() {
     check(EffectId::SensorLag, 42);
+}
+
+#[test]
+fn coulomb_asymmetry_is_found() {
+    check(EffectId::CoulombAsymmetry, 43);
+}
+
+#[test]
+fn stribeck_is_found() {
+    // Fs is checked against its interval; vs and alpha are fitted with it
+    // from generic starting values (10 mm/s, 1), not the planted 20 mm/s, 0.7.
+    let r = check(EffectId::Stribeck, 44);
+    let p = &r.effects_added[0].params;
+    assert!((p["vs"] / 0.02 - 1.0).abs() < 0.2, "{}", r.human());
+    assert!((p["alpha"] / 0.7 - 1.0).abs() < 0.2, "{}", r.human());
 }
 
 #[test]

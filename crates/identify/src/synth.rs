@@ -287,6 +287,8 @@ pub fn valve_planted_all(id: EffectId) -> Vec<(&'static str, f64)> {
         EffectId::CoulombAsymmetry => vec![("dFc", 40.0)],
         // a break-away level three times the Coulomb level, fading over ~20 mm/s
         EffectId::Stribeck => vec![("Fs", 150.0), ("vs", 0.02), ("alpha", 0.7)],
+        // bristles with a 0.25 mm relaxation length at Fc = 50 N, damped
+        EffectId::LugreDynamics => vec![("sigma0", 2e5), ("sigma1", 600.0)],
         _ => vec![],
     }
 }

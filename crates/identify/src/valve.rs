@@ -32,7 +32,7 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use hydrocyl_friction::{FrictionLaw, SteadySet, Stribeck, StribeckCurve};
+use hydrocyl_friction::{FrictionLaw, LuGre, SteadySet, Stribeck, StribeckCurve};
 use hydrocyl_ports::{Force, Velocity};
 use hydrocyl_system::run::RunOptions;
 use hydrocyl_system::signal::Signal as CmdSignal;
@@ -45,9 +45,10 @@ use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, smooth_gcv, smooth_with};
 
 /// Effects the valve rig exposes as parameters.
-pub const VALVE_EFFECTS: [EffectId; 11] = [
+pub const VALVE_EFFECTS: [EffectId; 12] = [
     EffectId::CoulombAsymmetry,
     EffectId::Stribeck,
+    EffectId::LugreDynamics,
     EffectId::ValveNullBias,
     EffectId::FlowGainError,
     EffectId::InternalLeakage,
@@ -76,38 +77,75 @@ pub fn get(rig: &ValveRig, id: EffectId, name: &str) -> Option<f64> {
         (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s,
         (EffectId::Viscous, "b") => match &rig.friction {
             FrictionLaw::CoulombViscous(c) => c.viscous,
-            FrictionLaw::Stribeck(s) => s.extending.sigma2,
-            _ => return None,
+            law => friction_sets(law)?.0.sigma2,
         },
-        (EffectId::CoulombAsymmetry, "dFc") => match &rig.friction {
-            FrictionLaw::CoulombViscous(_) => 0.0,
-            FrictionLaw::Stribeck(s) => {
-                s.extending.curve.coulomb.si() - s.retracting.curve.coulomb.si()
+        (EffectId::CoulombAsymmetry, "dFc") => {
+            let (e, r) = friction_sets(&rig.friction)?;
+            e.curve.coulomb.si() - r.curve.coulomb.si()
+        }
+        (EffectId::Stribeck, n) => {
+            let (e, r) = friction_sets(&rig.friction)?;
+            if !has_hump(&e, &r) {
+                0.0
+            } else {
+                match n {
+                    // the mean stiction level: Fc (mean) + the hump, which
+                    // both directions share
+                    "Fs" => 0.5 * (e.curve.stiction.si() + r.curve.stiction.si()),
+                    "vs" => e.curve.stribeck_velocity.si(),
+                    "alpha" => e.curve.stribeck_exponent,
+                    _ => return None,
+                }
             }
-            _ => return None,
-        },
-        (EffectId::Stribeck, n) => match &rig.friction {
-            FrictionLaw::CoulombViscous(_) => 0.0,
-            FrictionLaw::Stribeck(s) if !has_hump(s) => 0.0,
-            FrictionLaw::Stribeck(s) => match n {
-                // the mean stiction level: Fc (mean) + the hump, which both
-                // directions share
-                "Fs" => 0.5 * (s.extending.curve.stiction.si() + s.retracting.curve.stiction.si()),
-                "vs" => s.extending.curve.stribeck_velocity.si(),
-                "alpha" => s.extending.curve.stribeck_exponent,
+        }
+        (EffectId::LugreDynamics, n) => match &rig.friction {
+            FrictionLaw::LuGre(l) => match n {
+                "sigma0" => l.sigma0,
+                "sigma1" => l.sigma1,
                 _ => return None,
             },
-            _ => return None,
+            law => {
+                friction_sets(law)?;
+                0.0
+            }
         },
         _ => return None,
     })
 }
 
-/// `true` when a Stribeck law has a hump (stiction level away from the
-/// Coulomb level in either direction).
-fn has_hump(s: &Stribeck) -> bool {
-    s.extending.curve.stiction != s.extending.curve.coulomb
-        || s.retracting.curve.stiction != s.retracting.curve.coulomb
+/// `true` when the direction sets have a hump (stiction level away from
+/// the Coulomb level in either direction).
+fn has_hump(e: &SteadySet, r: &SteadySet) -> bool {
+    e.curve.stiction != e.curve.coulomb || r.curve.stiction != r.curve.coulomb
+}
+
+/// Smoothing velocity of `sgn(v)` given to a static law made from a LuGre
+/// law when `lugre_dynamics` is switched off again (LuGre has none; the
+/// declared one is not kept) \[m·s⁻¹\]: the `leaney-moog` value.
+const STATIC_SMOOTHING: f64 = 1e-3;
+
+/// The two direction sets (Stribeck curve and σ2) of the rig's friction
+/// law: a LuGre's or a Stribeck law's own, the coulomb-viscous law's exact
+/// Stribeck equivalent ([`as_stribeck`]); `None` for the other laws.
+fn friction_sets(law: &FrictionLaw) -> Option<(SteadySet, SteadySet)> {
+    match law {
+        FrictionLaw::LuGre(l) => Some((l.extending, l.retracting)),
+        _ => as_stribeck(law).map(|s| (s.extending, s.retracting)),
+    }
+}
+
+/// Edits the two direction sets in place: a LuGre law's, else those of the
+/// law as a Stribeck law (the coulomb-viscous law is converted exactly).
+fn with_sets(law: &mut FrictionLaw, f: impl FnOnce(&mut SteadySet, &mut SteadySet)) {
+    match law {
+        FrictionLaw::LuGre(l) => f(&mut l.extending, &mut l.retracting),
+        _ => {
+            if let Some(mut s) = as_stribeck(law) {
+                f(&mut s.extending, &mut s.retracting);
+                *law = FrictionLaw::Stribeck(s);
+            }
+        }
+    }
 }
 
 /// The valve rig's friction law as a [`Stribeck`] law (two direction sets),
@@ -140,13 +178,9 @@ fn as_stribeck(law: &FrictionLaw) -> Option<Stribeck> {
 
 /// Mean Coulomb level of the two directions \[N\] (the declared Fc).
 fn mean_coulomb(rig: &ValveRig) -> f64 {
-    match &rig.friction {
-        FrictionLaw::CoulombViscous(c) => c.coulomb.si(),
-        FrictionLaw::Stribeck(s) => {
-            0.5 * (s.extending.curve.coulomb.si() + s.retracting.curve.coulomb.si())
-        }
-        _ => 0.0,
-    }
+    friction_sets(&rig.friction).map_or(0.0, |(e, r)| {
+        0.5 * (e.curve.coulomb.si() + r.curve.coulomb.si())
+    })
 }
 
 /// Sets catalog parameter `name` of effect `id` in the rig.
@@ -163,69 +197,112 @@ pub fn set(rig: &mut ValveRig, id: EffectId, name: &str, v: f64) {
         (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s = v,
         (EffectId::Viscous, "b") => match &mut rig.friction {
             FrictionLaw::CoulombViscous(c) => c.viscous = v,
-            FrictionLaw::Stribeck(s) => {
-                s.extending.sigma2 = v;
-                s.retracting.sigma2 = v;
+            law => with_sets(law, |e, r| {
+                e.sigma2 = v;
+                r.sigma2 = v;
+            }),
+        },
+        (EffectId::CoulombAsymmetry, "dFc") => with_sets(&mut rig.friction, |e, r| {
+            // extending Fc + dFc/2, retracting Fc − dFc/2 (as on the friction
+            // bench), each direction's hump kept
+            let mean = 0.5 * (e.curve.coulomb.si() + r.curve.coulomb.si());
+            for (set, level) in [(e, mean + 0.5 * v), (r, mean - 0.5 * v)] {
+                let hump = set.curve.stiction.si() - set.curve.coulomb.si();
+                set.curve.coulomb = Force::new(level);
+                set.curve.stiction = Force::new(level + hump);
+            }
+        }),
+        (EffectId::Stribeck, n) => with_sets(&mut rig.friction, |e, r| {
+            let on = has_hump(e, r);
+            match n {
+                // Fs = 0 is the catalog's "off": no hump
+                "Fs" => {
+                    let mean = 0.5 * (e.curve.coulomb.si() + r.curve.coulomb.si());
+                    let hump = if v == 0.0 { 0.0 } else { v - mean };
+                    for set in [e, r] {
+                        set.curve.stiction = Force::new(set.curve.coulomb.si() + hump);
+                    }
+                }
+                // vs and alpha are inert without a hump; 0 (off) leaves them
+                "vs" if on || v != 0.0 => {
+                    e.curve.stribeck_velocity = Velocity::new(v);
+                    r.curve.stribeck_velocity = Velocity::new(v);
+                }
+                "alpha" if on || v != 0.0 => {
+                    e.curve.stribeck_exponent = v;
+                    r.curve.stribeck_exponent = v;
+                }
+                _ => {}
+            }
+        }),
+        // σ0 = 0 is the catalog's "off": the static law with the same
+        // curves; σ0 ≠ 0 puts the bristles in, keeping the curves and σ2
+        (EffectId::LugreDynamics, "sigma0") => match &mut rig.friction {
+            FrictionLaw::LuGre(l) if v != 0.0 => l.sigma0 = v,
+            FrictionLaw::LuGre(l) => {
+                rig.friction = FrictionLaw::Stribeck(Stribeck {
+                    extending: l.extending,
+                    retracting: l.retracting,
+                    smoothing_velocity: Velocity::new(STATIC_SMOOTHING),
+                });
+            }
+            law if v != 0.0 => {
+                if let Some((e, r)) = friction_sets(law) {
+                    *law = FrictionLaw::LuGre(LuGre {
+                        sigma0: v,
+                        sigma1: 0.0,
+                        extending: e,
+                        retracting: r,
+                    });
+                }
             }
             _ => {}
         },
-        (EffectId::CoulombAsymmetry, "dFc") => {
-            if let Some(mut s) = as_stribeck(&rig.friction) {
-                // extending Fc + dFc/2, retracting Fc − dFc/2 (as on the
-                // friction bench), each direction's hump kept
-                let mean = 0.5 * (s.extending.curve.coulomb.si() + s.retracting.curve.coulomb.si());
-                for (set, level) in [
-                    (&mut s.extending, mean + 0.5 * v),
-                    (&mut s.retracting, mean - 0.5 * v),
-                ] {
-                    let hump = set.curve.stiction.si() - set.curve.coulomb.si();
-                    set.curve.coulomb = Force::new(level);
-                    set.curve.stiction = Force::new(level + hump);
-                }
-                rig.friction = FrictionLaw::Stribeck(s);
-            }
-        }
-        (EffectId::Stribeck, n) => {
-            if let Some(mut s) = as_stribeck(&rig.friction) {
-                let on = has_hump(&s);
-                match n {
-                    // Fs = 0 is the catalog's "off": no hump
-                    "Fs" => {
-                        let mean = 0.5
-                            * (s.extending.curve.coulomb.si() + s.retracting.curve.coulomb.si());
-                        let hump = if v == 0.0 { 0.0 } else { v - mean };
-                        for set in [&mut s.extending, &mut s.retracting] {
-                            set.curve.stiction = Force::new(set.curve.coulomb.si() + hump);
-                        }
-                    }
-                    // vs and alpha are inert without a hump; 0 (off) leaves them
-                    "vs" if on || v != 0.0 => {
-                        s.extending.curve.stribeck_velocity = Velocity::new(v);
-                        s.retracting.curve.stribeck_velocity = Velocity::new(v);
-                    }
-                    "alpha" if on || v != 0.0 => {
-                        s.extending.curve.stribeck_exponent = v;
-                        s.retracting.curve.stribeck_exponent = v;
-                    }
-                    _ => {}
-                }
-                rig.friction = FrictionLaw::Stribeck(s);
+        // σ1 is inert without bristles
+        (EffectId::LugreDynamics, "sigma1") => {
+            if let FrictionLaw::LuGre(l) = &mut rig.friction {
+                l.sigma1 = v;
             }
         }
         _ => {}
     }
 }
 
-/// Where the trace of an effect that is off starts: its neutral values,
-/// except `stribeck`, whose hump must exist for vs and α to be seen at all
-/// (at Fs = Fc their Jacobian columns vanish): Fs = 2 Fc, vs = 10 mm/s,
-/// α = 1 — generic values, not the planted ones.
-fn start_trace(rig: &mut ValveRig, id: EffectId) {
-    if id == EffectId::Stribeck && !is_on(rig, id) {
-        let fc = mean_coulomb(rig);
-        set(rig, id, "Fs", 2.0 * fc);
-        set(rig, id, "vs", 0.01);
-        set(rig, id, "alpha", 1.0);
+/// Where the trace of an effect that is off starts (one rig per start;
+/// the trace keeps the best): its neutral values, except
+/// * `stribeck`, whose hump must exist for vs and α to be seen at all (at
+///   Fs = Fc their Jacobian columns vanish): Fs = 2 Fc, vs = 10 mm/s, α = 1;
+/// * `lugre_dynamics`, where a tiny σ0 would be soft, metre-long bristles,
+///   not a small step from "off": σ1 = 1000 N·s/m with σ0 = 1e5 and 1e6 N/m
+///   (relaxation lengths Fc/σ0 of 0.5 mm and 50 µm at the preset's Fc). The
+///   σ0–σ1 surface has two basins on this rig: from 1e6 alone the fit of a
+///   planted σ0 = 2e5, σ1 = 600 stopped at σ0 = 3.5e5, σ1 ≈ 0 (a slightly
+///   worse fit, with an interval that excluded the truth), so both are tried.
+///
+/// Generic values, not the planted ones.
+fn trace_starts(rig: &ValveRig, id: EffectId) -> Vec<ValveRig> {
+    let mut r = rig.clone();
+    if is_on(rig, id) {
+        return vec![r];
+    }
+    match id {
+        EffectId::Stribeck => {
+            let fc = mean_coulomb(rig);
+            set(&mut r, id, "Fs", 2.0 * fc);
+            set(&mut r, id, "vs", 0.01);
+            set(&mut r, id, "alpha", 1.0);
+            vec![r]
+        }
+        EffectId::LugreDynamics => [1e5, 1e6]
+            .iter()
+            .map(|&s0| {
+                let mut r = rig.clone();
+                set(&mut r, id, "sigma0", s0);
+                set(&mut r, id, "sigma1", 1000.0);
+                r
+            })
+            .collect(),
+        _ => vec![r],
     }
 }
 
@@ -251,6 +328,8 @@ fn typical(id: EffectId, name: &str, rig: &ValveRig) -> f64 {
         (EffectId::CoulombAsymmetry, _) | (EffectId::Stribeck, "Fs") => mean_coulomb(rig).max(1.0),
         (EffectId::Stribeck, "vs") => 0.01,
         (EffectId::Stribeck, _) => 1.0,
+        (EffectId::LugreDynamics, "sigma0") => 1e6,
+        (EffectId::LugreDynamics, _) => 1000.0,
         // a droop of 1 bar at 6 l/min
         (EffectId::SupplyDroop, _) => 1e9,
         (EffectId::SensorLag, _) => 5e-3,
@@ -289,6 +368,10 @@ fn negligible(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> bool {
         EffectId::Stribeck => {
             v("Fs") == 0.0 || (v("Fs") - mean_coulomb(rig)).abs() < 0.05 * mean_coulomb(declared)
         }
+        // bristles so stiff that their relaxation length Fc/σ0 is under
+        // 10 µm (half the position noise of the generated records) act as
+        // static friction
+        EffectId::LugreDynamics => v("sigma0") == 0.0 || mean_coulomb(rig) / v("sigma0") < 1e-5,
         _ => false,
     }
 }
@@ -313,6 +396,13 @@ fn bounds(id: EffectId, name: &str, rig: &ValveRig) -> (f64, f64) {
             "Fs" => (0.0, 10.0 * mean_coulomb(rig)),
             "vs" => (1e-4, 1.0),
             _ => (0.1, 4.0),
+        },
+        // σ0 above 1e7 N/m makes the bristle state stiff for the explicit
+        // integrator (relaxation time Fc/(σ0 |v|) of 0.1 ms at 50 mm/s) and is
+        // static friction to within the position noise anyway (below)
+        EffectId::LugreDynamics => match name {
+            "sigma0" => (1e3, 1e7),
+            _ => (0.0, 1e5),
         },
         EffectId::ExternalForce => (-1e6, 1e6),
         _ => id
@@ -682,27 +772,31 @@ fn gauss_newton_trace(
 }
 
 /// Runs `f` on every item, spread over the available cores (at most one
-/// thread per item), and returns the results in the order of `items`.
-fn trace_parallel<T: Send>(items: &[EffectId], f: &(dyn Fn(EffectId) -> T + Sync)) -> Vec<T> {
+/// thread per item; each thread takes the next item not yet taken, so a
+/// slow item does not hold up a queue), and returns the results in the
+/// order of `items`.
+fn trace_parallel<I: Sync, T: Send>(items: &[I], f: &(dyn Fn(&I) -> T + Sync)) -> Vec<T> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
     let threads = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
         .min(items.len())
         .max(1);
     if threads == 1 {
-        return items.iter().map(|&id| f(id)).collect();
+        return items.iter().map(f).collect();
     }
+    let next = AtomicUsize::new(0);
     let mut slots: Vec<Option<T>> = std::iter::repeat_with(|| None).take(items.len()).collect();
     std::thread::scope(|sc| {
         let handles: Vec<_> = (0..threads)
-            .map(|k| {
-                sc.spawn(move || {
-                    items
-                        .iter()
-                        .enumerate()
-                        .skip(k)
-                        .step_by(threads)
-                        .map(|(i, &id)| (i, f(id)))
-                        .collect::<Vec<_>>()
+            .map(|_| {
+                sc.spawn(|| {
+                    let mut done = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, Ordering::Relaxed);
+                        let Some(item) = items.get(i) else { break };
+                        done.push((i, f(item)));
+                    }
+                    done
                 })
             })
             .collect();
@@ -835,15 +929,21 @@ pub fn diagnose_valve(
             .filter(|&id| id == EffectId::BulkModulus || !is_on(&model, id))
             .filter(|id| !added.iter().any(|a| a.id == id.id()))
             .collect();
-        let trace_one = |id: EffectId| -> (ValveRig, EffectReport) {
+        // One job per candidate and start (see `trace_starts`).
+        let jobs: Vec<(EffectId, ValveRig)> = todo
+            .iter()
+            .flat_map(|&id| trace_starts(&model, id).into_iter().map(move |r| (id, r)))
+            .collect();
+        let trace_one = |job: &(EffectId, ValveRig)| -> (ValveRig, EffectReport, f64) {
+            let id = job.0;
             let params: ParamList = id.params().iter().map(|q| (id, q.name)).collect();
-            let mut trial = model.clone();
-            start_trace(&mut trial, id);
             // The candidate is traced together with the effects already added
             // (refitted jointly), so that an earlier effect that was standing
             // in for this one can give way.
             let joint: ParamList = free.iter().chain(params.iter()).copied().collect();
+            let mut trial = job.1.clone();
             let res = gauss_newton_trace(&mut trial, &joint, &pt, opts.holdout, Part::Train);
+            let rss_train = rss(&trial, &pt, opts.holdout, Part::Train);
             let rss1 = rss(&trial, &pt, opts.holdout, Part::All);
             let held = 1.0 - rss(&trial, &pt, opts.holdout, Part::Held) / rss0_held.max(1e-300);
             let share = 1.0 - rss1 / rss0.max(1e-300);
@@ -879,13 +979,35 @@ pub fn diagnose_valve(
                 rep.reason =
                     Some("fitted size negligible (indistinguishable from the declared rig)".into());
             }
-            (trial, rep)
+            (trial, rep, rss_train)
         };
-        // The candidates are independent: trace them on the available cores
+        // The jobs are independent: trace them on the available cores
         // (results taken in catalog order, so the outcome does not depend on
-        // the number of threads).
-        let traced = trace_parallel(&todo, &trace_one);
-        for (id, (trial, rep)) in todo.iter().copied().zip(traced) {
+        // the number of threads). Of a candidate's starts, the one ending
+        // lowest on the training part is kept.
+        let mut traced: Vec<Option<(EffectId, ValveRig, EffectReport, f64)>> =
+            trace_parallel(&jobs, &trace_one)
+                .into_iter()
+                .zip(&jobs)
+                .map(|((t, r, x), (id, _))| Some((*id, t, r, x)))
+                .collect();
+        let mut chosen: Vec<(EffectId, ValveRig, EffectReport)> = Vec::new();
+        for &id in &todo {
+            let mut pick: Option<(ValveRig, EffectReport, f64)> = None;
+            for slot in traced.iter_mut() {
+                if slot.as_ref().is_some_and(|s| s.0 == id) {
+                    if let Some((_, t, r, x)) = slot.take() {
+                        if pick.as_ref().is_none_or(|p| x < p.2) {
+                            pick = Some((t, r, x));
+                        }
+                    }
+                }
+            }
+            if let Some((t, r, _)) = pick {
+                chosen.push((id, t, r));
+            }
+        }
+        for (id, trial, rep) in chosen {
             if rep.reason.is_none()
                 && best
                     .as_ref()
@@ -1108,6 +1230,21 @@ mod tests {
         // and the hump switches off again at Fs = 0
         set(&mut r, EffectId::Stribeck, "Fs", 0.0);
         assert!(!is_on(&r, EffectId::Stribeck));
+        assert!((force(&r.friction, 0.2) - (70.0 + b * 0.2)).abs() < 1e-9);
+        // bristles in (the curves and σ2 kept), and out again
+        set(&mut r, EffectId::LugreDynamics, "sigma0", 2e5);
+        set(&mut r, EffectId::LugreDynamics, "sigma1", 600.0);
+        match &r.friction {
+            FrictionLaw::LuGre(l) => {
+                assert_eq!((l.sigma0, l.sigma1), (2e5, 600.0));
+                assert_eq!(l.extending.curve.coulomb.si(), 70.0);
+                assert_eq!(l.retracting.sigma2, b);
+            }
+            other => panic!("expected a LuGre law, got {other:?}"),
+        }
+        assert_eq!(get(&r, EffectId::CoulombAsymmetry, "dFc"), Some(40.0));
+        set(&mut r, EffectId::LugreDynamics, "sigma0", 0.0);
+        assert!(!is_on(&r, EffectId::LugreDynamics));
         assert!((force(&r.friction, 0.2) - (70.0 + b * 0.2)).abs() < 1e-9);
     }
 

@@ -90,6 +90,15 @@ fn stribeck_is_found() {
 }
 
 #[test]
+fn lugre_dynamics_is_found() {
+    let r = check(EffectId::LugreDynamics, 45);
+    let p = &r.effects_added[0].params;
+    let ci = &r.effects_added[0].ci95;
+    let s1 = ci["sigma1"].expect("interval");
+    assert!((p["sigma1"] - 600.0).abs() <= s1, "{}", r.human());
+}
+
+#[test]
 fn valve_null_bias_is_found() {
     check(EffectId::ValveNullBias, 32);
 }

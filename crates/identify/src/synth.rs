@@ -339,12 +339,35 @@ pub fn valve_record_delayed(
     seed: u64,
     delay: f64,
 ) -> Result<Record, String> {
+    valve_record_with(truth, n, dt, seed, delay, &valve_command)
+}
+
+/// A command with rests: [`valve_command`] for 0.6 s of every second, then
+/// `hold` (the spool demand at which the declared rig stands still) for
+/// 0.4 s. A record that only moves cannot tell a Coulomb asymmetry from a
+/// constant force (both are a constant force while moving); at rest the
+/// asymmetry vanishes and the constant force does not.
+pub fn valve_command_with_rests(t: f64, hold: f64) -> f64 {
+    if t.rem_euclid(1.0) < 0.6 {
+        hold + valve_command(t)
+    } else {
+        hold
+    }
+}
+
+/// As [`valve_record_delayed`] on any `command` (normalised spool demand as
+/// a function of time).
+pub fn valve_record_with(
+    truth: &hydrocyl_system::valve_rig::ValveRig,
+    n: usize,
+    dt: f64,
+    seed: u64,
+    delay: f64,
+    command: &dyn Fn(f64) -> f64,
+) -> Result<Record, String> {
     let t: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
-    let u: Vec<f64> = t.iter().map(|&t| valve_command(t)).collect();
-    let late: Vec<f64> = t
-        .iter()
-        .map(|&t| valve_command((t - delay).max(0.0)))
-        .collect();
+    let u: Vec<f64> = t.iter().map(|&t| command(t)).collect();
+    let late: Vec<f64> = t.iter().map(|&t| command((t - delay).max(0.0))).collect();
     let cmd = hydrocyl_system::signal::Signal::table(t.clone(), late).map_err(|e| e.to_string())?;
     let run = truth
         .simulate(

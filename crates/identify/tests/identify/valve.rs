@@ -80,6 +80,60 @@ fn coulomb_asymmetry_is_found() {
 }
 
 #[test]
+fn coulomb_asymmetry_is_told_from_a_constant_force_when_the_record_rests() {
+    // On the moving-only records a planted asymmetry comes back as an
+    // external force dFc/2 on some noise draws (docs/diagnose.md); with rests
+    // in the record the two differ. Seeds 51, 52, 57 are draws where the
+    // moving-only record was attributed to external_force.
+    let declared = ValveRig::leaney_moog();
+    let xm = declared.valve.stroke_m;
+    let hold = declared.spool_for_velocity(0.0).unwrap() / xm;
+    let mut truth = ValveRig::leaney_moog();
+    for (name, v) in valve_planted_all(EffectId::CoulombAsymmetry) {
+        set(&mut truth, EffectId::CoulombAsymmetry, name, v);
+    }
+    for seed in [51, 52, 57] {
+        let rec =
+            hydrocyl_identify::synth::valve_record_with(&truth, 2000, 1e-3, seed, 0.0, &|t| {
+                hydrocyl_identify::synth::valve_command_with_rests(t, hold)
+            })
+            .unwrap();
+        let r = diagnose_valve(
+            &declared,
+            &rec,
+            &DiagnoseOptions::default(),
+            &mut |_, _, _| {},
+        )
+        .unwrap();
+        let text = r.human();
+        assert_eq!(
+            r.effects_added.first().map(|e| e.id.as_str()),
+            Some("coulomb_asymmetry"),
+            "seed {seed}\n{text}"
+        );
+        assert!(
+            r.effects_added.iter().all(|e| e.id != "external_force"),
+            "seed {seed}\n{text}"
+        );
+        // the attribution is the point here; the value to 2 % (its interval
+        // is checked in `coulomb_asymmetry_is_found`; on one of these three
+        // draws it misses by 1.24x its half-width, see the coverage numbers)
+        let got = r.effects_added[0].params["dFc"];
+        eprintln!(
+            "seed {seed}: dFc {got:.3} ± {:.3}, p1 NRMSE {:.5} -> {:.5} (floor {:.5})",
+            r.effects_added[0].ci95["dFc"].unwrap_or(f64::NAN),
+            r.nrmse_before["p1"],
+            r.nrmse_after["p1"],
+            r.noise_floor["p1"]
+        );
+        assert!(
+            (got / 40.0 - 1.0).abs() < 0.02,
+            "seed {seed}: {got}\n{text}"
+        );
+    }
+}
+
+#[test]
 fn stribeck_is_found() {
     // Fs is checked against its interval; vs and alpha are fitted with it
     // from generic starting values (10 mm/s, 1), not the planted 20 mm/s, 0.7.

@@ -159,6 +159,50 @@ fn hybrid_real_time() -> Result<(), String> {
     Ok(())
 }
 
+/// `hydrocyl diagnose` on a 12 s, 1 kHz `leaney-moog` record with a planted
+/// internal leak (the speed case), against the reference of one
+/// simulation of the same record (generating it): the ratio says how many
+/// record simulations a diagnosis costs, the wall time is printed beside the
+/// goal (< 10 s on the development machine).
+fn valve_diagnose_time() -> Result<(), String> {
+    use hydrocyl_identify::catalog::EffectId;
+    use hydrocyl_identify::diagnose::DiagnoseOptions;
+    use hydrocyl_identify::synth;
+    use hydrocyl_identify::valve::{diagnose_valve, set};
+    use hydrocyl_system::valve_rig::ValveRig;
+    let mut truth = ValveRig::leaney_moog();
+    let (p, v) = synth::valve_planted(EffectId::InternalLeakage)
+        .ok_or("no planted internal_leakage value")?;
+    set(&mut truth, EffectId::InternalLeakage, p, v);
+    let mut rec = None;
+    let simulate = best_of(3, || {
+        let t0 = Instant::now();
+        rec = Some(synth::valve_record(&truth, 12_000, 1e-3, 9)?);
+        Ok(t0.elapsed().as_secs_f64())
+    })?;
+    let rec = rec.ok_or("no record")?;
+    let t0 = Instant::now();
+    let report = diagnose_valve(
+        &ValveRig::leaney_moog(),
+        &rec,
+        &DiagnoseOptions::default(),
+        &mut |_, _, _| {},
+    )
+    .map_err(|e| e.to_string())?;
+    let diagnose = t0.elapsed().as_secs_f64();
+    let found = report
+        .effects_added
+        .first()
+        .map_or("nothing", |e| e.id.as_str())
+        .to_string();
+    println!(
+        "diagnose, valve rig, 12 s at 1 kHz:                   {diagnose:7.2} s wall (goal < 10 s) = {:.0} record simulations ({:.0} ms each); found {found}",
+        diagnose / simulate,
+        simulate * 1e3
+    );
+    Ok(())
+}
+
 /// Runs the benchmarks; returns `false` only when a benchmark could not run
 /// (a benchmark has no pass/fail threshold).
 pub fn run() -> bool {
@@ -169,6 +213,7 @@ pub fn run() -> bool {
     for (name, r) in [
         ("valve rig", valve_rig_real_time()),
         ("hybrid rig", hybrid_real_time()),
+        ("diagnose", valve_diagnose_time()),
     ] {
         if let Err(e) = r {
             eprintln!("cargo xtask bench: {name}: {e}");

@@ -236,7 +236,10 @@ pub fn finite_difference_jacobian<M: FrictionModel + ?Sized>(
         }
     }
     if let Some(&z) = state.first() {
-        let hz = 1e-6 * z.abs().max(1e-9);
+        // z is a bristle deflection of order F/σ0 (micrometres); a step
+        // relative to |z| alone would be ~1e-15 m at z = 0, where rounding in
+        // a force of kN (the seal term) swamps the difference.
+        let hz = 1e-6 * z.abs().max(1e-7);
         let (zu, zd) = ([z + hz], [z - hz]);
         j.df_dz = (f(input, &zu) - f(input, &zd)) / (2.0 * hz);
         j.dzdot_dz = (zdot(input, &zu) - zdot(input, &zd)) / (2.0 * hz);

@@ -37,6 +37,18 @@ pub trait OdeSystem {
         false
     }
 
+    /// How many of the **last** states are quadratures: integrals that no
+    /// derivative depends on, not even their own (accumulated energies,
+    /// pumped volumes). Their Jacobian columns are zero by construction, so
+    /// the stiff solver neither differences them nor factorises them: it
+    /// solves the other states' block and gets the quadratures by forward
+    /// substitution. Default 0. A model that returns `k > 0` promises
+    /// `∂f_i/∂x_j = 0` for every `i` and every `j ≥ dim − k`; an analytic
+    /// [`jacobian`](OdeSystem::jacobian) may leave those columns unwritten.
+    fn n_quadratures(&self) -> usize {
+        0
+    }
+
     /// Number of switching functions.
     fn n_events(&self) -> usize {
         0

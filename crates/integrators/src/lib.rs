@@ -181,7 +181,7 @@ pub fn solve<S: OdeSystem + ?Sized>(
             opts,
         ),
         Method::Rosenbrock => driver::run(
-            rodas::Rodas4::new(n),
+            rodas::Rodas4::new(n, sys.n_quadratures().min(n)),
             Controller::Predictive { q: 4.0 },
             4.0,
             sys,

@@ -17,6 +17,14 @@
 //! as absolute, a natural scale for it); `f_t` is always a forward difference
 //! in `t` with `δ_t = sqrt(ε) · max(|t|, h)`. After a rejected step the
 //! Jacobian is reused and only `E` is refactorised.
+//!
+//! Quadrature states ([`OdeSystem::n_quadratures`], the last `q` states) have
+//! zero Jacobian columns, so `E` is block lower-triangular,
+//! `[[E_aa, 0], [−J_qa, I/(hγ)]]`: only the `n − q` active states are
+//! differenced and factorised, and each stage's quadrature part follows by
+//! forward substitution, `k_q = hγ (b_q + J_qa k_a)`. This is the same
+//! linear algebra, not an approximation; it keeps an energy ledger of dozens
+//! of integrals from turning a 9-state LU into a 70-state one.
 // The stage loops index several vectors in step; iterators would hide that.
 #![allow(clippy::needless_range_loop)]
 
@@ -72,6 +80,8 @@ const DD35: f64 = -0.659_438_912_571_687_2e+01;
 /// Rodas4 stepper; all work vectors and the LU buffer allocated once.
 pub(crate) struct Rodas4 {
     n: usize,
+    /// Active (non-quadrature) states: the first `na` of `n`.
+    na: usize,
     k: [Vec<f64>; 6],
     f0: Vec<f64>,
     ft: Vec<f64>,
@@ -90,15 +100,41 @@ pub(crate) struct Rodas4 {
     lin_bad: Option<usize>,
 }
 
+/// The stage solve `E k = b` with the quadratures substituted.
+struct BlockSolve<'a> {
+    lu: &'a SolverLu,
+    jac: &'a [f64],
+    n: usize,
+    na: usize,
+    h_gamma: f64,
+}
+
+impl BlockSolve<'_> {
+    /// Overwrites `b` with `k`.
+    #[inline]
+    fn solve(&self, b: &mut [f64]) {
+        let (n, na) = (self.n, self.na);
+        self.lu.solve(&mut b[..na]);
+        for i in na..n {
+            let row = &self.jac[i * n..i * n + na];
+            let s: f64 = row.iter().zip(&b[..na]).map(|(j, k)| j * k).sum();
+            b[i] = self.h_gamma * (b[i] + s);
+        }
+    }
+}
+
 /// First index of a non-finite entry.
 fn first_nonfinite(v: &[f64]) -> Option<usize> {
     v.iter().position(|x| !x.is_finite())
 }
 
 impl Rodas4 {
-    pub(crate) fn new(n: usize) -> Self {
+    /// A stepper for `n` states, the last `quadratures` of them quadratures.
+    pub(crate) fn new(n: usize, quadratures: usize) -> Self {
+        let na = n - quadratures.min(n);
         Self {
             n,
+            na,
             k: std::array::from_fn(|_| vec![0.0; n]),
             f0: vec![0.0; n],
             ft: vec![0.0; n],
@@ -106,7 +142,7 @@ impl Rodas4 {
             fy: vec![0.0; n],
             jac: vec![0.0; n * n],
             jac_valid: false,
-            lu: SolverLu::new(n),
+            lu: SolverLu::new(na),
             cont: std::array::from_fn(|_| vec![0.0; n]),
             scale: vec![1e-5; n],
             bad: None,
@@ -140,7 +176,14 @@ impl Rodas4 {
         stats.jac_evals += 1;
         if !sys.jacobian(t, x, &mut self.jac) {
             self.y.copy_from_slice(x);
+            // quadrature columns are zero: nothing depends on a quadrature
             for j in 0..n {
+                if j >= self.na {
+                    for i in 0..n {
+                        self.jac[i * n + j] = 0.0;
+                    }
+                    continue;
+                }
                 let xj = x[j];
                 self.y[j] = xj + sqrt_eps * xj.abs().max(self.scale[j]);
                 sys.rhs(t, &self.y, &mut self.fy);
@@ -185,15 +228,17 @@ impl Stepper for Rodas4 {
             // The driver reports the offending state from f_start().
             return Attempt::Done;
         }
-        // E = I/(hγ) − J.
+        // E = I/(hγ) − J on the active block (the quadratures are
+        // substituted, see the module docs).
         let fac = 1.0 / (h * GAMMA);
+        let na = self.na;
         {
             let e = self.lu.matrix_mut();
-            for i in 0..n {
-                for j in 0..n {
-                    e[i * n + j] = -self.jac[i * n + j];
+            for i in 0..na {
+                for j in 0..na {
+                    e[i * na + j] = -self.jac[i * n + j];
                 }
-                e[i * n + i] += fac;
+                e[i * na + i] += fac;
             }
         }
         stats.lu_decomps += 1;
@@ -202,13 +247,19 @@ impl Stepper for Rodas4 {
         }
         let [k1, k2, k3, k4, k5, k6] = &mut self.k;
         let (y, fy, f0, ft) = (&mut self.y, &mut self.fy, &self.f0, &self.ft);
-        let lu = &self.lu;
+        let solver = BlockSolve {
+            lu: &self.lu,
+            jac: &self.jac,
+            n,
+            na,
+            h_gamma: h * GAMMA,
+        };
         let inv_h = 1.0 / h;
 
         for i in 0..n {
             k1[i] = f0[i] + h * D1 * ft[i];
         }
-        lu.solve(k1);
+        solver.solve(k1);
 
         for i in 0..n {
             y[i] = x[i] + A21 * k1[i];
@@ -218,7 +269,7 @@ impl Stepper for Rodas4 {
         for i in 0..n {
             k2[i] = fy[i] + C21 * inv_h * k1[i] + h * D2 * ft[i];
         }
-        lu.solve(k2);
+        solver.solve(k2);
 
         for i in 0..n {
             y[i] = x[i] + A31 * k1[i] + A32 * k2[i];
@@ -228,7 +279,7 @@ impl Stepper for Rodas4 {
         for i in 0..n {
             k3[i] = fy[i] + inv_h * (C31 * k1[i] + C32 * k2[i]) + h * D3 * ft[i];
         }
-        lu.solve(k3);
+        solver.solve(k3);
 
         for i in 0..n {
             y[i] = x[i] + A41 * k1[i] + A42 * k2[i] + A43 * k3[i];
@@ -238,7 +289,7 @@ impl Stepper for Rodas4 {
         for i in 0..n {
             k4[i] = fy[i] + inv_h * (C41 * k1[i] + C42 * k2[i] + C43 * k3[i]) + h * D4 * ft[i];
         }
-        lu.solve(k4);
+        solver.solve(k4);
 
         for i in 0..n {
             y[i] = x[i] + A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i];
@@ -248,7 +299,7 @@ impl Stepper for Rodas4 {
         for i in 0..n {
             k5[i] = fy[i] + inv_h * (C51 * k1[i] + C52 * k2[i] + C53 * k3[i] + C54 * k4[i]);
         }
-        lu.solve(k5);
+        solver.solve(k5);
 
         for i in 0..n {
             y[i] += k5[i];
@@ -259,7 +310,7 @@ impl Stepper for Rodas4 {
             k6[i] = fy[i]
                 + inv_h * (C61 * k1[i] + C62 * k2[i] + C63 * k3[i] + C64 * k4[i] + C65 * k5[i]);
         }
-        lu.solve(k6);
+        solver.solve(k6);
         stats.rhs_evals += 5;
         self.bad = self.bad.or(bad);
 

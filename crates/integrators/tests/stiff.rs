@@ -133,3 +133,76 @@ fn fd_jacobian_matches_analytic_jacobian_results() {
         2 + 4 * b.stats.jac_evals + 5 * (b.stats.steps + b.stats.rejected)
     );
 }
+
+/// Van der Pol with two quadratures appended, `∫x₁ dt` and `∫x₁² dt`,
+/// declared as quadratures or not.
+struct VdpWithQuadratures {
+    vdp: VanDerPol,
+    declared: bool,
+}
+
+impl hydrocyl_integrators::OdeSystem for VdpWithQuadratures {
+    fn dim(&self) -> usize {
+        4
+    }
+    fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
+        self.vdp.rhs(t, &x[..2], &mut dx[..2]);
+        dx[2] = x[0];
+        dx[3] = x[0] * x[0];
+    }
+    fn n_quadratures(&self) -> usize {
+        if self.declared {
+            2
+        } else {
+            0
+        }
+    }
+}
+
+#[test]
+fn declared_quadratures_skip_their_jacobian_columns_and_change_nothing_else() {
+    use hydrocyl_integrators::OdeSystem;
+    let opts = Options {
+        rtol: 1e-8,
+        atol: vec![1e-8],
+        max_steps: 100_000,
+        ..Options::default()
+    };
+    let run = |declared: bool| {
+        let mut sys = VdpWithQuadratures {
+            vdp: VanDerPol { mu: 50.0 },
+            declared,
+        };
+        assert_eq!(sys.n_quadratures(), if declared { 2 } else { 0 });
+        solve(
+            Method::Rosenbrock,
+            &mut sys,
+            0.0,
+            &[2.0, 0.0, 0.0, 0.0],
+            100.0,
+            &opts,
+        )
+        .unwrap()
+    };
+    let (full, block) = (run(false), run(true));
+    let (a, b) = (full.state(full.t.len() - 1), block.state(block.t.len() - 1));
+    // the block solve is the same linear algebra: the same steps, the same
+    // answer to round-off
+    assert_eq!(full.stats.steps, block.stats.steps);
+    assert_eq!(full.stats.rejected, block.stats.rejected);
+    for i in 0..4 {
+        assert!(
+            (a[i] - b[i]).abs() <= 1e-9 * a[i].abs().max(1.0),
+            "state {i}: {} vs {}",
+            a[i],
+            b[i]
+        );
+    }
+    // two fewer finite-difference columns per Jacobian
+    assert_eq!(
+        full.stats.rhs_evals - block.stats.rhs_evals,
+        2 * full.stats.jac_evals
+    );
+    // ∫x₁² dt is positive and grows with the limit cycle's |x₁| ≈ 1..2
+    assert!(b[3] > 50.0 && b[2].is_finite(), "∫x₁² dt = {}", b[3]);
+}

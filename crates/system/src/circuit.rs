@@ -727,6 +727,12 @@ impl OdeSystem for Circuit {
             }
     }
 
+    /// The component quadratures and the energy ledger: integrals of
+    /// flows and powers that no component reads back.
+    fn n_quadratures(&self) -> usize {
+        self.dim() - self.n_states
+    }
+
     fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
         self.fill(t, x);
         let w = self.wires.borrow();

@@ -124,11 +124,12 @@ pub fn section() -> Section {
     let ok = run(&synth::declared_for(&[EffectId::PressureViscous]), &[rec]).is_ok();
     let el = t0.elapsed().as_secs_f64();
     s.check(
-        "friction bench: 12 s at 1 kHz diagnosed (wall time)",
-        format!("{el:.2} s"),
-        "< 10 s".into(),
-        ok && el < 10.0,
+        "friction bench: 12 s at 1 kHz record diagnosed",
+        if ok { "a report" } else { "an error" }.into(),
+        "a report".into(),
+        ok,
     );
+    timing_note(&mut s, "friction bench", el);
     valve(&mut s, &dir);
     real_data(&mut s);
     s
@@ -209,11 +210,12 @@ fn valve(s: &mut Section, dir: &Path) {
             });
             let el = t0.elapsed().as_secs_f64();
             s.check(
-                "valve rig: 12 s at 1 kHz diagnosed (wall time)",
-                format!("{el:.2} s"),
-                "< 10 s".into(),
-                ok && el < 10.0,
+                "valve rig: 12 s at 1 kHz record, internal_leakage found first",
+                if ok { "found" } else { "not found" }.into(),
+                "found".into(),
+                ok,
             );
+            timing_note(s, "valve rig", el);
         }
         Err(e) => s.check(
             "valve rig: 12 s record generated",
@@ -222,6 +224,16 @@ fn valve(s: &mut Section, dir: &Path) {
             false,
         ),
     }
+}
+
+/// Reports a diagnose wall time against the goal. Wall time depends on
+/// the machine and on what else runs on it, so it is reported here and
+/// measured as a ratio in `cargo xtask bench`, never asserted.
+fn timing_note(s: &mut Section, what: &str, seconds: f64) {
+    s.note(&format!(
+        "{what}: 12 s at 1 kHz diagnosed in {seconds:.2} s wall (goal < 10 s on the development machine; {}; not a pass/fail check)",
+        if seconds < 10.0 { "met here" } else { "NOT met here" }
+    ));
 }
 
 fn real_data(s: &mut Section) {

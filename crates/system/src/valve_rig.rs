@@ -19,6 +19,10 @@ use serde::{Deserialize, Serialize};
 /// The JSON `kind` of this rig.
 pub const KIND: &str = "valve-cylinder";
 
+/// Absolute vacuum on the gauge scale every rig uses \[Pa\]: no pressure
+/// parameter (tank, vapour/cavitation) may lie below it.
+pub const ABSOLUTE_VACUUM_GAUGE_PA: f64 = -101_325.0;
+
 /// Fluid properties.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -278,7 +282,12 @@ impl ValveRig {
         let fin = |p: &str, v: f64| check(p, v, true, "must be finite");
         pos("fluid.density_kg_per_m3", self.fluid.density_kg_per_m3)?;
         pos("fluid.bulk_modulus_pa", self.fluid.bulk_modulus_pa)?;
-        fin("supply.tank_pressure_pa", self.supply.tank_pressure_pa)?;
+        check(
+            "supply.tank_pressure_pa",
+            self.supply.tank_pressure_pa,
+            self.supply.tank_pressure_pa > ABSOLUTE_VACUUM_GAUGE_PA,
+            "must be above absolute vacuum (-101325 Pa gauge)",
+        )?;
         check(
             "supply.pressure_pa",
             self.supply.pressure_pa,
@@ -362,7 +371,13 @@ impl ValveRig {
             "cylinder.external_leakage_2_m3_per_s_pa",
             c.external_leakage_2_m3_per_s_pa,
         )?;
-        fin("cylinder.cavitation_pressure_pa", c.cavitation_pressure_pa)?;
+        check(
+            "cylinder.cavitation_pressure_pa",
+            c.cavitation_pressure_pa,
+            c.cavitation_pressure_pa >= ABSOLUTE_VACUUM_GAUGE_PA
+                && c.cavitation_pressure_pa <= self.supply.tank_pressure_pa,
+            "must lie between absolute vacuum (-101325 Pa gauge) and the tank pressure",
+        )?;
         check(
             "cylinder.x_tolerance",
             c.x_tolerance,

@@ -108,6 +108,11 @@ fn overrides_reach_every_parameter_and_bad_ones_are_named() {
             "valve.discharge_coefficient",
         ),
         ("friction.viscous=-1", "friction"),
+        (
+            "cylinder.cavitation_pressure_pa=1e5",
+            "cylinder.cavitation_pressure_pa",
+        ),
+        ("supply.tank_pressure_pa=-2e5", "supply.tank_pressure_pa"),
     ] {
         let mut v = fixture();
         rig::apply_set(&mut v, set).unwrap();

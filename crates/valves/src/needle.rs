@@ -89,9 +89,7 @@ impl NeedleValve {
                 reason: "must be at most 1",
             });
         }
-        positive(C, "cd", orifice.cd)?;
-        positive(C, "density", orifice.density.si())?;
-        positive(C, "dp_transition", orifice.dp_transition.si())?;
+        orifice.validate(C)?;
         Ok(Self {
             area,
             effective_factor,
@@ -231,6 +229,9 @@ mod tests {
         let mut o = n.orifice;
         o.cd = f64::NAN;
         assert!(NeedleValve::new(n.area, 0.8, o, n.reverse_check).is_err());
+        o.cd = 1.5;
+        let e = NeedleValve::new(n.area, 0.8, o, n.reverse_check).unwrap_err();
+        assert_eq!(e.name, "cd");
     }
 
     proptest! {

@@ -13,6 +13,7 @@
 //! the absolute flow error is at most `0.2011 Cd A √(2 Δp_t / ρ)` and vanishes
 //! as `√Δp_t` when `Δp_t → 0` (tested below).
 
+use crate::check::{positive, ParameterError};
 use hydrocyl_ports::{Area, Density, Pressure, VolumeFlow};
 use serde::{Deserialize, Serialize};
 
@@ -64,6 +65,23 @@ impl Orifice {
             density,
             dp_transition: DEFAULT_DP_TRANSITION,
         }
+    }
+
+    /// Checks the parameters on behalf of `component` (named in the error):
+    /// Cd in `(0, 1]` (a sharp edge cannot pass more than the ideal jet),
+    /// ρ > 0 and Δp_t > 0, all finite.
+    pub fn validate(&self, component: &'static str) -> Result<(), ParameterError> {
+        positive(component, "cd", self.cd)?;
+        if self.cd > 1.0 {
+            return Err(ParameterError {
+                component,
+                name: "cd",
+                value: self.cd,
+                reason: "a discharge coefficient must be at most 1",
+            });
+        }
+        positive(component, "density", self.density.si())?;
+        positive(component, "dp_transition", self.dp_transition.si())
     }
 
     /// Flow coefficient `Cd √(2/ρ)` \[m^1.5·kg^-0.5\]: flow per unit area per √Pa.
@@ -152,6 +170,30 @@ mod tests {
             let an = signed_sqrt_regularised_derivative(x, xt);
             prop_assume!((x.abs() - xt).abs() > 2.0 * h && x.abs() > 2.0 * h);
             prop_assert!((fd - an).abs() <= 1e-5 * an.abs().max(1e-3));
+        }
+    }
+
+    #[test]
+    fn validate_names_the_component_and_the_parameter() {
+        let ok = Orifice::new(0.625, Density::new(870.0));
+        assert!(ok.validate("test").is_ok());
+        assert!(Orifice::new(1.0, Density::new(870.0)).validate("t").is_ok());
+        for (o, name) in [
+            (Orifice::new(1.5, Density::new(870.0)), "cd"),
+            (Orifice::new(0.0, Density::new(870.0)), "cd"),
+            (Orifice::new(f64::NAN, Density::new(870.0)), "cd"),
+            (Orifice::new(0.6, Density::new(-1.0)), "density"),
+            (
+                Orifice {
+                    dp_transition: Pressure::ZERO,
+                    ..ok
+                },
+                "dp_transition",
+            ),
+        ] {
+            let e = o.validate("needle valve").unwrap_err();
+            assert_eq!((e.component, e.name), ("needle valve", name));
+            assert!(e.to_string().contains(name), "{e}");
         }
     }
 

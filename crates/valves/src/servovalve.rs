@@ -54,6 +54,16 @@ pub enum ServovalveError {
         /// The value given.
         value: f64,
     },
+    /// A parameter outside its physical range.
+    #[error("servovalve parameter `{name}` = {value} is out of range: {reason}")]
+    OutOfRange {
+        /// Parameter name.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// What it must satisfy.
+        reason: &'static str,
+    },
 }
 
 fn positive(name: &'static str, value: f64) -> Result<(), ServovalveError> {
@@ -247,6 +257,13 @@ impl Metering {
         }
         positive("spool_diameter", self.spool_diameter.si())?;
         positive("discharge_coefficient", self.orifice.cd)?;
+        if self.orifice.cd > 1.0 {
+            return Err(ServovalveError::OutOfRange {
+                name: "discharge_coefficient",
+                value: self.orifice.cd,
+                reason: "a discharge coefficient must be at most 1",
+            });
+        }
         positive("density", self.orifice.density.si())?;
         positive("regularisation", self.orifice.dp_transition.si())?;
         finite("null_bias", self.null_bias.si())?;
@@ -551,6 +568,10 @@ mod tests {
         m.spool_diameter = Position::new(-1.0);
         let e = m.validate().unwrap_err();
         assert!(e.to_string().contains("spool_diameter"));
+        let mut m = valve();
+        m.orifice.cd = 1.2;
+        let e = m.validate().unwrap_err();
+        assert!(e.to_string().contains("discharge_coefficient"), "{e}");
         let d = SpoolDynamics::First {
             time_constant_s: f64::NAN,
         };

@@ -231,6 +231,26 @@ impl WangHybrid {
                 });
             }
         }
+        let vacuum = crate::valve_rig::ABSOLUTE_VACUUM_GAUGE_PA;
+        if self.tank_pressure <= vacuum {
+            return Err(BuildError::Component {
+                component: "wang-hybrid".into(),
+                message: format!(
+                    "`tank_pressure` = {} Pa must be above absolute vacuum ({vacuum} Pa gauge)",
+                    self.tank_pressure
+                ),
+            });
+        }
+        if !(vacuum..=self.tank_pressure).contains(&self.vapour_pressure) {
+            return Err(BuildError::Component {
+                component: "wang-hybrid".into(),
+                message: format!(
+                    "`vapour_pressure` = {} Pa must lie between absolute vacuum ({vacuum} Pa gauge) \
+                     and the tank pressure ({} Pa)",
+                    self.vapour_pressure, self.tank_pressure
+                ),
+            });
+        }
         self.friction
             .validate()
             .map_err(|e| BuildError::Component {
@@ -426,5 +446,23 @@ mod tests {
         let mut r = WangHybrid::preset();
         r.relief_pilot.full_open = Pressure::new(1.0);
         assert!(r.build(Signal::Constant { value: 0.0 }).is_err());
+        // pressures below absolute vacuum, vapour above the tank, Cd above 1
+        for (field, value) in [
+            ("tank_pressure", -2.0e5),
+            ("vapour_pressure", -2.0e5),
+            ("vapour_pressure", 1.0e6),
+        ] {
+            let mut r = WangHybrid::preset();
+            match field {
+                "tank_pressure" => r.tank_pressure = value,
+                _ => r.vapour_pressure = value,
+            }
+            let e = r.build(Signal::Constant { value: 0.0 }).unwrap_err();
+            assert!(e.to_string().contains(field), "{field}={value}: {e}");
+        }
+        let mut r = WangHybrid::preset();
+        r.needle.orifice.cd = 1.5;
+        let e = r.build(Signal::Constant { value: 0.0 }).unwrap_err();
+        assert!(e.to_string().contains("`cd`"), "{e}");
     }
 }

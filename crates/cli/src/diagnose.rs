@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_identify::catalog::EffectId;
 use hydrocyl_identify::data::{write_atomic, ColumnMap, Record};
-use hydrocyl_identify::diagnose::{diagnose_bench, DiagnoseOptions, Outcome, RecordTrace};
-use hydrocyl_identify::valve::diagnose_valve;
+use hydrocyl_identify::diagnose::{diagnose_bench, DiagnoseOptions, RecordTrace};
+use hydrocyl_identify::valve::{diagnose_valve, diagnose_valve_traced};
 use hydrocyl_system::rig::valve_rig_from;
 use hydrocyl_system::valve_rig::ValveRig;
 
@@ -161,11 +161,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
             b.set_message(stage.to_string());
         }
     };
-    let (report, outcome) = match &rig {
+    let (report, traces) = match &rig {
         Rig::Bench(b) => {
             let o = diagnose_bench(b, &records, &opts, &mut progress)
                 .map_err(|e| CliError::Input(e.to_string()))?;
-            (o.report.clone(), Some(o))
+            (o.report, o.traces)
         }
         Rig::Valve(v) => {
             if records.len() != 1 {
@@ -174,17 +174,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
                     records.len()
                 )));
             }
-            let r = diagnose_valve(v, &records[0], &opts, &mut progress)
-                .map_err(|e| CliError::Input(e.to_string()))?;
-            (r, None)
+            if args.plots.is_some() {
+                let o = diagnose_valve_traced(v, &records[0], &opts, &mut progress)
+                    .map_err(|e| CliError::Input(e.to_string()))?;
+                (o.report, o.traces)
+            } else {
+                let r = diagnose_valve(v, &records[0], &opts, &mut progress)
+                    .map_err(|e| CliError::Input(e.to_string()))?;
+                (r, Vec::new())
+            }
         }
     };
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
     // Everything computed: now write, plots first, the report last.
-    if let (Some(dir), Some(o)) = (&args.plots, &outcome) {
-        write_plots(dir, o)?;
+    if let Some(dir) = &args.plots {
+        write_plots(dir, &traces)?;
     }
     if let Some(path) = &args.report {
         let json = serde_json::to_string_pretty(&report)
@@ -196,22 +202,32 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     if !args.quiet {
         print!("{}", report.human());
-        if args.plots.is_some() && outcome.is_none() {
-            println!("(plots are drawn for friction benches only so far)");
+        if let Some(dir) = &args.plots {
+            println!(
+                "plots: {} SVG files in {}",
+                plot_count(&traces),
+                dir.display()
+            );
         }
     }
     Ok(())
 }
 
-/// Writes, per record, `<stem>-force.svg` (measured, before, after) and, when
-/// an effect was added, `<stem>-residual.svg` (residual before vs the first
-/// added effect's regressor).
-fn write_plots(dir: &Path, outcome: &Outcome) -> Result<(), CliError> {
+/// Number of SVG files [`write_plots`] writes for `traces`.
+fn plot_count(traces: &[RecordTrace]) -> usize {
+    traces.len() + traces.iter().filter(|t| t.regressor.is_some()).count()
+}
+
+/// Writes, per record and compared channel, `<stem>-<channel>.svg` (measured,
+/// before and after against time, and below it the residuals before and
+/// after) and, when an effect with a regressor was added (friction benches),
+/// `<stem>-residual.svg` (residual before vs that effect's regressor).
+fn write_plots(dir: &Path, traces: &[RecordTrace]) -> Result<(), CliError> {
     std::fs::create_dir_all(dir).map_err(|e| CliError::Io {
         path: dir.display().to_string(),
         source: e,
     })?;
-    for (k, tr) in outcome.traces.iter().enumerate() {
+    for (k, tr) in traces.iter().enumerate() {
         let stem = Path::new(&tr.source)
             .file_stem()
             .and_then(|s| s.to_str())
@@ -241,25 +257,38 @@ fn bounds(series: &[&[f64]]) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// SI unit of a compared channel, for axis labels.
+fn unit(channel: &str) -> &'static str {
+    match channel {
+        "force" => "N",
+        "position" => "m",
+        "velocity" => "m/s",
+        "p1" | "p2" | "ps" => "Pa",
+        _ => "SI",
+    }
+}
+
 fn plot_series(path: &Path, tr: &RecordTrace) -> Result<(), Box<dyn std::error::Error>> {
     use plotters::prelude::*;
-    let root = SVGBackend::new(path, (1000, 450)).into_drawing_area();
+    let root = SVGBackend::new(path, (1000, 650)).into_drawing_area();
     root.fill(&WHITE)?;
-    let (lo, hi) = bounds(&[&tr.measured, &tr.before, &tr.after]);
+    let (upper, lower) = root.split_vertically(420);
     let t0 = tr.t[0];
     let t1 = *tr.t.last().unwrap_or(&t0);
-    let mut ch = ChartBuilder::on(&root)
+    let u = unit(&tr.channel);
+    let (lo, hi) = bounds(&[&tr.measured, &tr.before, &tr.after]);
+    let mut ch = ChartBuilder::on(&upper)
         .caption(
             format!("{}: {} measured vs simulated", tr.source, tr.channel),
             ("sans-serif", 16),
         )
         .margin(10)
         .x_label_area_size(35)
-        .y_label_area_size(60)
+        .y_label_area_size(70)
         .build_cartesian_2d(t0..t1, lo..hi)?;
     ch.configure_mesh()
         .x_desc("time [s]")
-        .y_desc(format!("{} [SI]", tr.channel))
+        .y_desc(format!("{} [{u}]", tr.channel))
         .draw()?;
     let series = [
         ("measured", &tr.measured, BLACK),
@@ -267,6 +296,32 @@ fn plot_series(path: &Path, tr: &RecordTrace) -> Result<(), Box<dyn std::error::
         ("after", &tr.after, BLUE),
     ];
     for (name, y, colour) in series {
+        ch.draw_series(LineSeries::new(
+            tr.t.iter().copied().zip(y.iter().copied()),
+            colour,
+        ))?
+        .label(name)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], colour));
+    }
+    ch.configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE)
+        .draw()?;
+    let resid =
+        |sim: &[f64]| -> Vec<f64> { tr.measured.iter().zip(sim).map(|(m, s)| m - s).collect() };
+    let (rb, ra) = (resid(&tr.before), resid(&tr.after));
+    let (lo, hi) = bounds(&[&rb, &ra]);
+    let mut ch = ChartBuilder::on(&lower)
+        .caption("residual = measured − simulated", ("sans-serif", 14))
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(70)
+        .build_cartesian_2d(t0..t1, lo..hi)?;
+    ch.configure_mesh()
+        .x_desc("time [s]")
+        .y_desc(format!("residual [{u}]"))
+        .draw()?;
+    for (name, y, colour) in [("before", &rb, RED), ("after", &ra, BLUE)] {
         ch.draw_series(LineSeries::new(
             tr.t.iter().copied().zip(y.iter().copied()),
             colour,

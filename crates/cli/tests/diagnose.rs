@@ -181,11 +181,14 @@ fn unknown_rig_is_an_error() {
 fn valve_rig_finds_the_planted_leak() {
     let dir = tempfile::tempdir().unwrap();
     let report = dir.path().join("r.json");
+    let plots = dir.path().join("plots");
     let out = bin()
         .args(["diagnose", "--rig", "leaney-moog", "--quiet", "--data"])
         .arg(fixtures().join("valve-internal_leakage.csv"))
         .arg("--report")
         .arg(&report)
+        .arg("--plots")
+        .arg(&plots)
         .output()
         .unwrap();
     assert!(
@@ -201,5 +204,9 @@ fn valve_rig_finds_the_planted_leak() {
     for ch in ["position", "velocity", "p1", "p2"] {
         assert!(json["nrmse_before"][ch].is_number(), "{ch}");
         assert!(json["nrmse_after"][ch].is_number(), "{ch}");
+        // one plot per channel: measured, before, after and the residuals
+        let svg = std::fs::read_to_string(plots.join(format!("valve-internal_leakage-{ch}.svg")))
+            .unwrap_or_else(|e| panic!("plot of {ch}: {e}"));
+        assert!(svg.contains("<svg") && svg.contains("residual"), "{ch}");
     }
 }

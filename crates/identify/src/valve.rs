@@ -40,7 +40,9 @@ use hydrocyl_system::valve_rig::ValveRig;
 
 use crate::catalog::EffectId;
 use crate::data::{Record, Signal};
-use crate::diagnose::{nrmse, DiagnoseError, DiagnoseOptions, EffectReport, Probe, Report};
+use crate::diagnose::{
+    nrmse, DiagnoseError, DiagnoseOptions, EffectReport, Probe, RecordTrace, Report,
+};
 use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, smooth_gcv, smooth_with};
 
@@ -861,6 +863,19 @@ fn channel_nrmse(rig: &ValveRig, p: &Prepared) -> BTreeMap<String, f64> {
     m
 }
 
+/// Everything the loop on the valve rig produces: the report, the series for
+/// plots (one [`RecordTrace`] per compared channel: measured, the declared
+/// model after its initial-state fit, and the final model) and the final rig.
+#[derive(Clone, Debug)]
+pub struct ValveOutcome {
+    /// The report.
+    pub report: Report,
+    /// Measured vs simulated before and after, per channel (SI units).
+    pub traces: Vec<RecordTrace>,
+    /// The final model: the declared rig with the added effects, refitted.
+    pub rig: ValveRig,
+}
+
 /// Runs the loop on a valve-controlled rig and one record (command,
 /// position, optionally velocity, p1, p2).
 pub fn diagnose_valve(
@@ -869,6 +884,59 @@ pub fn diagnose_valve(
     opts: &DiagnoseOptions,
     progress: &mut dyn FnMut(&str, usize, usize),
 ) -> Result<Report, DiagnoseError> {
+    diagnose_valve_inner(declared, rec, opts, progress, false).map(|o| o.report)
+}
+
+/// [`diagnose_valve`], also returning the measured and simulated series
+/// before and after (two more simulations of the record) and the final rig.
+pub fn diagnose_valve_traced(
+    declared: &ValveRig,
+    rec: &Record,
+    opts: &DiagnoseOptions,
+    progress: &mut dyn FnMut(&str, usize, usize),
+) -> Result<ValveOutcome, DiagnoseError> {
+    diagnose_valve_inner(declared, rec, opts, progress, true)
+}
+
+/// Measured, before and after series of every compared channel.
+fn traces(
+    rec: &Record,
+    p: &Prepared,
+    before: &ValveRig,
+    after: &ValveRig,
+) -> Result<Vec<RecordTrace>, DiagnoseError> {
+    let sim = |r: &ValveRig, what: &str| {
+        simulate(r, p).map_err(|e| DiagnoseError::Rig(format!("{what} model: {e}")))
+    };
+    let (b, a) = (sim(before, "declared")?, sim(after, "final")?);
+    let velocity = p
+        .meas
+        .iter()
+        .find(|(ch, _)| *ch == Signal::Velocity)
+        .map_or_else(Vec::new, |(_, v)| v.clone());
+    Ok(p.meas
+        .iter()
+        .zip(b.into_iter().zip(a))
+        .map(|((ch, m), (before, after))| RecordTrace {
+            source: rec.source.clone(),
+            t: p.t.clone(),
+            velocity: velocity.clone(),
+            channel: ch.name().to_string(),
+            measured: m.clone(),
+            before,
+            after,
+            regressor: None,
+        })
+        .collect())
+}
+
+fn diagnose_valve_inner(
+    declared: &ValveRig,
+    rec: &Record,
+    opts: &DiagnoseOptions,
+    progress: &mut dyn FnMut(&str, usize, usize),
+    want_traces: bool,
+) -> Result<ValveOutcome, DiagnoseError> {
     let start = Instant::now();
     let (p, info) = prepare(rec, opts.half_window)?;
     let mut rig0 = with_initial(declared, &p);
@@ -1143,7 +1211,12 @@ pub fn diagnose_valve(
             noise_ss += (sig * w).powi(2) * m.len() as f64;
         }
     }
-    Ok(Report {
+    let traces = if want_traces {
+        traces(rec, &p, &rig0, &model)?
+    } else {
+        Vec::new()
+    };
+    let report = Report {
         rig: declared.name.clone(),
         rig_kind: "valve-cylinder".into(),
         records: vec![rec.source.clone()],
@@ -1173,6 +1246,11 @@ pub fn diagnose_valve(
             50.0 * opts.min_share
         ),
         elapsed_s: start.elapsed().as_secs_f64(),
+    };
+    Ok(ValveOutcome {
+        report,
+        traces,
+        rig: model,
     })
 }
 

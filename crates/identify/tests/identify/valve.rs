@@ -1,9 +1,9 @@
 //! The loop on generated `leaney-moog` records with planted valve-rig effects.
 
 use hydrocyl_identify::catalog::EffectId;
-use hydrocyl_identify::diagnose::{DiagnoseOptions, Report};
+use hydrocyl_identify::diagnose::{nrmse, DiagnoseOptions, Report};
 use hydrocyl_identify::synth::{valve_planted, valve_planted_all, valve_record};
-use hydrocyl_identify::valve::{diagnose_valve, set};
+use hydrocyl_identify::valve::{diagnose_valve, diagnose_valve_traced, get, set};
 use hydrocyl_system::valve_rig::ValveRig;
 
 fn run(planted: &[EffectId], seed: u64) -> Report {
@@ -21,6 +21,40 @@ fn run(planted: &[EffectId], seed: u64) -> Report {
         &mut |_, _, _| {},
     )
     .unwrap()
+}
+
+#[test]
+fn traced_outcome_matches_its_report() {
+    // The series behind `--plots` are the runs the report's NRMSEs come
+    // from, and the final rig carries the added effect at its reported value.
+    let mut truth = ValveRig::leaney_moog();
+    for (name, v) in valve_planted_all(EffectId::InternalLeakage) {
+        set(&mut truth, EffectId::InternalLeakage, name, v);
+    }
+    let rec = valve_record(&truth, 2000, 1e-3, 31).unwrap();
+    let o = diagnose_valve_traced(
+        &ValveRig::leaney_moog(),
+        &rec,
+        &DiagnoseOptions::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    let r = &o.report;
+    assert_eq!(o.traces.len(), r.nrmse_after.len());
+    for tr in &o.traces {
+        assert_eq!(tr.t.len(), rec.len());
+        let (b, a) = (
+            nrmse(&tr.measured, &tr.before),
+            nrmse(&tr.measured, &tr.after),
+        );
+        assert_eq!(b, r.nrmse_before[&tr.channel], "{} before", tr.channel);
+        assert_eq!(a, r.nrmse_after[&tr.channel], "{} after", tr.channel);
+    }
+    let e = &r.effects_added[0];
+    assert_eq!(e.id, "internal_leakage");
+    for (name, v) in &e.params {
+        assert_eq!(get(&o.rig, EffectId::InternalLeakage, name), Some(*v));
+    }
 }
 
 fn check(id: EffectId, seed: u64) -> Report {

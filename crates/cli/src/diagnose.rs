@@ -268,71 +268,74 @@ fn unit(channel: &str) -> &'static str {
     }
 }
 
+/// One time-series panel: `lines` (name, values, colour) against `t`.
+fn time_panel(
+    area: &plotters::drawing::DrawingArea<
+        plotters::prelude::SVGBackend<'_>,
+        plotters::coord::Shift,
+    >,
+    caption: &str,
+    y_desc: &str,
+    t: &[f64],
+    lines: &[(&str, &[f64], plotters::style::RGBColor)],
+) -> Result<(), Box<dyn std::error::Error>> {
+    use plotters::prelude::*;
+    let t0 = t[0];
+    let t1 = *t.last().unwrap_or(&t0);
+    let ys: Vec<&[f64]> = lines.iter().map(|l| l.1).collect();
+    let (lo, hi) = bounds(&ys);
+    let mut ch = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 15))
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(70)
+        .build_cartesian_2d(t0..t1, lo..hi)?;
+    ch.configure_mesh()
+        .x_desc("time [s]")
+        .y_desc(y_desc)
+        .draw()?;
+    for &(name, y, colour) in lines {
+        ch.draw_series(LineSeries::new(
+            t.iter().copied().zip(y.iter().copied()),
+            colour,
+        ))?
+        .label(name)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], colour));
+    }
+    ch.configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE)
+        .draw()?;
+    Ok(())
+}
+
 fn plot_series(path: &Path, tr: &RecordTrace) -> Result<(), Box<dyn std::error::Error>> {
     use plotters::prelude::*;
     let root = SVGBackend::new(path, (1000, 650)).into_drawing_area();
     root.fill(&WHITE)?;
     let (upper, lower) = root.split_vertically(420);
-    let t0 = tr.t[0];
-    let t1 = *tr.t.last().unwrap_or(&t0);
     let u = unit(&tr.channel);
-    let (lo, hi) = bounds(&[&tr.measured, &tr.before, &tr.after]);
-    let mut ch = ChartBuilder::on(&upper)
-        .caption(
-            format!("{}: {} measured vs simulated", tr.source, tr.channel),
-            ("sans-serif", 16),
-        )
-        .margin(10)
-        .x_label_area_size(35)
-        .y_label_area_size(70)
-        .build_cartesian_2d(t0..t1, lo..hi)?;
-    ch.configure_mesh()
-        .x_desc("time [s]")
-        .y_desc(format!("{} [{u}]", tr.channel))
-        .draw()?;
-    let series = [
-        ("measured", &tr.measured, BLACK),
-        ("before", &tr.before, RED),
-        ("after", &tr.after, BLUE),
-    ];
-    for (name, y, colour) in series {
-        ch.draw_series(LineSeries::new(
-            tr.t.iter().copied().zip(y.iter().copied()),
-            colour,
-        ))?
-        .label(name)
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], colour));
-    }
-    ch.configure_series_labels()
-        .border_style(BLACK)
-        .background_style(WHITE)
-        .draw()?;
+    time_panel(
+        &upper,
+        &format!("{}: {} measured vs simulated", tr.source, tr.channel),
+        &format!("{} [{u}]", tr.channel),
+        &tr.t,
+        &[
+            ("measured", &tr.measured, BLACK),
+            ("before", &tr.before, RED),
+            ("after", &tr.after, BLUE),
+        ],
+    )?;
     let resid =
         |sim: &[f64]| -> Vec<f64> { tr.measured.iter().zip(sim).map(|(m, s)| m - s).collect() };
     let (rb, ra) = (resid(&tr.before), resid(&tr.after));
-    let (lo, hi) = bounds(&[&rb, &ra]);
-    let mut ch = ChartBuilder::on(&lower)
-        .caption("residual = measured − simulated", ("sans-serif", 14))
-        .margin(10)
-        .x_label_area_size(35)
-        .y_label_area_size(70)
-        .build_cartesian_2d(t0..t1, lo..hi)?;
-    ch.configure_mesh()
-        .x_desc("time [s]")
-        .y_desc(format!("residual [{u}]"))
-        .draw()?;
-    for (name, y, colour) in [("before", &rb, RED), ("after", &ra, BLUE)] {
-        ch.draw_series(LineSeries::new(
-            tr.t.iter().copied().zip(y.iter().copied()),
-            colour,
-        ))?
-        .label(name)
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], colour));
-    }
-    ch.configure_series_labels()
-        .border_style(BLACK)
-        .background_style(WHITE)
-        .draw()?;
+    time_panel(
+        &lower,
+        "residual = measured − simulated",
+        &format!("residual [{u}]"),
+        &tr.t,
+        &[("before", &rb, RED), ("after", &ra, BLUE)],
+    )?;
     root.present()?;
     Ok(())
 }

@@ -10,7 +10,7 @@ use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_identify::catalog::EffectId;
 use hydrocyl_identify::data::{write_atomic, ColumnMap, Record};
 use hydrocyl_identify::diagnose::{diagnose_bench, DiagnoseOptions, RecordTrace};
-use hydrocyl_identify::valve::{diagnose_valve, diagnose_valve_traced};
+use hydrocyl_identify::valve::diagnose_valve_traced;
 use hydrocyl_system::rig::valve_rig_from;
 use hydrocyl_system::valve_rig::ValveRig;
 
@@ -174,15 +174,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
                     records.len()
                 )));
             }
-            if args.plots.is_some() {
-                let o = diagnose_valve_traced(v, &records[0], &opts, &mut progress)
-                    .map_err(|e| CliError::Input(e.to_string()))?;
-                (o.report, o.traces)
-            } else {
-                let r = diagnose_valve(v, &records[0], &opts, &mut progress)
-                    .map_err(|e| CliError::Input(e.to_string()))?;
-                (r, Vec::new())
-            }
+            let o = diagnose_valve_traced(v, &records[0], &opts, &mut progress)
+                .map_err(|e| CliError::Input(e.to_string()))?;
+            (o.report, o.traces)
         }
     };
     if let Some(b) = &bar {

@@ -100,15 +100,9 @@ impl Component for SwitchedOrifice {
                 self.area.si()
             )));
         }
-        if !(self.orifice.cd > 0.0 && self.orifice.cd <= 1.0) {
-            return Err(bad(format!(
-                "discharge coefficient must be in (0, 1], got {}",
-                self.orifice.cd
-            )));
-        }
-        if !(self.orifice.density.si() > 0.0 && self.orifice.dp_transition.si() > 0.0) {
-            return Err(bad("density and regularisation must be positive".into()));
-        }
+        self.orifice
+            .validate("switched orifice")
+            .map_err(|e| bad(e.to_string()))?;
         if self.direction.abs() != 1.0 {
             return Err(bad(format!(
                 "direction must be +1 or -1, got {}",

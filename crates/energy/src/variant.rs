@@ -89,16 +89,11 @@ impl HybridVariant {
                     s.area_m2
                 ));
             }
-            if !(s.orifice.cd > 0.0 && s.orifice.cd <= 1.0) {
+            if let Err(e) = s.orifice.validate("solenoid valve") {
                 return bad(format!(
-                    "`solenoid_valves.orifice.cd` = {} must be in (0, 1]",
-                    s.orifice.cd
+                    "`solenoid_valves.orifice.{}` = {}: {}",
+                    e.name, e.value, e.reason
                 ));
-            }
-            if !(s.orifice.density.si() > 0.0 && s.orifice.dp_transition.si() > 0.0) {
-                return bad(
-                    "`solenoid_valves.orifice` density and dp_transition must be positive".into(),
-                );
             }
         }
         if let Some(t) = &self.needle_area_by_speed {

@@ -854,13 +854,16 @@ fn delay_probe(rig: &ValveRig, p: &Prepared, holdout: f64) -> Option<Probe> {
 }
 
 fn channel_nrmse(rig: &ValveRig, p: &Prepared) -> BTreeMap<String, f64> {
-    let mut m = BTreeMap::new();
-    if let Ok(sims) = simulate(rig, p) {
-        for ((ch, meas), s) in p.meas.iter().zip(&sims) {
-            m.insert(ch.name().to_string(), nrmse(meas, s));
-        }
-    }
-    m
+    simulate(rig, p).map_or_else(|_| BTreeMap::new(), |sims| nrmse_of(p, &sims))
+}
+
+/// NRMSE per measured channel of the simulated series `sims`.
+fn nrmse_of(p: &Prepared, sims: &[Vec<f64>]) -> BTreeMap<String, f64> {
+    p.meas
+        .iter()
+        .zip(sims)
+        .map(|((ch, meas), s)| (ch.name().to_string(), nrmse(meas, s)))
+        .collect()
 }
 
 /// Everything the loop on the valve rig produces: the report, the series for
@@ -884,58 +887,40 @@ pub fn diagnose_valve(
     opts: &DiagnoseOptions,
     progress: &mut dyn FnMut(&str, usize, usize),
 ) -> Result<Report, DiagnoseError> {
-    diagnose_valve_inner(declared, rec, opts, progress, false).map(|o| o.report)
+    diagnose_valve_traced(declared, rec, opts, progress).map(|o| o.report)
 }
 
-/// [`diagnose_valve`], also returning the measured and simulated series
-/// before and after (two more simulations of the record) and the final rig.
-pub fn diagnose_valve_traced(
-    declared: &ValveRig,
-    rec: &Record,
-    opts: &DiagnoseOptions,
-    progress: &mut dyn FnMut(&str, usize, usize),
-) -> Result<ValveOutcome, DiagnoseError> {
-    diagnose_valve_inner(declared, rec, opts, progress, true)
-}
-
-/// Measured, before and after series of every compared channel.
-fn traces(
-    rec: &Record,
-    p: &Prepared,
-    before: &ValveRig,
-    after: &ValveRig,
-) -> Result<Vec<RecordTrace>, DiagnoseError> {
-    let sim = |r: &ValveRig, what: &str| {
-        simulate(r, p).map_err(|e| DiagnoseError::Rig(format!("{what} model: {e}")))
-    };
-    let (b, a) = (sim(before, "declared")?, sim(after, "final")?);
+/// Measured, before and after series of every compared channel, from the
+/// runs the report's NRMSEs were computed on (empty where a run failed).
+fn traces(rec: &Record, p: &Prepared, before: &[Vec<f64>], after: &[Vec<f64>]) -> Vec<RecordTrace> {
     let velocity = p
         .meas
         .iter()
         .find(|(ch, _)| *ch == Signal::Velocity)
         .map_or_else(Vec::new, |(_, v)| v.clone());
-    Ok(p.meas
+    p.meas
         .iter()
-        .zip(b.into_iter().zip(a))
-        .map(|((ch, m), (before, after))| RecordTrace {
+        .zip(before.iter().zip(after))
+        .map(|((ch, m), (b, a))| RecordTrace {
             source: rec.source.clone(),
             t: p.t.clone(),
             velocity: velocity.clone(),
             channel: ch.name().to_string(),
             measured: m.clone(),
-            before,
-            after,
+            before: b.clone(),
+            after: a.clone(),
             regressor: None,
         })
-        .collect())
+        .collect()
 }
 
-fn diagnose_valve_inner(
+/// [`diagnose_valve`], also returning the measured and simulated series
+/// before and after (the runs the report's NRMSEs come from) and the final rig.
+pub fn diagnose_valve_traced(
     declared: &ValveRig,
     rec: &Record,
     opts: &DiagnoseOptions,
     progress: &mut dyn FnMut(&str, usize, usize),
-    want_traces: bool,
 ) -> Result<ValveOutcome, DiagnoseError> {
     let start = Instant::now();
     let (p, info) = prepare(rec, opts.half_window)?;
@@ -965,7 +950,8 @@ fn diagnose_valve_inner(
             )),
         }
     }
-    let nrmse_before = channel_nrmse(&rig0, &p);
+    let sims_before = simulate(&rig0, &p).unwrap_or_default();
+    let nrmse_before = nrmse_of(&p, &sims_before);
     let rss_before = rss(&rig0, &p, opts.holdout, Part::All);
     let candidates: Vec<EffectId> = opts
         .candidates
@@ -1199,7 +1185,8 @@ fn diagnose_valve_inner(
         }
     }
     progress("report", total, total);
-    let nrmse_after = channel_nrmse(&model, &p);
+    let sims_after = simulate(&model, &p).unwrap_or_default();
+    let nrmse_after = nrmse_of(&p, &sims_after);
     let rss_after = rss(&model, &p, opts.holdout, Part::All);
     let mut noise_floor = BTreeMap::new();
     let mut noise_ss = 0.0;
@@ -1211,11 +1198,7 @@ fn diagnose_valve_inner(
             noise_ss += (sig * w).powi(2) * m.len() as f64;
         }
     }
-    let traces = if want_traces {
-        traces(rec, &p, &rig0, &model)?
-    } else {
-        Vec::new()
-    };
+    let traces = traces(rec, &p, &sims_before, &sims_after);
     let report = Report {
         rig: declared.name.clone(),
         rig_kind: "valve-cylinder".into(),

@@ -49,6 +49,41 @@ pub enum RigError {
     Sim(String),
 }
 
+/// Absolute vacuum on the gauge scale every rig uses \[Pa\]: no pressure
+/// parameter (tank, vapour/cavitation) may lie below it.
+pub const ABSOLUTE_VACUUM_GAUGE_PA: f64 = -101_325.0;
+
+/// Which of a rig's tank and vapour (cavitation) pressures \[Pa gauge\] is
+/// unphysical and why: the tank must be above absolute vacuum, the vapour
+/// pressure between absolute vacuum and the tank pressure. `None` when both
+/// are physical (and finite).
+pub fn gauge_pressure_problem(tank: f64, vapour: f64) -> Option<(GaugePressure, String)> {
+    if !(tank.is_finite() && tank > ABSOLUTE_VACUUM_GAUGE_PA) {
+        return Some((
+            GaugePressure::Tank,
+            format!("must be above absolute vacuum ({ABSOLUTE_VACUUM_GAUGE_PA} Pa gauge)"),
+        ));
+    }
+    if !(ABSOLUTE_VACUUM_GAUGE_PA..=tank).contains(&vapour) {
+        return Some((
+            GaugePressure::Vapour,
+            format!(
+                "must lie between absolute vacuum ({ABSOLUTE_VACUUM_GAUGE_PA} Pa gauge) and the tank pressure ({tank} Pa)"
+            ),
+        ));
+    }
+    None
+}
+
+/// The pressure [`gauge_pressure_problem`] objects to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GaugePressure {
+    /// The tank (return) pressure.
+    Tank,
+    /// The vapour (cavitation) pressure.
+    Vapour,
+}
+
 /// A built-in rig.
 pub struct Preset {
     /// Name (`--rig <name>`).

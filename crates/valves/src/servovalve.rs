@@ -256,16 +256,18 @@ impl Metering {
             });
         }
         positive("spool_diameter", self.spool_diameter.si())?;
-        positive("discharge_coefficient", self.orifice.cd)?;
-        if self.orifice.cd > 1.0 {
-            return Err(ServovalveError::OutOfRange {
-                name: "discharge_coefficient",
-                value: self.orifice.cd,
-                reason: "a discharge coefficient must be at most 1",
-            });
-        }
-        positive("density", self.orifice.density.si())?;
-        positive("regularisation", self.orifice.dp_transition.si())?;
+        self.orifice
+            .validate("servovalve")
+            .map_err(|e| ServovalveError::OutOfRange {
+                // the servovalve's names for the orifice's parameters
+                name: match e.name {
+                    "cd" => "discharge_coefficient",
+                    "dp_transition" => "regularisation",
+                    other => other,
+                },
+                value: e.value,
+                reason: e.reason,
+            })?;
         finite("null_bias", self.null_bias.si())?;
         positive("flow_gain", self.flow_gain)
     }

@@ -1,12 +1,15 @@
 //! The loop on generated `leaney-moog` records with planted valve-rig effects.
 
 use hydrocyl_identify::catalog::EffectId;
+use hydrocyl_identify::data::Record;
 use hydrocyl_identify::diagnose::{nrmse, DiagnoseOptions, Report};
 use hydrocyl_identify::synth::{valve_planted, valve_planted_all, valve_record};
-use hydrocyl_identify::valve::{diagnose_valve, diagnose_valve_traced, get, set};
+use hydrocyl_identify::valve::{diagnose_valve, diagnose_valve_traced, get, set, ValveOutcome};
 use hydrocyl_system::valve_rig::ValveRig;
 
-fn run(planted: &[EffectId], seed: u64) -> Report {
+/// A 2 s record of `leaney-moog` with the `planted` effects, diagnosed
+/// against the rig without them.
+fn run_traced(planted: &[EffectId], seed: u64) -> (Record, ValveOutcome) {
     let mut truth = ValveRig::leaney_moog();
     for id in planted {
         for (name, v) in valve_planted_all(*id) {
@@ -14,24 +17,6 @@ fn run(planted: &[EffectId], seed: u64) -> Report {
         }
     }
     let rec = valve_record(&truth, 2000, 1e-3, seed).unwrap();
-    diagnose_valve(
-        &ValveRig::leaney_moog(),
-        &rec,
-        &DiagnoseOptions::default(),
-        &mut |_, _, _| {},
-    )
-    .unwrap()
-}
-
-#[test]
-fn traced_outcome_matches_its_report() {
-    // The series behind `--plots` are the runs the report's NRMSEs come
-    // from, and the final rig carries the added effect at its reported value.
-    let mut truth = ValveRig::leaney_moog();
-    for (name, v) in valve_planted_all(EffectId::InternalLeakage) {
-        set(&mut truth, EffectId::InternalLeakage, name, v);
-    }
-    let rec = valve_record(&truth, 2000, 1e-3, 31).unwrap();
     let o = diagnose_valve_traced(
         &ValveRig::leaney_moog(),
         &rec,
@@ -39,6 +24,18 @@ fn traced_outcome_matches_its_report() {
         &mut |_, _, _| {},
     )
     .unwrap();
+    (rec, o)
+}
+
+fn run(planted: &[EffectId], seed: u64) -> Report {
+    run_traced(planted, seed).1.report
+}
+
+#[test]
+fn traced_outcome_matches_its_report() {
+    // The series behind `--plots` are the runs the report's NRMSEs come
+    // from, and the final rig carries the added effect at its reported value.
+    let (rec, o) = run_traced(&[EffectId::InternalLeakage], 31);
     let r = &o.report;
     assert_eq!(o.traces.len(), r.nrmse_after.len());
     for tr in &o.traces {

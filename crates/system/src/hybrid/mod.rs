@@ -231,24 +231,16 @@ impl WangHybrid {
                 });
             }
         }
-        let vacuum = crate::valve_rig::ABSOLUTE_VACUUM_GAUGE_PA;
-        if self.tank_pressure <= vacuum {
+        if let Some((which, why)) =
+            crate::rig::gauge_pressure_problem(self.tank_pressure, self.vapour_pressure)
+        {
+            let (field, value) = match which {
+                crate::rig::GaugePressure::Tank => ("tank_pressure", self.tank_pressure),
+                crate::rig::GaugePressure::Vapour => ("vapour_pressure", self.vapour_pressure),
+            };
             return Err(BuildError::Component {
                 component: "wang-hybrid".into(),
-                message: format!(
-                    "`tank_pressure` = {} Pa must be above absolute vacuum ({vacuum} Pa gauge)",
-                    self.tank_pressure
-                ),
-            });
-        }
-        if !(vacuum..=self.tank_pressure).contains(&self.vapour_pressure) {
-            return Err(BuildError::Component {
-                component: "wang-hybrid".into(),
-                message: format!(
-                    "`vapour_pressure` = {} Pa must lie between absolute vacuum ({vacuum} Pa gauge) \
-                     and the tank pressure ({} Pa)",
-                    self.vapour_pressure, self.tank_pressure
-                ),
+                message: format!("`{field}` = {value} Pa {why}"),
             });
         }
         self.friction

@@ -119,6 +119,9 @@ pub struct RigKind {
     pub check: fn(&Value) -> Result<(), RigError>,
     /// Simulates the rig on a command, output at the given times.
     pub simulate: fn(&Value, Signal, &[f64], &RunOptions) -> Result<Run, RigError>,
+    /// Assembles the rig's circuit driven by a command (for callers that
+    /// step the circuit themselves, e.g. a co-simulation export).
+    pub circuit: fn(&Value, Signal) -> Result<crate::Circuit, RigError>,
 }
 
 /// The rig kinds hydrocyl knows. Other rig kinds add an entry here.
@@ -127,11 +130,13 @@ pub const RIG_KINDS: &[RigKind] = &[
         kind: valve_rig::KIND,
         check: |v| valve_rig_from(v).map(|_| ()),
         simulate: |v, cmd, t, o| valve_rig_from(v)?.simulate(cmd, t, o),
+        circuit: |v, cmd| valve_rig_from(v)?.circuit(cmd),
     },
     RigKind {
         kind: crate::hybrid::KIND,
         check: |v| crate::hybrid::WangHybrid::from_value(v).map(|_| ()),
         simulate: |v, cmd, t, o| crate::hybrid::WangHybrid::from_value(v)?.simulate(cmd, t, o),
+        circuit: |v, cmd| Ok(crate::hybrid::WangHybrid::from_value(v)?.build(cmd)?),
     },
 ];
 
@@ -212,6 +217,56 @@ pub fn simulate(
     (kind_of(v)?.simulate)(v, command, t_eval, opts)
 }
 
+/// Assembles the circuit of a rig value of any kind, driven by `command`.
+/// Its [`Circuit::initial_state`](crate::Circuit::initial_state) is the
+/// rig's initial state.
+pub fn circuit(v: &Value, command: Signal) -> Result<crate::Circuit, RigError> {
+    (kind_of(v)?.circuit)(v, command)
+}
+
+/// One numeric parameter of a rig: its path (as `--set` takes it) and value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Parameter {
+    /// Dotted path, e.g. `load.mass_kg` (`--set` syntax).
+    pub path: String,
+    /// Current value (`None` for a parameter left `null`, e.g. an initial
+    /// pressure that the rig computes from its steady state).
+    pub value: Option<f64>,
+}
+
+/// Every numeric (or `null`) leaf of a rig value, keys in sorted order, as
+/// `--set` paths. Strings (the kind, names, model choices) are not listed.
+pub fn parameters(v: &Value) -> Vec<Parameter> {
+    fn walk(v: &Value, prefix: &str, out: &mut Vec<Parameter>) {
+        let join = |k: &str| {
+            if prefix.is_empty() {
+                k.to_string()
+            } else {
+                format!("{prefix}.{k}")
+            }
+        };
+        match v {
+            Value::Object(m) => m.iter().for_each(|(k, v)| walk(v, &join(k), out)),
+            Value::Array(a) => a
+                .iter()
+                .enumerate()
+                .for_each(|(i, v)| walk(v, &join(&i.to_string()), out)),
+            Value::Number(n) => out.push(Parameter {
+                path: prefix.to_string(),
+                value: n.as_f64(),
+            }),
+            Value::Null => out.push(Parameter {
+                path: prefix.to_string(),
+                value: None,
+            }),
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    walk(v, "", &mut out);
+    out
+}
+
 /// Applies one `path=value` override (`cylinder.area_1_m2=1.2e-3`,
 /// `initial.p1=3e6`, `valve.dynamics.order="second"`). The path must exist in
 /// the rig (a `null` entry such as `initial.p1` exists); the value is parsed
@@ -281,5 +336,38 @@ fn describe(v: &Value) -> &'static str {
         Value::String(_) => "a string",
         Value::Array(_) => "an array",
         Value::Object(_) => "an object",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parameters_are_the_numeric_leaves_as_set_paths() {
+        let v = preset("leaney-moog").unwrap();
+        let ps = parameters(&v);
+        let mass = ps.iter().find(|p| p.path == "load.mass_kg").unwrap();
+        assert_eq!(mass.value, Some(100.0));
+        let p1 = ps.iter().find(|p| p.path == "initial.p1").unwrap();
+        assert_eq!(p1.value, None);
+        assert!(ps.iter().all(|p| !p.path.starts_with("kind")));
+        // every listed path is settable
+        let mut w = v.clone();
+        for p in &ps {
+            apply_set(&mut w, &format!("{}={}", p.path, p.value.unwrap_or(1.0))).unwrap();
+        }
+    }
+
+    #[test]
+    fn circuit_of_a_preset_has_its_initial_state() {
+        for p in PRESETS {
+            let c = circuit(&(p.json)(), Signal::Constant { value: 0.0 }).unwrap();
+            assert!(
+                c.n_states() > 0 && c.initial_state().len() == c.n_states(),
+                "{}",
+                p.name
+            );
+        }
     }
 }

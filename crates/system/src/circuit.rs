@@ -424,6 +424,7 @@ pub struct Circuit {
     q_offsets: Vec<usize>,
     n_quad: usize,
     wire_names: Vec<String>,
+    probe_names: Option<Vec<Option<String>>>,
 }
 
 impl std::fmt::Debug for Circuit {
@@ -538,6 +539,7 @@ impl Circuit {
             q_offsets,
             n_quad: q,
             wire_names: net.names,
+            probe_names: None,
         })
     }
 
@@ -632,9 +634,38 @@ impl Circuit {
         a.iter().map(|s| rtol * s).collect()
     }
 
-    /// The probes of every component, in component order.
+    /// The probes of every component, in component order, under the names
+    /// given by [`Circuit::name_probes`] (if it was called).
     pub fn probes(&self) -> Vec<Probe> {
-        self.comps.iter().flat_map(|c| c.probes()).collect()
+        let all = self.comps.iter().flat_map(|c| c.probes());
+        match &self.probe_names {
+            None => all.collect(),
+            Some(names) => all
+                .zip(names)
+                .filter_map(|(mut p, n)| {
+                    n.clone().map(|n| {
+                        p.name = n;
+                        p
+                    })
+                })
+                .collect(),
+        }
+    }
+
+    /// Renames the probes (the run's output columns): `name(component,
+    /// probe)` gives the column of each probe, `None` leaves it out.
+    pub fn name_probes(&mut self, name: impl Fn(&str, &str) -> Option<String>) {
+        let names = self
+            .comps
+            .iter()
+            .flat_map(|c| {
+                c.probes()
+                    .into_iter()
+                    .map(|p| name(c.name(), &p.name))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        self.probe_names = Some(names);
     }
 
     /// Diagnostics of every component, names prefixed by the component's.

@@ -114,6 +114,7 @@ pub mod chapter3;
 pub mod circuit;
 pub mod components;
 pub mod hybrid;
+pub mod netlist;
 pub mod rig;
 pub mod run;
 pub mod sensor;

@@ -138,6 +138,12 @@ pub const RIG_KINDS: &[RigKind] = &[
         simulate: |v, cmd, t, o| crate::hybrid::WangHybrid::from_value(v)?.simulate(cmd, t, o),
         circuit: |v, cmd| Ok(crate::hybrid::WangHybrid::from_value(v)?.build(cmd)?),
     },
+    RigKind {
+        kind: crate::netlist::KIND,
+        check: |v| crate::netlist::read(v).map(|_| ()).map_err(RigError::from),
+        simulate: crate::netlist::simulate,
+        circuit: crate::netlist::circuit,
+    },
 ];
 
 /// Deserialises and validates a `valve-cylinder` rig.
@@ -171,10 +177,17 @@ pub fn load(name_or_path: &str) -> Result<Value, RigError> {
                 .join(", ")
         ),
     })?;
-    serde_json::from_str(&text).map_err(|e| RigError::Invalid {
+    let v = serde_json::from_str(&text).map_err(|e| RigError::Invalid {
         path: name_or_path.into(),
         why: format!("not valid JSON: {e}"),
-    })
+    })?;
+    if let Some((key, line)) = crate::netlist::locate::scan(&text).duplicate {
+        return Err(RigError::Invalid {
+            path: format!("{name_or_path}: {key}"),
+            why: format!("duplicate key at line {line} (a key may appear once in an object)"),
+        });
+    }
+    Ok(v)
 }
 
 /// The kind entry of a rig value.
@@ -227,16 +240,36 @@ pub fn circuit(v: &Value, command: Signal) -> Result<crate::Circuit, RigError> {
 /// One numeric parameter of a rig: its path (as `--set` takes it) and value.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Parameter {
-    /// Dotted path, e.g. `load.mass_kg` (`--set` syntax).
+    /// Dotted path, e.g. `load.mass` (`--set` syntax).
     pub path: String,
     /// Current value (`None` for a parameter left `null`, e.g. an initial
     /// pressure that the rig computes from its steady state).
     pub value: Option<f64>,
+    /// SI unit, where the rig kind declares it (netlists do).
+    pub unit: Option<&'static str>,
+    /// What it is, where the rig kind declares it.
+    pub doc: Option<&'static str>,
 }
 
-/// Every numeric (or `null`) leaf of a rig value, keys in sorted order, as
-/// `--set` paths. Strings (the kind, names, model choices) are not listed.
+/// Every parameter of a rig as `--set` paths. For a netlist: every
+/// parameter and initial state of every component, defaults filled in, with
+/// unit and meaning (a netlist that does not read gives none). For the older
+/// rig kinds: every numeric (or `null`) leaf of the value, in file order.
 pub fn parameters(v: &Value) -> Vec<Parameter> {
+    if v.get("kind").and_then(Value::as_str) == Some(crate::netlist::KIND) {
+        return crate::netlist::parameters(v)
+            .map(|ps| {
+                ps.into_iter()
+                    .map(|p| Parameter {
+                        path: p.path,
+                        value: p.value,
+                        unit: Some(p.unit),
+                        doc: Some(p.doc),
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+    }
     fn walk(v: &Value, prefix: &str, out: &mut Vec<Parameter>) {
         let join = |k: &str| {
             if prefix.is_empty() {
@@ -254,10 +287,14 @@ pub fn parameters(v: &Value) -> Vec<Parameter> {
             Value::Number(n) => out.push(Parameter {
                 path: prefix.to_string(),
                 value: n.as_f64(),
+                unit: None,
+                doc: None,
             }),
             Value::Null => out.push(Parameter {
                 path: prefix.to_string(),
                 value: None,
+                unit: None,
+                doc: None,
             }),
             _ => {}
         }
@@ -282,6 +319,9 @@ pub fn apply_set(rig: &mut Value, assignment: &str) -> Result<(), RigError> {
     let path = path.trim();
     let new: Value = serde_json::from_str(text.trim())
         .unwrap_or_else(|_| Value::String(text.trim().to_string()));
+    if rig.get("kind").and_then(Value::as_str) == Some(crate::netlist::KIND) {
+        return crate::netlist::set(rig, path, new);
+    }
     let mut cur = rig;
     let mut walked = String::new();
     for seg in path.split('.') {

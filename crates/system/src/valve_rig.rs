@@ -473,72 +473,28 @@ impl ValveRig {
     /// steady pressures at rest for the initial spool position (section
     /// 3.3.4: X factor at the spool's travel, `P_LE = (F_ext + F_friction(v0))/A_E`).
     pub fn initial_pressures(&self) -> Result<(f64, f64), RigError> {
-        let pt = self.supply.tank_pressure_pa;
-        let ps = self.supply.pressure_pa - pt;
-        let cyl = self.cylinder_model();
+        if let (Some(a), Some(b)) = (self.initial.p1, self.initial.p2) {
+            return Ok((a, b));
+        }
         let fric = self
             .friction_model()
             .steady_force(&FrictionInput::at_velocity(Velocity::new(
                 self.initial.velocity,
             )))
             .si();
-        let load = Force::new(self.load.external_force_n + fric);
-        if let (Some(a), Some(b)) = (self.initial.p1, self.initial.p2) {
-            return Ok((a, b));
-        }
-        // steady (p1, p2) for a supply `ps` above tank
-        let steady = |ps: f64| {
-            hydrocyl_xfactor::steady_pressures(
-                self.travel(self.initial.spool),
-                Pressure::new(ps),
-                cyl.gamma(),
-                cyl.area_1,
-                load,
-            )
-            .map(|s| (s.p1.si() + pt, s.p2.si() + pt))
-            .map_err(|e| RigError::Invalid {
-                path: "initial.p1".into(),
-                why: format!("no steady state to start from ({e}); give initial.p1 and initial.p2"),
-            })
-        };
-        let rs = self.supply.droop_resistance_pa_s_per_m3;
-        let (s1, s2) = if rs > 0.0 {
-            // With droop the valve sees Ps0 − Rs Q_s, and Q_s (the underlap's
-            // flow at rest) depends on the steady pressures: bisection on the
-            // supply above tank, h(ps) = ps + Rs Q_s(ps) − (Ps0 − pt), which
-            // rises with ps (h < 0 near 0 where nothing flows, h ≥ 0 at Ps0).
-            let ps_source = ps;
-            let m = self.metering();
-            let xs = Position::new(self.initial.spool);
-            let h = |ps: f64| -> Result<f64, RigError> {
-                let (a, b) = steady(ps)?;
-                let q = m
-                    .flows(
-                        xs,
-                        Pressure::new(ps + pt),
-                        Pressure::new(pt),
-                        Pressure::new(a),
-                        Pressure::new(b),
-                    )
-                    .qp
-                    .si();
-                Ok(ps + rs * q - ps_source)
-            };
-            let (mut lo, mut hi) = (1e-9 * ps_source, ps_source);
-            if h(hi)? > 0.0 {
-                for _ in 0..80 {
-                    let mid = 0.5 * (lo + hi);
-                    if h(mid)? < 0.0 {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-            }
-            steady(hi)?
-        } else {
-            steady(ps)?
-        };
+        let (s1, s2) = steady_pressures_at_rest(&SteadyDrive {
+            metering: self.metering(),
+            cylinder: self.cylinder_model(),
+            supply: self.supply.pressure_pa,
+            tank: self.supply.tank_pressure_pa,
+            droop_resistance: self.supply.droop_resistance_pa_s_per_m3,
+            spool: self.initial.spool,
+            load: self.load.external_force_n + fric,
+        })
+        .map_err(|why| RigError::Invalid {
+            path: "initial.p1".into(),
+            why,
+        })?;
         Ok((self.initial.p1.unwrap_or(s1), self.initial.p2.unwrap_or(s2)))
     }
 
@@ -752,4 +708,90 @@ impl ValveRig {
         let ur = self.spool_for_velocity(-v.abs())? / xm;
         Ok((0.5 * (ue + ur), 0.5 * (ue - ur)))
     }
+}
+
+/// A valve-controlled drive at rest, as [`steady_pressures_at_rest`] needs it.
+#[derive(Clone, Copy, Debug)]
+pub struct SteadyDrive {
+    /// The four-way metering.
+    pub metering: Metering,
+    /// The cylinder.
+    pub cylinder: Cylinder,
+    /// Supply (source) pressure Ps0 \[Pa\].
+    pub supply: f64,
+    /// Tank pressure \[Pa\].
+    pub tank: f64,
+    /// Supply droop resistance Rs \[Pa·s·m⁻³\] (0 = stiff supply).
+    pub droop_resistance: f64,
+    /// Spool position \[m\].
+    pub spool: f64,
+    /// Force opposing extension: external load plus friction at the initial
+    /// velocity \[N\].
+    pub load: f64,
+}
+
+/// The steady chamber pressures `(p1, p2)` \[Pa\] of a valve-controlled drive
+/// at rest for a spool position (section 3.3.4: the X factor at the spool's
+/// travel, `P_LE = load / A_E`); with supply droop, the supply the valve sees
+/// is solved by bisection. `Err` says why there is no steady state.
+pub fn steady_pressures_at_rest(d: &SteadyDrive) -> Result<(f64, f64), String> {
+    let pt = d.tank;
+    let ps_source = d.supply - pt;
+    let m = d.metering;
+    let u0 = m.underlap.si();
+    let x = d.spool + m.null_bias.si();
+    let travel = if u0 > 0.0 {
+        x / u0
+    } else if x >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    };
+    let load = Force::new(d.load);
+    let steady = |ps: f64| {
+        hydrocyl_xfactor::steady_pressures(
+            travel,
+            Pressure::new(ps),
+            d.cylinder.gamma(),
+            d.cylinder.area_1,
+            load,
+        )
+        .map(|s| (s.p1.si() + pt, s.p2.si() + pt))
+        .map_err(|e| format!("no steady state to start from ({e}); give initial.p1 and initial.p2"))
+    };
+    let rs = d.droop_resistance;
+    if rs <= 0.0 {
+        return steady(ps_source);
+    }
+    // With droop the valve sees Ps0 − Rs Q_s, and Q_s (the underlap's flow
+    // at rest) depends on the steady pressures: bisection on the supply
+    // above tank, h(ps) = ps + Rs Q_s(ps) − (Ps0 − pt), which rises with ps
+    // (h < 0 near 0 where nothing flows, h ≥ 0 at Ps0).
+    let xs = Position::new(d.spool);
+    let h = |ps: f64| -> Result<f64, String> {
+        let (a, b) = steady(ps)?;
+        let q = m
+            .flows(
+                xs,
+                Pressure::new(ps + pt),
+                Pressure::new(pt),
+                Pressure::new(a),
+                Pressure::new(b),
+            )
+            .qp
+            .si();
+        Ok(ps + rs * q - ps_source)
+    };
+    let (mut lo, mut hi) = (1e-9 * ps_source, ps_source);
+    if h(hi)? > 0.0 {
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if h(mid)? < 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+    }
+    steady(hi)
 }

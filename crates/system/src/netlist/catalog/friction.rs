@@ -1,0 +1,329 @@
+//! Friction laws on a rod (eqs 2.34–2.40, 5.1–5.14): one component type per
+//! law of the friction crate. Each reads the rod's velocity and, where the
+//! law has a pressure term, the chamber pressures at the optional ports `A`
+//! and `B`. The parameter names are the law's field paths.
+
+use super::super::registry::{
+    param, ComponentType, Default::*, Instance, ParamSpec, PortSpec, Range, Role,
+};
+use super::{built, port};
+use crate::circuit::Component;
+use crate::components::Friction;
+use hydrocyl_friction::{CoulombViscous, Dahl, FrictionLaw, Karnopp, LuGre, Stribeck, Wang};
+use serde::de::DeserializeOwned;
+
+const PORTS: &[PortSpec] = &[
+    port(
+        "rod",
+        super::MECH,
+        Role::Reads,
+        false,
+        "the rod (body) it acts on",
+    ),
+    port(
+        "A",
+        super::HYD,
+        Role::Reads,
+        true,
+        "cap-side chamber (pressure terms)",
+    ),
+    port(
+        "B",
+        super::HYD,
+        Role::Reads,
+        true,
+        "rod-side chamber (pressure terms)",
+    ),
+];
+
+const PROBES: &[(&str, &str)] = &[("force", "N")];
+
+macro_rules! curve {
+    ($p:literal) => {
+        [
+            param(
+                concat!($p, ".coulomb"),
+                "N",
+                Required,
+                Range::POSITIVE,
+                "Coulomb level Fc",
+            ),
+            param(
+                concat!($p, ".stiction"),
+                "N",
+                Required,
+                Range::POSITIVE,
+                "stiction (break-away) level Fs",
+            ),
+            param(
+                concat!($p, ".stribeck_velocity"),
+                "m/s",
+                Required,
+                Range::POSITIVE,
+                "Stribeck velocity vs",
+            ),
+            param(
+                concat!($p, ".stribeck_exponent"),
+                "-",
+                Required,
+                Range::POSITIVE,
+                "Stribeck exponent δ",
+            ),
+        ]
+    };
+}
+
+const fn join<const A: usize, const B: usize, const N: usize>(
+    a: [ParamSpec; A],
+    b: [ParamSpec; B],
+) -> [ParamSpec; N] {
+    let mut out = [a[0]; N];
+    let mut i = 0;
+    while i < A {
+        out[i] = a[i];
+        i += 1;
+    }
+    while i < N {
+        out[i] = b[i - A];
+        i += 1;
+    }
+    out
+}
+
+const SIGMA2_E: ParamSpec = param(
+    "extending.sigma2",
+    "N s/m",
+    Required,
+    Range::NON_NEGATIVE,
+    "viscous coefficient σ2, extending",
+);
+const SIGMA2_R: ParamSpec = param(
+    "retracting.sigma2",
+    "N s/m",
+    Required,
+    Range::NON_NEGATIVE,
+    "viscous coefficient σ2, retracting",
+);
+const SIGMA0: ParamSpec = param(
+    "sigma0",
+    "N/m",
+    Required,
+    Range::POSITIVE,
+    "bristle stiffness σ0",
+);
+const SIGMA1: ParamSpec = param(
+    "sigma1",
+    "N s/m",
+    Required,
+    Range::NON_NEGATIVE,
+    "bristle damping σ1",
+);
+
+const COULOMB_VISCOUS: &[ParamSpec] = &[
+    param(
+        "coulomb",
+        "N",
+        Required,
+        Range::NON_NEGATIVE,
+        "Coulomb level Fc",
+    ),
+    param(
+        "viscous",
+        "N s/m",
+        Required,
+        Range::NON_NEGATIVE,
+        "viscous coefficient b",
+    ),
+    param(
+        "smoothing_velocity",
+        "m/s",
+        Required,
+        Range::POSITIVE,
+        "smoothing velocity of the tanh",
+    ),
+];
+
+const STRIBECK: [ParamSpec; 11] = join(
+    join::<4, 4, 8>(curve!("extending.curve"), curve!("retracting.curve")),
+    [
+        SIGMA2_E,
+        SIGMA2_R,
+        param(
+            "smoothing_velocity",
+            "m/s",
+            Required,
+            Range::POSITIVE,
+            "smoothing velocity of the tanh",
+        ),
+    ],
+);
+
+const KARNOPP: [ParamSpec; 5] = join(
+    curve!("curve"),
+    [param(
+        "sigma2",
+        "N s/m",
+        Required,
+        Range::NON_NEGATIVE,
+        "viscous coefficient σ2",
+    )],
+);
+
+const DAHL: &[ParamSpec] = &[
+    param(
+        "coulomb",
+        "N",
+        Required,
+        Range::POSITIVE,
+        "Coulomb level Fc",
+    ),
+    SIGMA0,
+    param(
+        "sigma2",
+        "N s/m",
+        Required,
+        Range::NON_NEGATIVE,
+        "viscous coefficient σ2",
+    ),
+];
+
+const LUGRE: [ParamSpec; 12] = join(
+    [SIGMA0, SIGMA1],
+    join::<8, 2, 10>(
+        join::<4, 4, 8>(curve!("extending.curve"), curve!("retracting.curve")),
+        [SIGMA2_E, SIGMA2_R],
+    ),
+);
+
+const WANG: [ParamSpec; 14] = join(
+    [SIGMA0, SIGMA1],
+    join::<8, 4, 12>(
+        join::<4, 4, 8>(curve!("extending.curve"), curve!("retracting.curve")),
+        [
+            param(
+                "extending.k_pressure",
+                "m^3 s/N",
+                Required,
+                Range::NON_NEGATIVE,
+                "seal gain K (K (p1 − p2)² v), extending",
+            ),
+            param(
+                "extending.h_acceleration",
+                "N^2 s/m^4",
+                Required,
+                Range::NON_NEGATIVE,
+                "acceleration gain H (K H a), extending",
+            ),
+            param(
+                "retracting.k_pressure",
+                "m^3 s/N",
+                Required,
+                Range::NON_NEGATIVE,
+                "seal gain K, retracting",
+            ),
+            param(
+                "retracting.h_acceleration",
+                "N^2 s/m^4",
+                Required,
+                Range::NON_NEGATIVE,
+                "acceleration gain H, retracting",
+            ),
+        ],
+    ),
+);
+
+fn build_with<T: DeserializeOwned>(
+    inst: &Instance,
+    wrap: fn(T) -> FrictionLaw,
+) -> Result<Box<dyn Component>, String> {
+    let law = wrap(inst.law::<T>("")?);
+    hydrocyl_friction::FrictionModel::validate(&law).map_err(|e| e.to_string())?;
+    let chambers =
+        (inst.connected("A") && inst.connected("B")).then(|| (inst.node("A"), inst.node("B")));
+    if inst.connected("A") != inst.connected("B") {
+        return Err("connect both chamber ports `A` and `B`, or neither".into());
+    }
+    built(Friction::new(
+        &inst.name,
+        inst.node("rod"),
+        chambers,
+        Box::new(law),
+    ))
+}
+
+/// The friction law of an instance of one of these types (`None` for
+/// another type).
+pub(crate) fn law_of(inst: &Instance) -> Option<Result<FrictionLaw, String>> {
+    Some(match inst.ty.name {
+        "friction_coulomb_viscous" => inst
+            .law::<CoulombViscous>("")
+            .map(FrictionLaw::CoulombViscous),
+        "friction_stribeck" => inst.law::<Stribeck>("").map(FrictionLaw::Stribeck),
+        "friction_karnopp" => inst.law::<Karnopp>("").map(FrictionLaw::Karnopp),
+        "friction_dahl" => inst.law::<Dahl>("").map(FrictionLaw::Dahl),
+        "friction_lugre" => inst.law::<LuGre>("").map(FrictionLaw::LuGre),
+        "friction_wang" => inst.law::<Wang>("").map(FrictionLaw::Wang),
+        _ => return None,
+    })
+}
+
+macro_rules! friction_type {
+    ($name:literal, $summary:literal, $params:expr, $law:ty, $variant:path) => {
+        ComponentType {
+            name: $name,
+            summary: $summary,
+            ports: PORTS,
+            params: $params,
+            states: &[],
+            build: |i| build_with::<$law>(i, $variant),
+            hints: None,
+            probes: PROBES,
+        }
+    };
+}
+
+/// The friction component types.
+pub const TYPES: &[ComponentType] = &[
+    friction_type!(
+        "friction_coulomb_viscous",
+        "Coulomb + viscous friction, Fc tanh(v/v_t) + b v",
+        COULOMB_VISCOUS,
+        CoulombViscous,
+        FrictionLaw::CoulombViscous
+    ),
+    friction_type!(
+        "friction_stribeck",
+        "static Stribeck friction with extending/retracting curves (eqs 2.36–2.40)",
+        &STRIBECK,
+        Stribeck,
+        FrictionLaw::Stribeck
+    ),
+    friction_type!(
+        "friction_karnopp",
+        "Karnopp stick–slip friction (eq 2.39)",
+        &KARNOPP,
+        Karnopp,
+        FrictionLaw::Karnopp
+    ),
+    friction_type!(
+        "friction_dahl",
+        "Dahl bristle friction (eq 2.34)",
+        DAHL,
+        Dahl,
+        FrictionLaw::Dahl
+    ),
+    friction_type!(
+        "friction_lugre",
+        "LuGre friction with directional Stribeck curves (eqs 2.35–2.37)",
+        &LUGRE,
+        LuGre,
+        FrictionLaw::LuGre
+    ),
+    friction_type!(
+        "friction_wang",
+        "Wang's LuGre friction with seal-pressure and acceleration terms (eq 5.14)",
+        &WANG,
+        Wang,
+        FrictionLaw::Wang
+    ),
+];

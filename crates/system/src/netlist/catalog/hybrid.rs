@@ -1,0 +1,231 @@
+//! The hybrid pump-controlled drive's components (chapter 6): the identified
+//! servomotor–pump (section 6.2.1), relief valves (eqs 6.6–6.10), check
+//! valves (eqs 6.11–6.13) and the pilot-operated return path (DDDC four-way
+//! and NCCC needle valve, eqs 6.2–6.5, 6.14–6.19).
+
+use super::super::registry::{param, ComponentType, Default::*, Instance, ParamSpec, Range, Role};
+use super::hydraulic::orifice_params;
+use super::{built, port, HYD, SIG};
+use crate::hybrid::components::{
+    CheckComponent, PumpComponent, ReliefComponent, ReturnNodes, ReturnPath,
+};
+use hydrocyl_pump_motor::IdentifiedPump;
+use hydrocyl_valves::check::CheckValve;
+use hydrocyl_valves::needle::NeedleValve;
+use hydrocyl_valves::pilot_valve::PilotFourWay;
+use hydrocyl_valves::relief::ReliefValve;
+use serde::de::DeserializeOwned;
+
+/// A law from the instance's parameters under `prefix`, checked by `check`.
+fn law<T: DeserializeOwned, E: std::fmt::Display>(
+    i: &Instance,
+    prefix: &str,
+    check: impl Fn(&T) -> Result<(), E>,
+) -> Result<T, String> {
+    let t: T = i.law(prefix)?;
+    check(&t).map_err(|e| e.to_string())?;
+    Ok(t)
+}
+
+macro_rules! check_params {
+    ($p:literal) => {
+        [
+            param(
+                concat!($p, "cracking"),
+                "Pa",
+                Required,
+                Range::NON_NEGATIVE,
+                "cracking pressure p_c",
+            ),
+            param(
+                concat!($p, "opening_range"),
+                "Pa",
+                Required,
+                Range::POSITIVE,
+                "opening range Δp_o (fully open at p_c + Δp_o)",
+            ),
+            param(
+                concat!($p, "k_open"),
+                "m^3/(s Pa^0.5)",
+                Required,
+                Range::POSITIVE,
+                "full-open flow coefficient K_c",
+            ),
+        ]
+    };
+}
+
+const CHECK: [ParamSpec; 3] = check_params!("");
+
+const RETURN: [ParamSpec; 14] = {
+    let o = orifice_params!("needle.orifice.");
+    let c = check_params!("needle.reverse_check.");
+    [
+        param(
+            "four_way.spring_rate",
+            "Pa/m",
+            Required,
+            Range::POSITIVE,
+            "pilot spool centring spring rate k_s",
+        ),
+        param(
+            "four_way.overlap",
+            "m",
+            Required,
+            Range::NON_NEGATIVE,
+            "overlap x_o",
+        ),
+        param(
+            "four_way.stroke",
+            "m",
+            Required,
+            Range::POSITIVE,
+            "opening travel beyond the overlap",
+        ),
+        param(
+            "four_way.hole_radius",
+            "m",
+            Required,
+            Range::POSITIVE,
+            "radius of each port hole",
+        ),
+        param(
+            "four_way.k_p",
+            "m^3/(s Pa^0.5)",
+            Required,
+            Range::POSITIVE,
+            "full-shift coefficient P→A, P→B (eq 6.4)",
+        ),
+        param(
+            "four_way.k_t",
+            "m^3/(s Pa^0.5)",
+            Required,
+            Range::POSITIVE,
+            "full-shift coefficient A→T, B→T (eq 6.5)",
+        ),
+        param(
+            "four_way.dp_transition",
+            "Pa",
+            Value(1000.0),
+            Range::POSITIVE,
+            "transition pressure of the regularised root",
+        ),
+        param(
+            "needle.area",
+            "m^2",
+            Required,
+            Range::NON_NEGATIVE,
+            "needle opening area Avn",
+        ),
+        param(
+            "needle.effective_factor",
+            "-",
+            Required,
+            Range::UNIT,
+            "effective-area factor",
+        ),
+        o[0],
+        o[1],
+        o[2],
+        c[0],
+        c[1],
+    ]
+};
+
+/// The component types of this family.
+pub const TYPES: &[ComponentType] = &[
+    ComponentType {
+        name: "pump_identified",
+        summary: "servomotor and bidirectional gear pump, identified 2nd-order command → flow model (section 6.2.1)",
+        ports: &[
+            port("command", SIG, Role::Reads, false, "command [V]"),
+            port("a", HYD, Role::Reads, false, "port delivering for a positive command"),
+            port("b", HYD, Role::Reads, false, "port delivering for a negative command"),
+        ],
+        params: &[
+            param("gain", "m^3/(s V)", Required, Range::POSITIVE, "steady flow per volt K"),
+            param("natural_frequency", "rad/s", Required, Range::POSITIVE, "natural frequency ω_n"),
+            param("damping", "-", Required, Range::POSITIVE, "damping ratio ζ"),
+        ],
+        states: &[],
+        build: |i| {
+            let p: IdentifiedPump = i.law("")?;
+            built(PumpComponent::new(&i.name, p, i.node("command"), i.node("a"), i.node("b")))
+        },
+        hints: None,
+        probes: &[("flow", "m^3/s")],
+    },
+    ComponentType {
+        name: "relief_valve",
+        summary: "direct relief valve with linear opening between p_c and P_m (eqs 6.6–6.10)",
+        ports: &[
+            port("inlet", HYD, Role::Reads, false, "inlet"),
+            port("outlet", HYD, Role::Reads, false, "outlet (p_c is referred to it)"),
+        ],
+        params: &[
+            param("cracking", "Pa", Required, Range::NON_NEGATIVE, "cracking pressure p_c"),
+            param("full_open", "Pa", Required, Range::POSITIVE, "pressure difference P_m at full opening (> p_c)"),
+            param("kv", "m^3/(s Pa^0.5)", Required, Range::POSITIVE, "fully-open flow coefficient K_v"),
+        ],
+        states: &[],
+        build: |i| {
+            let v: ReliefValve = law(i, "", |v: &ReliefValve| {
+                ReliefValve::new(v.cracking, v.kv, v.full_open).map(|_| ())
+            })?;
+            built(ReliefComponent::new(&i.name, v, i.node("inlet"), i.node("outlet")))
+        },
+        hints: None,
+        probes: &[("flow", "m^3/s")],
+    },
+    ComponentType {
+        name: "check_valve",
+        summary: "spring-loaded check valve, inlet → outlet (eqs 6.11–6.13)",
+        ports: &[
+            port("inlet", HYD, Role::Reads, false, "inlet"),
+            port("outlet", HYD, Role::Reads, false, "outlet"),
+        ],
+        params: &CHECK,
+        states: &[],
+        build: |i| {
+            let v: CheckValve = law(i, "", |v: &CheckValve| {
+                CheckValve::new(v.cracking, v.opening_range, v.k_open).map(|_| ())
+            })?;
+            built(CheckComponent::new(&i.name, v, i.node("inlet"), i.node("outlet")))
+        },
+        hints: None,
+        probes: &[("flow", "m^3/s")],
+    },
+    ComponentType {
+        name: "pilot_return_path",
+        summary: "pilot-shifted DDDC four-way valve opening the unfed chamber to T, in series with the NCCC needle valve to tank (eqs 6.2–6.5, 6.14–6.19)",
+        ports: &[
+            port("pilot_1", HYD, Role::Reads, false, "pilot port 1 (pump line 1)"),
+            port("pilot_2", HYD, Role::Reads, false, "pilot port 6 (pump line 2)"),
+            port("A", HYD, Role::Reads, false, "work port A (chamber 1)"),
+            port("B", HYD, Role::Reads, false, "work port B (chamber 2)"),
+            port("T", HYD, Role::Reads, false, "the tank, behind the needle valve"),
+        ],
+        params: &RETURN,
+        states: &[],
+        build: |i| {
+            let fw: PilotFourWay = law(i, "four_way", PilotFourWay::validate)?;
+            let needle: NeedleValve = law(i, "needle", |n: &NeedleValve| {
+                NeedleValve::new(n.area, n.effective_factor, n.orifice, n.reverse_check).map(|_| ())
+            })?;
+            built(ReturnPath::with_nodes(
+                &i.name,
+                fw,
+                needle,
+                ReturnNodes {
+                    pilot_1: i.node("pilot_1"),
+                    pilot_2: i.node("pilot_2"),
+                    a: i.node("A"),
+                    b: i.node("B"),
+                    tank: i.node("T"),
+                },
+            ))
+        },
+        hints: None,
+        probes: &[("pilot_spool", "m"), ("return_flow_1", "m^3/s"), ("return_flow_2", "m^3/s")],
+    },
+];

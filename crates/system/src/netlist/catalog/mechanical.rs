@@ -1,0 +1,289 @@
+//! The asymmetric cylinder in its two forms (eqs 2.10–2.15; the generalised
+//! one-pressure form of eqs 2.16–2.26, 3.3–3.4) and the moving mass with its
+//! end stops (eq 2.27).
+
+use super::super::registry::{
+    param, ComponentType, Default::*, Instance, ParamSpec, Range, Role, StateSpec,
+};
+use super::servo::{metering, METERING};
+use super::{built, port, HYD, MECH, SIG};
+use crate::circuit::Component;
+use crate::components::{GeneralisedCylinder, Mass, TwoChamberCylinder};
+use hydrocyl_actuator::generalised::XMethod;
+use hydrocyl_actuator::{Cylinder, StrokeEnds};
+use hydrocyl_ports::{Area, Position, Pressure};
+
+/// The cylinder's parameters (names of [`Cylinder`]'s fields) and the
+/// reported cavitation pressure.
+const CYLINDER: [ParamSpec; 10] = [
+    param(
+        "area_1",
+        "m^2",
+        Required,
+        Range::POSITIVE,
+        "cap-side piston area A1",
+    ),
+    param(
+        "area_2",
+        "m^2",
+        Required,
+        Range::POSITIVE,
+        "rod-side annulus area A2",
+    ),
+    param(
+        "stroke",
+        "m",
+        Required,
+        Range::POSITIVE,
+        "stroke; the piston moves in ±stroke/2 from mid-stroke",
+    ),
+    param(
+        "chamber_length_1",
+        "m",
+        Required,
+        Range::POSITIVE,
+        "V1 = A1 (l1 + x)",
+    ),
+    param(
+        "chamber_length_2",
+        "m",
+        Required,
+        Range::POSITIVE,
+        "V2 = A2 (l2 − x)",
+    ),
+    param(
+        "bulk_modulus",
+        "Pa",
+        Required,
+        Range::POSITIVE,
+        "effective bulk modulus B of the chambers",
+    ),
+    param(
+        "internal_leakage",
+        "m^3/(s Pa)",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "internal leakage coefficient Cl (A → B)",
+    ),
+    param(
+        "external_leakage_1",
+        "m^3/(s Pa)",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "external leakage coefficient of chamber 1",
+    ),
+    param(
+        "external_leakage_2",
+        "m^3/(s Pa)",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "external leakage coefficient of chamber 2",
+    ),
+    param(
+        "cavitation_pressure",
+        "Pa",
+        Value(0.0),
+        Range::GAUGE_PRESSURE,
+        "chamber pressure below which cavitation is reported",
+    ),
+];
+
+pub(crate) fn cylinder(i: &Instance) -> Result<Cylinder, String> {
+    let c = Cylinder {
+        area_1: Area::new(i.get("area_1")),
+        area_2: Area::new(i.get("area_2")),
+        stroke: Position::new(i.get("stroke")),
+        chamber_length_1: Position::new(i.get("chamber_length_1")),
+        chamber_length_2: Position::new(i.get("chamber_length_2")),
+        bulk_modulus: Pressure::new(i.get("bulk_modulus")),
+        internal_leakage: i.get("internal_leakage"),
+        external_leakage_1: i.get("external_leakage_1"),
+        external_leakage_2: i.get("external_leakage_2"),
+    };
+    c.validate().map_err(|e| e.to_string())?;
+    Ok(c)
+}
+
+/// The rod's end stops and any initial motion given on the cylinder, for the
+/// rod's owner (the mass).
+fn rod_hints(i: &Instance) -> Vec<(&'static str, &'static str, f64)> {
+    let s = i.get("stroke");
+    let mut h = vec![("rod", "stop_min", -0.5 * s), ("rod", "stop_max", 0.5 * s)];
+    if let Some(x) = i.initial("position") {
+        h.push(("rod", "initial.position", x));
+    }
+    if let Some(v) = i.initial("velocity") {
+        h.push(("rod", "initial.velocity", v));
+    }
+    h
+}
+
+const MOTION: [StateSpec; 2] = [
+    StateSpec {
+        name: "position",
+        unit: "m",
+        default: Absent,
+        doc: "initial piston position from mid-stroke (given to the rod's mass)",
+    },
+    StateSpec {
+        name: "velocity",
+        unit: "m/s",
+        default: Absent,
+        doc: "initial piston velocity (given to the rod's mass)",
+    },
+];
+
+const GENERALISED: [ParamSpec; 18] = {
+    let (c, m) = (CYLINDER, METERING);
+    [
+        c[0],
+        c[1],
+        c[2],
+        c[3],
+        c[4],
+        c[5],
+        c[6],
+        c[7],
+        c[8],
+        c[9],
+        m[0],
+        m[1],
+        m[2],
+        m[3],
+        m[4],
+        m[5],
+        m[6],
+        param(
+            "x_tolerance",
+            "-",
+            Value(0.0),
+            Range::NON_NEGATIVE,
+            "absolute tolerance of a bracketing X root; 0 = the exact analytical root",
+        ),
+    ]
+};
+
+fn generalised(i: &Instance) -> Result<Box<dyn Component>, String> {
+    let p_le = i
+        .initial("load_pressure")
+        .ok_or("initial.load_pressure is required")?;
+    let tol = i.get("x_tolerance");
+    let x_method = if tol > 0.0 {
+        XMethod::Numerical { tol }
+    } else {
+        XMethod::Analytical
+    };
+    let mut g = GeneralisedCylinder::new(
+        &i.name,
+        i.node("spool"),
+        i.node("P"),
+        i.node("T"),
+        i.node("A"),
+        i.node("B"),
+        i.node("rod"),
+        cylinder(i)?,
+        metering(i)?,
+        x_method,
+        p_le,
+    );
+    g.cavitation_pressure = i.get("cavitation_pressure");
+    built(g)
+}
+
+/// The component types of this family.
+pub const TYPES: &[ComponentType] = &[
+    ComponentType {
+        name: "cylinder",
+        summary: "asymmetric (single-rod) cylinder: two chamber pressures, leakage, force on the rod (eqs 2.10–2.15)",
+        ports: &[
+            port("A", HYD, Role::Owns, false, "cap-side chamber (p1)"),
+            port("B", HYD, Role::Owns, false, "rod-side chamber (p2)"),
+            port("rod", MECH, Role::Reads, false, "the rod: + extending"),
+        ],
+        params: &CYLINDER,
+        states: &[
+            StateSpec { name: "p1", unit: "Pa", default: Absent, doc: "initial cap-side pressure (default: the steady state at rest of the valve feeding it, section 3.3.4)" },
+            StateSpec { name: "p2", unit: "Pa", default: Absent, doc: "initial rod-side pressure (default: as p1)" },
+            MOTION[0],
+            MOTION[1],
+        ],
+        build: |i| {
+            let (Some(p1), Some(p2)) = (i.initial("p1"), i.initial("p2")) else {
+                return Err("initial.p1 and initial.p2 are needed".into());
+            };
+            let p = (p1, p2);
+            let mut c = TwoChamberCylinder::new(&i.name, i.node("A"), i.node("B"), i.node("rod"), cylinder(i)?, p);
+            c.cavitation_pressure = i.get("cavitation_pressure");
+            built(c)
+        },
+        hints: Some(rod_hints),
+        probes: &[("p1", "Pa"), ("p2", "Pa"), ("p_le", "Pa")],
+    },
+    ComponentType {
+        name: "generalised_cylinder",
+        summary: "the generalised one-pressure actuator with the valve's metering merged in, Leaney's X factor (eqs 2.16–2.26, 3.3, 3.4)",
+        ports: &[
+            port("spool", SIG, Role::Reads, false, "spool position x_s [m]"),
+            port("P", HYD, Role::Reads, false, "supply port"),
+            port("T", HYD, Role::Reads, false, "tank port"),
+            port("A", HYD, Role::Owns, false, "cap-side chamber (p1, algebraic)"),
+            port("B", HYD, Role::Owns, false, "rod-side chamber (p2, algebraic)"),
+            port("rod", MECH, Role::Reads, false, "the rod: + extending"),
+        ],
+        params: &GENERALISED,
+        states: &[
+            StateSpec { name: "load_pressure", unit: "Pa", default: Absent, doc: "initial load pressure P_LE (default: the steady state at rest, section 3.3.4)" },
+            MOTION[0],
+            MOTION[1],
+        ],
+        build: generalised,
+        hints: Some(rod_hints),
+        probes: &[("p1", "Pa"), ("p2", "Pa")],
+    },
+    ComponentType {
+        name: "mass",
+        summary: "the moving mass (piston, rod, load) with hard end stops: (m + Σc) a = ΣF − F_ext (eq 2.27)",
+        ports: &[port("rod", MECH, Role::Owns, false, "the body it moves")],
+        params: &[
+            param("mass", "kg", Required, Range::POSITIVE, "moving mass m"),
+            param("external_force", "N", Value(0.0), Range::ANY, "external force F_ext opposing extension"),
+            param("stop_min", "m", Absent, Range::ANY, "retracted end stop (default: from a cylinder on the rod)"),
+            param("stop_max", "m", Absent, Range::ANY, "extended end stop (default: from a cylinder on the rod)"),
+        ],
+        states: &[
+            StateSpec { name: "position", unit: "m", default: Absent, doc: "initial position (default 0 or the cylinder's)" },
+            StateSpec { name: "velocity", unit: "m/s", default: Absent, doc: "initial velocity (default 0 or the cylinder's)" },
+        ],
+        build: |i| {
+            let lo = i.opt("stop_min").or_else(|| i.hint("rod", "stop_min"));
+            let hi = i.opt("stop_max").or_else(|| i.hint("rod", "stop_max"));
+            let stops = match (lo, hi) {
+                (Some(lo), Some(hi)) if lo < hi => Some(StrokeEnds {
+                    min: Position::new(lo),
+                    max: Position::new(hi),
+                }),
+                (None, None) => None,
+                _ => return Err("give both end stops stop_min < stop_max, or neither".into()),
+            };
+            let pick = |k: &str| {
+                let own = i.initial(k);
+                let given = i.hint("rod", &format!("initial.{k}"));
+                match (own, given) {
+                    (Some(_), Some(_)) => Err(format!(
+                        "initial.{k} is given both here and on the cylinder at the rod; give it once"
+                    )),
+                    (a, b) => Ok(a.or(b).unwrap_or(0.0)),
+                }
+            };
+            let x0 = (pick("position")?, pick("velocity")?);
+            if let Some(s) = stops {
+                if !(s.min.si()..=s.max.si()).contains(&x0.0) {
+                    return Err(format!("initial position {} m is outside the end stops", x0.0));
+                }
+            }
+            built(Mass::new(&i.name, i.node("rod"), i.get("mass"), i.get("external_force"), stops, x0))
+        },
+        hints: None,
+        probes: &[("position", "m"), ("velocity", "m/s")],
+    },
+];

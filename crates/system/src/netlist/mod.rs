@@ -1,0 +1,290 @@
+//! Circuits as data: a **netlist** names components by type and parameters
+//! and joins their typed ports; [`circuit`] turns it into a [`Circuit`].
+//!
+//! ```json
+//! {
+//!   "kind": "netlist",
+//!   "name": "fill",
+//!   "components": {
+//!     "supply": { "type": "pressure_source", "pressure": 7.0e6 },
+//!     "restrictor": { "type": "orifice", "area": 1.0e-7, "cd": 0.65, "density": 870.0 },
+//!     "line": { "type": "volume", "volume": 1.0e-4, "bulk_modulus": 7.0e8 }
+//!   },
+//!   "connections": [
+//!     ["supply.port", "restrictor.a"],
+//!     ["restrictor.b", "line.port"]
+//!   ],
+//!   "outputs": { "p_line": "line.p" }
+//! }
+//! ```
+//!
+//! * `components`: each entry's `type` is a registered component type
+//!   ([`registry::types`], `hydrocyl components`); its other keys are the
+//!   type's parameters (nested objects for dotted names such as
+//!   `orifice.cd`), `initial` its initial states. Absent parameters take
+//!   their defaults; every value is range-checked.
+//! * `connections`: each entry joins two or more endpoints, `component.port`
+//!   or a bare node name. Joined ports form a node; connected ports share a
+//!   domain (hydraulic, mechanical, signal); each node has exactly one owner
+//!   (a volume, chamber or pressure source; a mass; a signal source); every
+//!   required port is connected.
+//! * `outputs` (optional): output columns → probes `component.probe`. Without
+//!   it every probe is an output named `component.probe`.
+//!
+//! The parameter path of every value is `<component>.<parameter>` and
+//! `<component>.initial.<state>` — in `--set`, [`parameters`] and the docs.
+//! The components' order is the state vector's order.
+
+pub mod locate;
+pub mod reader;
+pub mod registry;
+
+mod catalog;
+pub mod steady;
+
+use crate::circuit::{BuildError, Circuit};
+use crate::rig::RigError;
+use crate::run::{run, Run, RunOptions, SimError};
+use crate::signal::Signal;
+pub use reader::{read, NetlistError, Schematic};
+use serde_json::{Map, Value};
+
+/// The `kind` of a netlist rig file.
+pub const KIND: &str = "netlist";
+
+impl From<NetlistError> for RigError {
+    fn from(e: NetlistError) -> Self {
+        RigError::Invalid {
+            path: e.path,
+            why: e.why,
+        }
+    }
+}
+
+/// The output column of probe `probe` of component `component` when the
+/// netlist lists no outputs: `component.probe`, with a probe name that
+/// repeats the component's (`friction_force` of `friction`) shortened.
+fn probe_path(component: &str, probe: &str) -> String {
+    let local = probe
+        .strip_prefix(component)
+        .and_then(|r| r.strip_prefix('_'))
+        .unwrap_or(probe);
+    format!("{component}.{local}")
+}
+
+/// Assembles the circuit of a checked netlist, the first `command_input`
+/// driven by `command`.
+pub fn assemble(s: &Schematic, command: Signal) -> Result<Circuit, RigError> {
+    command.validate().map_err(|e| RigError::Invalid {
+        path: "command".into(),
+        why: e.to_string(),
+    })?;
+    let inputs: Vec<&str> = s
+        .instances
+        .iter()
+        .filter(|i| i.ty.name == "command_input")
+        .map(|i| i.name.as_str())
+        .collect();
+    if inputs.len() > 1 {
+        return Err(RigError::Invalid {
+            path: format!("components.{}", inputs[1]),
+            why: "a netlist has at most one command_input so far".into(),
+        });
+    }
+    let mut comps = Vec::with_capacity(s.instances.len());
+    for inst in &s.instances {
+        let mut inst = inst.clone();
+        if inst.ty.name == "command_input" {
+            inst.input = Some(command.clone());
+        }
+        let c = (inst.ty.build)(&inst).map_err(|why| RigError::Invalid {
+            path: format!("components.{}", inst.name),
+            why,
+        })?;
+        comps.push(c);
+    }
+    let mut c = Circuit::build(comps).map_err(|e| match e {
+        BuildError::Component { component, message } => RigError::Invalid {
+            path: format!("components.{component}"),
+            why: message,
+        },
+        BuildError::AlgebraicLoop(names) => RigError::Invalid {
+            path: "connections".into(),
+            why: format!(
+                "algebraic loop between components {names}: put a volume or a mass between them"
+            ),
+        },
+        other => RigError::Build(other),
+    })?;
+    let outputs = s.outputs.clone();
+    c.name_probes(|comp, probe| {
+        let path = probe_path(comp, probe);
+        if outputs.is_empty() {
+            Some(path)
+        } else {
+            outputs
+                .iter()
+                .find(|(_, p)| *p == path)
+                .map(|(col, _)| col.clone())
+        }
+    });
+    Ok(c)
+}
+
+/// Reads a netlist value and assembles its circuit.
+pub fn circuit(v: &Value, command: Signal) -> Result<Circuit, RigError> {
+    assemble(&schematic(v)?, command)
+}
+
+/// Reads and checks a netlist value, with absent initial chamber pressures
+/// filled in by the steady state at rest (see [`steady`]).
+pub fn schematic(v: &Value) -> Result<Schematic, RigError> {
+    let mut s = read(v)?;
+    steady::fill(&mut s)?;
+    Ok(s)
+}
+
+/// Simulates a netlist on `command`, output at `t_eval`.
+pub fn simulate(
+    v: &Value,
+    command: Signal,
+    t_eval: &[f64],
+    opts: &RunOptions,
+) -> Result<Run, RigError> {
+    let mut c = circuit(v, command)?;
+    let x0 = c.initial_state();
+    run(&mut c, &x0, t_eval, opts).map_err(|e| match e {
+        SimError::Build(b) => RigError::from(b),
+        other => RigError::Sim(other.to_string()),
+    })
+}
+
+/// One parameter of a netlist: its path, value, unit and meaning.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamInfo {
+    /// `<component>.<parameter>` or `<component>.initial.<state>`.
+    pub path: String,
+    /// Its value (given or default; `None`: absent).
+    pub value: Option<f64>,
+    /// SI unit.
+    pub unit: &'static str,
+    /// What it is.
+    pub doc: &'static str,
+}
+
+/// Every parameter and initial state of a netlist, defaults filled in, in
+/// component order.
+pub fn parameters(v: &Value) -> Result<Vec<ParamInfo>, RigError> {
+    let s = schematic(v)?;
+    let mut out = Vec::new();
+    for inst in &s.instances {
+        for p in inst.ty.params {
+            out.push(ParamInfo {
+                path: format!("{}.{}", inst.name, p.name),
+                value: inst.opt(p.name),
+                unit: p.unit,
+                doc: p.doc,
+            });
+        }
+        for st in inst.ty.states {
+            out.push(ParamInfo {
+                path: format!("{}.initial.{}", inst.name, st.name),
+                value: inst.initial(st.name),
+                unit: st.unit,
+                doc: st.doc,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Sets parameter `path` (`<component>.<parameter>` or
+/// `<component>.initial.<state>`) to `value` (a number, or `null` for an
+/// optional one) in a netlist value. The path must be a parameter of the
+/// component's type; a parameter absent from the file (a default) is added.
+pub fn set(v: &mut Value, path: &str, value: Value) -> Result<(), RigError> {
+    let unknown = |hint: String| RigError::UnknownPath {
+        path: path.to_string(),
+        hint,
+    };
+    let (comp, rest) = path
+        .split_once('.')
+        .ok_or_else(|| unknown(" (a netlist parameter is `<component>.<parameter>`)".into()))?;
+    let comps = v
+        .get_mut("components")
+        .and_then(Value::as_object_mut)
+        .ok_or_else(|| unknown(" (the netlist has no components)".into()))?;
+    let names: Vec<String> = comps.keys().cloned().collect();
+    let obj = comps
+        .get_mut(comp)
+        .and_then(Value::as_object_mut)
+        .ok_or_else(|| {
+            unknown(format!(
+                " (no component `{comp}`; components: {})",
+                names.join(", ")
+            ))
+        })?;
+    let ty = obj
+        .get("type")
+        .and_then(Value::as_str)
+        .and_then(registry::lookup)
+        .ok_or_else(|| unknown(format!(" (component `{comp}` has no known type)")))?;
+    let known = match rest.strip_prefix("initial.") {
+        Some(state) => ty.state(state).is_some(),
+        None => ty.param(rest).is_some(),
+    };
+    if !known {
+        let mut all: Vec<String> = ty.params.iter().map(|p| p.name.to_string()).collect();
+        all.extend(ty.states.iter().map(|s| format!("initial.{}", s.name)));
+        return Err(unknown(format!(
+            " (`{comp}` is a {}; its parameters: {})",
+            ty.name,
+            all.join(", ")
+        )));
+    }
+    if !(value.is_number() || value.is_null()) {
+        return Err(RigError::Invalid {
+            path: path.to_string(),
+            why: format!("a parameter is a number, got `{value}`"),
+        });
+    }
+    registry::insert_path(obj, rest, value);
+    Ok(())
+}
+
+/// The netlist with every parameter and initial state written out
+/// (defaults filled in): what `--print-rig` shows.
+pub fn expanded(v: &Value) -> Result<Value, RigError> {
+    let s = read(v)?;
+    let mut out = v.clone();
+    let comps = out
+        .get_mut("components")
+        .and_then(Value::as_object_mut)
+        .expect("read checked it");
+    for inst in &s.instances {
+        let obj = comps
+            .get_mut(&inst.name)
+            .and_then(Value::as_object_mut)
+            .expect("read checked it");
+        for p in inst.ty.params {
+            registry::insert_path(
+                obj,
+                p.name,
+                inst.opt(p.name).map(Value::from).unwrap_or(Value::Null),
+            );
+        }
+        if !inst.ty.states.is_empty() {
+            let mut init = Map::new();
+            for st in inst.ty.states {
+                init.insert(
+                    st.name.to_string(),
+                    inst.initial(st.name)
+                        .map(Value::from)
+                        .unwrap_or(Value::Null),
+                );
+            }
+            obj.insert("initial".into(), Value::Object(init));
+        }
+    }
+    Ok(out)
+}

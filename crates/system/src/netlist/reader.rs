@@ -1,0 +1,577 @@
+//! Reading a netlist: JSON value → checked [`Schematic`] (instances with
+//! their parameters, initial states and nodes). Every error names the JSON
+//! path it is about.
+
+use super::registry::{lookup, types, Default, Domain, Instance, Role};
+use serde_json::{Map, Value};
+use std::collections::BTreeMap;
+
+/// A netlist problem at a JSON path.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NetlistError {
+    /// JSON path, e.g. `components.valve.orifice.cd` or `connections[3]`.
+    pub path: String,
+    /// What is wrong.
+    pub why: String,
+}
+
+fn err<T>(path: impl Into<String>, why: impl Into<String>) -> Result<T, NetlistError> {
+    Err(NetlistError {
+        path: path.into(),
+        why: why.into(),
+    })
+}
+
+/// A checked netlist.
+#[derive(Clone, Debug)]
+pub struct Schematic {
+    /// The netlist's name.
+    pub name: String,
+    /// The components, in file order (the state vector's order).
+    pub instances: Vec<Instance>,
+    /// Output columns `(column, probe path)`; empty = every probe under its
+    /// `<component>.<probe>` path.
+    pub outputs: Vec<(String, String)>,
+    /// The nodes: name → (domain, the ports on it as `component.port`).
+    pub nodes: BTreeMap<String, (Domain, Vec<String>)>,
+}
+
+impl Schematic {
+    /// The instance named `name`.
+    pub fn instance(&self, name: &str) -> Option<&Instance> {
+        self.instances.iter().find(|i| i.name == name)
+    }
+}
+
+fn valid_name(s: &str) -> bool {
+    !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+}
+
+/// Flattens a component's parameter object into dotted names; `null`
+/// leaves are left out (absent).
+fn flatten(
+    m: &Map<String, Value>,
+    prefix: &str,
+    path: &str,
+    out: &mut BTreeMap<String, f64>,
+) -> Result<(), NetlistError> {
+    for (k, v) in m {
+        let name = if prefix.is_empty() {
+            k.clone()
+        } else {
+            format!("{prefix}.{k}")
+        };
+        let at = format!("{path}.{k}");
+        match v {
+            Value::Number(n) => {
+                let x = n.as_f64().unwrap_or(f64::NAN);
+                out.insert(name, x);
+            }
+            Value::Null => {}
+            Value::Object(o) => flatten(o, &name, &at, out)?,
+            other => {
+                return err(
+                    at,
+                    format!("a parameter is a number, got {}", kind_of(other)),
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+fn kind_of(v: &Value) -> &'static str {
+    match v {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    }
+}
+
+/// Keys of a component object that are not parameters.
+const RESERVED: [&str; 3] = ["type", "initial", "description"];
+
+fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistError> {
+    let path = format!("components.{name}");
+    if !valid_name(name) {
+        return err(
+            path,
+            "a component name is letters, digits, `_` and `-` (no dots)",
+        );
+    }
+    let Value::Object(obj) = v else {
+        return err(
+            path,
+            format!("a component is an object, got {}", kind_of(v)),
+        );
+    };
+    let ty_name = match obj.get("type") {
+        Some(Value::String(s)) => s.as_str(),
+        Some(other) => {
+            return err(
+                format!("{path}.type"),
+                format!("must be a string, got {}", kind_of(other)),
+            )
+        }
+        None => return err(path, "missing `type` (see `hydrocyl components`)"),
+    };
+    let Some(ty) = lookup(ty_name) else {
+        return err(
+            format!("{path}.type"),
+            format!(
+                "unknown component type `{ty_name}` (known: {})",
+                types()
+                    .iter()
+                    .map(|t| t.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        );
+    };
+    // parameters
+    let mut given = BTreeMap::new();
+    let rest: Map<String, Value> = obj
+        .iter()
+        .filter(|(k, _)| !RESERVED.contains(&k.as_str()))
+        .map(|(k, v)| (k.clone(), v.clone()))
+        .collect();
+    flatten(&rest, "", &path, &mut given)?;
+    for k in given.keys() {
+        if ty.param(k).is_none() {
+            return err(
+                format!("{path}.{k}"),
+                format!(
+                    "`{ty_name}` has no parameter `{k}` (its parameters: {})",
+                    ty.params
+                        .iter()
+                        .map(|p| p.name)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            );
+        }
+    }
+    let mut params = BTreeMap::new();
+    for p in ty.params {
+        let at = format!("{path}.{}", p.name);
+        match (given.get(p.name), p.default) {
+            (Some(&x), _) => {
+                if !p.range.contains(x) {
+                    return err(
+                        at,
+                        format!(
+                            "{x} [{}] is out of range: must be {}",
+                            p.unit,
+                            p.range.describe()
+                        ),
+                    );
+                }
+                params.insert(p.name.to_string(), x);
+            }
+            (None, Default::Value(d)) => {
+                params.insert(p.name.to_string(), d);
+            }
+            (None, Default::Absent) => {}
+            (None, Default::Required) => {
+                return err(at, format!("missing ({} [{}])", p.doc, p.unit));
+            }
+        }
+    }
+    // initial states
+    let mut initial = BTreeMap::new();
+    let given_initial = match obj.get("initial") {
+        None => Map::new(),
+        Some(Value::Object(m)) => m.clone(),
+        Some(other) => {
+            return err(
+                format!("{path}.initial"),
+                format!("must be an object, got {}", kind_of(other)),
+            )
+        }
+    };
+    for k in given_initial.keys() {
+        if ty.state(k).is_none() {
+            return err(
+                format!("{path}.initial.{k}"),
+                format!(
+                    "`{ty_name}` has no initial state `{k}` (its states: {})",
+                    if ty.states.is_empty() {
+                        "none".to_string()
+                    } else {
+                        ty.states
+                            .iter()
+                            .map(|s| s.name)
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    }
+                ),
+            );
+        }
+    }
+    for s in ty.states {
+        let at = format!("{path}.initial.{}", s.name);
+        let value = match given_initial.get(s.name) {
+            Some(Value::Number(n)) => {
+                let x = n.as_f64().unwrap_or(f64::NAN);
+                if !x.is_finite() {
+                    return err(at, "must be finite");
+                }
+                Some(x)
+            }
+            Some(Value::Null) | None => match s.default {
+                Default::Value(d) => Some(d),
+                Default::Absent => None,
+                Default::Required => return err(at, format!("missing ({} [{}])", s.doc, s.unit)),
+            },
+            Some(other) => return err(at, format!("must be a number, got {}", kind_of(other))),
+        };
+        initial.insert(s.name.to_string(), value);
+    }
+    Ok(Instance {
+        name: name.to_string(),
+        ty,
+        params,
+        initial,
+        nodes: BTreeMap::new(),
+        hints: BTreeMap::new(),
+        input: None,
+    })
+}
+
+/// Union–find over connection endpoints.
+struct Sets {
+    parent: Vec<usize>,
+}
+
+impl Sets {
+    fn find(&mut self, i: usize) -> usize {
+        let mut r = i;
+        while self.parent[r] != r {
+            r = self.parent[r];
+        }
+        let mut j = i;
+        while self.parent[j] != r {
+            let n = self.parent[j];
+            self.parent[j] = r;
+            j = n;
+        }
+        r
+    }
+    fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            self.parent[rb.max(ra)] = ra.min(rb);
+        }
+    }
+}
+
+/// An endpoint: a component port, or a named node.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum End {
+    Port(usize, &'static str),
+    Named(String),
+}
+
+/// Reads and checks a netlist value.
+pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
+    let Value::Object(root) = v else {
+        return err("", "a netlist is a JSON object");
+    };
+    for k in root.keys() {
+        if ![
+            "kind",
+            "name",
+            "description",
+            "components",
+            "connections",
+            "outputs",
+        ]
+        .contains(&k.as_str())
+        {
+            return err(
+                k.clone(),
+                "unknown key (a netlist has kind, name, description, components, connections, outputs)",
+            );
+        }
+    }
+    let name = root
+        .get("name")
+        .and_then(Value::as_str)
+        .unwrap_or("netlist")
+        .to_string();
+    let Some(Value::Object(comps)) = root.get("components") else {
+        return err("components", "missing: an object of named components");
+    };
+    let mut instances = comps
+        .iter()
+        .map(|(n, c)| read_instance(n, c))
+        .collect::<Result<Vec<_>, _>>()?;
+
+    // endpoints and their sets
+    let mut ends: Vec<End> = Vec::new();
+    let mut first_use: Vec<String> = Vec::new();
+    let mut index = |e: End, at: &str, ends: &mut Vec<End>| -> usize {
+        if let Some(i) = ends.iter().position(|x| *x == e) {
+            i
+        } else {
+            ends.push(e);
+            first_use.push(at.to_string());
+            ends.len() - 1
+        }
+    };
+    let conns = match root.get("connections") {
+        None => Vec::new(),
+        Some(Value::Array(a)) => a.clone(),
+        Some(other) => {
+            return err(
+                "connections",
+                format!("must be an array, got {}", kind_of(other)),
+            )
+        }
+    };
+    let mut pairs = Vec::new();
+    for (ci, c) in conns.iter().enumerate() {
+        let at = format!("connections[{ci}]");
+        let Value::Array(items) = c else {
+            return err(
+                at,
+                "a connection is an array of two or more `component.port` (or node) names",
+            );
+        };
+        if items.len() < 2 {
+            return err(at, "a connection joins two or more ports");
+        }
+        let mut ids = Vec::new();
+        for (k, item) in items.iter().enumerate() {
+            let at_k = format!("{at}[{k}]");
+            let Value::String(s) = item else {
+                return err(at_k, "must be a string `component.port` or a node name");
+            };
+            let e = match s.split_once('.') {
+                Some((c, p)) => {
+                    let Some(ci) = instances.iter().position(|i| i.name == c) else {
+                        return err(at_k, format!("no component named `{c}`"));
+                    };
+                    let ty = instances[ci].ty;
+                    let Some(ps) = ty.port(p) else {
+                        return err(
+                            at_k,
+                            format!(
+                                "`{c}` ({}) has no port `{p}` (its ports: {})",
+                                ty.name,
+                                ty.ports
+                                    .iter()
+                                    .map(|p| p.name)
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
+                            ),
+                        );
+                    };
+                    End::Port(ci, ps.name)
+                }
+                None if valid_name(s) => End::Named(s.clone()),
+                None => return err(at_k, "a node name is letters, digits, `_` and `-`"),
+            };
+            ids.push(index(e, &at, &mut ends));
+        }
+        for w in ids.windows(2) {
+            pairs.push((w[0], w[1]));
+        }
+    }
+    let mut sets = Sets {
+        parent: (0..ends.len()).collect(),
+    };
+    for (a, b) in pairs {
+        sets.union(a, b);
+    }
+    let mut groups: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for i in 0..ends.len() {
+        groups.entry(sets.find(i)).or_default().push(i);
+    }
+
+    // each group is a node: one domain, one owner, one name
+    let mut nodes = BTreeMap::new();
+    for members in groups.values() {
+        let at = &first_use[members[0]];
+        let mut domain: Option<(Domain, String)> = None;
+        let mut owners = Vec::new();
+        let mut named: Option<String> = None;
+        let mut ports = Vec::new();
+        for &m in members {
+            match &ends[m] {
+                End::Named(n) => {
+                    if let Some(prev) = &named {
+                        if prev != n {
+                            return err(
+                                at.clone(),
+                                format!("nodes `{prev}` and `{n}` are joined: a node has one name"),
+                            );
+                        }
+                    }
+                    named = Some(n.clone());
+                }
+                End::Port(ci, p) => {
+                    let inst = &instances[*ci];
+                    let spec = inst.ty.port(p).expect("checked above");
+                    let label = format!("{}.{p}", inst.name);
+                    match &domain {
+                        Some((d, other)) if *d != spec.domain => {
+                            return err(
+                                at.clone(),
+                                format!(
+                                    "`{label}` is {} but `{other}` is {}: connected ports share a domain",
+                                    spec.domain.name(),
+                                    d.name()
+                                ),
+                            )
+                        }
+                        None => domain = Some((spec.domain, label.clone())),
+                        _ => {}
+                    }
+                    if spec.role == Role::Owns {
+                        owners.push(label.clone());
+                    }
+                    ports.push(label);
+                }
+            }
+        }
+        let Some((domain, _)) = domain else {
+            return err(at.clone(), "this node joins no component port");
+        };
+        match owners.len() {
+            1 => {}
+            0 => {
+                return err(
+                    at.clone(),
+                    format!(
+                        "the {} node of {} has no owner: {}",
+                        domain.name(),
+                        ports.join(", "),
+                        match domain {
+                            Domain::Hydraulic =>
+                                "connect a volume, a cylinder chamber or a pressure source to it",
+                            Domain::Mechanical => "connect a mass to it",
+                            Domain::Signal =>
+                                "connect a signal source (command input, spool) to it",
+                        }
+                    ),
+                )
+            }
+            _ => {
+                return err(
+                    at.clone(),
+                    format!(
+                        "the {} node is owned by both {}: a node has exactly one owner",
+                        domain.name(),
+                        owners.join(" and ")
+                    ),
+                )
+            }
+        }
+        let node = named.unwrap_or_else(|| owners[0].clone());
+        for &m in members {
+            if let End::Port(ci, p) = &ends[m] {
+                instances[*ci].nodes.insert(p.to_string(), node.clone());
+            }
+        }
+        nodes.insert(node, (domain, ports));
+    }
+
+    // every required port connected
+    for inst in &instances {
+        for p in inst.ty.ports {
+            if !p.optional && !inst.nodes.contains_key(p.name) {
+                return err(
+                    format!("components.{}", inst.name),
+                    format!(
+                        "port `{}` ({}, {}) is not connected",
+                        p.name,
+                        p.domain.name(),
+                        p.doc
+                    ),
+                );
+            }
+        }
+    }
+
+    // hints to the owners of nodes
+    let mut hints = Vec::new();
+    for inst in &instances {
+        if let Some(h) = inst.ty.hints {
+            for (port, key, value) in h(inst) {
+                if let Some(node) = inst.nodes.get(port) {
+                    hints.push((node.clone(), key, value));
+                }
+            }
+        }
+    }
+    for (node, key, value) in hints {
+        for inst in instances.iter_mut() {
+            let owned: Vec<String> = inst
+                .nodes
+                .iter()
+                .filter(|(p, n)| {
+                    **n == node && inst.ty.port(p).is_some_and(|s| s.role == Role::Owns)
+                })
+                .map(|(p, _)| p.clone())
+                .collect();
+            for p in owned {
+                inst.hints.insert((p, key.to_string()), value);
+            }
+        }
+    }
+
+    // outputs
+    let mut outputs = Vec::new();
+    match root.get("outputs") {
+        None => {}
+        Some(Value::Object(m)) => {
+            for (col, probe) in m {
+                let at = format!("outputs.{col}");
+                let Value::String(p) = probe else {
+                    return err(at, "an output names a probe `component.probe`");
+                };
+                let Some((c, pr)) = p.split_once('.') else {
+                    return err(at, "an output names a probe `component.probe`");
+                };
+                let Some(inst) = instances.iter().find(|i| i.name == c) else {
+                    return err(at, format!("no component named `{c}`"));
+                };
+                if !inst.ty.probes.iter().any(|(n, _)| *n == pr) {
+                    return err(
+                        at,
+                        format!(
+                            "`{c}` ({}) has no output `{pr}` (its outputs: {})",
+                            inst.ty.name,
+                            inst.ty
+                                .probes
+                                .iter()
+                                .map(|(n, _)| *n)
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        ),
+                    );
+                }
+                outputs.push((col.clone(), p.clone()));
+            }
+        }
+        Some(other) => {
+            return err(
+                "outputs",
+                format!("must be an object, got {}", kind_of(other)),
+            )
+        }
+    }
+
+    Ok(Schematic {
+        name,
+        instances,
+        outputs,
+        nodes,
+    })
+}

@@ -4,6 +4,7 @@
 //! `main` turns an error into one line on stderr and exit code 2.
 
 mod bench_sim;
+mod components;
 mod diagnose;
 mod error;
 mod simulate;
@@ -29,6 +30,9 @@ enum Command {
     Simulate(simulate::Args),
     /// Diagnose a rig against a measured record: residuals, missing effects, refits.
     Diagnose(diagnose::Args),
+    /// List the component types a netlist can use: ports, parameters (unit,
+    /// default, range), initial states and outputs.
+    Components(components::Args),
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
@@ -36,6 +40,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Xfactor(a) => xfactor::run(a),
         Command::Simulate(a) => simulate::run(a),
         Command::Diagnose(a) => diagnose::run(a),
+        Command::Components(a) => components::run(a),
     }
 }
 

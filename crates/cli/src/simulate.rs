@@ -266,7 +266,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         None
     };
     if args.print_rig {
-        let text = serde_json::to_string_pretty(&value)
+        // a netlist is printed with every parameter written out (defaults
+        // filled in), under the paths `--set` takes
+        let shown = if kind == Some(hydrocyl_system::netlist::KIND) {
+            hydrocyl_system::netlist::expanded(&value).map_err(rig_err)?
+        } else {
+            value.clone()
+        };
+        let text = serde_json::to_string_pretty(&shown)
             .map_err(|e| CliError::Input(format!("rig: {e}")))?;
         println!("{text}");
         return Ok(());

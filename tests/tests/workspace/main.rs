@@ -2,6 +2,7 @@
 
 mod layout;
 mod measured;
+mod netlist;
 mod rigs;
 
 use std::path::{Path, PathBuf};

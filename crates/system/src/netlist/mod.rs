@@ -61,13 +61,14 @@ impl From<NetlistError> for RigError {
     }
 }
 
-/// The output column of probe `probe` of component `component` when the
-/// netlist lists no outputs: `component.probe`, with a probe name that
-/// repeats the component's (`friction_force` of `friction`) shortened.
-fn probe_path(component: &str, probe: &str) -> String {
+/// The path `component.probe` of a probe a component publishes: a probe
+/// name that repeats the instance's (`relief_1_flow` of `relief_1`) is
+/// shortened to the type's declared name (`flow`).
+fn probe_path(component: &str, declared: &[(&str, &str)], probe: &str) -> String {
     let local = probe
         .strip_prefix(component)
         .and_then(|r| r.strip_prefix('_'))
+        .filter(|r| declared.iter().any(|(n, _)| n == r))
         .unwrap_or(probe);
     format!("{component}.{local}")
 }
@@ -117,8 +118,18 @@ pub fn assemble(s: &Schematic, command: Signal) -> Result<Circuit, RigError> {
         other => RigError::Build(other),
     })?;
     let outputs = s.outputs.clone();
+    let declared: Vec<(String, &[(&str, &str)])> = s
+        .instances
+        .iter()
+        .map(|i| (i.name.clone(), i.ty.probes))
+        .collect();
     c.name_probes(|comp, probe| {
-        let path = probe_path(comp, probe);
+        let types = declared
+            .iter()
+            .find(|(n, _)| n == comp)
+            .map(|(_, p)| *p)
+            .unwrap_or(&[]);
+        let path = probe_path(comp, types, probe);
         if outputs.is_empty() {
             Some(path)
         } else {

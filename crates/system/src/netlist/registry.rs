@@ -380,40 +380,63 @@ pub fn catalog_markdown() -> String {
         ));
     }
     for t in types() {
-        s.push_str(&format!("\n### `{}`\n\n{}\n\n", t.name, t.summary));
-        if !t.params.is_empty() {
-            s.push_str("| parameter | unit | default | range | meaning |\n|---|---|---|---|---|\n");
-            for p in t.params {
-                s.push_str(&format!(
-                    "| `{}` | {} | {} | {} | {} |\n",
-                    p.name,
-                    p.unit,
-                    describe_default(p.default),
-                    p.range.describe(),
-                    p.doc
-                ));
-            }
+        s.push('\n');
+        s.push_str(&type_markdown(t));
+    }
+    s
+}
+
+/// One type's section of the catalog: its ports, parameters, initial
+/// states and outputs.
+pub fn type_markdown(t: &ComponentType) -> String {
+    let mut s = format!("### `{}`\n\n{}\n\n", t.name, t.summary);
+    s.push_str("| port | domain | role | meaning |\n|---|---|---|---|\n");
+    for p in t.ports {
+        s.push_str(&format!(
+            "| `{}` | {} | {}{} | {} |\n",
+            p.name,
+            p.domain.name(),
+            if p.role == Role::Owns {
+                "owns"
+            } else {
+                "reads"
+            },
+            if p.optional { ", optional" } else { "" },
+            p.doc
+        ));
+    }
+    if !t.params.is_empty() {
+        s.push_str("\n| parameter | unit | default | range | meaning |\n|---|---|---|---|---|\n");
+        for p in t.params {
+            s.push_str(&format!(
+                "| `{}` | {} | {} | {} | {} |\n",
+                p.name,
+                p.unit,
+                describe_default(p.default),
+                p.range.describe(),
+                p.doc
+            ));
         }
-        if !t.states.is_empty() {
-            s.push_str("\n| initial state | unit | default | meaning |\n|---|---|---|---|\n");
-            for st in t.states {
-                s.push_str(&format!(
-                    "| `initial.{}` | {} | {} | {} |\n",
-                    st.name,
-                    st.unit,
-                    describe_default(st.default),
-                    st.doc
-                ));
-            }
+    }
+    if !t.states.is_empty() {
+        s.push_str("\n| initial state | unit | default | meaning |\n|---|---|---|---|\n");
+        for st in t.states {
+            s.push_str(&format!(
+                "| `initial.{}` | {} | {} | {} |\n",
+                st.name,
+                st.unit,
+                describe_default(st.default),
+                st.doc
+            ));
         }
-        if !t.probes.is_empty() {
-            let p: Vec<String> = t
-                .probes
-                .iter()
-                .map(|(n, u)| format!("`{n}` \\[{u}\\]"))
-                .collect();
-            s.push_str(&format!("\nOutputs: {}.\n", p.join(", ")));
-        }
+    }
+    if !t.probes.is_empty() {
+        let p: Vec<String> = t
+            .probes
+            .iter()
+            .map(|(n, u)| format!("`{n}` [{u}]"))
+            .collect();
+        s.push_str(&format!("\nOutputs: {}.\n", p.join(", ")));
     }
     s
 }

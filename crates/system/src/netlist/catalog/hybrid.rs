@@ -57,7 +57,7 @@ macro_rules! check_params {
 
 const CHECK: [ParamSpec; 3] = check_params!("");
 
-const RETURN: [ParamSpec; 14] = {
+const RETURN: [ParamSpec; 15] = {
     let o = orifice_params!("needle.orifice.");
     let c = check_params!("needle.reverse_check.");
     [
@@ -129,6 +129,7 @@ const RETURN: [ParamSpec; 14] = {
         o[2],
         c[0],
         c[1],
+        c[2],
     ]
 };
 

@@ -1,0 +1,491 @@
+//! Circuits as data: the netlist presets reproduce the hand-built rigs, the
+//! example circuits (which no rig kind could express) meet closed-form
+//! steady states, and bad netlists are refused with the JSON path.
+
+use super::{files, root};
+use hydrocyl_ports::{Area, Density, Pressure};
+use hydrocyl_system::rig;
+use hydrocyl_system::run::{Run, RunOptions, Solver};
+use hydrocyl_system::signal::Signal;
+use hydrocyl_valves::check::CheckValve;
+use hydrocyl_valves::orifice::Orifice;
+use serde_json::Value;
+
+fn load(rel: &str) -> Value {
+    rig::load(root().join(rel).to_str().unwrap()).unwrap_or_else(|e| panic!("{rel}: {e}"))
+}
+
+fn times(t_end: f64, dt: f64) -> Vec<f64> {
+    let n = (t_end / dt).round() as usize;
+    (0..=n).map(|k| k as f64 * dt).collect()
+}
+
+fn square() -> Signal {
+    Signal::Square {
+        amplitude: 0.2,
+        period_s: 1.0,
+        bias: 0.0,
+    }
+}
+
+/// Each netlist preset gives the very run of the hand-built rig it replaces:
+/// the same steps and every channel equal to the last bit.
+#[test]
+fn netlist_presets_reproduce_the_hand_built_rigs() {
+    let t = times(2.0, 0.01);
+    for (name, cmd) in [
+        ("leaney-moog", square()),
+        ("wang-valve-c10", square()),
+        (
+            "wang-hybrid",
+            Signal::Square {
+                amplitude: 3.0,
+                period_s: 1.0,
+                bias: 0.5,
+            },
+        ),
+    ] {
+        let legacy = rig::preset(name).unwrap();
+        let net = load(&format!("fixtures/rigs/netlist/{name}.json"));
+        let opts = RunOptions {
+            solver: Solver::Rosenbrock,
+            ..RunOptions::default()
+        };
+        let a = rig::simulate(&legacy, cmd.clone(), &t, &opts).unwrap();
+        let b = rig::simulate(&net, cmd, &t, &opts).unwrap();
+        assert_eq!(a.stats.steps, b.stats.steps, "{name}");
+        assert_eq!(a.channels.len(), b.channels.len(), "{name}");
+        for c in &a.channels {
+            let other = b
+                .channel(&c.name)
+                .unwrap_or_else(|| panic!("{name}: no `{}` in the netlist run", c.name));
+            assert_eq!(c.values, other, "{name}: channel `{}`", c.name);
+        }
+    }
+}
+
+/// The parameter paths of a netlist are `<component>.<parameter>` and
+/// `<component>.initial.<state>`, listed with units, settable by `--set`.
+#[test]
+fn one_parameter_path_scheme() {
+    for f in files(&root().join("fixtures/rigs/netlist"), ".json") {
+        let mut v = load(f.strip_prefix(root()).unwrap().to_str().unwrap());
+        let ps = rig::parameters(&v);
+        assert!(
+            ps.iter().any(|p| p.path == "cylinder.initial.position"),
+            "{}",
+            f.display()
+        );
+        assert!(ps
+            .iter()
+            .any(|p| p.path == "load.mass" && p.unit == Some("kg")));
+        rig::apply_set(&mut v, "cylinder.initial.position=-0.06").unwrap();
+        rig::apply_set(&mut v, "load.mass=50").unwrap();
+        let run = rig::simulate(
+            &v,
+            Signal::Constant { value: 0.0 },
+            &[0.0, 0.001],
+            &RunOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            run.channel("position").unwrap()[0],
+            -0.06,
+            "{}",
+            f.display()
+        );
+        let err = rig::apply_set(&mut v, "load.mass_kg=50")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("load.mass_kg") && err.contains("mass, external_force"),
+            "{err}"
+        );
+    }
+}
+
+fn steady_speed(run: &Run, channel: &str, from: f64, to: f64) -> f64 {
+    let v = run.channel(channel).unwrap();
+    let sel: Vec<f64> = run
+        .time
+        .iter()
+        .zip(v)
+        .filter(|(t, _)| **t >= from && **t <= to)
+        .map(|(_, v)| *v)
+        .collect();
+    sel.iter().sum::<f64>() / sel.len() as f64
+}
+
+/// Bisection for the root of a function that changes sign on `[lo, hi]`.
+fn root_of(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
+    let flo = f(lo);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if (f(mid) > 0.0) == (flo > 0.0) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// Δp across an orifice of coefficient `k = Cd A √(2/ρ)` passing `q`.
+fn dp(q: f64, k: f64) -> f64 {
+    (q / k).powi(2)
+}
+
+fn k_of(cd: f64, area: f64, rho: f64) -> f64 {
+    cd * area * (2.0 / rho).sqrt()
+}
+
+/// leaney-moog's valve fully open; `(A1, A2, Ps, k_valve, F(v))`.
+fn valve_drive(v: &Value) -> (f64, f64, f64, f64, impl Fn(f64) -> f64) {
+    let c = &v["components"];
+    let (a1, a2) = (
+        c["cylinder"]["area_1"].as_f64().unwrap(),
+        c["cylinder"]["area_2"].as_f64().unwrap(),
+    );
+    let ps = c["supply"]["pressure"].as_f64().unwrap();
+    let w = std::f64::consts::PI * c["valve"]["spool_diameter"].as_f64().unwrap();
+    let open = c["spool"]["stroke"].as_f64().unwrap() + c["valve"]["underlap"].as_f64().unwrap();
+    let k_valve = k_of(
+        c["valve"]["orifice"]["cd"].as_f64().unwrap(),
+        w * open,
+        870.0,
+    );
+    let fr = c["friction"].clone();
+    let friction = move |v: f64| {
+        fr["coulomb"].as_f64().unwrap() * (v / fr["smoothing_velocity"].as_f64().unwrap()).tanh()
+            + fr["viscous"].as_f64().unwrap() * v
+    };
+    (a1, a2, ps, k_valve, friction)
+}
+
+/// (a) A meter-out needle valve sets the extending speed: with the spool
+/// fully open, `p1 = Ps − Δp_PA(A1 v)`, `p2 = Δp_BT(A2 v) + Δp_needle(A2 v)`
+/// and `p1 A1 − p2 A2 = F(v)` give one speed, which the run settles to.
+#[test]
+fn meter_out_needle_sets_the_extending_speed() {
+    let v = load("fixtures/rigs/examples/meter-out-needle.json");
+    let (a1, a2, ps, kv, friction) = valve_drive(&v);
+    let kn = k_of(0.65, 0.5e-6, 870.0);
+    let expected = root_of(
+        |s| {
+            let p1 = ps - dp(a1 * s, kv);
+            let p2 = dp(a2 * s, kv) + dp(a2 * s, kn);
+            p1 * a1 - p2 * a2 - friction(s)
+        },
+        0.0,
+        1.0,
+    );
+    let t = times(3.0, 0.005);
+    let run = rig::simulate(
+        &v,
+        Signal::Constant { value: 1.0 },
+        &t,
+        &RunOptions::default(),
+    )
+    .unwrap();
+    let got = steady_speed(&run, "velocity", 2.0, 3.0);
+    assert!(
+        (got - expected).abs() < 2e-3 * expected,
+        "steady extending speed {got} m/s, closed form {expected} m/s"
+    );
+    // without the needle the same drive extends faster: the needle sets it
+    let free = root_of(
+        |s| (ps - dp(a1 * s, kv)) * a1 - dp(a2 * s, kv) * a2 - friction(s),
+        0.0,
+        2.0,
+    );
+    assert!(free > 1.5 * expected, "{free} vs {expected}");
+    // retracting, the rod side fills through the bypass check
+    let back = rig::simulate(
+        &v,
+        Signal::Constant { value: -1.0 },
+        &times(0.5, 0.005),
+        &RunOptions::default(),
+    )
+    .unwrap();
+    assert!(back
+        .channel("bypass_flow")
+        .unwrap()
+        .iter()
+        .any(|q| *q > 1e-5));
+}
+
+/// (b) Two identical cylinders in parallel on one valve move together, each
+/// at the speed the closed form gives for the shared valve flow, about half
+/// a single cylinder's; the outputs are named per cylinder.
+#[test]
+fn two_cylinders_in_parallel_share_the_valve_flow() {
+    let v = load("fixtures/rigs/examples/two-cylinders-parallel.json");
+    let c = &v["components"];
+    let (a1, a2) = (
+        c["cylinder_1"]["area_1"].as_f64().unwrap(),
+        c["cylinder_1"]["area_2"].as_f64().unwrap(),
+    );
+    let ps = c["supply"]["pressure"].as_f64().unwrap();
+    let w = std::f64::consts::PI * c["valve"]["spool_diameter"].as_f64().unwrap();
+    let u = 0.3;
+    let open =
+        u * c["spool"]["stroke"].as_f64().unwrap() + c["valve"]["underlap"].as_f64().unwrap();
+    let kv = k_of(0.625, w * open, 870.0);
+    let kh = k_of(0.65, 1.0e-5, 870.0);
+    let fr = &c["friction_1"];
+    let friction = |v: f64| {
+        fr["coulomb"].as_f64().unwrap() * (v / fr["smoothing_velocity"].as_f64().unwrap()).tanh()
+            + fr["viscous"].as_f64().unwrap() * v
+    };
+    let speed = |n: f64, hoses: bool| {
+        root_of(
+            |s| {
+                let h = if hoses { 1.0 } else { 0.0 };
+                let p1 = ps - dp(n * a1 * s, kv) - h * dp(a1 * s, kh);
+                let p2 = dp(n * a2 * s, kv) + h * dp(a2 * s, kh);
+                p1 * a1 - p2 * a2 - friction(s)
+            },
+            0.0,
+            2.0,
+        )
+    };
+    let expected = speed(2.0, true);
+    let t = times(1.2, 0.005);
+    let opts = RunOptions {
+        solver: Solver::Rosenbrock,
+        rtol: 1e-7,
+        ..RunOptions::default()
+    };
+    let run = rig::simulate(&v, Signal::Constant { value: u }, &t, &opts).unwrap();
+    let v1 = steady_speed(&run, "load_1.velocity", 0.8, 1.2);
+    let v2 = steady_speed(&run, "load_2.velocity", 0.8, 1.2);
+    assert!((v1 - v2).abs() < 1e-9, "{v1} vs {v2}");
+    assert!(
+        (v1 - expected).abs() < 2e-3 * expected,
+        "each {v1} m/s, closed form {expected} m/s"
+    );
+    let ratio = v1 / speed(1.0, false);
+    assert!((0.45..0.55).contains(&ratio), "{ratio}");
+}
+
+/// (c) A pump-controlled closed circuit without the pilot-operated valve:
+/// extending, the pump's steady flow `K u` less the flushing orifice's bleed
+/// fills the cap side, `A1 v = K u − Q_flush(p1)`; the rod side's deficit
+/// `K u − A2 v` comes from the tank through its anti-cavitation check, which
+/// sets p2 below the tank; and `p1 A1 − p2 A2 = F(v)`.
+#[test]
+fn pump_closed_circuit_meets_its_steady_state() {
+    let v = load("fixtures/rigs/examples/pump-closed-circuit.json");
+    let c = &v["components"];
+    let (a1, a2) = (
+        c["cylinder"]["area_1"].as_f64().unwrap(),
+        c["cylinder"]["area_2"].as_f64().unwrap(),
+    );
+    let q_pump = c["pump"]["gain"].as_f64().unwrap() * 2.0;
+    let check: CheckValve = serde_json::from_value(serde_json::json!({
+        "cracking": c["check_b"]["cracking"], "opening_range": c["check_b"]["opening_range"], "k_open": c["check_b"]["k_open"]
+    }))
+    .unwrap();
+    let flush = Orifice::new(0.65, Density::new(900.0));
+    let fr = &c["friction"];
+    let friction = |v: f64| {
+        fr["coulomb"].as_f64().unwrap() * (v / fr["smoothing_velocity"].as_f64().unwrap()).tanh()
+            + fr["viscous"].as_f64().unwrap() * v
+    };
+    let p2_of = |s: f64| {
+        let deficit = q_pump - a2 * s;
+        root_of(
+            |p2| check.flow(Pressure::ZERO, Pressure::new(p2)).si() - deficit,
+            -1.0e6,
+            0.0,
+        )
+    };
+    let expected = root_of(
+        |s| {
+            let p1 = (friction(s) + p2_of(s) * a2) / a1;
+            q_pump
+                - flush
+                    .flow(Area::new(0.3e-6), Pressure::new(p1), Pressure::ZERO)
+                    .si()
+                - a1 * s
+        },
+        1e-6,
+        q_pump / a1,
+    );
+    let t = times(3.0, 0.005);
+    let run = rig::simulate(
+        &v,
+        Signal::Constant { value: 2.0 },
+        &t,
+        &RunOptions::default(),
+    )
+    .unwrap();
+    let got = steady_speed(&run, "velocity", 2.0, 3.0);
+    assert!(
+        (got - expected).abs() < 2e-3 * expected,
+        "{got} vs closed form {expected}"
+    );
+    let p2 = steady_speed(&run, "p2", 2.0, 3.0);
+    assert!(
+        p2 < 0.0 && (p2 - p2_of(expected)).abs() < 0.02 * p2.abs(),
+        "{p2}"
+    );
+}
+
+/// Bad netlists: one line naming the JSON path and what is wrong.
+#[test]
+fn bad_netlists_are_refused_by_path() {
+    let base = load("fixtures/rigs/netlist/leaney-moog.json");
+    let cases: &[(&str, &dyn Fn(&mut Value), &[&str])] = &[
+        (
+            "unknown type",
+            &|v| v["components"]["valve"]["type"] = "four_way".into(),
+            &["components.valve.type", "unknown component type `four_way`"],
+        ),
+        (
+            "unknown port",
+            &|v| v["connections"][4][1] = "cylinder.C".into(),
+            &["connections[4][1]", "no port `C`", "A, B, rod"],
+        ),
+        (
+            "domain mismatch",
+            &|v| v["connections"][6][1] = "valve.A".into(),
+            &["connections", "share a domain"],
+        ),
+        (
+            "two owners",
+            &|v| v["connections"][2][1] = "tank.port".into(),
+            &[
+                "connections[2]",
+                "owned by both",
+                "supply.port",
+                "tank.port",
+            ],
+        ),
+        (
+            "dangling port",
+            &|v| {
+                v["connections"].as_array_mut().unwrap().remove(3);
+            },
+            &["components.tank", "port `port`", "not connected"],
+        ),
+        (
+            "no owner",
+            &|v| {
+                v["connections"].as_array_mut().unwrap().remove(2);
+                v["connections"]
+                    .as_array_mut()
+                    .unwrap()
+                    .push(serde_json::json!(["valve.P", "friction.A"]));
+            },
+            &["not connected"],
+        ),
+        (
+            "out of range",
+            &|v| v["components"]["valve"]["orifice"]["cd"] = 1.5.into(),
+            &["components.valve.orifice.cd", "(0, 1]"],
+        ),
+        (
+            "unknown parameter",
+            &|v| v["components"]["load"]["mass_kg"] = 1.0.into(),
+            &["components.load.mass_kg", "no parameter"],
+        ),
+        (
+            "missing parameter",
+            &|v| {
+                v["components"]["load"]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove("mass");
+            },
+            &["components.load.mass", "missing"],
+        ),
+        (
+            "a string for a number",
+            &|v| v["components"]["load"]["mass"] = "100".into(),
+            &["components.load.mass", "a number"],
+        ),
+        (
+            "unknown component in a connection",
+            &|v| v["connections"][0][0] = "cmd.out".into(),
+            &["connections[0][0]", "no component named `cmd`"],
+        ),
+        (
+            "unknown output",
+            &|v| v["outputs"]["p3"] = "cylinder.p3".into(),
+            &["outputs.p3", "no output `p3`"],
+        ),
+    ];
+    for (what, edit, words) in cases {
+        let mut v = base.clone();
+        edit(&mut v);
+        let err = rig::check(&v)
+            .and_then(|_| {
+                rig::simulate(&v, square(), &[0.0, 0.01], &RunOptions::default()).map(|_| ())
+            })
+            .expect_err(what)
+            .to_string();
+        assert!(!err.contains('\n'), "{what}: {err}");
+        for w in *words {
+            assert!(err.contains(w), "{what}: `{err}` lacks `{w}`");
+        }
+    }
+}
+
+/// A duplicate key in a rig file is refused with its path and line.
+#[test]
+fn a_duplicate_key_is_refused_with_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("dup.json");
+    let text = std::fs::read_to_string(root().join("fixtures/rigs/netlist/leaney-moog.json"))
+        .unwrap()
+        .replacen("\"mass\": 100.0", "\"mass\": 100.0, \"mass\": 50.0", 1);
+    std::fs::write(&f, text).unwrap();
+    let err = rig::load(f.to_str().unwrap()).unwrap_err().to_string();
+    assert!(
+        err.contains("components.load.mass") && err.contains("duplicate key at line"),
+        "{err}"
+    );
+}
+
+/// The probes each component type declares are the ones its components
+/// publish: every netlist fixture, run without an `outputs` list, gives one
+/// column per declared probe, named `<component>.<probe>`.
+#[test]
+fn declared_probes_are_the_published_ones() {
+    use hydrocyl_system::netlist::registry;
+    let mut dirs = files(&root().join("fixtures/rigs/netlist"), ".json");
+    dirs.extend(files(&root().join("fixtures/rigs/examples"), ".json"));
+    for f in dirs {
+        let mut v = load(f.strip_prefix(root()).unwrap().to_str().unwrap());
+        v.as_object_mut().unwrap().remove("outputs");
+        let run = rig::simulate(
+            &v,
+            Signal::Constant { value: 0.0 },
+            &[0.0, 1e-4],
+            &RunOptions::default(),
+        )
+        .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        let mut want: Vec<String> = Vec::new();
+        for (name, c) in v["components"].as_object().unwrap() {
+            let t = registry::lookup(c["type"].as_str().unwrap()).unwrap();
+            want.extend(t.probes.iter().map(|(p, _)| format!("{name}.{p}")));
+        }
+        let mut got: Vec<String> = run.channels.iter().map(|c| c.name.clone()).collect();
+        want.sort();
+        got.sort();
+        assert_eq!(got, want, "{}", f.display());
+    }
+}
+
+/// docs/components.md is the registry's catalog (regenerate it with
+/// `hydrocyl components > docs/components.md` after the header).
+#[test]
+fn the_component_docs_are_the_registry() {
+    let doc = std::fs::read_to_string(root().join("docs/components.md")).unwrap();
+    let catalog = hydrocyl_system::netlist::registry::catalog_markdown();
+    assert!(
+        doc.ends_with(&catalog),
+        "docs/components.md is out of date: regenerate its catalog with `hydrocyl components`"
+    );
+}

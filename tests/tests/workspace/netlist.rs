@@ -332,11 +332,14 @@ fn pump_closed_circuit_meets_its_steady_state() {
     );
 }
 
+/// A bad-netlist case: what, the edit that breaks it, the words the message must hold.
+type Case<'a> = (&'a str, &'a dyn Fn(&mut Value), &'a [&'a str]);
+
 /// Bad netlists: one line naming the JSON path and what is wrong.
 #[test]
 fn bad_netlists_are_refused_by_path() {
     let base = load("fixtures/rigs/netlist/leaney-moog.json");
-    let cases: &[(&str, &dyn Fn(&mut Value), &[&str])] = &[
+    let cases: &[Case] = &[
         (
             "unknown type",
             &|v| v["components"]["valve"]["type"] = "four_way".into(),

@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! hydrocyl simulate --rig leaney-moog --command cmd.csv --out run.csv \
-//!     [--set cylinder.formulation=generalised-analytical] [--set initial.p1=2e6] \
+//!     [--set load.mass=50] [--set cylinder.initial.p1=2e6] \
 //!     [--solver dp45|rosenbrock|rk4] [--rtol 1e-6] [--print-rig]
 //! ```
 //!
@@ -262,7 +262,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let variant = if kind == Some(variant::KIND) {
         Some(load_variant(&args.rig, &value)?)
     } else {
-        rig::check(&value).map_err(rig_err)?;
+        rig::check(&value).map_err(|e| rig_err(rig::at_line(e, &args.rig)))?;
         None
     };
     if args.print_rig {

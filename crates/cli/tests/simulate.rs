@@ -91,10 +91,10 @@ fn writes_the_measured_data_format_at_the_command_times() {
 fn overrides_and_solvers_change_the_run() {
     let dir = tempfile::tempdir().unwrap();
     let cmd = write_command(dir.path(), "cmd.csv", &square(200, 0.005));
-    let run = |extra: &[&str], name: &str| {
+    let run_on = |rig: &str, extra: &[&str], name: &str| {
         let out = dir.path().join(name);
         let st = hydrocyl()
-            .args(["simulate", "--rig", "leaney-moog", "--command"])
+            .args(["simulate", "--rig", rig, "--command"])
             .arg(&cmd)
             .arg("--out")
             .arg(&out)
@@ -108,31 +108,29 @@ fn overrides_and_solvers_change_the_run() {
         );
         read_csv(&out).1
     };
+    let run = |extra: &[&str], name: &str| run_on("leaney-moog", extra, name);
     let base = run(&[], "a.csv");
     let start = run(
         &[
             "--set",
-            "initial.position=0.1",
+            "cylinder.initial.position=0.1",
             "--set",
-            "initial.p1=2e6",
+            "cylinder.initial.p1=2e6",
             "--set",
-            "initial.p2=4e6",
+            "cylinder.initial.p2=4e6",
         ],
         "b.csv",
     );
     assert_eq!(start[0][2], 0.1);
     assert_eq!((start[0][4], start[0][5]), (2e6, 4e6));
-    let heavy = run(&["--set", "load.mass_kg=1000"], "c.csv");
+    let heavy = run(&["--set", "load.mass=1000"], "c.csv");
     assert!((heavy[20][3] - base[20][3]).abs() > 1e-3);
     for solver in ["rosenbrock", "rk4"] {
         let other = run(&["--solver", solver], &format!("{solver}.csv"));
         let k = other.len() - 1;
         assert!((other[k][3] - base[k][3]).abs() < 1e-4, "{solver}");
     }
-    let gen = run(
-        &["--set", "cylinder.formulation=generalised-analytical"],
-        "g.csv",
-    );
+    let gen = run_on("leaney-moog-generalised", &[], "g.csv");
     assert!((gen[90][3] - base[90][3]).abs() < 5e-3);
 }
 
@@ -147,16 +145,16 @@ fn errors_are_one_line_with_exit_code_2_and_no_output() {
     std::fs::write(&nocol, "time,u\n0,0\n0.1,1\n").unwrap();
     let cases: Vec<(Vec<String>, &str)> = vec![
         (
-            vec!["--set".into(), "cylinder.area_1_m2=-1".into()],
-            "cylinder.area_1_m2",
+            vec!["--set".into(), "cylinder.area_1=-1".into()],
+            "cylinder.area_1",
         ),
         (
             vec!["--set".into(), "cylinder.colour=red".into()],
             "cylinder.colour",
         ),
         (
-            vec!["--set".into(), "initial.position=1".into()],
-            "initial.position",
+            vec!["--set".into(), "cylinder.initial.position=1".into()],
+            "initial position 1 m is outside the end stops",
         ),
         (vec!["--solver".into(), "euler".into()], "euler"),
         (vec!["--rig".into(), "no-such-rig".into()], "no-such-rig"),
@@ -220,7 +218,7 @@ fn rig_files_and_print_rig_round_trip() {
             "leaney-moog",
             "--print-rig",
             "--set",
-            "load.mass_kg=42",
+            "load.mass=42",
         ])
         .output()
         .unwrap();
@@ -228,7 +226,9 @@ fn rig_files_and_print_rig_round_trip() {
     let rig = dir.path().join("rig.json");
     std::fs::write(&rig, &st.stdout).unwrap();
     let v: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
-    assert_eq!(v["load"]["mass_kg"], 42.0);
+    assert_eq!(v["components"]["load"]["mass"], 42.0);
+    // every parameter is written out, defaults included
+    assert_eq!(v["components"]["valve"]["null_bias"], 0.0);
     let cmd = write_command(dir.path(), "cmd.csv", &square(20, 0.01));
     let out = dir.path().join("out.csv");
     let st = hydrocyl()
@@ -413,4 +413,37 @@ fn hybrid_variants_are_simulated_on_their_base_rig() {
         "solenoid valve open: {}",
         drop(&h3, &sol)
     );
+}
+
+/// A netlist error names the JSON path and its line in the file; nothing
+/// is written.
+#[test]
+fn netlist_errors_name_the_path_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/rigs/leaney-moog.json"),
+    )
+    .unwrap();
+    let line = text.lines().position(|l| l.contains("\"cd\"")).unwrap() + 1;
+    let rig = dir.path().join("bad.json");
+    std::fs::write(&rig, text.replace("\"cd\": 0.625", "\"cd\": 1.5")).unwrap();
+    let cmd = write_command(dir.path(), "cmd.csv", &[(0.0, 0.0), (0.1, 0.2)]);
+    let out = dir.path().join("out.csv");
+    let st = hydrocyl()
+        .args(["simulate", "--rig"])
+        .arg(&rig)
+        .arg("--command")
+        .arg(&cmd)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        err.contains("components.valve.orifice.cd") && err.contains(&format!("line {line} of")),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(!out.exists());
 }

@@ -119,6 +119,7 @@ pub mod rig;
 pub mod run;
 pub mod sensor;
 pub mod signal;
+pub mod valve_netlist;
 pub mod valve_rig;
 
 pub use circuit::{

@@ -92,24 +92,31 @@ pub struct Preset {
     pub json: fn() -> Value,
 }
 
-/// The built-in presets. Other rig kinds add their presets here (one line each).
+/// The built-in presets: the netlist files of `fixtures/rigs/`.
 pub const PRESETS: &[Preset] = &[
     Preset {
         name: "leaney-moog",
-        json: || serde_json::to_value(ValveRig::leaney_moog()).unwrap_or(Value::Null),
+        json: || netlist_preset(crate::valve_netlist::FUNDAMENTAL),
+    },
+    Preset {
+        name: "leaney-moog-generalised",
+        json: || netlist_preset(crate::valve_netlist::GENERALISED),
     },
     Preset {
         name: "wang-valve-c10",
-        json: || {
-            serde_json::from_str(include_str!("../../../fixtures/rigs/wang-valve-c10.json"))
-                .unwrap_or(Value::Null)
-        },
+        json: || netlist_preset(include_str!("../../../fixtures/rigs/wang-valve-c10.json")),
     },
     Preset {
         name: "wang-hybrid",
-        json: || serde_json::to_value(crate::hybrid::WangHybrid::preset()).unwrap_or(Value::Null),
+        json: || netlist_preset(include_str!("../../../fixtures/rigs/wang-hybrid.json")),
     },
 ];
+
+/// An embedded preset file's value (`Null` if it did not parse, which the
+/// presets' tests rule out).
+fn netlist_preset(text: &str) -> Value {
+    serde_json::from_str(text).unwrap_or(Value::Null)
+}
 
 /// A rig kind: how a checked JSON value of that kind is simulated.
 pub struct RigKind {
@@ -146,8 +153,13 @@ pub const RIG_KINDS: &[RigKind] = &[
     },
 ];
 
-/// Deserialises and validates a `valve-cylinder` rig.
+/// Deserialises and validates a `valve-cylinder` rig: a rig file of that
+/// kind, or a netlist of the valve-cylinder circuit
+/// ([`ValveRig::from_netlist`]).
 pub fn valve_rig_from(v: &Value) -> Result<ValveRig, RigError> {
+    if v.get("kind").and_then(Value::as_str) == Some(crate::netlist::KIND) {
+        return ValveRig::from_netlist(v);
+    }
     let r: ValveRig = serde_json::from_value(v.clone()).map_err(|e| RigError::Invalid {
         path: "rig".into(),
         why: e.to_string(),
@@ -188,6 +200,38 @@ pub fn load(name_or_path: &str) -> Result<Value, RigError> {
         });
     }
     Ok(v)
+}
+
+/// Adds the line of the error's JSON path in the rig file `source` (when
+/// `source` is a file, not a preset name, and the path is in it) to the
+/// message: `... (line 12 of rig.json)`.
+pub fn at_line(e: RigError, source: &str) -> RigError {
+    if preset(source).is_some() {
+        return e;
+    }
+    let Ok(text) = std::fs::read_to_string(source) else {
+        return e;
+    };
+    let located = crate::netlist::locate::scan(&text);
+    let line = |path: &str| located.line_of(path).filter(|_| !path.is_empty());
+    match e {
+        RigError::Invalid { path, why } => match line(&path) {
+            Some(l) => RigError::Invalid {
+                why: format!("{why} (line {l} of {source})"),
+                path,
+            },
+            None => RigError::Invalid { path, why },
+        },
+        RigError::OutOfRange { path, value, why } => match line(&path) {
+            Some(l) => RigError::OutOfRange {
+                why: format!("{why} (line {l} of {source})"),
+                path,
+                value,
+            },
+            None => RigError::OutOfRange { path, value, why },
+        },
+        other => other,
+    }
 }
 
 /// The kind entry of a rig value.
@@ -305,7 +349,8 @@ pub fn parameters(v: &Value) -> Vec<Parameter> {
 }
 
 /// Applies one `path=value` override (`cylinder.area_1_m2=1.2e-3`,
-/// `initial.p1=3e6`, `valve.dynamics.order="second"`). The path must exist in
+/// `initial.p1=3e6`, `valve.dynamics.order="second"`; on a netlist
+/// `<component>.<parameter>`, see [`crate::netlist::set`]). The path must exist in
 /// the rig (a `null` entry such as `initial.p1` exists); the value is parsed
 /// as JSON, else taken as a string; a number may only replace a number (or a
 /// `null`), a string a string.
@@ -384,19 +429,28 @@ mod tests {
     use super::*;
 
     #[test]
-    fn parameters_are_the_numeric_leaves_as_set_paths() {
+    fn parameters_are_set_paths_with_units() {
         let v = preset("leaney-moog").unwrap();
         let ps = parameters(&v);
-        let mass = ps.iter().find(|p| p.path == "load.mass_kg").unwrap();
-        assert_eq!(mass.value, Some(100.0));
-        let p1 = ps.iter().find(|p| p.path == "initial.p1").unwrap();
-        assert_eq!(p1.value, None);
-        assert!(ps.iter().all(|p| !p.path.starts_with("kind")));
+        let mass = ps.iter().find(|p| p.path == "load.mass").unwrap();
+        assert_eq!((mass.value, mass.unit), (Some(100.0), Some("kg")));
+        // the steady initial pressure is listed with its computed value
+        let p1 = ps.iter().find(|p| p.path == "cylinder.initial.p1").unwrap();
+        assert!(p1.value.unwrap() > 1e6);
         // every listed path is settable
         let mut w = v.clone();
         for p in &ps {
-            apply_set(&mut w, &format!("{}={}", p.path, p.value.unwrap_or(1.0))).unwrap();
+            apply_set(&mut w, &format!("{}={}", p.path, p.value.unwrap_or(0.0))).unwrap();
         }
+        // an older rig kind lists its numeric leaves
+        let old = serde_json::to_value(crate::valve_rig::ValveRig::leaney_moog()).unwrap();
+        let leaves = parameters(&old);
+        assert!(leaves
+            .iter()
+            .any(|p| p.path == "load.mass_kg" && p.value == Some(100.0)));
+        assert!(leaves
+            .iter()
+            .any(|p| p.path == "initial.p1" && p.value.is_none()));
     }
 
     #[test]

@@ -3,11 +3,9 @@
 //! slideway (thesis chapter 3; rigs.md). Every parameter is a field of
 //! [`ValveRig`], which is also the JSON rig file (`fixtures/rigs/leaney-moog.json`).
 
-use crate::circuit::{Circuit, Component};
-use crate::components::*;
+use crate::circuit::Circuit;
 use crate::rig::{gauge_pressure_problem, GaugePressure, RigError};
 use crate::run::{run, Run, RunOptions, SimError};
-use crate::sensor::LaggedPressureSensor;
 use crate::signal::Signal;
 use hydrocyl_actuator::Cylinder;
 use hydrocyl_friction::{CoulombViscous, FrictionInput, FrictionLaw, FrictionModel};
@@ -499,97 +497,15 @@ impl ValveRig {
     }
 
     /// Assembles the rig's circuit driven by `command` (normalised spool
-    /// demand), with the formulation of `cylinder.formulation`.
+    /// demand): the netlist of its formulation ([`ValveRig::to_netlist`])
+    /// through the netlist assembler — the topology is in the netlist files.
     pub fn circuit(&self, command: Signal) -> Result<Circuit, RigError> {
-        self.validate()?;
-        command.validate().map_err(|e| RigError::Invalid {
-            path: "command".into(),
-            why: e.to_string(),
-        })?;
-        let (p1, p2) = self.initial_pressures()?;
-        let cyl = self.cylinder_model();
-        let metering = self.metering();
-        let droop = self.supply.droop_resistance_pa_s_per_m3 > 0.0;
-        let mut comps: Vec<Box<dyn Component>> = vec![
-            Box::new(PressureSource::new(
-                "supply",
-                "P",
-                Pressure::new(self.supply.pressure_pa),
-                // with droop, `ps` is the pressure the valve sees (below)
-                (!droop).then_some("ps"),
-            )),
-            Box::new(PressureSource::new(
-                "tank",
-                "T",
-                Pressure::new(self.supply.tank_pressure_pa),
-                None,
-            )),
-            Box::new(CommandInput::new("command", "command", command)),
-            Box::new(ServoSpool::new(
-                "spool",
-                "command",
-                "spool",
-                self.spool(),
-                self.initial.spool,
-            )),
-        ];
-        match self.cylinder.formulation {
-            Formulation::Fundamental => {
-                let mut valve = FourWayValve::new("valve", "spool", "P", "T", "A", "B", metering);
-                valve.supply_resistance = self.supply.droop_resistance_pa_s_per_m3;
-                valve.supply_probe = droop.then(|| "ps".to_string());
-                comps.push(Box::new(valve));
-                let mut c = TwoChamberCylinder::new("cylinder", "A", "B", "rod", cyl, (p1, p2));
-                c.cavitation_pressure = self.cylinder.cavitation_pressure_pa;
-                comps.push(Box::new(c));
-            }
-            f => {
-                let x_method = if f == Formulation::GeneralisedAnalytical {
-                    XMethod::Analytical
-                } else {
-                    XMethod::Numerical {
-                        tol: self.cylinder.x_tolerance,
-                    }
-                };
-                let p_le = cyl.force(Pressure::new(p1), Pressure::new(p2)).si()
-                    / cyl.effective_area().si();
-                let mut g = GeneralisedCylinder::new(
-                    "cylinder", "spool", "P", "T", "A", "B", "rod", cyl, metering, x_method, p_le,
-                );
-                g.cavitation_pressure = self.cylinder.cavitation_pressure_pa;
-                comps.push(Box::new(g));
-            }
-        }
-        comps.push(Box::new(Mass::new(
-            "load",
-            "rod",
-            self.load.mass_kg,
-            self.load.external_force_n,
-            Some(cyl.stroke_ends()),
-            (self.initial.position, self.initial.velocity),
-        )));
-        comps.push(Box::new(Friction::new(
-            "friction",
-            "rod",
-            Some(("A", "B")),
-            self.friction_model(),
-        )));
-        let tau = self.sensors.pressure_lag_s;
-        if tau > 0.0 {
-            for (node, probe, p0) in [("A", "p1_sensor", p1), ("B", "p2_sensor", p2)] {
-                comps.push(Box::new(LaggedPressureSensor::new(
-                    &format!("sensor_{node}"),
-                    node,
-                    probe,
-                    tau,
-                    p0,
-                )));
-            }
-        }
-        Circuit::build(comps).map_err(RigError::from)
+        crate::netlist::circuit(&self.to_netlist()?, command)
     }
 
-    /// Simulates the rig on `command`, output at `t_eval`.
+    /// Simulates the rig on `command`, output at `t_eval`. With lagged
+    /// pressure sensors, `p1`/`p2` are what the sensors read and
+    /// `p1_chamber`/`p2_chamber` the chamber pressures.
     pub fn simulate(
         &self,
         command: Signal,
@@ -598,28 +514,10 @@ impl ValveRig {
     ) -> Result<Run, RigError> {
         let mut c = self.circuit(command)?;
         let x0 = c.initial_state();
-        let mut r = run(&mut c, &x0, t_eval, opts).map_err(|e| match e {
+        run(&mut c, &x0, t_eval, opts).map_err(|e| match e {
             SimError::Build(b) => RigError::from(b),
             other => RigError::Sim(other.to_string()),
-        })?;
-        if self.sensors.pressure_lag_s > 0.0 {
-            // `p1`/`p2` become what the sensors read, the chamber pressures
-            // move to `p1_chamber`/`p2_chamber` (column order kept).
-            for k in ["p1", "p2"] {
-                let sensor = r
-                    .channels
-                    .iter()
-                    .position(|c| c.name == format!("{k}_sensor"));
-                let chamber = r.channels.iter().position(|c| c.name == k);
-                if let (Some(s), Some(c)) = (sensor, chamber) {
-                    let (lo, hi) = (s.min(c), s.max(c));
-                    let (a, b) = r.channels.split_at_mut(hi);
-                    std::mem::swap(&mut a[lo].values, &mut b[0].values);
-                    r.channels[s].name = format!("{k}_chamber");
-                }
-            }
-        }
-        Ok(r)
+        })
     }
 
     /// Steady piston velocity at spool position `xs` \[m·s⁻¹\]: the exact

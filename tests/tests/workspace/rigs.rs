@@ -63,7 +63,11 @@ fn every_preset_runs_a_step() {
     let t: Vec<f64> = (0..=60).map(|k| k as f64 * 0.01).collect();
     for p in rig::PRESETS {
         let v = rig::preset(p.name).unwrap();
-        let after = if v["kind"] == "hybrid-pump" { 2.0 } else { 0.2 };
+        let after = if v["components"]["pump"].is_object() {
+            2.0
+        } else {
+            0.2
+        };
         let cmd = Signal::Step {
             time_s: 0.1,
             before: 0.0,
@@ -85,8 +89,8 @@ fn every_preset_runs_a_step() {
             );
         }
         let x = run.channel("position").unwrap();
-        let cyl = &v["cylinder"];
-        let stroke = cyl["stroke_m"].as_f64().or(cyl["stroke"].as_f64());
+        let cyl = &v["components"]["cylinder"];
+        let stroke = cyl["stroke"].as_f64();
         let half_stroke = stroke.expect("every rig states its stroke") / 2.0;
         assert!(
             x.iter().all(|x| x.abs() <= half_stroke + 1e-12),

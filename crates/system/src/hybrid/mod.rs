@@ -34,6 +34,7 @@
 
 pub mod chapter7;
 pub mod components;
+mod netlist;
 
 pub use components::{CheckComponent, PumpComponent, ReliefComponent, ReturnNodes, ReturnPath};
 
@@ -163,6 +164,11 @@ impl WangHybrid {
 
     /// The rig from its JSON form (the `fixtures/rigs/wang-hybrid.json` format), checked.
     pub fn from_json(text: &str) -> Result<Self, RigError> {
+        if let Ok(v) = serde_json::from_str::<serde_json::Value>(text) {
+            if v.get("kind").and_then(serde_json::Value::as_str) == Some(crate::netlist::KIND) {
+                return Self::from_netlist(&v);
+            }
+        }
         let r: Self = serde_json::from_str(text).map_err(|e| RigError::Invalid {
             path: "rig".into(),
             why: format!("line {} column {}: {e}", e.line(), e.column()),
@@ -173,6 +179,9 @@ impl WangHybrid {
 
     /// The rig from a JSON value, checked.
     pub fn from_value(v: &serde_json::Value) -> Result<Self, RigError> {
+        if v.get("kind").and_then(serde_json::Value::as_str) == Some(crate::netlist::KIND) {
+            return Self::from_netlist(v);
+        }
         let r: Self = serde_json::from_value(v.clone()).map_err(|e| RigError::Invalid {
             path: "rig".into(),
             why: e.to_string(),

@@ -46,6 +46,7 @@ use crate::circuit::{BuildError, Circuit};
 use crate::rig::RigError;
 use crate::run::{run, Run, RunOptions, SimError};
 use crate::signal::Signal;
+pub(crate) use catalog::friction_law_of as catalog_friction_law;
 pub use reader::{read, NetlistError, Schematic};
 use serde_json::{Map, Value};
 

@@ -36,7 +36,7 @@ pub(super) fn built<C: Component + 'static>(c: C) -> Result<Box<dyn Component>, 
     Ok(Box::new(c))
 }
 
-pub(super) use friction::law_of as friction_law_of;
+pub(crate) use friction::law_of as friction_law_of;
 pub(super) use mechanical::cylinder as cylinder_of;
 pub(super) use servo::metering as metering_of;
 

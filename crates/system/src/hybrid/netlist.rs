@@ -1,0 +1,207 @@
+//! The `hybrid-pump` rig read from a netlist of its circuit (the
+//! `wang-hybrid` preset file): the typed view the chapter-7 and chapter-8
+//! studies work on.
+
+use super::{WangHybrid, KIND};
+use crate::netlist::{self, registry::Instance};
+use crate::rig::RigError;
+use hydrocyl_actuator::Cylinder;
+use hydrocyl_ports::{Area, Position, Pressure};
+use serde_json::Value;
+
+/// The components of the hybrid circuit, in state order.
+const PARTS: [(&str, &str); 15] = [
+    ("command", "command_input"),
+    ("pump", "pump_identified"),
+    ("line_1", "volume"),
+    ("line_2", "volume"),
+    ("cylinder", "cylinder"),
+    ("load", "mass"),
+    ("friction", "friction_*"),
+    ("tank", "pressure_source"),
+    ("relief_1", "relief_valve"),
+    ("relief_2", "relief_valve"),
+    ("relief_3_line_1", "relief_valve"),
+    ("relief_3_line_2", "relief_valve"),
+    ("check_1", "check_valve"),
+    ("check_2", "check_valve"),
+    ("return", "pilot_return_path"),
+];
+
+/// Ports the circuit joins: each group shares one node.
+const NODES: [&[(&str, &str)]; 7] = [
+    &[("command", "out"), ("pump", "command")],
+    &[
+        ("pump", "a"),
+        ("line_1", "port"),
+        ("relief_1", "inlet"),
+        ("relief_3_line_1", "inlet"),
+        ("check_1", "outlet"),
+        ("return", "pilot_1"),
+    ],
+    &[
+        ("pump", "b"),
+        ("line_2", "port"),
+        ("relief_2", "inlet"),
+        ("relief_3_line_2", "inlet"),
+        ("check_2", "outlet"),
+        ("return", "pilot_2"),
+    ],
+    &[
+        ("cylinder", "A"),
+        ("friction", "A"),
+        ("relief_1", "outlet"),
+        ("return", "A"),
+    ],
+    &[
+        ("cylinder", "B"),
+        ("friction", "B"),
+        ("relief_2", "outlet"),
+        ("return", "B"),
+    ],
+    &[
+        ("tank", "port"),
+        ("relief_3_line_1", "outlet"),
+        ("relief_3_line_2", "outlet"),
+        ("check_1", "inlet"),
+        ("check_2", "inlet"),
+        ("return", "T"),
+    ],
+    &[("cylinder", "rod"), ("load", "rod"), ("friction", "rod")],
+];
+
+/// A law from an instance's parameters under `prefix`.
+fn typed<T: serde::de::DeserializeOwned>(i: &Instance, prefix: &str) -> Result<T, RigError> {
+    i.law(prefix)
+        .map_err(|e| bad(format!("components.{}", i.name), e))
+}
+
+fn bad(path: impl Into<String>, why: impl Into<String>) -> RigError {
+    RigError::Invalid {
+        path: path.into(),
+        why: why.into(),
+    }
+}
+
+impl WangHybrid {
+    /// The rig a netlist of the hybrid circuit describes (the components and
+    /// wiring of the `wang-hybrid` preset; relief valves 1/2, 3 and the
+    /// check valves each pairwise equal). Another circuit is refused, naming
+    /// what differs.
+    pub fn from_netlist(v: &Value) -> Result<WangHybrid, RigError> {
+        let s = netlist::read(v)?;
+        if let Some(extra) = s
+            .instances
+            .iter()
+            .find(|i| !PARTS.iter().any(|(n, _)| *n == i.name))
+        {
+            return Err(bad(
+                format!("components.{}", extra.name),
+                "is not part of the hybrid circuit this study works on (the wang-hybrid preset's components)",
+            ));
+        }
+        let get = |name: &str| -> Result<&Instance, RigError> {
+            let ty = PARTS
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, t)| *t)
+                .unwrap_or("");
+            let i = s.instance(name).ok_or_else(|| {
+                bad(
+                    "components",
+                    format!("the hybrid circuit has a component `{name}` ({ty})"),
+                )
+            })?;
+            let ok = match ty.strip_suffix('*') {
+                Some(prefix) => i.ty.name.starts_with(prefix),
+                None => i.ty.name == ty,
+            };
+            if !ok {
+                return Err(bad(
+                    format!("components.{name}.type"),
+                    format!("is `{}`; the hybrid circuit needs `{ty}`", i.ty.name),
+                ));
+            }
+            Ok(i)
+        };
+        for (name, _) in PARTS {
+            get(name)?;
+        }
+        for group in NODES {
+            let (c0, p0) = group[0];
+            let n0 = get(c0)?.node(p0);
+            for (c, p) in &group[1..] {
+                if n0.is_empty() || get(c)?.node(p) != n0 {
+                    return Err(bad("connections", format!("`{c0}.{p0}` and `{c}.{p}` must be joined for the hybrid circuit this study works on")));
+                }
+            }
+        }
+        for (a, b) in [
+            ("relief_1", "relief_2"),
+            ("relief_3_line_1", "relief_3_line_2"),
+            ("check_1", "check_2"),
+            ("line_1", "line_2"),
+        ] {
+            if get(a)?.params != get(b)?.params {
+                return Err(bad(
+                    format!("components.{b}"),
+                    format!("differs from `{a}`; the hybrid rig's studies take them equal"),
+                ));
+            }
+        }
+        let cyl = get("cylinder")?;
+        let load = get("load")?;
+        let friction = get("friction")?;
+        let tank = get("tank")?.get("pressure");
+        let line = get("line_1")?;
+        let r = WangHybrid {
+            kind: KIND.into(),
+            pump: typed(get("pump")?, "")?,
+            pump_line_volume: line.get("volume"),
+            bulk_modulus: line.get("bulk_modulus"),
+            relief_pilot: typed(get("relief_1")?, "")?,
+            relief_safety: typed(get("relief_3_line_1")?, "")?,
+            check: typed(get("check_1")?, "")?,
+            four_way: typed(get("return")?, "four_way")?,
+            needle: typed(get("return")?, "needle")?,
+            cylinder: Cylinder {
+                area_1: Area::new(cyl.get("area_1")),
+                area_2: Area::new(cyl.get("area_2")),
+                stroke: Position::new(cyl.get("stroke")),
+                chamber_length_1: Position::new(cyl.get("chamber_length_1")),
+                chamber_length_2: Position::new(cyl.get("chamber_length_2")),
+                bulk_modulus: Pressure::new(cyl.get("bulk_modulus")),
+                internal_leakage: cyl.get("internal_leakage"),
+                external_leakage_1: cyl.get("external_leakage_1"),
+                external_leakage_2: cyl.get("external_leakage_2"),
+            },
+            mass: load.get("mass"),
+            external_force: load.get("external_force"),
+            friction: netlist::catalog_friction_law(friction)
+                .expect("a friction_* type")
+                .map_err(|e| bad("components.friction", e))?,
+            tank_pressure: tank,
+            vapour_pressure: cyl.get("cavitation_pressure"),
+            initial_position: cyl
+                .initial("position")
+                .or_else(|| load.initial("position"))
+                .unwrap_or(0.0),
+        };
+        // the rig starts at rest with every volume at the tank pressure
+        for (name, state) in [
+            ("cylinder", "p1"),
+            ("cylinder", "p2"),
+            ("line_1", "pressure"),
+            ("line_2", "pressure"),
+        ] {
+            if get(name)?.initial(state).is_some_and(|p| p != tank) {
+                return Err(bad(
+                    format!("components.{name}.initial.{state}"),
+                    "the hybrid rig's studies start with every volume at the tank pressure",
+                ));
+            }
+        }
+        r.validate()?;
+        Ok(r)
+    }
+}

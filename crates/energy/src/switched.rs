@@ -14,7 +14,7 @@
 //! every switch.
 
 use hydrocyl_integrators::{Crossing, EventAction};
-use hydrocyl_ports::{Area, Pressure};
+use hydrocyl_ports::{Area, VolumeFlow};
 use hydrocyl_system::circuit::{BuildError, Component, HydraulicNode, Netlist, PowerTerms, Wire};
 use hydrocyl_system::Wires;
 use hydrocyl_valves::orifice::Orifice;
@@ -32,7 +32,7 @@ pub struct SwitchedOrifice {
     pub orifice: Orifice,
     /// +1: open for a positive signal; −1: open for a negative one.
     pub direction: f64,
-    signal: Wire,
+    signal: Wire<f64>,
     inlet: HydraulicNode,
     outlet: HydraulicNode,
     switches: usize,
@@ -50,10 +50,7 @@ impl SwitchedOrifice {
         orifice: Orifice,
         direction: f64,
     ) -> Self {
-        let unbound = HydraulicNode {
-            pressure: Wire::UNBOUND,
-            inflow: Wire::UNBOUND,
-        };
+        let unbound = HydraulicNode::UNBOUND;
         Self {
             name: name.into(),
             signal_name: signal.into(),
@@ -70,17 +67,15 @@ impl SwitchedOrifice {
     }
 
     /// Flow from inlet to outlet \[m³·s⁻¹\].
-    fn flow(&self, w: &Wires) -> f64 {
+    fn flow(&self, w: &Wires) -> VolumeFlow {
         if self.direction * w.get(self.signal) > 0.0 {
-            self.orifice
-                .flow(
-                    self.area,
-                    Pressure::new(w.get(self.inlet.pressure)),
-                    Pressure::new(w.get(self.outlet.pressure)),
-                )
-                .si()
+            self.orifice.flow(
+                self.area,
+                w.get(self.inlet.pressure),
+                w.get(self.outlet.pressure),
+            )
         } else {
-            0.0
+            VolumeFlow::ZERO
         }
     }
 }
@@ -140,7 +135,8 @@ impl Component for SwitchedOrifice {
         self.switches = 0;
     }
     fn power(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
-        p.dissipated = (w.get(self.inlet.pressure) - w.get(self.outlet.pressure)) * self.flow(w);
+        p.dissipated =
+            ((w.get(self.inlet.pressure) - w.get(self.outlet.pressure)) * self.flow(w)).si();
     }
     fn diagnostics(&self) -> Vec<(String, f64)> {
         vec![("switches".into(), self.switches as f64)]

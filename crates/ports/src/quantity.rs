@@ -4,6 +4,31 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
 
+/// What every quantity newtype is: a `Copy` wrapper of its SI value, so that
+/// generic code (the circuit assembler's typed wires) can store quantities as
+/// bare `f64` and hand them back typed. `f64` itself is the dimensionless
+/// quantity (a normalised command, a count, a ratio).
+pub trait Quantity: Copy + fmt::Debug + 'static {
+    /// The SI unit symbol, e.g. `"Pa"` (`"-"` for a dimensionless `f64`).
+    const UNIT: &'static str;
+    /// The quantity from its SI value.
+    fn from_si(si: f64) -> Self;
+    /// The SI value.
+    fn si(self) -> f64;
+}
+
+impl Quantity for f64 {
+    const UNIT: &'static str = "-";
+    #[inline(always)]
+    fn from_si(si: f64) -> Self {
+        si
+    }
+    #[inline(always)]
+    fn si(self) -> f64 {
+        self
+    }
+}
+
 /// Defines one SI quantity newtype with the operations every quantity has:
 /// addition and subtraction of like quantities, scaling by `f64`, the ratio of
 /// two like quantities as a plain `f64`, and summation.
@@ -52,6 +77,18 @@ macro_rules! quantity {
             #[inline(always)]
             pub fn min(self, other: Self) -> Self {
                 Self(self.0.min(other.0))
+            }
+        }
+
+        impl Quantity for $name {
+            const UNIT: &'static str = $unit;
+            #[inline(always)]
+            fn from_si(si: f64) -> Self {
+                Self(si)
+            }
+            #[inline(always)]
+            fn si(self) -> f64 {
+                self.0
             }
         }
 

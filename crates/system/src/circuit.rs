@@ -4,49 +4,191 @@
 //! See the crate docs for the causality rules and how to add a component.
 
 use hydrocyl_integrators::{Crossing, EventAction, OdeSystem};
+use hydrocyl_ports::{Force, Mass, Position, Pressure, Quantity, Velocity, VolumeFlow};
 use std::cell::RefCell;
 use std::collections::HashMap;
+use std::marker::PhantomData;
 use thiserror::Error;
 
-/// Index of one scalar in the circuit's wire table (a pressure, an
-/// accumulated flow, a position, a signal, ...).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct Wire(usize);
+/// An effort or signal wire carrying a quantity `Q` (a pressure, a position,
+/// a velocity, a spool travel, a normalised command as `f64`): written by its
+/// one owner, read by the others. The type parameter makes a unit or domain
+/// slip inside a component a compile error; the wire itself is an index into
+/// the circuit's table of `f64` (the quantities are `#[repr(transparent)]`
+/// newtypes, so typed access costs nothing).
+pub struct Wire<Q>(usize, PhantomData<fn() -> Q>);
 
-impl Wire {
-    /// A placeholder for a component's wire fields before
-    /// [`Component::bind`] sets them (never read: [`Circuit::build`] binds
-    /// every component before anything is evaluated).
-    pub const UNBOUND: Wire = Wire(usize::MAX);
+/// An accumulator wire carrying a quantity `Q`: every component but the
+/// node's owner **adds** to it (flows into a hydraulic node, forces and added
+/// masses on a body); zeroed at the start of each evaluation.
+///
+/// A pressure cannot be added into a flow accumulator:
+///
+/// ```compile_fail,E0308
+/// use hydrocyl_ports::{Pressure, VolumeFlow};
+/// use hydrocyl_system::{Acc, Wires};
+///
+/// let mut w = Wires::default();
+/// let inflow: Acc<VolumeFlow> = Acc::UNBOUND;
+/// w.add(inflow, Pressure::from_bar(1.0)); // error: expected `VolumeFlow`
+/// ```
+///
+/// while a flow can (the same code with the right quantity compiles):
+///
+/// ```no_run
+/// use hydrocyl_ports::{Pressure, VolumeFlow};
+/// use hydrocyl_system::{Acc, Wires};
+///
+/// let mut w = Wires::default();
+/// let inflow: Acc<VolumeFlow> = Acc::UNBOUND;
+/// w.add(inflow, VolumeFlow::from_l_per_min(1.0));
+/// ```
+pub struct Acc<Q>(usize, PhantomData<fn() -> Q>);
+
+/// An untyped wire index, for readers that want every wire as a column of
+/// `f64` (probes, output sampling, [`Circuit::find_wire`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct AnyWire(usize);
+
+macro_rules! typed_wire {
+    ($t:ident) => {
+        impl<Q> $t<Q> {
+            /// A placeholder for a component's wire fields before
+            /// [`Component::bind`] sets them (never read: [`Circuit::build`]
+            /// binds every component before anything is evaluated).
+            pub const UNBOUND: Self = Self(usize::MAX, PhantomData);
+
+            /// The untyped index (for probes and output columns).
+            #[inline(always)]
+            pub const fn raw(self) -> AnyWire {
+                AnyWire(self.0)
+            }
+        }
+        impl<Q> Clone for $t<Q> {
+            fn clone(&self) -> Self {
+                *self
+            }
+        }
+        impl<Q> Copy for $t<Q> {}
+        impl<Q> PartialEq for $t<Q> {
+            fn eq(&self, o: &Self) -> bool {
+                self.0 == o.0
+            }
+        }
+        impl<Q> Eq for $t<Q> {}
+        impl<Q> std::hash::Hash for $t<Q> {
+            fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+                self.0.hash(h)
+            }
+        }
+        impl<Q: Quantity> std::fmt::Debug for $t<Q> {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                write!(f, "{}<{}>({})", stringify!($t), Q::UNIT, self.0)
+            }
+        }
+        impl<Q> From<$t<Q>> for AnyWire {
+            fn from(w: $t<Q>) -> AnyWire {
+                w.raw()
+            }
+        }
+    };
+}
+typed_wire!(Wire);
+typed_wire!(Acc);
+
+/// A wire handle [`Wires::get`] can read: a typed [`Wire`] or [`Acc`] gives
+/// its quantity, an [`AnyWire`] gives the bare SI `f64`.
+pub trait ReadWire: Copy {
+    /// What reading it gives.
+    type Value;
+    /// The table index.
+    fn index(self) -> usize;
+    /// The value from its SI `f64`.
+    fn value(si: f64) -> Self::Value;
+}
+
+impl<Q: Quantity> ReadWire for Wire<Q> {
+    type Value = Q;
+    #[inline(always)]
+    fn index(self) -> usize {
+        self.0
+    }
+    #[inline(always)]
+    fn value(si: f64) -> Q {
+        Q::from_si(si)
+    }
+}
+
+impl<Q: Quantity> ReadWire for Acc<Q> {
+    type Value = Q;
+    #[inline(always)]
+    fn index(self) -> usize {
+        self.0
+    }
+    #[inline(always)]
+    fn value(si: f64) -> Q {
+        Q::from_si(si)
+    }
+}
+
+impl ReadWire for AnyWire {
+    type Value = f64;
+    #[inline(always)]
+    fn index(self) -> usize {
+        self.0
+    }
+    #[inline(always)]
+    fn value(si: f64) -> f64 {
+        si
+    }
 }
 
 /// The wires of a hydraulic node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct HydraulicNode {
-    /// The node pressure \[Pa\] (the effort), written by the node's one owner.
-    pub pressure: Wire,
+    /// The node pressure (the effort), written by the node's one owner.
+    pub pressure: Wire<Pressure>,
     /// Accumulator of the volume flow **into** the node from every component
-    /// except its owner \[m³·s⁻¹\]; zeroed at the start of each evaluation.
-    pub inflow: Wire,
+    /// except its owner; zeroed at the start of each evaluation.
+    pub inflow: Acc<VolumeFlow>,
+}
+
+impl HydraulicNode {
+    /// A placeholder before [`Component::bind`] (see [`Wire::UNBOUND`]).
+    pub const UNBOUND: Self = Self {
+        pressure: Wire::UNBOUND,
+        inflow: Acc::UNBOUND,
+    };
 }
 
 /// The wires of a mechanical (translational) node: a rigid body.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MechanicalNode {
-    /// Position, + extending \[m\] (written by the owner, a mass).
-    pub position: Wire,
-    /// Velocity \[m·s⁻¹\] (written by the owner).
-    pub velocity: Wire,
+    /// Position, + extending (written by the owner, a mass).
+    pub position: Wire<Position>,
+    /// Velocity (written by the owner).
+    pub velocity: Wire<Velocity>,
     /// Accumulator of the forces on the body from every component except its
-    /// owner, + in the + direction \[N\]; zeroed at each evaluation.
-    pub force: Wire,
+    /// owner, + in the + direction; zeroed at each evaluation.
+    pub force: Acc<Force>,
     /// Accumulator of masses added by acceleration-proportional terms
-    /// (`c a` friction terms moved to the mass side) \[kg\].
-    pub added_mass: Wire,
-    /// Accumulator of hold requests: a component that sticks the body (a
-    /// friction law in its stick mode) adds 1; while it is positive the owner
-    /// holds the body at rest (`dv/dt = 0`, and `v = 0` after the event).
-    pub hold: Wire,
+    /// (`c a` friction terms moved to the mass side).
+    pub added_mass: Acc<Mass>,
+    /// Accumulator of hold requests (a count): a component that sticks the
+    /// body (a friction law in its stick mode) adds 1; while it is positive
+    /// the owner holds the body at rest (`dv/dt = 0`, and `v = 0` after the event).
+    pub hold: Acc<f64>,
+}
+
+impl MechanicalNode {
+    /// A placeholder before [`Component::bind`] (see [`Wire::UNBOUND`]).
+    pub const UNBOUND: Self = Self {
+        position: Wire::UNBOUND,
+        velocity: Wire::UNBOUND,
+        force: Acc::UNBOUND,
+        added_mass: Acc::UNBOUND,
+        hold: Acc::UNBOUND,
+    };
 }
 
 /// When a component writes a wire it owns.
@@ -68,20 +210,25 @@ pub struct Wires {
 }
 
 impl Wires {
-    /// Value of a wire.
+    /// Value of a wire: the quantity of a [`Wire`] or [`Acc`], the SI `f64`
+    /// of an [`AnyWire`].
     #[inline(always)]
-    pub fn get(&self, w: Wire) -> f64 {
-        self.v[w.0]
+    pub fn get<W: ReadWire>(&self, w: W) -> W::Value {
+        W::value(self.v[w.index()])
     }
     /// Sets a wire (only its owner should).
     #[inline(always)]
-    pub fn set(&mut self, w: Wire, value: f64) {
-        self.v[w.0] = value;
+    pub fn set<Q: Quantity>(&mut self, w: Wire<Q>, value: Q) {
+        self.v[w.0] = value.si();
     }
-    /// Adds to an accumulator wire (flows into a node, forces on a body).
+    /// Adds to an accumulator (flows into a node, forces on a body).
     #[inline(always)]
-    pub fn add(&mut self, w: Wire, value: f64) {
-        self.v[w.0] += value;
+    pub fn add<Q: Quantity>(&mut self, w: Acc<Q>, value: Q) {
+        self.v[w.0] += value.si();
+    }
+    #[inline(always)]
+    fn zero(&mut self, i: usize) {
+        self.v[i] = 0.0;
     }
 }
 
@@ -115,6 +262,18 @@ pub enum BuildError {
     /// Algebraic components depend on each other in a cycle.
     #[error("algebraic loop between components: {0}")]
     AlgebraicLoop(String),
+    /// Two components use one wire (a signal) as different quantities.
+    #[error("`{component}` uses wire `{wire}` in {second}, but it was declared in {first}")]
+    UnitMismatch {
+        /// The wire (`sig:<name>`, ...).
+        wire: String,
+        /// The unit it was first declared in.
+        first: &'static str,
+        /// The unit the second use asks for.
+        second: &'static str,
+        /// The component of the second use.
+        component: String,
+    },
     /// A component rejected its parameters or connections.
     #[error("component `{component}`: {message}")]
     Component {
@@ -155,7 +314,18 @@ pub struct Probe {
     /// SI unit, e.g. `Pa`.
     pub unit: &'static str,
     /// The wire it reads.
-    pub wire: Wire,
+    pub wire: AnyWire,
+}
+
+impl Probe {
+    /// A probe named `name` on a typed wire, in the wire's SI unit.
+    pub fn of<Q: Quantity>(name: impl Into<String>, wire: Wire<Q>) -> Self {
+        Self {
+            name: name.into(),
+            unit: Q::UNIT,
+            wire: wire.raw(),
+        }
+    }
 }
 
 /// A component of a circuit. Implement this to add a new component type: it
@@ -271,37 +441,54 @@ struct Owned {
 }
 
 /// The registry components bind to: it turns node and signal names into
-/// wires and records who owns (sets) and who reads each.
+/// wires and records who owns (sets) and who reads each, and in which unit.
 #[derive(Debug, Default)]
 pub struct Netlist {
     names: Vec<String>,
-    index: HashMap<String, Wire>,
+    units: Vec<&'static str>,
+    index: HashMap<String, usize>,
     owners: HashMap<usize, Owned>,
-    accumulators: Vec<Wire>,
-    reads: Vec<(usize, Wire, &'static str, String)>,
+    accumulators: Vec<usize>,
+    reads: Vec<(usize, usize, &'static str, String)>,
+    mismatch: Option<BuildError>,
     current: usize,
     component_names: Vec<String>,
 }
 
 impl Netlist {
-    fn wire(&mut self, key: String) -> Wire {
-        if let Some(w) = self.index.get(&key) {
-            return *w;
+    /// The index of wire `key` carrying `Q`; a second use of the key in
+    /// another unit is recorded as a [`BuildError::UnitMismatch`].
+    fn slot<Q: Quantity>(&mut self, key: String) -> usize {
+        if let Some(&i) = self.index.get(&key) {
+            if self.units[i] != Q::UNIT && self.mismatch.is_none() {
+                self.mismatch = Some(BuildError::UnitMismatch {
+                    wire: key,
+                    first: self.units[i],
+                    second: Q::UNIT,
+                    component: self.component_names[self.current].clone(),
+                });
+            }
+            return i;
         }
-        let w = Wire(self.names.len());
+        let i = self.names.len();
         self.names.push(key.clone());
-        self.index.insert(key, w);
-        w
+        self.units.push(Q::UNIT);
+        self.index.insert(key, i);
+        i
+    }
+
+    fn wire<Q: Quantity>(&mut self, key: String) -> Wire<Q> {
+        Wire(self.slot::<Q>(key), PhantomData)
     }
 
     fn own(
         &mut self,
-        w: Wire,
+        w: usize,
         kind: &'static str,
         node: &str,
         c: Causality,
     ) -> Result<(), BuildError> {
-        if let Some(o) = self.owners.get(&w.0) {
+        if let Some(o) = self.owners.get(&w) {
             return Err(BuildError::TwoOwners {
                 kind,
                 node: node.to_string(),
@@ -310,7 +497,7 @@ impl Netlist {
             });
         }
         self.owners.insert(
-            w.0,
+            w,
             Owned {
                 owner: self.current,
                 causality: c,
@@ -319,16 +506,16 @@ impl Netlist {
         Ok(())
     }
 
-    fn read(&mut self, w: Wire, kind: &'static str, node: &str) {
+    fn read(&mut self, w: usize, kind: &'static str, node: &str) {
         self.reads.push((self.current, w, kind, node.to_string()));
     }
 
-    fn accumulator(&mut self, key: String) -> Wire {
-        let w = self.wire(key);
-        if !self.accumulators.contains(&w) {
-            self.accumulators.push(w);
+    fn accumulator<Q: Quantity>(&mut self, key: String) -> Acc<Q> {
+        let i = self.slot::<Q>(key);
+        if !self.accumulators.contains(&i) {
+            self.accumulators.push(i);
         }
-        w
+        Acc(i, PhantomData)
     }
 
     fn hyd(&mut self, node: &str) -> HydraulicNode {
@@ -340,7 +527,7 @@ impl Netlist {
     /// Connects to hydraulic node `node`: read its pressure, add flows into it.
     pub fn hydraulic(&mut self, node: &str) -> HydraulicNode {
         let h = self.hyd(node);
-        self.read(h.pressure, "hydraulic node", node);
+        self.read(h.pressure.0, "hydraulic node", node);
         h
     }
 
@@ -348,7 +535,7 @@ impl Netlist {
     /// hydraulic node has exactly one owner.
     pub fn own_hydraulic(&mut self, node: &str, c: Causality) -> Result<HydraulicNode, BuildError> {
         let h = self.hyd(node);
-        self.own(h.pressure, "hydraulic node", node, c)?;
+        self.own(h.pressure.0, "hydraulic node", node, c)?;
         Ok(h)
     }
 
@@ -365,38 +552,43 @@ impl Netlist {
     /// Connects to mechanical node `node`: read position and velocity, add forces.
     pub fn mechanical(&mut self, node: &str) -> MechanicalNode {
         let m = self.mech(node);
-        self.read(m.position, "mechanical node", node);
-        self.read(m.velocity, "mechanical node", node);
+        self.read(m.position.0, "mechanical node", node);
+        self.read(m.velocity.0, "mechanical node", node);
         m
     }
 
     /// Becomes the owner of mechanical node `node` (sets position and velocity).
     pub fn own_mechanical(&mut self, node: &str) -> Result<MechanicalNode, BuildError> {
         let m = self.mech(node);
-        self.own(m.position, "mechanical node", node, Causality::Stored)?;
-        self.own(m.velocity, "mechanical node", node, Causality::Stored)?;
+        self.own(m.position.0, "mechanical node", node, Causality::Stored)?;
+        self.own(m.velocity.0, "mechanical node", node, Causality::Stored)?;
         Ok(m)
     }
 
-    /// Reads signal `name` (a command, a spool position, a pilot travel).
-    pub fn signal(&mut self, name: &str) -> Wire {
+    /// Reads signal `name` (a command, a spool position, a pilot travel) as
+    /// a `Q`; every user of a signal must agree on its quantity.
+    pub fn signal<Q: Quantity>(&mut self, name: &str) -> Wire<Q> {
         let w = self.wire(format!("sig:{name}"));
-        self.read(w, "signal", name);
+        self.read(w.0, "signal", name);
         w
     }
 
-    /// Becomes the writer of signal `name`.
-    pub fn own_signal(&mut self, name: &str, c: Causality) -> Result<Wire, BuildError> {
+    /// Becomes the writer of signal `name`, a `Q`.
+    pub fn own_signal<Q: Quantity>(
+        &mut self,
+        name: &str,
+        c: Causality,
+    ) -> Result<Wire<Q>, BuildError> {
         let w = self.wire(format!("sig:{name}"));
-        self.own(w, "signal", name, c)?;
+        self.own(w.0, "signal", name, c)?;
         Ok(w)
     }
 
     /// A wire private to the calling component (scratch values passed from
     /// `evaluate` to `derivatives`); `key` need only be unique per component.
-    pub fn private(&mut self, key: &str) -> Wire {
+    pub fn private<Q: Quantity>(&mut self, key: &str) -> Wire<Q> {
         let name = format!("priv:{}:{key}", self.component_names[self.current]);
-        let w = self.wire(name.clone());
+        let w = self.wire(name);
         self.owners.insert(
             w.0,
             Owned {
@@ -415,7 +607,7 @@ pub struct Circuit {
     offsets: Vec<usize>,
     ev_offsets: Vec<usize>,
     order: Vec<usize>,
-    accumulators: Vec<Wire>,
+    accumulators: Vec<usize>,
     wires: RefCell<Wires>,
     n_states: usize,
     n_events: usize,
@@ -467,11 +659,14 @@ impl Circuit {
             net.current = i;
             c.bind(&mut net)?;
         }
+        if let Some(e) = net.mismatch.take() {
+            return Err(e);
+        }
         // every read wire has an owner; dependencies on algebraic owners
         let n = comps.len();
         let mut deps: Vec<Vec<usize>> = vec![Vec::new(); n];
         for (reader, w, kind, node) in &net.reads {
-            match net.owners.get(&w.0) {
+            match net.owners.get(w) {
                 None => {
                     return Err(BuildError::NoOwner {
                         kind,
@@ -688,7 +883,7 @@ impl Circuit {
     }
 
     /// Evaluates every wire at `(t, x)` and copies the values of `wires` into `out`.
-    pub fn read_wires(&self, t: f64, x: &[f64], wires: &[Wire], out: &mut [f64]) {
+    pub fn read_wires(&self, t: f64, x: &[f64], wires: &[AnyWire], out: &mut [f64]) {
         self.fill(t, x);
         let w = self.wires.borrow();
         for (o, wire) in out.iter_mut().zip(wires) {
@@ -697,13 +892,14 @@ impl Circuit {
     }
 
     /// Name of a wire (`hyd:<node>:p`, `mech:<node>:v`, `sig:<name>`, ...).
-    pub fn wire_name(&self, w: Wire) -> &str {
+    pub fn wire_name(&self, w: impl Into<AnyWire>) -> &str {
+        let w = w.into();
         &self.wire_names[w.0]
     }
 
     /// Finds a wire by its name.
-    pub fn find_wire(&self, name: &str) -> Option<Wire> {
-        self.wire_names.iter().position(|n| n == name).map(Wire)
+    pub fn find_wire(&self, name: &str) -> Option<AnyWire> {
+        self.wire_names.iter().position(|n| n == name).map(AnyWire)
     }
 
     /// Per-component power terms at `(t, x)` (the ledger's integrands), in component order.
@@ -735,8 +931,8 @@ impl Circuit {
     /// Publish + evaluate: every wire is current for `(t, x)`.
     fn fill(&self, t: f64, x: &[f64]) {
         let mut w = self.wires.borrow_mut();
-        for a in &self.accumulators {
-            w.set(*a, 0.0);
+        for &a in &self.accumulators {
+            w.zero(a);
         }
         for (i, c) in self.comps.iter().enumerate() {
             c.publish(t, &x[self.offsets[i]..self.offsets[i + 1]], &mut w);
@@ -849,7 +1045,7 @@ mod tests {
         name: String,
         inp: String,
         out: String,
-        w: (Wire, Wire),
+        w: (Wire<f64>, Wire<f64>),
     }
 
     impl Component for Gain {
@@ -920,6 +1116,31 @@ mod tests {
 
         let dup = Circuit::build(vec![gain("g", "a", "b"), gain("g", "b", "c")]).unwrap_err();
         assert!(dup.to_string().contains("two components"), "{dup}");
+    }
+
+    #[test]
+    fn a_signal_used_as_two_quantities_is_a_build_error() {
+        // the spool writes `x` as a position; the gain reads it as a bare f64
+        let spool = crate::components::ServoSpool::new(
+            "spool",
+            "u",
+            "x",
+            hydrocyl_valves::servovalve::Spool::leaney_moog(),
+            0.0,
+        );
+        let cmd = crate::components::CommandInput::new(
+            "cmd",
+            "u",
+            crate::signal::Signal::Constant { value: 0.0 },
+        );
+        let e =
+            Circuit::build(vec![Box::new(cmd), Box::new(spool), gain("g", "x", "y")]).unwrap_err();
+        assert!(matches!(e, BuildError::UnitMismatch { .. }), "{e}");
+        let msg = e.to_string();
+        assert!(
+            msg.contains("sig:x") && msg.contains("`g`") && msg.contains("m"),
+            "{msg}"
+        );
     }
 
     #[test]

@@ -36,6 +36,19 @@
 //!   algebraic wire are evaluated after its writer (an algebraic loop is a
 //!   build error naming the components).
 //!
+//! * **Wires are typed** by the quantity they carry (`hydrocyl-ports`
+//!   newtypes): a [`Wire<Q>`](Wire) is an effort or signal with one writer,
+//!   an [`Acc<Q>`](Acc) an accumulator every other component adds to. A
+//!   [`HydraulicNode`] is `Wire<Pressure>` + `Acc<VolumeFlow>`, a
+//!   [`MechanicalNode`] `Wire<Position>`, `Wire<Velocity>`, `Acc<Force>`,
+//!   `Acc<Mass>`; [`Wires::get`]/[`Wires::set`]/[`Wires::add`] take and
+//!   return the quantity, so adding a pressure into a flow accumulator does
+//!   not compile (see [`Acc`]). Signals are typed where their meaning is
+//!   fixed (a spool travel is a `Position`, a relief flow a `VolumeFlow`); a
+//!   command is a bare `f64`. Two components that use one signal name as
+//!   different quantities are a build error ([`BuildError::UnitMismatch`]).
+//!   Output columns read wires untyped ([`AnyWire`], [`Probe`]).
+//!
 //! Each evaluation of `rhs(t, x)`: zero the accumulators → `publish` all →
 //! `evaluate` in the dependency order → `derivatives` of each stateful
 //! component from its own state slice and the wires. Components never see the
@@ -49,7 +62,8 @@
 //!   (switching functions: relief cracking, check opening, stops), `power`
 //!   (the energy ledger), `quadratures`, `probes` (output columns) and
 //!   `diagnostics` (counters). Placeholders for wire fields before `bind`:
-//!   [`Wire::UNBOUND`]. No change to the assembler is needed.
+//!   [`Wire::UNBOUND`], [`HydraulicNode::UNBOUND`], [`MechanicalNode::UNBOUND`]. No
+//!   change to the assembler is needed.
 //! * **A new rig kind** (e.g. the hybrid pump-controlled rig): a module that
 //!   builds its `Vec<Box<dyn Component>>` and calls [`Circuit::build`], a
 //!   serde struct for its JSON file, and one entry in [`rig::RIG_KINDS`] (and
@@ -123,6 +137,6 @@ pub mod valve_netlist;
 pub mod valve_rig;
 
 pub use circuit::{
-    BuildError, Causality, Circuit, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms,
-    Probe, Wire, Wires,
+    Acc, AnyWire, BuildError, Causality, Circuit, Component, HydraulicNode, MechanicalNode,
+    Netlist, PowerTerms, Probe, ReadWire, Wire, Wires,
 };

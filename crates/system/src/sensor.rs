@@ -16,6 +16,7 @@
 use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, Netlist, Probe, Wire, Wires,
 };
+use hydrocyl_ports::Pressure;
 
 /// A pressure transducer with a first-order lag on hydraulic node `node`.
 #[derive(Debug)]
@@ -28,7 +29,7 @@ pub struct LaggedPressureSensor {
     /// Reading at the start \[Pa\] (the node's initial pressure: a sensor at rest).
     pub initial_reading: f64,
     node: Option<HydraulicNode>,
-    out: Wire,
+    out: Wire<Pressure>,
 }
 
 impl LaggedPressureSensor {
@@ -91,17 +92,13 @@ impl Component for LaggedPressureSensor {
         x[0] = self.initial_reading;
     }
     fn publish(&self, _t: f64, x: &[f64], w: &mut Wires) {
-        w.set(self.out, x[0]);
+        w.set(self.out, Pressure::new(x[0]));
     }
     fn derivatives(&self, _t: f64, x: &[f64], w: &Wires, dx: &mut [f64]) {
-        let p = self.node.map_or(x[0], |n| w.get(n.pressure));
+        let p = self.node.map_or(x[0], |n| w.get(n.pressure).si());
         dx[0] = (p - x[0]) / self.time_constant;
     }
     fn probes(&self) -> Vec<Probe> {
-        vec![Probe {
-            name: self.probe.clone(),
-            unit: "Pa",
-            wire: self.out,
-        }]
+        vec![Probe::of(self.probe.clone(), self.out)]
     }
 }

@@ -8,7 +8,7 @@ use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, Netlist, PowerTerms, Probe, Wire, Wires,
 };
 use hydrocyl_integrators::{Crossing, EventAction};
-use hydrocyl_ports::{Pressure, Voltage};
+use hydrocyl_ports::{Position, Pressure, Voltage, VolumeFlow};
 use hydrocyl_pump_motor::IdentifiedPump;
 use hydrocyl_valves::check::CheckValve;
 use hydrocyl_valves::needle::NeedleValve;
@@ -16,11 +16,7 @@ use hydrocyl_valves::orifice::signed_sqrt_regularised;
 use hydrocyl_valves::pilot_valve::{series_coefficient, PilotFourWay};
 use hydrocyl_valves::relief::ReliefValve;
 
-const UNBOUND: Wire = Wire::UNBOUND;
-const UNBOUND_NODE: HydraulicNode = HydraulicNode {
-    pressure: UNBOUND,
-    inflow: UNBOUND,
-};
+const UNBOUND_NODE: HydraulicNode = HydraulicNode::UNBOUND;
 
 /// The servomotor and gear pump as the identified second-order command →
 /// flow model, moving flow from node `line_b` to node `line_a` (negative
@@ -33,10 +29,12 @@ pub struct PumpComponent {
     line_b: String,
     /// The model.
     pub pump: IdentifiedPump,
-    u: Wire,
+    /// The command in volts (the command signal is untyped: a normalised
+    /// command on the valve rig, the servo drive's voltage here).
+    u: Wire<f64>,
     a: HydraulicNode,
     b: HydraulicNode,
-    flow: Wire,
+    flow: Wire<VolumeFlow>,
     reversals: usize,
 }
 
@@ -55,10 +53,10 @@ impl PumpComponent {
             line_a: line_a.into(),
             line_b: line_b.into(),
             pump,
-            u: UNBOUND,
+            u: Wire::UNBOUND,
             a: UNBOUND_NODE,
             b: UNBOUND_NODE,
-            flow: UNBOUND,
+            flow: Wire::UNBOUND,
             reversals: 0,
         }
     }
@@ -98,10 +96,10 @@ impl Component for PumpComponent {
         s[1] = 1.0e-3;
     }
     fn publish(&self, _t: f64, x: &[f64], w: &mut Wires) {
-        w.set(self.flow, x[0]);
+        w.set(self.flow, VolumeFlow::new(x[0]));
     }
     fn evaluate(&self, _t: f64, x: &[f64], w: &mut Wires) {
-        let q = self.pump.flow(x).si();
+        let q = self.pump.flow(x);
         w.add(self.a.inflow, q);
         w.add(self.b.inflow, -q);
     }
@@ -127,7 +125,7 @@ impl Component for PumpComponent {
     }
     fn power(&self, _t: f64, x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         // the pump takes Q in at p_B and delivers it at p_A: its shaft brings (p_A − p_B) Q
-        p.source = (w.get(self.a.pressure) - w.get(self.b.pressure)) * x[0];
+        p.source = ((w.get(self.a.pressure) - w.get(self.b.pressure)) * VolumeFlow::new(x[0])).si();
     }
     fn n_quadratures(&self) -> usize {
         1
@@ -139,11 +137,7 @@ impl Component for PumpComponent {
         q[0] = x[0];
     }
     fn probes(&self) -> Vec<Probe> {
-        vec![Probe {
-            name: "pump_flow".into(),
-            unit: "m^3/s",
-            wire: self.flow,
-        }]
+        vec![Probe::of("pump_flow", self.flow)]
     }
     fn diagnostics(&self) -> Vec<(String, f64)> {
         vec![("reversals".into(), self.reversals as f64)]
@@ -164,7 +158,7 @@ pub struct ReliefComponent {
     pub valve: ReliefValve,
     i: HydraulicNode,
     o: HydraulicNode,
-    flow: Wire,
+    flow: Wire<VolumeFlow>,
     cracks: usize,
     full_opens: usize,
 }
@@ -179,7 +173,7 @@ impl ReliefComponent {
             valve,
             i: UNBOUND_NODE,
             o: UNBOUND_NODE,
-            flow: UNBOUND,
+            flow: Wire::UNBOUND,
             cracks: 0,
             full_opens: 0,
         }
@@ -205,11 +199,7 @@ impl Component for ReliefComponent {
     fn evaluate(&self, _t: f64, _x: &[f64], w: &mut Wires) {
         let q = self
             .valve
-            .flow(
-                Pressure::new(w.get(self.i.pressure)),
-                Pressure::new(w.get(self.o.pressure)),
-            )
-            .si();
+            .flow(w.get(self.i.pressure), w.get(self.o.pressure));
         w.add(self.i.inflow, -q);
         w.add(self.o.inflow, q);
         w.set(self.flow, q);
@@ -218,10 +208,7 @@ impl Component for ReliefComponent {
         2
     }
     fn events(&self, _t: f64, _x: &[f64], w: &Wires, g: &mut [f64]) {
-        let (pi, po) = (
-            Pressure::new(w.get(self.i.pressure)),
-            Pressure::new(w.get(self.o.pressure)),
-        );
+        let (pi, po) = (w.get(self.i.pressure), w.get(self.o.pressure));
         g[0] = self.valve.crack_margin(pi, po);
         g[1] = self.valve.full_open_margin(pi, po);
     }
@@ -245,10 +232,7 @@ impl Component for ReliefComponent {
     fn power(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         p.dissipated = self
             .valve
-            .power_dissipated(
-                Pressure::new(w.get(self.i.pressure)),
-                Pressure::new(w.get(self.o.pressure)),
-            )
+            .power_dissipated(w.get(self.i.pressure), w.get(self.o.pressure))
             .si();
     }
     fn n_quadratures(&self) -> usize {
@@ -258,14 +242,10 @@ impl Component for ReliefComponent {
         vec![format!("{}.volume", self.name)]
     }
     fn quadratures(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], q: &mut [f64]) {
-        q[0] = w.get(self.flow);
+        q[0] = w.get(self.flow).si();
     }
     fn probes(&self) -> Vec<Probe> {
-        vec![Probe {
-            name: format!("{}_flow", self.name),
-            unit: "m^3/s",
-            wire: self.flow,
-        }]
+        vec![Probe::of(format!("{}_flow", self.name), self.flow)]
     }
     fn diagnostics(&self) -> Vec<(String, f64)> {
         vec![
@@ -290,7 +270,7 @@ pub struct CheckComponent {
     pub valve: CheckValve,
     i: HydraulicNode,
     o: HydraulicNode,
-    flow: Wire,
+    flow: Wire<VolumeFlow>,
     openings: usize,
 }
 
@@ -304,7 +284,7 @@ impl CheckComponent {
             valve,
             i: UNBOUND_NODE,
             o: UNBOUND_NODE,
-            flow: UNBOUND,
+            flow: Wire::UNBOUND,
             openings: 0,
         }
     }
@@ -332,11 +312,7 @@ impl Component for CheckComponent {
     fn evaluate(&self, _t: f64, _x: &[f64], w: &mut Wires) {
         let q = self
             .valve
-            .flow(
-                Pressure::new(w.get(self.i.pressure)),
-                Pressure::new(w.get(self.o.pressure)),
-            )
-            .si();
+            .flow(w.get(self.i.pressure), w.get(self.o.pressure));
         w.add(self.i.inflow, -q);
         w.add(self.o.inflow, q);
         w.set(self.flow, q);
@@ -345,10 +321,9 @@ impl Component for CheckComponent {
         1
     }
     fn events(&self, _t: f64, _x: &[f64], w: &Wires, g: &mut [f64]) {
-        g[0] = self.valve.crack_margin(
-            Pressure::new(w.get(self.i.pressure)),
-            Pressure::new(w.get(self.o.pressure)),
-        );
+        g[0] = self
+            .valve
+            .crack_margin(w.get(self.i.pressure), w.get(self.o.pressure));
     }
     fn on_event(
         &mut self,
@@ -366,10 +341,7 @@ impl Component for CheckComponent {
     fn power(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         p.dissipated = self
             .valve
-            .power_dissipated(
-                Pressure::new(w.get(self.i.pressure)),
-                Pressure::new(w.get(self.o.pressure)),
-            )
+            .power_dissipated(w.get(self.i.pressure), w.get(self.o.pressure))
             .si();
     }
     fn n_quadratures(&self) -> usize {
@@ -379,14 +351,10 @@ impl Component for CheckComponent {
         vec![format!("{}.volume", self.name)]
     }
     fn quadratures(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], q: &mut [f64]) {
-        q[0] = w.get(self.flow);
+        q[0] = w.get(self.flow).si();
     }
     fn probes(&self) -> Vec<Probe> {
-        vec![Probe {
-            name: format!("{}_flow", self.name),
-            unit: "m^3/s",
-            wire: self.flow,
-        }]
+        vec![Probe::of(format!("{}_flow", self.name), self.flow)]
     }
     fn diagnostics(&self) -> Vec<(String, f64)> {
         vec![("opened".into(), self.openings as f64)]
@@ -435,9 +403,9 @@ pub struct ReturnPath {
     a: HydraulicNode,
     b: HydraulicNode,
     t: HydraulicNode,
-    spool: Wire,
-    flow_a: Wire,
-    flow_b: Wire,
+    spool: Wire<Position>,
+    flow_a: Wire<VolumeFlow>,
+    flow_b: Wire<VolumeFlow>,
     counts: [usize; 4],
 }
 
@@ -492,9 +460,9 @@ impl ReturnPath {
             a: UNBOUND_NODE,
             b: UNBOUND_NODE,
             t: UNBOUND_NODE,
-            spool: UNBOUND,
-            flow_a: UNBOUND,
-            flow_b: UNBOUND,
+            spool: Wire::UNBOUND,
+            flow_a: Wire::UNBOUND,
+            flow_b: Wire::UNBOUND,
             counts: [0; 4],
         }
     }
@@ -541,16 +509,16 @@ impl ReturnPath {
     }
 
     fn state(&self, w: &Wires) -> (f64, f64, f64, f64) {
-        let pp1 = Pressure::new(w.get(self.pp1.pressure));
-        let pp2 = Pressure::new(w.get(self.pp2.pressure));
-        let y = self.four_way.opening(pp1, pp2);
+        let y = self
+            .four_way
+            .opening(w.get(self.pp1.pressure), w.get(self.pp2.pressure));
         let (px, pt) = (
             if y > 0.0 {
-                w.get(self.b.pressure)
+                w.get(self.b.pressure).si()
             } else {
-                w.get(self.a.pressure)
+                w.get(self.a.pressure).si()
             },
-            w.get(self.t.pressure),
+            w.get(self.t.pressure).si(),
         );
         let (q, pm) = self.series_flow(self.four_way.return_coefficient(y), px, pt);
         (y, q, pm, pt)
@@ -591,22 +559,22 @@ impl Component for ReturnPath {
         } else {
             self.a.inflow
         };
+        let q = VolumeFlow::new(q);
         w.add(from, -q);
         w.add(self.t.inflow, q);
-        let s = self.four_way.spool_travel(
-            Pressure::new(w.get(self.pp1.pressure)),
-            Pressure::new(w.get(self.pp2.pressure)),
-        );
-        w.set(self.spool, s.si());
-        w.set(self.flow_a, if y > 0.0 { 0.0 } else { q });
-        w.set(self.flow_b, if y > 0.0 { q } else { 0.0 });
+        let s = self
+            .four_way
+            .spool_travel(w.get(self.pp1.pressure), w.get(self.pp2.pressure));
+        w.set(self.spool, s);
+        let none = VolumeFlow::ZERO;
+        w.set(self.flow_a, if y > 0.0 { none } else { q });
+        w.set(self.flow_b, if y > 0.0 { q } else { none });
     }
     fn n_events(&self) -> usize {
         4
     }
     fn events(&self, _t: f64, _x: &[f64], w: &Wires, g: &mut [f64]) {
-        let pp1 = Pressure::new(w.get(self.pp1.pressure));
-        let pp2 = Pressure::new(w.get(self.pp2.pressure));
+        let (pp1, pp2) = (w.get(self.pp1.pressure), w.get(self.pp2.pressure));
         g[0] = self.four_way.extend_shift_margin(pp1, pp2);
         g[1] = self.four_way.retract_shift_margin(pp1, pp2);
         g[2] = self.four_way.full_shift_margin(pp1, pp2);
@@ -629,9 +597,9 @@ impl Component for ReturnPath {
     fn power(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         let (y, q, _, pt) = self.state(w);
         let px = if y > 0.0 {
-            w.get(self.b.pressure)
+            w.get(self.b.pressure).si()
         } else {
-            w.get(self.a.pressure)
+            w.get(self.a.pressure).si()
         };
         p.dissipated = q * (px - pt);
     }
@@ -645,26 +613,14 @@ impl Component for ReturnPath {
         ]
     }
     fn quadratures(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], q: &mut [f64]) {
-        q[0] = w.get(self.flow_a);
-        q[1] = w.get(self.flow_b);
+        q[0] = w.get(self.flow_a).si();
+        q[1] = w.get(self.flow_b).si();
     }
     fn probes(&self) -> Vec<Probe> {
         vec![
-            Probe {
-                name: "pilot_spool".into(),
-                unit: "m",
-                wire: self.spool,
-            },
-            Probe {
-                name: "return_flow_1".into(),
-                unit: "m^3/s",
-                wire: self.flow_a,
-            },
-            Probe {
-                name: "return_flow_2".into(),
-                unit: "m^3/s",
-                wire: self.flow_b,
-            },
+            Probe::of("pilot_spool", self.spool),
+            Probe::of("return_flow_1", self.flow_a),
+            Probe::of("return_flow_2", self.flow_b),
         ]
     }
     fn diagnostics(&self) -> Vec<(String, f64)> {

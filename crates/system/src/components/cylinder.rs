@@ -1,0 +1,194 @@
+//! The two-chamber cylinder (eqs 2.10–2.15, 2.27).
+
+use crate::circuit::{
+    BuildError, Causality, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe,
+    Wire, Wires,
+};
+use hydrocyl_actuator::Cylinder;
+use hydrocyl_integrators::{Crossing, EventAction};
+use hydrocyl_ports::Pressure;
+
+/// Cavitation bookkeeping of a chamber.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Cavitation {
+    pub(super) entries: usize,
+}
+
+/// The fundamental two-chamber cylinder (eqs 2.10–2.15, 2.27): owns the
+/// chamber nodes A (cap side, p1) and B (rod side, p2), pushes the rod.
+///
+/// Cavitation is **reported**, not hidden: a switching function per chamber
+/// crosses zero when its pressure falls below `cavitation_pressure`, and the
+/// entries are counted ([`Component::diagnostics`] `cavitation_entries_1/2`).
+/// The fluid model is not changed below it (constant B), so a run with
+/// entries has left the model's range there.
+#[derive(Debug)]
+pub struct TwoChamberCylinder {
+    name: String,
+    a_name: String,
+    b_name: String,
+    rod_name: String,
+    /// The cylinder.
+    pub cylinder: Cylinder,
+    /// Pressure below which a chamber is reported as cavitating \[Pa\].
+    pub cavitation_pressure: f64,
+    /// Initial (p1, p2) \[Pa\].
+    pub initial_pressures: (f64, f64),
+    cav: [Cavitation; 2],
+    a: HydraulicNode,
+    b: HydraulicNode,
+    rod: MechanicalNode,
+    p_le: Wire<Pressure>,
+}
+
+impl TwoChamberCylinder {
+    /// A cylinder owning nodes `a` (chamber 1) and `b` (chamber 2), acting on body `rod`.
+    pub fn new(
+        name: &str,
+        a: &str,
+        b: &str,
+        rod: &str,
+        cylinder: Cylinder,
+        initial_pressures: (f64, f64),
+    ) -> Self {
+        Self {
+            name: name.into(),
+            a_name: a.into(),
+            b_name: b.into(),
+            rod_name: rod.into(),
+            cylinder,
+            cavitation_pressure: 0.0,
+            initial_pressures,
+            cav: [Cavitation::default(); 2],
+            a: HydraulicNode::UNBOUND,
+            b: HydraulicNode::UNBOUND,
+            rod: MechanicalNode::UNBOUND,
+            p_le: Wire::UNBOUND,
+        }
+    }
+
+    /// `(dp1/dt, dp2/dt)` at this instant \[Pa·s⁻¹\].
+    fn rates(&self, x: &[f64], w: &Wires) -> (f64, f64) {
+        self.cylinder.pressure_rates(
+            w.get(self.rod.position),
+            w.get(self.rod.velocity),
+            Pressure::new(x[0]),
+            Pressure::new(x[1]),
+            w.get(self.a.inflow),
+            -w.get(self.b.inflow),
+        )
+    }
+}
+
+impl Component for TwoChamberCylinder {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
+        self.cylinder
+            .validate()
+            .map_err(|e| BuildError::Component {
+                component: self.name.clone(),
+                message: e.to_string(),
+            })?;
+        self.a = net.own_hydraulic(&self.a_name, Causality::Stored)?;
+        self.b = net.own_hydraulic(&self.b_name, Causality::Stored)?;
+        self.rod = net.mechanical(&self.rod_name);
+        self.p_le = net.private("p_le");
+        Ok(())
+    }
+    fn n_states(&self) -> usize {
+        2
+    }
+    fn state_names(&self) -> Vec<String> {
+        vec![format!("{}.p1", self.name), format!("{}.p2", self.name)]
+    }
+    fn state_scales(&self, s: &mut [f64]) {
+        s.fill(1.0e6);
+    }
+    fn initial_state(&self, x: &mut [f64]) {
+        x[0] = self.initial_pressures.0;
+        x[1] = self.initial_pressures.1;
+    }
+    fn publish(&self, _t: f64, x: &[f64], w: &mut Wires) {
+        w.set(self.a.pressure, Pressure::new(x[0]));
+        w.set(self.b.pressure, Pressure::new(x[1]));
+    }
+    fn evaluate(&self, _t: f64, x: &[f64], w: &mut Wires) {
+        let f = self
+            .cylinder
+            .force(Pressure::new(x[0]), Pressure::new(x[1]));
+        w.add(self.rod.force, f);
+        w.set(self.p_le, f / self.cylinder.effective_area());
+    }
+    fn derivatives(&self, _t: f64, x: &[f64], w: &Wires, dx: &mut [f64]) {
+        let (d1, d2) = self.rates(x, w);
+        dx[0] = d1;
+        dx[1] = d2;
+    }
+    fn n_events(&self) -> usize {
+        2
+    }
+    fn events(&self, _t: f64, x: &[f64], _w: &Wires, g: &mut [f64]) {
+        g[0] = x[0] - self.cavitation_pressure;
+        g[1] = x[1] - self.cavitation_pressure;
+    }
+    fn on_event(
+        &mut self,
+        _t: f64,
+        _x: &mut [f64],
+        _w: &Wires,
+        which: usize,
+        dir: Crossing,
+    ) -> EventAction {
+        if dir == Crossing::Falling {
+            self.cav[which].entries += 1;
+        }
+        EventAction::Continue
+    }
+    fn reset(&mut self, _t: f64, _x: &[f64], _w: &Wires) {
+        self.cav = [Cavitation::default(); 2];
+    }
+    fn power(&self, _t: f64, x: &[f64], w: &Wires, dx: &[f64], p: &mut PowerTerms) {
+        let (v1, v2) = self.cylinder.volumes(w.get(self.rod.position));
+        let b = self.cylinder.bulk_modulus.si();
+        let (p1, p2) = (Pressure::new(x[0]), Pressure::new(x[1]));
+        let (ql, qe1, qe2) = self.cylinder.leakage(p1, p2);
+        p.storage = x[0] * v1.si() / b * dx[0] + x[1] * v2.si() / b * dx[1];
+        p.dissipated = ql.si() * (x[0] - x[1]) + qe1.si() * x[0] + qe2.si() * x[1];
+        p.stored = 0.5 * (v1.si() * x[0] * x[0] + v2.si() * x[1] * x[1]) / b;
+    }
+    fn n_quadratures(&self) -> usize {
+        4
+    }
+    fn quadrature_names(&self) -> Vec<String> {
+        ["q1_in", "q2_in", "p1_a1_v_over_b", "p2_a2_v_over_b"]
+            .iter()
+            .map(|s| format!("{}.{s}", self.name))
+            .collect()
+    }
+    fn quadratures(&self, _t: f64, x: &[f64], w: &Wires, _dx: &[f64], q: &mut [f64]) {
+        // ∫Q1 dt, ∫Q2_in dt (the valve's flows), ∫p1 A1 v/B dt, ∫p2 A2 v/B dt:
+        // with these, ∫(Q1 − A1 v − V1/B dp1/dt) dt is computable exactly
+        // (∫V1/B dp1 = [V1 p1/B] − ∫p1 A1 v/B dt).
+        let v = w.get(self.rod.velocity).si();
+        let b = self.cylinder.bulk_modulus.si();
+        q[0] = w.get(self.a.inflow).si();
+        q[1] = w.get(self.b.inflow).si();
+        q[2] = x[0] * self.cylinder.area_1.si() * v / b;
+        q[3] = x[1] * self.cylinder.area_2.si() * v / b;
+    }
+    fn probes(&self) -> Vec<Probe> {
+        vec![
+            Probe::of("p1", self.a.pressure),
+            Probe::of("p2", self.b.pressure),
+            Probe::of("p_le", self.p_le),
+        ]
+    }
+    fn diagnostics(&self) -> Vec<(String, f64)> {
+        vec![
+            ("cavitation_entries_1".into(), self.cav[0].entries as f64),
+            ("cavitation_entries_2".into(), self.cav[1].entries as f64),
+        ]
+    }
+}

@@ -1,0 +1,118 @@
+//! The servovalve's four-way metering (eqs 2.8, 2.9, 3.2).
+
+use crate::circuit::{
+    BuildError, Component, HydraulicNode, Netlist, PowerTerms, Probe, Wire, Wires,
+};
+use hydrocyl_ports::{Position, Pressure};
+use hydrocyl_valves::servovalve::Metering;
+
+/// The four-way metering of the servovalve between supply P, tank T and the
+/// service ports A, B (eqs 2.8, 2.9, 3.2).
+#[derive(Debug)]
+pub struct FourWayValve {
+    name: String,
+    ports: [String; 4],
+    spool_name: String,
+    /// Metering geometry and orifice law.
+    pub metering: Metering,
+    /// Supply droop resistance Rs \[Pa·s·m⁻³\]: the valve sees
+    /// `Ps = P − Rs Q_P` ([`Metering::drooped_supply`]); 0 = off.
+    pub supply_resistance: f64,
+    /// Output name of the supply pressure the valve sees (with droop on).
+    pub supply_probe: Option<String>,
+    spool: Wire<Position>,
+    p: HydraulicNode,
+    t: HydraulicNode,
+    a: HydraulicNode,
+    b: HydraulicNode,
+    ps: Wire<Pressure>,
+}
+
+impl FourWayValve {
+    /// A valve reading signal `spool` \[m\], joining nodes `p`, `t`, `a`, `b`.
+    pub fn new(
+        name: &str,
+        spool: &str,
+        p: &str,
+        t: &str,
+        a: &str,
+        b: &str,
+        metering: Metering,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            ports: [p.into(), t.into(), a.into(), b.into()],
+            spool_name: spool.into(),
+            metering,
+            supply_resistance: 0.0,
+            supply_probe: None,
+            spool: Wire::UNBOUND,
+            p: HydraulicNode::UNBOUND,
+            t: HydraulicNode::UNBOUND,
+            a: HydraulicNode::UNBOUND,
+            b: HydraulicNode::UNBOUND,
+            ps: Wire::UNBOUND,
+        }
+    }
+
+    /// The flows and the supply pressure the valve sees (drooped when
+    /// `supply_resistance > 0`).
+    fn flows(&self, w: &Wires) -> (hydrocyl_valves::servovalve::MeteringFlows, Pressure) {
+        let g = |n: &HydraulicNode| w.get(n.pressure);
+        self.metering.flows_drooped(
+            w.get(self.spool),
+            g(&self.p),
+            self.supply_resistance,
+            g(&self.t),
+            g(&self.a),
+            g(&self.b),
+        )
+    }
+}
+
+impl Component for FourWayValve {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
+        self.metering
+            .validate()
+            .map_err(|e| BuildError::Component {
+                component: self.name.clone(),
+                message: e.to_string(),
+            })?;
+        self.spool = net.signal(&self.spool_name);
+        self.p = net.hydraulic(&self.ports[0]);
+        self.t = net.hydraulic(&self.ports[1]);
+        self.a = net.hydraulic(&self.ports[2]);
+        self.b = net.hydraulic(&self.ports[3]);
+        if !(self.supply_resistance.is_finite() && self.supply_resistance >= 0.0) {
+            return Err(BuildError::Component {
+                component: self.name.clone(),
+                message: format!(
+                    "supply_resistance must be finite and non-negative, got {}",
+                    self.supply_resistance
+                ),
+            });
+        }
+        self.ps = net.private("ps");
+        Ok(())
+    }
+    fn evaluate(&self, _t: f64, _x: &[f64], w: &mut Wires) {
+        let (f, ps) = self.flows(w);
+        w.add(self.p.inflow, -f.qp);
+        w.add(self.t.inflow, f.qt);
+        w.add(self.a.inflow, f.qa);
+        w.add(self.b.inflow, -f.qb);
+        w.set(self.ps, ps);
+    }
+    fn power(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
+        p.dissipated = self.flows(w).0.dissipated;
+    }
+    fn probes(&self) -> Vec<Probe> {
+        self.supply_probe
+            .iter()
+            .map(|n| Probe::of(n.clone(), self.ps))
+            .collect()
+    }
+}

@@ -1,0 +1,57 @@
+//! A fixed sharp-edged orifice between two nodes.
+
+use crate::circuit::{BuildError, Component, HydraulicNode, Netlist, PowerTerms, Wires};
+use hydrocyl_ports::VolumeFlow;
+use hydrocyl_valves::orifice::Orifice;
+
+/// A fixed sharp-edged orifice between two nodes (flow from `a` to `b`).
+#[derive(Debug)]
+pub struct FixedOrifice {
+    name: String,
+    a_name: String,
+    b_name: String,
+    /// Opening area \[m²\].
+    pub area: hydrocyl_ports::Area,
+    /// The orifice law.
+    pub orifice: Orifice,
+    a: HydraulicNode,
+    b: HydraulicNode,
+}
+
+impl FixedOrifice {
+    /// An orifice of `area` between nodes `a` and `b`.
+    pub fn new(name: &str, a: &str, b: &str, area: hydrocyl_ports::Area, orifice: Orifice) -> Self {
+        Self {
+            name: name.into(),
+            a_name: a.into(),
+            b_name: b.into(),
+            area,
+            orifice,
+            a: HydraulicNode::UNBOUND,
+            b: HydraulicNode::UNBOUND,
+        }
+    }
+    fn flow(&self, w: &Wires) -> VolumeFlow {
+        self.orifice
+            .flow(self.area, w.get(self.a.pressure), w.get(self.b.pressure))
+    }
+}
+
+impl Component for FixedOrifice {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
+        self.a = net.hydraulic(&self.a_name);
+        self.b = net.hydraulic(&self.b_name);
+        Ok(())
+    }
+    fn evaluate(&self, _t: f64, _x: &[f64], w: &mut Wires) {
+        let q = self.flow(w);
+        w.add(self.a.inflow, -q);
+        w.add(self.b.inflow, q);
+    }
+    fn power(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
+        p.dissipated = ((w.get(self.a.pressure) - w.get(self.b.pressure)) * self.flow(w)).si();
+    }
+}

@@ -1,0 +1,96 @@
+//! A constant hydraulic volume (a capacitive node owner).
+
+use crate::circuit::{
+    BuildError, Causality, Component, HydraulicNode, Netlist, PowerTerms, Probe, Wires,
+};
+use hydrocyl_ports::{HydraulicPort, Pressure};
+
+/// A constant hydraulic volume (a pipeline, a hose, a pump line):
+/// `dp/dt = B/V ΣQ_in`.
+#[derive(Debug)]
+pub struct Volume {
+    name: String,
+    node_name: String,
+    /// Volume V \[m³\].
+    pub volume: f64,
+    /// Effective bulk modulus B \[Pa\].
+    pub bulk_modulus: f64,
+    /// Initial pressure \[Pa\].
+    pub initial_pressure: f64,
+    probe: Option<String>,
+    node: HydraulicNode,
+}
+
+impl Volume {
+    /// A volume `volume` \[m³\] with bulk modulus `bulk_modulus` \[Pa\] owning node `node`.
+    pub fn new(
+        name: &str,
+        node: &str,
+        volume: f64,
+        bulk_modulus: f64,
+        initial_pressure: f64,
+        probe: Option<&str>,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            node_name: node.into(),
+            volume,
+            bulk_modulus,
+            initial_pressure,
+            probe: probe.map(str::to_string),
+            node: HydraulicNode::UNBOUND,
+        }
+    }
+}
+
+impl Component for Volume {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
+        if !(self.volume > 0.0
+            && self.volume.is_finite()
+            && self.bulk_modulus > 0.0
+            && self.bulk_modulus.is_finite())
+        {
+            return Err(BuildError::Component {
+                component: self.name.clone(),
+                message: format!(
+                    "volume {} m^3 and bulk modulus {} Pa must be positive",
+                    self.volume, self.bulk_modulus
+                ),
+            });
+        }
+        self.node = net.own_hydraulic(&self.node_name, Causality::Stored)?;
+        Ok(())
+    }
+    fn n_states(&self) -> usize {
+        1
+    }
+    fn state_names(&self) -> Vec<String> {
+        vec![format!("{}.p", self.name)]
+    }
+    fn state_scales(&self, s: &mut [f64]) {
+        s[0] = 1.0e6;
+    }
+    fn initial_state(&self, x: &mut [f64]) {
+        x[0] = self.initial_pressure;
+    }
+    fn publish(&self, _t: f64, x: &[f64], w: &mut Wires) {
+        w.set(self.node.pressure, Pressure::new(x[0]));
+    }
+    fn derivatives(&self, _t: f64, _x: &[f64], w: &Wires, dx: &mut [f64]) {
+        dx[0] = self.bulk_modulus / self.volume * w.get(self.node.inflow).si();
+    }
+    fn power(&self, _t: f64, x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
+        let port = HydraulicPort::new(Pressure::new(x[0]), w.get(self.node.inflow));
+        p.storage = port.power().si();
+        p.stored = 0.5 * self.volume * x[0] * x[0] / self.bulk_modulus;
+    }
+    fn probes(&self) -> Vec<Probe> {
+        self.probe
+            .iter()
+            .map(|n| Probe::of(n.clone(), self.node.pressure))
+            .collect()
+    }
+}

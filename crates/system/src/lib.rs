@@ -128,6 +128,7 @@ pub mod chapter3;
 pub mod circuit;
 pub mod components;
 pub mod hybrid;
+mod binding;
 pub mod netlist;
 pub mod rig;
 pub mod run;
@@ -135,6 +136,7 @@ pub mod sensor;
 pub mod signal;
 pub mod valve_netlist;
 pub mod valve_rig;
+mod wires;
 
 pub use circuit::{
     Acc, AnyWire, BuildError, Causality, Circuit, Component, HydraulicNode, MechanicalNode,

@@ -124,11 +124,11 @@
 //! ```
 #![warn(missing_docs)]
 
+mod binding;
 pub mod chapter3;
 pub mod circuit;
 pub mod components;
 pub mod hybrid;
-mod binding;
 pub mod netlist;
 pub mod rig;
 pub mod run;

@@ -10,11 +10,13 @@ use std::marker::PhantomData;
 /// When a component writes a wire it owns.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Causality {
-    /// From its own state and time only, in [`Component::publish`](crate::Component::publish) (volumes,
-    /// masses, spools, command sources). Readers need no ordering.
+    /// From its own state and time only, in
+    /// [`Component::publish`](crate::Component::publish) (volumes, masses,
+    /// spools, command sources). Readers need no ordering.
     Stored,
-    /// Algebraically from other wires, in [`Component::evaluate`](crate::Component::evaluate) (a pilot
-    /// spool travel from line pressures; the generalised actuator's chamber
+    /// Algebraically from other wires, in
+    /// [`Component::evaluate`](crate::Component::evaluate) (a pilot spool
+    /// travel from line pressures; the generalised actuator's chamber
     /// pressures). Readers are evaluated after the writer.
     Algebraic,
 }

@@ -54,8 +54,9 @@ macro_rules! typed_wire {
     ($t:ident) => {
         impl<Q> $t<Q> {
             /// A placeholder for a component's wire fields before
-            /// [`Component::bind`](crate::Component::bind) sets them (never read: [`Circuit::build`](crate::Circuit::build)
-            /// binds every component before anything is evaluated).
+            /// [`Component::bind`](crate::Component::bind) sets them (never
+            /// read: [`Circuit::build`](crate::Circuit::build) binds every
+            /// component before anything is evaluated).
             pub const UNBOUND: Self = Self(usize::MAX, PhantomData);
 
             /// The untyped index (for probes and output columns).
@@ -154,7 +155,8 @@ pub struct HydraulicNode {
 }
 
 impl HydraulicNode {
-    /// A placeholder before [`Component::bind`](crate::Component::bind) (see [`Wire::UNBOUND`]).
+    /// A placeholder before [`Component::bind`](crate::Component::bind)
+    /// (see [`Wire::UNBOUND`]).
     pub const UNBOUND: Self = Self {
         pressure: Wire::UNBOUND,
         inflow: Acc::UNBOUND,
@@ -181,7 +183,8 @@ pub struct MechanicalNode {
 }
 
 impl MechanicalNode {
-    /// A placeholder before [`Component::bind`](crate::Component::bind) (see [`Wire::UNBOUND`]).
+    /// A placeholder before [`Component::bind`](crate::Component::bind)
+    /// (see [`Wire::UNBOUND`]).
     pub const UNBOUND: Self = Self {
         position: Wire::UNBOUND,
         velocity: Wire::UNBOUND,

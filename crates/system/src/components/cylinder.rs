@@ -14,6 +14,16 @@ pub(super) struct Cavitation {
     pub(super) entries: usize,
 }
 
+impl Cavitation {
+    /// Counts an entry of chamber `which` when its switching function falls.
+    pub(super) fn count(cav: &mut [Cavitation; 2], which: usize, dir: Crossing) -> EventAction {
+        if dir == Crossing::Falling {
+            cav[which].entries += 1;
+        }
+        EventAction::Continue
+    }
+}
+
 /// The fundamental two-chamber cylinder (eqs 2.10–2.15, 2.27): owns the
 /// chamber nodes A (cap side, p1) and B (rod side, p2), pushes the rod.
 ///
@@ -141,10 +151,7 @@ impl Component for TwoChamberCylinder {
         which: usize,
         dir: Crossing,
     ) -> EventAction {
-        if dir == Crossing::Falling {
-            self.cav[which].entries += 1;
-        }
-        EventAction::Continue
+        Cavitation::count(&mut self.cav, which, dir)
     }
     fn reset(&mut self, _t: f64, _x: &[f64], _w: &Wires) {
         self.cav = [Cavitation::default(); 2];

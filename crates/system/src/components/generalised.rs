@@ -223,10 +223,7 @@ impl Component for GeneralisedCylinder {
         which: usize,
         dir: Crossing,
     ) -> EventAction {
-        if dir == Crossing::Falling {
-            self.cav[which].entries += 1;
-        }
-        EventAction::Continue
+        Cavitation::count(&mut self.cav, which, dir)
     }
     fn diagnostics(&self) -> Vec<(String, f64)> {
         vec![

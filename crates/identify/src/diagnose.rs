@@ -29,6 +29,7 @@ use thiserror::Error;
 use crate::bench::{bench_signals, BenchSignals, FrictionBench, ParamRef, BENCH_EFFECTS};
 use crate::catalog::EffectId;
 use crate::data::{DataError, Record};
+use crate::data_checks::DataProblem;
 use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, SmootherInfo};
 
@@ -79,6 +80,14 @@ pub enum DiagnoseError {
     /// No records given.
     #[error("no measured records given")]
     NoData,
+    /// The data checks left nothing to fit.
+    #[error("{file}: nothing usable to diagnose: {why}")]
+    Unusable {
+        /// The record.
+        file: String,
+        /// The data problems, one after the other.
+        why: String,
+    },
 }
 
 /// One effect in the report.
@@ -125,6 +134,9 @@ pub struct Report {
     pub records: Vec<String>,
     /// Samples used, all records.
     pub samples: usize,
+    /// Problems of the data found before any fit (the channel named is
+    /// left out of the fit).
+    pub data_problems: Vec<DataProblem>,
     /// Smoother of the first record (window chosen per record; see `smoother_windows`).
     pub smoother: SmootherInfo,
     /// Half-width chosen for each record.
@@ -470,6 +482,22 @@ pub fn diagnose_bench(
     if records.is_empty() {
         return Err(DiagnoseError::NoData);
     }
+    // Data problems that need no rig facts; the bench's output is the force,
+    // so a constant force leaves nothing to fit.
+    let mut data_problems = Vec::new();
+    for r in records {
+        let problems = crate::data_checks::check_record(r, None);
+        if let Some(p) = problems
+            .iter()
+            .find(|p| p.channel == "force" && p.kind == crate::data_checks::ProblemKind::Constant)
+        {
+            return Err(DiagnoseError::Unusable {
+                file: r.source.clone(),
+                why: p.message.clone(),
+            });
+        }
+        data_problems.extend(problems);
+    }
     let mut sigs = Vec::new();
     let mut windows = Vec::new();
     let mut smoother = None;
@@ -768,6 +796,7 @@ pub fn diagnose_bench(
         rig_kind: "friction-bench".into(),
         records: records.iter().map(|r| r.source.clone()).collect(),
         samples: measured.len(),
+        data_problems,
         smoother: smoother.expect("at least one record"),
         smoother_windows: windows,
         initial_state: if rig.has(EffectId::LugreDynamics) || added.iter().any(|a| a.id == "lugre_dynamics") {

@@ -40,11 +40,19 @@ use hydrocyl_system::valve_rig::ValveRig;
 
 use crate::catalog::EffectId;
 use crate::data::{Record, Signal};
+use crate::data_checks::{check_record, ProblemKind, RigFacts};
 use crate::diagnose::{
     nrmse, DiagnoseError, DiagnoseOptions, EffectReport, Probe, RecordTrace, Report,
 };
 use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, smooth_gcv, smooth_with};
+
+mod accept;
+mod stops;
+
+/// Most candidates refitted in one round of the loop (the best by traced
+/// share first); each refit is a full Levenberg–Marquardt fit.
+const MAX_REFITS_PER_ROUND: usize = 3;
 
 /// Effects the valve rig exposes as parameters.
 pub const VALVE_EFFECTS: [EffectId; 12] = [
@@ -415,6 +423,22 @@ fn bounds(id: EffectId, name: &str, rig: &ValveRig) -> (f64, f64) {
     }
 }
 
+/// What the data checks need to know about a valve rig: the stroke, the
+/// supply above tank and the steady velocity per unit command at full
+/// demand (mean of the two directions; none with a drooping supply).
+pub fn rig_facts(rig: &ValveRig) -> RigFacts {
+    let xm = rig.valve.stroke_m;
+    let gain = match (rig.steady_velocity(xm), rig.steady_velocity(-xm)) {
+        (Ok(up), Ok(down)) if up > 0.0 && down < 0.0 => Some(0.5 * (up - down)),
+        _ => None,
+    };
+    RigFacts {
+        stroke: rig.cylinder.stroke_m,
+        supply: rig.supply.pressure_pa - rig.supply.tank_pressure_pa,
+        velocity_gain: gain,
+    }
+}
+
 #[derive(Clone)]
 struct Prepared {
     /// Relative tolerance of the simulations (looser while tracing).
@@ -429,15 +453,19 @@ struct Prepared {
     /// count the position twice).
     weights: Vec<f64>,
     /// Initial state estimates: smoothed position, velocity, p1, p2 at t0.
-    x0: f64,
-    v0: f64,
+    x0: Option<f64>,
+    v0: Option<f64>,
     p10: Option<f64>,
     p20: Option<f64>,
+    /// Restarts of the simulation where the measured piston leaves a stop.
+    restarts: Vec<stops::Restart>,
 }
 
 fn prepare(
     rec: &Record,
     half: Option<usize>,
+    excluded: &[Signal],
+    stroke: f64,
 ) -> Result<(Prepared, crate::smooth::SmootherInfo), DiagnoseError> {
     let t = rec.time.clone();
     let command = rec.require(Signal::Command)?.to_vec();
@@ -446,11 +474,15 @@ fn prepare(
         Some(h) => smooth_with(&t, x, h, 3),
         None => smooth_gcv(&t, x, 3, 400),
     };
+    let position_ok = !excluded.contains(&Signal::Position);
     let mut meas = Vec::new();
     for ch in CHANNELS {
+        if excluded.contains(&ch) {
+            continue;
+        }
         match (ch, rec.get(ch)) {
             (_, Some(v)) => meas.push((ch, v.to_vec())),
-            (Signal::Velocity, None) => meas.push((ch, s.d1.clone())),
+            (Signal::Velocity, None) if position_ok => meas.push((ch, s.d1.clone())),
             _ => {}
         }
     }
@@ -473,17 +505,32 @@ fn prepare(
             }
         })
         .collect();
-    let v0 = rec.get(Signal::Velocity).map_or(s.d1[0], |v| v[0]);
+    // A position left out of the fit (a data problem) gives no initial
+    // state: the rig's declared one is kept.
+    let v0 = match rec.get(Signal::Velocity) {
+        Some(v) if !excluded.contains(&Signal::Velocity) => Some(v[0]),
+        _ => position_ok.then(|| s.d1[0]),
+    };
     // The first sample's noise would start the simulation off the record:
     // take the smoothed values at t0 (local cubic fit over the GCV window).
-    let p0 = |sig: Signal| rec.get(sig).map(|y| smooth_gcv(&t, y, 3, 100).value[0]);
+    let p0 = |sig: Signal| {
+        (!excluded.contains(&sig))
+            .then(|| rec.get(sig).map(|y| smooth_gcv(&t, y, 3, 100).value[0]))
+            .flatten()
+    };
     let (p10, p20) = (p0(Signal::P1), p0(Signal::P2));
+    let restarts = if position_ok {
+        stops::restarts(x, stroke, (5.0 * noise_sigma(x)).max(1e-4 * stroke))
+    } else {
+        Vec::new()
+    };
     Ok((
         Prepared {
             rtol: 1e-8,
-            x0: s.value[0],
+            x0: position_ok.then(|| s.value[0]),
             p10,
             p20,
+            restarts,
             t,
             command,
             meas,
@@ -500,8 +547,13 @@ fn prepare(
 /// rig when p1/p2 are not measured), spool at the first command.
 fn with_initial(rig: &ValveRig, p: &Prepared) -> ValveRig {
     let mut r = rig.clone();
-    r.initial.position = p.x0;
-    r.initial.velocity = p.v0;
+    if let Some(x0) = p.x0 {
+        let half = 0.5 * r.cylinder.stroke_m;
+        r.initial.position = x0.clamp(-half, half);
+    }
+    if let Some(v0) = p.v0 {
+        r.initial.velocity = v0;
+    }
     r.initial.spool = (p.command[0] * r.valve.stroke_m).clamp(-r.valve.stroke_m, r.valve.stroke_m);
     r.initial.p1 = p.p10;
     r.initial.p2 = p.p20;
@@ -524,7 +576,8 @@ fn simulate(rig: &ValveRig, p: &Prepared) -> Result<Vec<Vec<f64>>, String> {
 /// [`simulate`] over the first `n` samples only (the training part needs no
 /// more; at least two samples are simulated).
 fn simulate_prefix(rig: &ValveRig, p: &Prepared, n: usize) -> Result<Vec<Vec<f64>>, String> {
-    let t = &p.t[..n.clamp(2.min(p.t.len()), p.t.len())];
+    let n = n.clamp(2.min(p.t.len()), p.t.len());
+    let t = &p.t[..n];
     let cmd = CmdSignal::table(p.t.clone(), p.command.clone()).map_err(|e| e.to_string())?;
     let opts = RunOptions {
         rtol: p.rtol,
@@ -536,27 +589,48 @@ fn simulate_prefix(rig: &ValveRig, p: &Prepared, n: usize) -> Result<Vec<Vec<f64
             "sensors.pressure_lag_s must be finite and non-negative, got {tau}"
         ));
     }
-    let run = if tau > 0.0 {
-        let mut ideal = rig.clone();
-        ideal.sensors.pressure_lag_s = 0.0;
-        ideal.simulate(cmd, t, &opts)
-    } else {
-        rig.simulate(cmd, t, &opts)
-    }
-    .map_err(|e| e.to_string())?;
-    p.meas
+    let mut seg = rig.clone();
+    seg.sensors.pressure_lag_s = 0.0;
+    let mut out: Vec<Vec<f64>> = vec![Vec::with_capacity(n); p.meas.len()];
+    // One segment per stretch between restarts at stop exits (`stops`).
+    let mut cuts = p
+        .restarts
         .iter()
-        .map(|(ch, _)| {
+        .filter(|r| r.index > 0 && r.index + 1 < n)
+        .peekable();
+    let mut a = 0;
+    loop {
+        let next = cuts.next();
+        let b = next.map_or(n - 1, |r| r.index);
+        let run = seg
+            .simulate(cmd.clone(), &t[a..=b], &opts)
+            .map_err(|e| e.to_string())?;
+        // the restart sample belongs to the next segment
+        let keep = if next.is_some() { b - a } else { b - a + 1 };
+        for (o, (ch, _)) in out.iter_mut().zip(&p.meas) {
             let v = run
                 .channel(ch.name())
-                .map(|v| v.to_vec())
                 .ok_or_else(|| format!("simulation has no channel '{}'", ch.name()))?;
-            Ok(match ch {
-                Signal::P1 | Signal::P2 if tau > 0.0 => lag_samples(t, &v, tau),
-                _ => v,
-            })
-        })
-        .collect()
+            o.extend_from_slice(&v[..keep]);
+        }
+        let Some(r) = next else { break };
+        let last = |name: &str| run.channel(name).and_then(|v| v.last().copied());
+        let xm = seg.valve.stroke_m;
+        seg.initial.position = r.position;
+        seg.initial.velocity = 0.0;
+        seg.initial.spool = last("spool").unwrap_or(0.0).clamp(-xm, xm);
+        seg.initial.p1 = last("p1");
+        seg.initial.p2 = last("p2");
+        a = b;
+    }
+    if tau > 0.0 {
+        for (o, (ch, _)) in out.iter_mut().zip(&p.meas) {
+            if matches!(ch, Signal::P1 | Signal::P2) {
+                *o = lag_samples(t, o, tau);
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// A first-order lag `τ dy/dt = u − y` applied to samples `u` at times `t`,
@@ -659,10 +733,13 @@ fn fit(
         .zip(&x0)
         .map(|((id, n), x)| x.abs().max(typical(*id, n, rig)))
         .collect();
+    // the initial position stays within the stroke (a record may start
+    // with the piston on a stop)
     let xi = rig.initial.position;
+    let half = 0.5 * rig.cylinder.stroke_m;
     x0.push(xi);
-    lo.push(xi - 0.01);
-    hi.push(xi + 0.01);
+    lo.push((xi - 0.01).max(-half));
+    hi.push((xi + 0.01).min(half));
     typ.push(1e-3);
     let vi = rig.initial.velocity;
     x0.push(vi);
@@ -726,8 +803,14 @@ fn gauss_newton_trace(
                 set(&mut t, id, n, get(rig, id, n).unwrap_or(0.0) + h);
                 h
             } else if j == params.len() {
-                t.initial.position += 1e-5;
-                1e-5
+                // step away from a stop the piston may start on
+                let h = if t.initial.position + 1e-5 > 0.5 * rig.cylinder.stroke_m {
+                    -1e-5
+                } else {
+                    1e-5
+                };
+                t.initial.position += h;
+                h
             } else {
                 t.initial.velocity += 1e-4;
                 1e-4
@@ -758,7 +841,8 @@ fn gauss_newton_trace(
                 let v = (get(rig, *id, n).unwrap_or(0.0) + alpha * delta[j]).clamp(lo, hi);
                 set(&mut t, *id, n, v);
             }
-            t.initial.position += alpha * delta[k - 2];
+            let half = 0.5 * rig.cylinder.stroke_m;
+            t.initial.position = (t.initial.position + alpha * delta[k - 2]).clamp(-half, half);
             t.initial.velocity += alpha * delta[k - 1];
             if rss(&t, p, holdout, part) < rss0 {
                 accepted = Some(t);
@@ -838,6 +922,7 @@ fn delay_probe(rig: &ValveRig, p: &Prepared, holdout: f64) -> Option<Probe> {
             v0: p.v0,
             p10: p.p10,
             p20: p.p20,
+            restarts: p.restarts.clone(),
         };
         q.command[0] = p.command[0];
         let r = rss(rig, &q, holdout, Part::All);
@@ -923,12 +1008,39 @@ pub fn diagnose_valve_traced(
     progress: &mut dyn FnMut(&str, usize, usize),
 ) -> Result<ValveOutcome, DiagnoseError> {
     let start = Instant::now();
-    let (p, info) = prepare(rec, opts.half_window)?;
+    // Data problems first: each named channel is left out of the fit.
+    let data_problems = check_record(rec, Some(&rig_facts(declared)));
+    let mut excluded: Vec<Signal> = data_problems
+        .iter()
+        .filter_map(|p| Signal::from_name(&p.channel))
+        .collect();
+    if data_problems.iter().any(|p| p.kind == ProblemKind::Sign) {
+        excluded.push(Signal::Velocity);
+    }
+    let (p, info) = prepare(rec, opts.half_window, &excluded, declared.cylinder.stroke_m)?;
+    if p.weights.iter().all(|w| *w == 0.0) {
+        let why = if data_problems.is_empty() {
+            "no measured channel to compare (position, velocity, p1, p2)".to_string()
+        } else {
+            data_problems
+                .iter()
+                .map(|p| p.message.as_str())
+                .collect::<Vec<_>>()
+                .join("; ")
+        };
+        return Err(DiagnoseError::Unusable {
+            file: rec.source.clone(),
+            why,
+        });
+    }
     let mut rig0 = with_initial(declared, &p);
     simulate(&rig0, &p)
         .map_err(|e| DiagnoseError::Rig(format!("declared model does not simulate: {e}")))?;
     let nrmse_declared = channel_nrmse(&rig0, &p);
-    let mut warnings: Vec<String> = Vec::new();
+    let mut warnings: Vec<String> = data_problems
+        .iter()
+        .map(|p| format!("{} left out of the fit: {}", p.channel, p.message))
+        .collect();
     // Tracing compares candidates with each other, and the initial-state
     // fit below only starts the refits: a looser integration tolerance is
     // enough there. The refits use the tight one (a loose one puts
@@ -961,6 +1073,15 @@ pub fn diagnose_valve_traced(
         .filter(|e| VALVE_EFFECTS.contains(e))
         .filter(|e| e.params().iter().all(|q| get(&rig0, *e, q.name).is_some()))
         .collect();
+    // Noise floor of each compared channel as an NRMSE (the weights' floor
+    // of 1e-4 of the range for noise-free records).
+    let floors: BTreeMap<String, f64> = p
+        .meas
+        .iter()
+        .zip(p.ranges.iter().zip(&p.weights))
+        .filter(|(_, (_, w))| **w > 0.0)
+        .map(|((ch, _), (r, w))| (ch.name().to_string(), 1.0 / (w * r)))
+        .collect();
     let mut model = rig0.clone();
     let mut free: ParamList = Vec::new();
     let mut added: Vec<EffectReport> = Vec::new();
@@ -976,7 +1097,6 @@ pub fn diagnose_valve_traced(
         let rss0_held = rss(&model, &pt, opts.holdout, Part::Held);
         let rho = lm::lag1_autocorrelation(&r0).clamp(0.0, 0.999);
         let neff = (r0.len() as f64 * (1.0 - rho) / (1.0 + rho)).max(2.0);
-        let mut best: Option<(EffectId, ValveRig, EffectReport)> = None;
         let todo: Vec<EffectId> = candidates
             .iter()
             .copied()
@@ -999,14 +1119,25 @@ pub fn diagnose_valve_traced(
             let res = gauss_newton_trace(&mut trial, &joint, &pt, opts.holdout, Part::Train);
             let rss_train = rss(&trial, &pt, opts.holdout, Part::Train);
             let rss1 = rss(&trial, &pt, opts.holdout, Part::All);
-            let held = 1.0 - rss(&trial, &pt, opts.holdout, Part::Held) / rss0_held.max(1e-300);
-            let share = 1.0 - rss1 / rss0.max(1e-300);
-            let dbic = neff * (rss1 / rss0.max(1e-300)).ln() + params.len() as f64 * neff.ln();
+            let rss1_held = rss(&trial, &pt, opts.holdout, Part::Held);
+            // A trace whose simulation fails scores nothing (finite numbers
+            // only reach the report) and says why below.
+            let sim_failed = !(rss1.is_finite() && rss1_held.is_finite() && rss_train.is_finite());
+            let (share, held, dbic) = if sim_failed {
+                (0.0, 0.0, 0.0)
+            } else {
+                (
+                    1.0 - rss1 / rss0.max(1e-300),
+                    1.0 - rss1_held / rss0_held.max(1e-300),
+                    neff * (rss1 / rss0.max(1e-300)).max(1e-300).ln()
+                        + params.len() as f64 * neff.ln(),
+                )
+            };
             let mut rep = EffectReport {
                 id: id.id().into(),
                 params: params
                     .iter()
-                    .map(|(eid, n)| (n.to_string(), get(&trial, *eid, n).unwrap_or(f64::NAN)))
+                    .filter_map(|(eid, n)| get(&trial, *eid, n).map(|v| (n.to_string(), v)))
                     .collect(),
                 ci95: BTreeMap::new(),
                 explained_share: share,
@@ -1016,6 +1147,8 @@ pub fn diagnose_valve_traced(
             };
             if let Err(e) = &res {
                 rep.reason = Some(format!("fit failed: {e}"));
+            } else if sim_failed {
+                rep.reason = Some("the rig does not simulate at the traced values".into());
             } else if share < opts.min_share {
                 rep.reason = Some(format!(
                     "explains {:.1} % < {:.1} %",
@@ -1061,24 +1194,22 @@ pub fn diagnose_valve_traced(
                 chosen.push((id, t, r));
             }
         }
+        // Candidates that explain a share worth having, best first.
+        let mut eligible: Vec<(EffectId, ValveRig, EffectReport)> = Vec::new();
         for (id, trial, rep) in chosen {
-            if rep.reason.is_none()
-                && best
-                    .as_ref()
-                    .is_none_or(|(_, _, r)| rep.explained_share > r.explained_share)
-            {
-                best = Some((id, trial, rep.clone()));
+            if rep.reason.is_none() {
+                eligible.push((id, trial, rep.clone()));
             }
             last.insert(id, rep);
         }
+        eligible.sort_by(|a, b| b.2.explained_share.total_cmp(&a.2.explained_share));
         if let Some(pr) = delay_probe(&model, &pt, opts.holdout) {
+            let top = eligible.first().map(|(id, _, r)| (*id, r.explained_share));
             if pr.explained_share >= opts.min_share
-                && best
-                    .as_ref()
-                    .is_none_or(|(_, _, r)| pr.explained_share > r.explained_share + opts.min_share)
+                && top.is_none_or(|(_, share)| pr.explained_share > share + opts.min_share)
             {
-                if let Some((id, _, _)) = &best {
-                    if let Some(r) = last.get_mut(id) {
+                if let Some((id, _)) = top {
+                    if let Some(r) = last.get_mut(&id) {
                         r.reason = Some(format!(
                             "the residual is better explained by a {} ({:.1} %), which is not in the catalog",
                             pr.what,
@@ -1090,37 +1221,54 @@ pub fn diagnose_valve_traced(
                 break;
             }
         }
-        let Some((id, trial, rep)) = best else { break };
-        model = trial;
-        free.extend(id.params().iter().map(|q| (id, q.name)));
-        progress("refit", round + 1, total);
-        // A refit that does not converge keeps the traced values (no
-        // intervals) and says so, rather than losing the whole diagnosis.
-        let mut refit = model.clone();
-        let res = match fit(&mut refit, &free, &p, opts.holdout, Part::All) {
-            Ok(res) => {
-                model = refit;
-                res
-            }
-            Err(e) => {
-                warnings.push(format!(
-                    "refit after adding {}: {e}; the traced values are kept, without intervals",
-                    id.id()
+        // The acceptance rule (`accept`): refit each candidate in turn with
+        // the effects already added; the first that earns its place is added.
+        let base = accept::Baseline {
+            model: &model,
+            declared,
+            nrmse: channel_nrmse(&model, &p),
+            floors: floors.clone(),
+            p: &p,
+            holdout: opts.holdout,
+        };
+        let mut accepted: Option<(EffectId, ValveRig, EffectReport, ParamList, lm::LmResult)> =
+            None;
+        for (id, _, _) in eligible.iter().skip(MAX_REFITS_PER_ROUND) {
+            if let Some(r) = last.get_mut(id) {
+                r.reason = Some(format!(
+                    "not refitted: {MAX_REFITS_PER_ROUND} candidates explaining more were refitted first in its round"
                 ));
-                lm::LmResult {
-                    x: free
-                        .iter()
-                        .map(|(eid, n)| get(&model, *eid, n).unwrap_or(f64::NAN))
-                        .collect(),
-                    ci95: vec![f64::NAN; free.len()],
-                    rss: f64::NAN,
-                    m: 0,
-                    iterations: 0,
-                    evaluations: 0,
-                    at_bound: vec![false; free.len()],
+            }
+        }
+        for (id, trial, rep) in eligible.into_iter().take(MAX_REFITS_PER_ROUND) {
+            progress(&format!("refit {}", id.id()), round + 1, total);
+            let joint: ParamList = free
+                .iter()
+                .copied()
+                .chain(id.params().iter().map(|q| (id, q.name)))
+                .collect();
+            let mut refit = trial;
+            let verdict = match fit(&mut refit, &joint, &p, opts.holdout, Part::All) {
+                Ok(res) => accept::verdict(id, &joint, &res, &refit, &base).map(|()| res),
+                Err(e) => Err(format!("refit failed: {e}")),
+            };
+            match verdict {
+                Ok(res) => {
+                    accepted = Some((id, refit, rep, joint, res));
+                    break;
+                }
+                Err(why) => {
+                    if let Some(r) = last.get_mut(&id) {
+                        r.reason = Some(why);
+                    }
                 }
             }
+        }
+        let Some((id, refit, rep, joint, res)) = accepted else {
+            break;
         };
+        model = refit;
+        free = joint;
         last.remove(&id);
         added.push(rep);
         for ((eid, n), (x, ci)) in free.iter().zip(res.x.iter().zip(&res.ci95)) {
@@ -1204,6 +1352,7 @@ pub fn diagnose_valve_traced(
         rig_kind: "valve-cylinder".into(),
         records: vec![rec.source.clone()],
         samples: rec.len(),
+        data_problems,
         smoother: info.clone(),
         smoother_windows: vec![info.half_window],
         initial_state: "velocity and chamber pressures at the first sample from the smoother's local cubic fit (not the raw noisy sample), initial position and velocity fitted first on the declared model and again with every refit (the rig integrates flow into position; the smoother's one-sided derivative at the first sample is noisy); spool at the first command; the rig's steady pressures where p1/p2 are not measured".into(),

@@ -170,8 +170,47 @@ pub struct Report {
     pub noise_share: f64,
     /// The selection rule, in words.
     pub selection: String,
+    /// Wall time of each stage of the loop \[s\] (summed over rounds).
+    pub wall_times_s: BTreeMap<String, f64>,
     /// Wall time of the loop \[s\].
     pub elapsed_s: f64,
+}
+
+/// Wall time per stage of the loop, for the report.
+#[derive(Debug)]
+pub struct StageClock {
+    last: Instant,
+    times: BTreeMap<String, f64>,
+}
+
+impl StageClock {
+    /// A clock starting now.
+    pub fn new() -> Self {
+        Self {
+            last: Instant::now(),
+            times: BTreeMap::new(),
+        }
+    }
+
+    /// Books the time since the last lap to `stage`.
+    pub fn lap(&mut self, stage: &str) {
+        let now = Instant::now();
+        *self.times.entry(stage.to_string()).or_insert(0.0) +=
+            now.duration_since(self.last).as_secs_f64();
+        self.last = now;
+    }
+
+    /// The times booked, the rest of the time as `report`.
+    pub fn finish(mut self) -> BTreeMap<String, f64> {
+        self.lap("report");
+        self.times
+    }
+}
+
+impl Default for StageClock {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 /// Time series for plots, one per record.
@@ -830,6 +869,7 @@ pub fn diagnose_bench(
             50.0 * opts.min_share,
             100.0 * opts.holdout
         ),
+        wall_times_s: BTreeMap::from([("total".to_string(), start.elapsed().as_secs_f64())]),
         elapsed_s: start.elapsed().as_secs_f64(),
     };
     Ok(Outcome {
@@ -863,20 +903,34 @@ impl Report {
             self.smoother_windows
         );
         let _ = writeln!(s, "initial state: {}", self.initial_state);
+        if !self.data_problems.is_empty() {
+            let _ = writeln!(s, "\ndata problems (channel left out of the fit):");
+            for p in &self.data_problems {
+                let kind = serde_json::to_value(p.kind)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_string))
+                    .unwrap_or_default();
+                let _ = writeln!(s, "  {:<10} {:<10} {}", p.channel, kind, p.message);
+            }
+        }
         let _ = writeln!(
             s,
             "\n{:<10} {:>10} {:>10} {:>10} {:>12}",
             "channel", "declared", "before", "after", "noise floor"
         );
+        let num = |v: Option<&f64>| match v {
+            Some(v) if v.is_finite() => format!("{v:.3e}"),
+            _ => "n/a".to_string(),
+        };
         for (k, v) in &self.nrmse_after {
             let _ = writeln!(
                 s,
-                "{:<10} {:>10.3e} {:>10.3e} {:>10.3e} {:>12.3e}",
+                "{:<10} {:>10} {:>10} {:>10} {:>12}",
                 k,
-                self.nrmse_declared.get(k).copied().unwrap_or(f64::NAN),
-                self.nrmse_before.get(k).copied().unwrap_or(f64::NAN),
-                v,
-                self.noise_floor.get(k).copied().unwrap_or(f64::NAN)
+                num(self.nrmse_declared.get(k)),
+                num(self.nrmse_before.get(k)),
+                num(Some(v)),
+                num(self.noise_floor.get(k))
             );
         }
         if !self.declared_refit.is_empty() {
@@ -914,12 +968,23 @@ impl Report {
         for e in &self.effects_rejected {
             let _ = writeln!(s, "  {:<22} {}", e.id, e.reason.as_deref().unwrap_or(""));
         }
+        let noise = if self.noise_share.is_finite() {
+            format!(
+                "sensor noise accounts for {:.0} % of what is left",
+                100.0 * self.noise_share
+            )
+        } else {
+            "no noise estimate".to_string()
+        };
         let _ = writeln!(
             s,
-            "\nunexplained: {:.1} % of the residual before is left; sensor noise accounts for {:.0} % of what is left{}",
+            "\nunexplained: {:.1} % of the residual before is left; {noise}{}",
             100.0 * self.unexplained_share,
-            100.0 * self.noise_share,
-            if self.noise_share < 0.5 { " — structured residual no catalog effect explains" } else { "" }
+            if self.noise_share < 0.5 {
+                " — structured residual no catalog effect explains"
+            } else {
+                ""
+            }
         );
         if let Some(p) = &self.unexplained_resembles {
             let _ = writeln!(
@@ -933,7 +998,12 @@ impl Report {
         for w in &self.warnings {
             let _ = writeln!(s, "warning: {w}");
         }
-        let _ = writeln!(s, "time: {:.2} s", self.elapsed_s);
+        let stages: Vec<String> = self
+            .wall_times_s
+            .iter()
+            .map(|(k, v)| format!("{k} {v:.2} s"))
+            .collect();
+        let _ = writeln!(s, "time: {:.2} s ({})", self.elapsed_s, stages.join(", "));
         s
     }
 }

@@ -1008,6 +1008,7 @@ pub fn diagnose_valve_traced(
     progress: &mut dyn FnMut(&str, usize, usize),
 ) -> Result<ValveOutcome, DiagnoseError> {
     let start = Instant::now();
+    let mut clock = crate::diagnose::StageClock::new();
     // Data problems first: each named channel is left out of the fit.
     let data_problems = check_record(rec, Some(&rig_facts(declared)));
     let mut excluded: Vec<Signal> = data_problems
@@ -1062,6 +1063,7 @@ pub fn diagnose_valve_traced(
             )),
         }
     }
+    clock.lap("checks, smoothing and initial-state fit");
     let sims_before = simulate(&rig0, &p).unwrap_or_default();
     let nrmse_before = nrmse_of(&p, &sims_before);
     let rss_before = rss(&rig0, &p, opts.holdout, Part::All);
@@ -1089,7 +1091,7 @@ pub fn diagnose_valve_traced(
     let mut resembles: Option<Probe> = None;
     let total = opts.max_effects + 1;
     for round in 0..opts.max_effects {
-        progress("tracing", round, total);
+        progress(&format!("tracing, round {}", round + 1), round, total);
         let mut r0 = Vec::new();
         residual(&model, &pt, opts.holdout, Part::All, &mut r0)
             .map_err(|e| DiagnoseError::Rig(e.to_string()))?;
@@ -1223,6 +1225,7 @@ pub fn diagnose_valve_traced(
         }
         // The acceptance rule (`accept`): refit each candidate in turn with
         // the effects already added; the first that earns its place is added.
+        clock.lap("tracing");
         let base = accept::Baseline {
             model: &model,
             declared,
@@ -1278,6 +1281,7 @@ pub fn diagnose_valve_traced(
             }
         }
     }
+    clock.lap("refits");
     // Backward step: an effect whose refitted size became negligible once
     // later effects were added was standing in for them; drop it and refit.
     let stale: Vec<EffectId> = added
@@ -1333,6 +1337,7 @@ pub fn diagnose_valve_traced(
         }
     }
     progress("report", total, total);
+    clock.lap("backward step");
     let sims_after = simulate(&model, &p).unwrap_or_default();
     let nrmse_after = nrmse_of(&p, &sims_after);
     let rss_after = rss(&model, &p, opts.holdout, Part::All);
@@ -1377,6 +1382,7 @@ pub fn diagnose_valve_traced(
             100.0 * opts.min_share,
             50.0 * opts.min_share
         ),
+        wall_times_s: clock.finish(),
         elapsed_s: start.elapsed().as_secs_f64(),
     };
     Ok(ValveOutcome {

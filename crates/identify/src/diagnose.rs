@@ -110,6 +110,15 @@ pub struct EffectReport {
     pub reason: Option<String>,
 }
 
+/// A catalog effect not tried on a rig, and why.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NotApplicable {
+    /// Catalog id.
+    pub id: String,
+    /// Why it does not apply.
+    pub why: String,
+}
+
 /// One fitted declared parameter.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ParamReport {
@@ -157,8 +166,8 @@ pub struct Report {
     pub effects_added: Vec<EffectReport>,
     /// Effects tried and rejected (last round's scores).
     pub effects_rejected: Vec<EffectReport>,
-    /// Catalog effects the rig kind has no balance for (not tried).
-    pub effects_not_applicable: Vec<String>,
+    /// Catalog effects not tried on this rig, each with the reason.
+    pub effects_not_applicable: Vec<NotApplicable>,
     /// Residual sum of squares after, as a share of before.
     pub unexplained_share: f64,
     /// An out-of-catalog shape the unexplained residual resembles, if a probe
@@ -853,7 +862,14 @@ pub fn diagnose_bench(
         effects_not_applicable: EffectId::ALL
             .iter()
             .filter(|e| !BENCH_EFFECTS.contains(e))
-            .map(|e| e.id().to_string())
+            .map(|e| NotApplicable {
+                id: e.id().to_string(),
+                why: format!(
+                    "the friction bench has only the force balance; {} belongs to the {:?} balance",
+                    e.id(),
+                    e.balance()
+                ),
+            })
             .collect(),
         unexplained_share: rss_after / rss_before.max(1e-300),
         unexplained_resembles: resembles,
@@ -967,6 +983,12 @@ impl Report {
         let _ = writeln!(s, "\neffects tried and rejected:");
         for e in &self.effects_rejected {
             let _ = writeln!(s, "  {:<22} {}", e.id, e.reason.as_deref().unwrap_or(""));
+        }
+        if !self.effects_not_applicable.is_empty() {
+            let _ = writeln!(s, "\neffects not applicable to this rig:");
+            for e in &self.effects_not_applicable {
+                let _ = writeln!(s, "  {:<22} {}", e.id, e.why);
+            }
         }
         let noise = if self.noise_share.is_finite() {
             format!(

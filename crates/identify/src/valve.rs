@@ -42,7 +42,7 @@ use crate::catalog::EffectId;
 use crate::data::{Record, Signal};
 use crate::data_checks::{check_record, ProblemKind, RigFacts};
 use crate::diagnose::{
-    nrmse, DiagnoseError, DiagnoseOptions, EffectReport, Probe, RecordTrace, Report,
+    nrmse, DiagnoseError, DiagnoseOptions, EffectReport, NotApplicable, Probe, RecordTrace, Report,
 };
 use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, smooth_gcv, smooth_with};
@@ -55,9 +55,11 @@ mod stops;
 const MAX_REFITS_PER_ROUND: usize = 3;
 
 /// Effects the valve rig exposes as parameters.
-pub const VALVE_EFFECTS: [EffectId; 12] = [
+pub const VALVE_EFFECTS: [EffectId; 14] = [
     EffectId::CoulombAsymmetry,
     EffectId::Stribeck,
+    EffectId::PressureViscous,
+    EffectId::AccelerationFriction,
     EffectId::LugreDynamics,
     EffectId::ValveNullBias,
     EffectId::FlowGainError,
@@ -69,6 +71,20 @@ pub const VALVE_EFFECTS: [EffectId; 12] = [
     EffectId::SupplyDroop,
     EffectId::SensorLag,
 ];
+
+/// Why effect `id` is not tried on this valve rig.
+fn not_applicable_why(id: EffectId, rig: &ValveRig, opts: &DiagnoseOptions) -> String {
+    if opts.candidates.as_ref().is_some_and(|c| !c.contains(&id)) {
+        return "left out by --effects".into();
+    }
+    if !VALVE_EFFECTS.contains(&id) {
+        return "not a parameter of the valve rig".into();
+    }
+    format!(
+        "its parameters are not switchable on the declared friction law `{}` (coulomb-viscous, stribeck and lugre are)",
+        rig.friction.name()
+    )
+}
 
 /// The channels compared, in report order.
 const CHANNELS: [Signal; 4] = [Signal::Position, Signal::Velocity, Signal::P1, Signal::P2];
@@ -85,6 +101,8 @@ pub fn get(rig: &ValveRig, id: EffectId, name: &str) -> Option<f64> {
         (EffectId::ExternalForce, "F0") => rig.load.external_force_n,
         (EffectId::SupplyDroop, "Rs") => rig.supply.droop_resistance_pa_s_per_m3,
         (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s,
+        (EffectId::PressureViscous, "K") => rig.friction_terms.k_pressure,
+        (EffectId::AccelerationFriction, "H") => rig.friction_terms.h_acceleration,
         (EffectId::Viscous, "b") => match &rig.friction {
             FrictionLaw::CoulombViscous(c) => c.viscous,
             law => friction_sets(law)?.0.sigma2,
@@ -205,6 +223,8 @@ pub fn set(rig: &mut ValveRig, id: EffectId, name: &str, v: f64) {
         (EffectId::ExternalForce, "F0") => rig.load.external_force_n = v,
         (EffectId::SupplyDroop, "Rs") => rig.supply.droop_resistance_pa_s_per_m3 = v,
         (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s = v,
+        (EffectId::PressureViscous, "K") => rig.friction_terms.k_pressure = v,
+        (EffectId::AccelerationFriction, "H") => rig.friction_terms.h_acceleration = v,
         (EffectId::Viscous, "b") => match &mut rig.friction {
             FrictionLaw::CoulombViscous(c) => c.viscous = v,
             law => with_sets(law, |e, r| {
@@ -343,7 +363,14 @@ fn typical(id: EffectId, name: &str, rig: &ValveRig) -> f64 {
         // a droop of 1 bar at 6 l/min
         (EffectId::SupplyDroop, _) => 1e9,
         (EffectId::SensorLag, _) => 5e-3,
-        _ => 1.0,
+        // 10 N at half the supply across the piston and 10 mm/s
+        (EffectId::PressureViscous, _) => {
+            10.0 / ((0.5 * rig.supply.pressure_pa).powi(2) * 0.01).max(1e-300)
+        }
+        // K H = 10 % of the moving mass
+        (EffectId::AccelerationFriction, _) => {
+            0.1 * rig.load.mass_kg / rig.friction_terms.k_pressure.max(1e-300)
+        }
     }
 }
 
@@ -373,6 +400,12 @@ fn negligible(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> bool {
         }
         // a lag under 0.1 ms is below any record's resolution here
         EffectId::SensorLag => v("tau") < 1e-4,
+        // under 1 N at half the supply across the piston and 10 mm/s
+        EffectId::PressureViscous => v("K") * (0.5 * rig.supply.pressure_pa).powi(2) * 0.01 < 1.0,
+        // an added mass K H under 1 % of the moving mass
+        EffectId::AccelerationFriction => {
+            rig.friction_terms.k_pressure * v("H") < 0.01 * rig.load.mass_kg
+        }
         // friction terms under 5 % of the declared Coulomb level
         EffectId::CoulombAsymmetry => v("dFc").abs() < 0.05 * mean_coulomb(declared),
         EffectId::Stribeck => {
@@ -382,7 +415,6 @@ fn negligible(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> bool {
         // 10 µm (half the position noise of the generated records) act as
         // static friction
         EffectId::LugreDynamics => v("sigma0") == 0.0 || mean_coulomb(rig) / v("sigma0") < 1e-5,
-        _ => false,
     }
 }
 
@@ -415,6 +447,9 @@ fn bounds(id: EffectId, name: &str, rig: &ValveRig) -> (f64, f64) {
             _ => (0.0, 1e5),
         },
         EffectId::ExternalForce => (-1e6, 1e6),
+        // K up to 1 kN at half the supply and 10 mm/s; K H up to 10x the mass
+        EffectId::PressureViscous => (0.0, 100.0 * typical(id, name, rig)),
+        EffectId::AccelerationFriction => (0.0, 100.0 * typical(id, name, rig)),
         _ => id
             .params()
             .iter()
@@ -1099,12 +1134,34 @@ pub fn diagnose_valve_traced(
         let rss0_held = rss(&model, &pt, opts.holdout, Part::Held);
         let rho = lm::lag1_autocorrelation(&r0).clamp(0.0, 0.999);
         let neff = (r0.len() as f64 * (1.0 - rho) / (1.0 + rho)).max(2.0);
-        let todo: Vec<EffectId> = candidates
+        let mut todo: Vec<EffectId> = candidates
             .iter()
             .copied()
             .filter(|&id| id == EffectId::BulkModulus || !is_on(&model, id))
             .filter(|id| !added.iter().any(|a| a.id == id.id()))
             .collect();
+        // `K H a` needs the pressure term's K (eq 5.12)
+        if model.friction_terms.k_pressure == 0.0 {
+            let id = EffectId::AccelerationFriction;
+            if let Some(k) = todo.iter().position(|e| *e == id) {
+                todo.remove(k);
+                last.insert(
+                    id,
+                    EffectReport {
+                        id: id.id().into(),
+                        params: BTreeMap::new(),
+                        ci95: BTreeMap::new(),
+                        explained_share: 0.0,
+                        heldout_share: 0.0,
+                        delta_bic: 0.0,
+                        reason: Some(
+                            "not traced: needs pressure_viscous's K (the term is K H a, eq 5.12)"
+                                .into(),
+                        ),
+                    },
+                );
+            }
+        }
         // One job per candidate and start (see `trace_starts`).
         let jobs: Vec<(EffectId, ValveRig)> = todo
             .iter()
@@ -1371,7 +1428,10 @@ pub fn diagnose_valve_traced(
         effects_not_applicable: EffectId::ALL
             .iter()
             .filter(|e| !candidates.contains(e))
-            .map(|e| e.id().to_string())
+            .map(|e| NotApplicable {
+                id: e.id().to_string(),
+                why: not_applicable_why(*e, declared, opts),
+            })
             .collect(),
         unexplained_share: rss_after / rss_before.max(1e-300),
         unexplained_resembles: resembles,

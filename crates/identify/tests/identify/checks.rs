@@ -186,3 +186,23 @@ fn a_record_resting_on_an_end_stop_is_diagnosed() {
         );
     }
 }
+
+#[test]
+fn pressure_viscous_is_found_on_the_valve_rig() {
+    // K (p1 - p2)^2 v as an additive term on the coulomb-viscous law:
+    // about 100 N at 2.5 MPa across the piston and 50 mm/s.
+    let mut t = truth(&[]);
+    set(&mut t, EffectId::PressureViscous, "K", 3e-10);
+    let rec = valve_record(&t, 2000, 1e-3, 67).unwrap();
+    let r = diagnose(&rec).unwrap();
+    assert_finite(&r);
+    let first = r.effects_added.first().expect(&r.human());
+    assert_eq!(first.id, "pressure_viscous", "{}", r.human());
+    let ci = first.ci95["K"].unwrap();
+    assert!((first.params["K"] - 3e-10).abs() <= ci, "{}", r.human());
+    // K H a is offered once K is there, and every effect not tried says why
+    assert!(r
+        .effects_not_applicable
+        .iter()
+        .all(|e| !e.why.is_empty() && e.id != "pressure_viscous"));
+}

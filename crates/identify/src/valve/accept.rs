@@ -124,7 +124,7 @@ pub(super) fn verdict(
         rss(base.model, base.p, base.holdout, Part::Held),
         rss(refit, base.p, base.holdout, Part::Held),
     );
-    if !(h1 < h0) {
+    if h1.partial_cmp(&h0) != Some(std::cmp::Ordering::Less) {
         return Err(format!(
             "the held-out part does not improve (weighted SS {h0:.4e} -> {h1:.4e})"
         ));

@@ -210,3 +210,31 @@ fn valve_rig_finds_the_planted_leak() {
         assert!(svg.contains("<svg") && svg.contains("residual"), "{ch}");
     }
 }
+
+#[test]
+fn a_valve_record_with_nothing_usable_exits_2_naming_the_problems() {
+    // every measured channel constant (an all-zero record)
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("zeros.csv");
+    let mut csv = String::from("time [s],command,position [mm],p1 [bar],p2 [bar]\n");
+    for i in 0..200 {
+        csv.push_str(&format!("{:.3},0,0,0,0\n", i as f64 * 1e-3));
+    }
+    std::fs::write(&data, csv).unwrap();
+    let report = dir.path().join("report.json");
+    let out = bin()
+        .args(["diagnose", "--rig", "leaney-moog", "--data"])
+        .arg(&data)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("nothing usable") && err.contains("position"),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(!report.exists());
+}

@@ -24,6 +24,8 @@
 //! * [`Wang`] — the thesis's new model, eq 5.4 pressure term `K (p1 − p2)² v`
 //!   and eq 5.12/5.14 acceleration term `K H a`, Tables 5-8, 5-9, 5-10.
 //!
+//! [`WithSealTerms`] adds the eq 5.4 and 5.12 seal terms to any of them.
+//!
 //! [`FrictionLaw`] holds any of them and (de)serialises with a `"model"` tag,
 //! so a rig file picks its friction by name. [`ident`] fits steady friction
 //! curves (eq 2.40 / 5.8) to measured points with [`hydrocyl_fit`].
@@ -58,6 +60,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod additive;
 mod coulomb;
 mod curve;
 mod dahl;
@@ -70,6 +73,7 @@ mod model;
 mod stribeck;
 mod wang;
 
+pub use additive::{SealTerms, WithSealTerms};
 pub use coulomb::CoulombViscous;
 pub use curve::StribeckCurve;
 pub use dahl::Dahl;

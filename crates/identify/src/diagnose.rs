@@ -29,6 +29,7 @@ use thiserror::Error;
 use crate::bench::{bench_signals, BenchSignals, FrictionBench, ParamRef, BENCH_EFFECTS};
 use crate::catalog::EffectId;
 use crate::data::{DataError, Record};
+use crate::data_checks::DataProblem;
 use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, SmootherInfo};
 
@@ -79,6 +80,14 @@ pub enum DiagnoseError {
     /// No records given.
     #[error("no measured records given")]
     NoData,
+    /// The data checks left nothing to fit.
+    #[error("{file}: nothing usable to diagnose: {why}")]
+    Unusable {
+        /// The record.
+        file: String,
+        /// The data problems, one after the other.
+        why: String,
+    },
 }
 
 /// One effect in the report.
@@ -99,6 +108,15 @@ pub struct EffectReport {
     /// Why it was rejected (absent for an added effect).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
+}
+
+/// A catalog effect not tried on a rig, and why.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NotApplicable {
+    /// Catalog id.
+    pub id: String,
+    /// Why it does not apply.
+    pub why: String,
 }
 
 /// One fitted declared parameter.
@@ -125,6 +143,9 @@ pub struct Report {
     pub records: Vec<String>,
     /// Samples used, all records.
     pub samples: usize,
+    /// Problems of the data found before any fit (the channel named is
+    /// left out of the fit).
+    pub data_problems: Vec<DataProblem>,
     /// Smoother of the first record (window chosen per record; see `smoother_windows`).
     pub smoother: SmootherInfo,
     /// Half-width chosen for each record.
@@ -145,8 +166,8 @@ pub struct Report {
     pub effects_added: Vec<EffectReport>,
     /// Effects tried and rejected (last round's scores).
     pub effects_rejected: Vec<EffectReport>,
-    /// Catalog effects the rig kind has no balance for (not tried).
-    pub effects_not_applicable: Vec<String>,
+    /// Catalog effects not tried on this rig, each with the reason.
+    pub effects_not_applicable: Vec<NotApplicable>,
     /// Residual sum of squares after, as a share of before.
     pub unexplained_share: f64,
     /// An out-of-catalog shape the unexplained residual resembles, if a probe
@@ -158,8 +179,47 @@ pub struct Report {
     pub noise_share: f64,
     /// The selection rule, in words.
     pub selection: String,
+    /// Wall time of each stage of the loop \[s\] (summed over rounds).
+    pub wall_times_s: BTreeMap<String, f64>,
     /// Wall time of the loop \[s\].
     pub elapsed_s: f64,
+}
+
+/// Wall time per stage of the loop, for the report.
+#[derive(Debug)]
+pub struct StageClock {
+    last: Instant,
+    times: BTreeMap<String, f64>,
+}
+
+impl StageClock {
+    /// A clock starting now.
+    pub fn new() -> Self {
+        Self {
+            last: Instant::now(),
+            times: BTreeMap::new(),
+        }
+    }
+
+    /// Books the time since the last lap to `stage`.
+    pub fn lap(&mut self, stage: &str) {
+        let now = Instant::now();
+        *self.times.entry(stage.to_string()).or_insert(0.0) +=
+            now.duration_since(self.last).as_secs_f64();
+        self.last = now;
+    }
+
+    /// The times booked, the rest of the time as `report`.
+    pub fn finish(mut self) -> BTreeMap<String, f64> {
+        self.lap("report");
+        self.times
+    }
+}
+
+impl Default for StageClock {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 /// Time series for plots, one per record.
@@ -470,6 +530,22 @@ pub fn diagnose_bench(
     if records.is_empty() {
         return Err(DiagnoseError::NoData);
     }
+    // Data problems that need no rig facts; the bench's output is the force,
+    // so a constant force leaves nothing to fit.
+    let mut data_problems = Vec::new();
+    for r in records {
+        let problems = crate::data_checks::check_record(r, None);
+        if let Some(p) = problems
+            .iter()
+            .find(|p| p.channel == "force" && p.kind == crate::data_checks::ProblemKind::Constant)
+        {
+            return Err(DiagnoseError::Unusable {
+                file: r.source.clone(),
+                why: p.message.clone(),
+            });
+        }
+        data_problems.extend(problems);
+    }
     let mut sigs = Vec::new();
     let mut windows = Vec::new();
     let mut smoother = None;
@@ -768,6 +844,7 @@ pub fn diagnose_bench(
         rig_kind: "friction-bench".into(),
         records: records.iter().map(|r| r.source.clone()).collect(),
         samples: measured.len(),
+        data_problems,
         smoother: smoother.expect("at least one record"),
         smoother_windows: windows,
         initial_state: if rig.has(EffectId::LugreDynamics) || added.iter().any(|a| a.id == "lugre_dynamics") {
@@ -785,7 +862,14 @@ pub fn diagnose_bench(
         effects_not_applicable: EffectId::ALL
             .iter()
             .filter(|e| !BENCH_EFFECTS.contains(e))
-            .map(|e| e.id().to_string())
+            .map(|e| NotApplicable {
+                id: e.id().to_string(),
+                why: format!(
+                    "the friction bench has only the force balance; {} belongs to the {:?} balance",
+                    e.id(),
+                    e.balance()
+                ),
+            })
             .collect(),
         unexplained_share: rss_after / rss_before.max(1e-300),
         unexplained_resembles: resembles,
@@ -801,6 +885,7 @@ pub fn diagnose_bench(
             50.0 * opts.min_share,
             100.0 * opts.holdout
         ),
+        wall_times_s: BTreeMap::from([("total".to_string(), start.elapsed().as_secs_f64())]),
         elapsed_s: start.elapsed().as_secs_f64(),
     };
     Ok(Outcome {
@@ -834,20 +919,34 @@ impl Report {
             self.smoother_windows
         );
         let _ = writeln!(s, "initial state: {}", self.initial_state);
+        if !self.data_problems.is_empty() {
+            let _ = writeln!(s, "\ndata problems (channel left out of the fit):");
+            for p in &self.data_problems {
+                let kind = serde_json::to_value(p.kind)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_string))
+                    .unwrap_or_default();
+                let _ = writeln!(s, "  {:<10} {:<10} {}", p.channel, kind, p.message);
+            }
+        }
         let _ = writeln!(
             s,
             "\n{:<10} {:>10} {:>10} {:>10} {:>12}",
             "channel", "declared", "before", "after", "noise floor"
         );
+        let num = |v: Option<&f64>| match v {
+            Some(v) if v.is_finite() => format!("{v:.3e}"),
+            _ => "n/a".to_string(),
+        };
         for (k, v) in &self.nrmse_after {
             let _ = writeln!(
                 s,
-                "{:<10} {:>10.3e} {:>10.3e} {:>10.3e} {:>12.3e}",
+                "{:<10} {:>10} {:>10} {:>10} {:>12}",
                 k,
-                self.nrmse_declared.get(k).copied().unwrap_or(f64::NAN),
-                self.nrmse_before.get(k).copied().unwrap_or(f64::NAN),
-                v,
-                self.noise_floor.get(k).copied().unwrap_or(f64::NAN)
+                num(self.nrmse_declared.get(k)),
+                num(self.nrmse_before.get(k)),
+                num(Some(v)),
+                num(self.noise_floor.get(k))
             );
         }
         if !self.declared_refit.is_empty() {
@@ -885,12 +984,29 @@ impl Report {
         for e in &self.effects_rejected {
             let _ = writeln!(s, "  {:<22} {}", e.id, e.reason.as_deref().unwrap_or(""));
         }
+        if !self.effects_not_applicable.is_empty() {
+            let _ = writeln!(s, "\neffects not applicable to this rig:");
+            for e in &self.effects_not_applicable {
+                let _ = writeln!(s, "  {:<22} {}", e.id, e.why);
+            }
+        }
+        let noise = if self.noise_share.is_finite() {
+            format!(
+                "sensor noise accounts for {:.0} % of what is left",
+                100.0 * self.noise_share
+            )
+        } else {
+            "no noise estimate".to_string()
+        };
         let _ = writeln!(
             s,
-            "\nunexplained: {:.1} % of the residual before is left; sensor noise accounts for {:.0} % of what is left{}",
+            "\nunexplained: {:.1} % of the residual before is left; {noise}{}",
             100.0 * self.unexplained_share,
-            100.0 * self.noise_share,
-            if self.noise_share < 0.5 { " — structured residual no catalog effect explains" } else { "" }
+            if self.noise_share < 0.5 {
+                " — structured residual no catalog effect explains"
+            } else {
+                ""
+            }
         );
         if let Some(p) = &self.unexplained_resembles {
             let _ = writeln!(
@@ -904,7 +1020,12 @@ impl Report {
         for w in &self.warnings {
             let _ = writeln!(s, "warning: {w}");
         }
-        let _ = writeln!(s, "time: {:.2} s", self.elapsed_s);
+        let stages: Vec<String> = self
+            .wall_times_s
+            .iter()
+            .map(|(k, v)| format!("{k} {v:.2} s"))
+            .collect();
+        let _ = writeln!(s, "time: {:.2} s ({})", self.elapsed_s, stages.join(", "));
         s
     }
 }

@@ -20,6 +20,8 @@
 //! * [`data`] — the CSV format: unit suffixes converted to SI (time \[s\],
 //!   position \[m\], velocity \[m·s⁻¹\], pressures \[Pa\], flow \[m³·s⁻¹\],
 //!   force \[N\]); errors name file, row and column; first-order hold.
+//! * [`data_checks`] — data problems named before any fit (constant,
+//!   clipped, quantised channels; units and signs that contradict the rig).
 //! * [`smooth`] — Savitzky–Golay on uneven steps, window by GCV.
 //! * [`catalog`] — the effect catalog as data (ids, balances, parameters).
 //! * [`bench`](mod@bench) — the `friction-bench` rig: force balance
@@ -52,6 +54,7 @@
 pub mod bench;
 pub mod catalog;
 pub mod data;
+pub mod data_checks;
 pub mod diagnose;
 pub mod lm;
 pub mod smooth;

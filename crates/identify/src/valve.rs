@@ -40,16 +40,26 @@ use hydrocyl_system::valve_rig::ValveRig;
 
 use crate::catalog::EffectId;
 use crate::data::{Record, Signal};
+use crate::data_checks::{check_record, ProblemKind, RigFacts};
 use crate::diagnose::{
-    nrmse, DiagnoseError, DiagnoseOptions, EffectReport, Probe, RecordTrace, Report,
+    nrmse, DiagnoseError, DiagnoseOptions, EffectReport, NotApplicable, Probe, RecordTrace, Report,
 };
 use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, smooth_gcv, smooth_with};
 
+mod accept;
+mod stops;
+
+/// Most candidates refitted in one round of the loop (the best by traced
+/// share first); each refit is a full Levenberg–Marquardt fit.
+const MAX_REFITS_PER_ROUND: usize = 3;
+
 /// Effects the valve rig exposes as parameters.
-pub const VALVE_EFFECTS: [EffectId; 12] = [
+pub const VALVE_EFFECTS: [EffectId; 14] = [
     EffectId::CoulombAsymmetry,
     EffectId::Stribeck,
+    EffectId::PressureViscous,
+    EffectId::AccelerationFriction,
     EffectId::LugreDynamics,
     EffectId::ValveNullBias,
     EffectId::FlowGainError,
@@ -61,6 +71,20 @@ pub const VALVE_EFFECTS: [EffectId; 12] = [
     EffectId::SupplyDroop,
     EffectId::SensorLag,
 ];
+
+/// Why effect `id` is not tried on this valve rig.
+fn not_applicable_why(id: EffectId, rig: &ValveRig, opts: &DiagnoseOptions) -> String {
+    if opts.candidates.as_ref().is_some_and(|c| !c.contains(&id)) {
+        return "left out by --effects".into();
+    }
+    if !VALVE_EFFECTS.contains(&id) {
+        return "not a parameter of the valve rig".into();
+    }
+    format!(
+        "its parameters are not switchable on the declared friction law `{}` (coulomb-viscous, stribeck and lugre are)",
+        rig.friction.name()
+    )
+}
 
 /// The channels compared, in report order.
 const CHANNELS: [Signal; 4] = [Signal::Position, Signal::Velocity, Signal::P1, Signal::P2];
@@ -77,6 +101,8 @@ pub fn get(rig: &ValveRig, id: EffectId, name: &str) -> Option<f64> {
         (EffectId::ExternalForce, "F0") => rig.load.external_force_n,
         (EffectId::SupplyDroop, "Rs") => rig.supply.droop_resistance_pa_s_per_m3,
         (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s,
+        (EffectId::PressureViscous, "K") => rig.friction_terms.k_pressure,
+        (EffectId::AccelerationFriction, "H") => rig.friction_terms.h_acceleration,
         (EffectId::Viscous, "b") => match &rig.friction {
             FrictionLaw::CoulombViscous(c) => c.viscous,
             law => friction_sets(law)?.0.sigma2,
@@ -197,6 +223,8 @@ pub fn set(rig: &mut ValveRig, id: EffectId, name: &str, v: f64) {
         (EffectId::ExternalForce, "F0") => rig.load.external_force_n = v,
         (EffectId::SupplyDroop, "Rs") => rig.supply.droop_resistance_pa_s_per_m3 = v,
         (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s = v,
+        (EffectId::PressureViscous, "K") => rig.friction_terms.k_pressure = v,
+        (EffectId::AccelerationFriction, "H") => rig.friction_terms.h_acceleration = v,
         (EffectId::Viscous, "b") => match &mut rig.friction {
             FrictionLaw::CoulombViscous(c) => c.viscous = v,
             law => with_sets(law, |e, r| {
@@ -335,7 +363,14 @@ fn typical(id: EffectId, name: &str, rig: &ValveRig) -> f64 {
         // a droop of 1 bar at 6 l/min
         (EffectId::SupplyDroop, _) => 1e9,
         (EffectId::SensorLag, _) => 5e-3,
-        _ => 1.0,
+        // 10 N at half the supply across the piston and 10 mm/s
+        (EffectId::PressureViscous, _) => {
+            10.0 / ((0.5 * rig.supply.pressure_pa).powi(2) * 0.01).max(1e-300)
+        }
+        // K H = 10 % of the moving mass
+        (EffectId::AccelerationFriction, _) => {
+            0.1 * rig.load.mass_kg / rig.friction_terms.k_pressure.max(1e-300)
+        }
     }
 }
 
@@ -365,6 +400,12 @@ fn negligible(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> bool {
         }
         // a lag under 0.1 ms is below any record's resolution here
         EffectId::SensorLag => v("tau") < 1e-4,
+        // under 1 N at half the supply across the piston and 10 mm/s
+        EffectId::PressureViscous => v("K") * (0.5 * rig.supply.pressure_pa).powi(2) * 0.01 < 1.0,
+        // an added mass K H under 1 % of the moving mass
+        EffectId::AccelerationFriction => {
+            rig.friction_terms.k_pressure * v("H") < 0.01 * rig.load.mass_kg
+        }
         // friction terms under 5 % of the declared Coulomb level
         EffectId::CoulombAsymmetry => v("dFc").abs() < 0.05 * mean_coulomb(declared),
         EffectId::Stribeck => {
@@ -374,7 +415,6 @@ fn negligible(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> bool {
         // 10 µm (half the position noise of the generated records) act as
         // static friction
         EffectId::LugreDynamics => v("sigma0") == 0.0 || mean_coulomb(rig) / v("sigma0") < 1e-5,
-        _ => false,
     }
 }
 
@@ -407,11 +447,30 @@ fn bounds(id: EffectId, name: &str, rig: &ValveRig) -> (f64, f64) {
             _ => (0.0, 1e5),
         },
         EffectId::ExternalForce => (-1e6, 1e6),
+        // K up to 1 kN at half the supply and 10 mm/s; K H up to 10x the mass
+        EffectId::PressureViscous => (0.0, 100.0 * typical(id, name, rig)),
+        EffectId::AccelerationFriction => (0.0, 100.0 * typical(id, name, rig)),
         _ => id
             .params()
             .iter()
             .find(|p| p.name == name)
             .map_or((f64::NEG_INFINITY, f64::INFINITY), |p| (p.lower, p.upper)),
+    }
+}
+
+/// What the data checks need to know about a valve rig: the stroke, the
+/// supply above tank and the steady velocity per unit command at full
+/// demand (mean of the two directions; none with a drooping supply).
+pub fn rig_facts(rig: &ValveRig) -> RigFacts {
+    let xm = rig.valve.stroke_m;
+    let gain = match (rig.steady_velocity(xm), rig.steady_velocity(-xm)) {
+        (Ok(up), Ok(down)) if up > 0.0 && down < 0.0 => Some(0.5 * (up - down)),
+        _ => None,
+    };
+    RigFacts {
+        stroke: rig.cylinder.stroke_m,
+        supply: rig.supply.pressure_pa - rig.supply.tank_pressure_pa,
+        velocity_gain: gain,
     }
 }
 
@@ -429,15 +488,19 @@ struct Prepared {
     /// count the position twice).
     weights: Vec<f64>,
     /// Initial state estimates: smoothed position, velocity, p1, p2 at t0.
-    x0: f64,
-    v0: f64,
+    x0: Option<f64>,
+    v0: Option<f64>,
     p10: Option<f64>,
     p20: Option<f64>,
+    /// Restarts of the simulation where the measured piston leaves a stop.
+    restarts: Vec<stops::Restart>,
 }
 
 fn prepare(
     rec: &Record,
     half: Option<usize>,
+    excluded: &[Signal],
+    stroke: f64,
 ) -> Result<(Prepared, crate::smooth::SmootherInfo), DiagnoseError> {
     let t = rec.time.clone();
     let command = rec.require(Signal::Command)?.to_vec();
@@ -446,11 +509,15 @@ fn prepare(
         Some(h) => smooth_with(&t, x, h, 3),
         None => smooth_gcv(&t, x, 3, 400),
     };
+    let position_ok = !excluded.contains(&Signal::Position);
     let mut meas = Vec::new();
     for ch in CHANNELS {
+        if excluded.contains(&ch) {
+            continue;
+        }
         match (ch, rec.get(ch)) {
             (_, Some(v)) => meas.push((ch, v.to_vec())),
-            (Signal::Velocity, None) => meas.push((ch, s.d1.clone())),
+            (Signal::Velocity, None) if position_ok => meas.push((ch, s.d1.clone())),
             _ => {}
         }
     }
@@ -473,17 +540,32 @@ fn prepare(
             }
         })
         .collect();
-    let v0 = rec.get(Signal::Velocity).map_or(s.d1[0], |v| v[0]);
+    // A position left out of the fit (a data problem) gives no initial
+    // state: the rig's declared one is kept.
+    let v0 = match rec.get(Signal::Velocity) {
+        Some(v) if !excluded.contains(&Signal::Velocity) => Some(v[0]),
+        _ => position_ok.then(|| s.d1[0]),
+    };
     // The first sample's noise would start the simulation off the record:
     // take the smoothed values at t0 (local cubic fit over the GCV window).
-    let p0 = |sig: Signal| rec.get(sig).map(|y| smooth_gcv(&t, y, 3, 100).value[0]);
+    let p0 = |sig: Signal| {
+        (!excluded.contains(&sig))
+            .then(|| rec.get(sig).map(|y| smooth_gcv(&t, y, 3, 100).value[0]))
+            .flatten()
+    };
     let (p10, p20) = (p0(Signal::P1), p0(Signal::P2));
+    let restarts = if position_ok {
+        stops::restarts(x, stroke, (5.0 * noise_sigma(x)).max(1e-4 * stroke))
+    } else {
+        Vec::new()
+    };
     Ok((
         Prepared {
             rtol: 1e-8,
-            x0: s.value[0],
+            x0: position_ok.then(|| s.value[0]),
             p10,
             p20,
+            restarts,
             t,
             command,
             meas,
@@ -500,8 +582,13 @@ fn prepare(
 /// rig when p1/p2 are not measured), spool at the first command.
 fn with_initial(rig: &ValveRig, p: &Prepared) -> ValveRig {
     let mut r = rig.clone();
-    r.initial.position = p.x0;
-    r.initial.velocity = p.v0;
+    if let Some(x0) = p.x0 {
+        let half = 0.5 * r.cylinder.stroke_m;
+        r.initial.position = x0.clamp(-half, half);
+    }
+    if let Some(v0) = p.v0 {
+        r.initial.velocity = v0;
+    }
     r.initial.spool = (p.command[0] * r.valve.stroke_m).clamp(-r.valve.stroke_m, r.valve.stroke_m);
     r.initial.p1 = p.p10;
     r.initial.p2 = p.p20;
@@ -524,7 +611,8 @@ fn simulate(rig: &ValveRig, p: &Prepared) -> Result<Vec<Vec<f64>>, String> {
 /// [`simulate`] over the first `n` samples only (the training part needs no
 /// more; at least two samples are simulated).
 fn simulate_prefix(rig: &ValveRig, p: &Prepared, n: usize) -> Result<Vec<Vec<f64>>, String> {
-    let t = &p.t[..n.clamp(2.min(p.t.len()), p.t.len())];
+    let n = n.clamp(2.min(p.t.len()), p.t.len());
+    let t = &p.t[..n];
     let cmd = CmdSignal::table(p.t.clone(), p.command.clone()).map_err(|e| e.to_string())?;
     let opts = RunOptions {
         rtol: p.rtol,
@@ -536,27 +624,48 @@ fn simulate_prefix(rig: &ValveRig, p: &Prepared, n: usize) -> Result<Vec<Vec<f64
             "sensors.pressure_lag_s must be finite and non-negative, got {tau}"
         ));
     }
-    let run = if tau > 0.0 {
-        let mut ideal = rig.clone();
-        ideal.sensors.pressure_lag_s = 0.0;
-        ideal.simulate(cmd, t, &opts)
-    } else {
-        rig.simulate(cmd, t, &opts)
-    }
-    .map_err(|e| e.to_string())?;
-    p.meas
+    let mut seg = rig.clone();
+    seg.sensors.pressure_lag_s = 0.0;
+    let mut out: Vec<Vec<f64>> = vec![Vec::with_capacity(n); p.meas.len()];
+    // One segment per stretch between restarts at stop exits (`stops`).
+    let mut cuts = p
+        .restarts
         .iter()
-        .map(|(ch, _)| {
+        .filter(|r| r.index > 0 && r.index + 1 < n)
+        .peekable();
+    let mut a = 0;
+    loop {
+        let next = cuts.next();
+        let b = next.map_or(n - 1, |r| r.index);
+        let run = seg
+            .simulate(cmd.clone(), &t[a..=b], &opts)
+            .map_err(|e| e.to_string())?;
+        // the restart sample belongs to the next segment
+        let keep = if next.is_some() { b - a } else { b - a + 1 };
+        for (o, (ch, _)) in out.iter_mut().zip(&p.meas) {
             let v = run
                 .channel(ch.name())
-                .map(|v| v.to_vec())
                 .ok_or_else(|| format!("simulation has no channel '{}'", ch.name()))?;
-            Ok(match ch {
-                Signal::P1 | Signal::P2 if tau > 0.0 => lag_samples(t, &v, tau),
-                _ => v,
-            })
-        })
-        .collect()
+            o.extend_from_slice(&v[..keep]);
+        }
+        let Some(r) = next else { break };
+        let last = |name: &str| run.channel(name).and_then(|v| v.last().copied());
+        let xm = seg.valve.stroke_m;
+        seg.initial.position = r.position;
+        seg.initial.velocity = 0.0;
+        seg.initial.spool = last("spool").unwrap_or(0.0).clamp(-xm, xm);
+        seg.initial.p1 = last("p1");
+        seg.initial.p2 = last("p2");
+        a = b;
+    }
+    if tau > 0.0 {
+        for (o, (ch, _)) in out.iter_mut().zip(&p.meas) {
+            if matches!(ch, Signal::P1 | Signal::P2) {
+                *o = lag_samples(t, o, tau);
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// A first-order lag `τ dy/dt = u − y` applied to samples `u` at times `t`,
@@ -659,10 +768,13 @@ fn fit(
         .zip(&x0)
         .map(|((id, n), x)| x.abs().max(typical(*id, n, rig)))
         .collect();
+    // the initial position stays within the stroke (a record may start
+    // with the piston on a stop)
     let xi = rig.initial.position;
+    let half = 0.5 * rig.cylinder.stroke_m;
     x0.push(xi);
-    lo.push(xi - 0.01);
-    hi.push(xi + 0.01);
+    lo.push((xi - 0.01).max(-half));
+    hi.push((xi + 0.01).min(half));
     typ.push(1e-3);
     let vi = rig.initial.velocity;
     x0.push(vi);
@@ -726,8 +838,14 @@ fn gauss_newton_trace(
                 set(&mut t, id, n, get(rig, id, n).unwrap_or(0.0) + h);
                 h
             } else if j == params.len() {
-                t.initial.position += 1e-5;
-                1e-5
+                // step away from a stop the piston may start on
+                let h = if t.initial.position + 1e-5 > 0.5 * rig.cylinder.stroke_m {
+                    -1e-5
+                } else {
+                    1e-5
+                };
+                t.initial.position += h;
+                h
             } else {
                 t.initial.velocity += 1e-4;
                 1e-4
@@ -758,7 +876,8 @@ fn gauss_newton_trace(
                 let v = (get(rig, *id, n).unwrap_or(0.0) + alpha * delta[j]).clamp(lo, hi);
                 set(&mut t, *id, n, v);
             }
-            t.initial.position += alpha * delta[k - 2];
+            let half = 0.5 * rig.cylinder.stroke_m;
+            t.initial.position = (t.initial.position + alpha * delta[k - 2]).clamp(-half, half);
             t.initial.velocity += alpha * delta[k - 1];
             if rss(&t, p, holdout, part) < rss0 {
                 accepted = Some(t);
@@ -838,6 +957,7 @@ fn delay_probe(rig: &ValveRig, p: &Prepared, holdout: f64) -> Option<Probe> {
             v0: p.v0,
             p10: p.p10,
             p20: p.p20,
+            restarts: p.restarts.clone(),
         };
         q.command[0] = p.command[0];
         let r = rss(rig, &q, holdout, Part::All);
@@ -923,12 +1043,40 @@ pub fn diagnose_valve_traced(
     progress: &mut dyn FnMut(&str, usize, usize),
 ) -> Result<ValveOutcome, DiagnoseError> {
     let start = Instant::now();
-    let (p, info) = prepare(rec, opts.half_window)?;
+    let mut clock = crate::diagnose::StageClock::new();
+    // Data problems first: each named channel is left out of the fit.
+    let data_problems = check_record(rec, Some(&rig_facts(declared)));
+    let mut excluded: Vec<Signal> = data_problems
+        .iter()
+        .filter_map(|p| Signal::from_name(&p.channel))
+        .collect();
+    if data_problems.iter().any(|p| p.kind == ProblemKind::Sign) {
+        excluded.push(Signal::Velocity);
+    }
+    let (p, info) = prepare(rec, opts.half_window, &excluded, declared.cylinder.stroke_m)?;
+    if p.weights.iter().all(|w| *w == 0.0) {
+        let why = if data_problems.is_empty() {
+            "no measured channel to compare (position, velocity, p1, p2)".to_string()
+        } else {
+            data_problems
+                .iter()
+                .map(|p| p.message.as_str())
+                .collect::<Vec<_>>()
+                .join("; ")
+        };
+        return Err(DiagnoseError::Unusable {
+            file: rec.source.clone(),
+            why,
+        });
+    }
     let mut rig0 = with_initial(declared, &p);
     simulate(&rig0, &p)
         .map_err(|e| DiagnoseError::Rig(format!("declared model does not simulate: {e}")))?;
     let nrmse_declared = channel_nrmse(&rig0, &p);
-    let mut warnings: Vec<String> = Vec::new();
+    let mut warnings: Vec<String> = data_problems
+        .iter()
+        .map(|p| format!("{} left out of the fit: {}", p.channel, p.message))
+        .collect();
     // Tracing compares candidates with each other, and the initial-state
     // fit below only starts the refits: a looser integration tolerance is
     // enough there. The refits use the tight one (a loose one puts
@@ -950,6 +1098,7 @@ pub fn diagnose_valve_traced(
             )),
         }
     }
+    clock.lap("checks, smoothing and initial-state fit");
     let sims_before = simulate(&rig0, &p).unwrap_or_default();
     let nrmse_before = nrmse_of(&p, &sims_before);
     let rss_before = rss(&rig0, &p, opts.holdout, Part::All);
@@ -961,6 +1110,15 @@ pub fn diagnose_valve_traced(
         .filter(|e| VALVE_EFFECTS.contains(e))
         .filter(|e| e.params().iter().all(|q| get(&rig0, *e, q.name).is_some()))
         .collect();
+    // Noise floor of each compared channel as an NRMSE (the weights' floor
+    // of 1e-4 of the range for noise-free records).
+    let floors: BTreeMap<String, f64> = p
+        .meas
+        .iter()
+        .zip(p.ranges.iter().zip(&p.weights))
+        .filter(|(_, (_, w))| **w > 0.0)
+        .map(|((ch, _), (r, w))| (ch.name().to_string(), 1.0 / (w * r)))
+        .collect();
     let mut model = rig0.clone();
     let mut free: ParamList = Vec::new();
     let mut added: Vec<EffectReport> = Vec::new();
@@ -968,7 +1126,7 @@ pub fn diagnose_valve_traced(
     let mut resembles: Option<Probe> = None;
     let total = opts.max_effects + 1;
     for round in 0..opts.max_effects {
-        progress("tracing", round, total);
+        progress(&format!("tracing, round {}", round + 1), round, total);
         let mut r0 = Vec::new();
         residual(&model, &pt, opts.holdout, Part::All, &mut r0)
             .map_err(|e| DiagnoseError::Rig(e.to_string()))?;
@@ -976,13 +1134,34 @@ pub fn diagnose_valve_traced(
         let rss0_held = rss(&model, &pt, opts.holdout, Part::Held);
         let rho = lm::lag1_autocorrelation(&r0).clamp(0.0, 0.999);
         let neff = (r0.len() as f64 * (1.0 - rho) / (1.0 + rho)).max(2.0);
-        let mut best: Option<(EffectId, ValveRig, EffectReport)> = None;
-        let todo: Vec<EffectId> = candidates
+        let mut todo: Vec<EffectId> = candidates
             .iter()
             .copied()
             .filter(|&id| id == EffectId::BulkModulus || !is_on(&model, id))
             .filter(|id| !added.iter().any(|a| a.id == id.id()))
             .collect();
+        // `K H a` needs the pressure term's K (eq 5.12)
+        if model.friction_terms.k_pressure == 0.0 {
+            let id = EffectId::AccelerationFriction;
+            if let Some(k) = todo.iter().position(|e| *e == id) {
+                todo.remove(k);
+                last.insert(
+                    id,
+                    EffectReport {
+                        id: id.id().into(),
+                        params: BTreeMap::new(),
+                        ci95: BTreeMap::new(),
+                        explained_share: 0.0,
+                        heldout_share: 0.0,
+                        delta_bic: 0.0,
+                        reason: Some(
+                            "not traced: needs pressure_viscous's K (the term is K H a, eq 5.12)"
+                                .into(),
+                        ),
+                    },
+                );
+            }
+        }
         // One job per candidate and start (see `trace_starts`).
         let jobs: Vec<(EffectId, ValveRig)> = todo
             .iter()
@@ -999,14 +1178,25 @@ pub fn diagnose_valve_traced(
             let res = gauss_newton_trace(&mut trial, &joint, &pt, opts.holdout, Part::Train);
             let rss_train = rss(&trial, &pt, opts.holdout, Part::Train);
             let rss1 = rss(&trial, &pt, opts.holdout, Part::All);
-            let held = 1.0 - rss(&trial, &pt, opts.holdout, Part::Held) / rss0_held.max(1e-300);
-            let share = 1.0 - rss1 / rss0.max(1e-300);
-            let dbic = neff * (rss1 / rss0.max(1e-300)).ln() + params.len() as f64 * neff.ln();
+            let rss1_held = rss(&trial, &pt, opts.holdout, Part::Held);
+            // A trace whose simulation fails scores nothing (finite numbers
+            // only reach the report) and says why below.
+            let sim_failed = !(rss1.is_finite() && rss1_held.is_finite() && rss_train.is_finite());
+            let (share, held, dbic) = if sim_failed {
+                (0.0, 0.0, 0.0)
+            } else {
+                (
+                    1.0 - rss1 / rss0.max(1e-300),
+                    1.0 - rss1_held / rss0_held.max(1e-300),
+                    neff * (rss1 / rss0.max(1e-300)).max(1e-300).ln()
+                        + params.len() as f64 * neff.ln(),
+                )
+            };
             let mut rep = EffectReport {
                 id: id.id().into(),
                 params: params
                     .iter()
-                    .map(|(eid, n)| (n.to_string(), get(&trial, *eid, n).unwrap_or(f64::NAN)))
+                    .filter_map(|(eid, n)| get(&trial, *eid, n).map(|v| (n.to_string(), v)))
                     .collect(),
                 ci95: BTreeMap::new(),
                 explained_share: share,
@@ -1016,6 +1206,8 @@ pub fn diagnose_valve_traced(
             };
             if let Err(e) = &res {
                 rep.reason = Some(format!("fit failed: {e}"));
+            } else if sim_failed {
+                rep.reason = Some("the rig does not simulate at the traced values".into());
             } else if share < opts.min_share {
                 rep.reason = Some(format!(
                     "explains {:.1} % < {:.1} %",
@@ -1061,24 +1253,22 @@ pub fn diagnose_valve_traced(
                 chosen.push((id, t, r));
             }
         }
+        // Candidates that explain a share worth having, best first.
+        let mut eligible: Vec<(EffectId, ValveRig, EffectReport)> = Vec::new();
         for (id, trial, rep) in chosen {
-            if rep.reason.is_none()
-                && best
-                    .as_ref()
-                    .is_none_or(|(_, _, r)| rep.explained_share > r.explained_share)
-            {
-                best = Some((id, trial, rep.clone()));
+            if rep.reason.is_none() {
+                eligible.push((id, trial, rep.clone()));
             }
             last.insert(id, rep);
         }
+        eligible.sort_by(|a, b| b.2.explained_share.total_cmp(&a.2.explained_share));
         if let Some(pr) = delay_probe(&model, &pt, opts.holdout) {
+            let top = eligible.first().map(|(id, _, r)| (*id, r.explained_share));
             if pr.explained_share >= opts.min_share
-                && best
-                    .as_ref()
-                    .is_none_or(|(_, _, r)| pr.explained_share > r.explained_share + opts.min_share)
+                && top.is_none_or(|(_, share)| pr.explained_share > share + opts.min_share)
             {
-                if let Some((id, _, _)) = &best {
-                    if let Some(r) = last.get_mut(id) {
+                if let Some((id, _)) = top {
+                    if let Some(r) = last.get_mut(&id) {
                         r.reason = Some(format!(
                             "the residual is better explained by a {} ({:.1} %), which is not in the catalog",
                             pr.what,
@@ -1090,37 +1280,55 @@ pub fn diagnose_valve_traced(
                 break;
             }
         }
-        let Some((id, trial, rep)) = best else { break };
-        model = trial;
-        free.extend(id.params().iter().map(|q| (id, q.name)));
-        progress("refit", round + 1, total);
-        // A refit that does not converge keeps the traced values (no
-        // intervals) and says so, rather than losing the whole diagnosis.
-        let mut refit = model.clone();
-        let res = match fit(&mut refit, &free, &p, opts.holdout, Part::All) {
-            Ok(res) => {
-                model = refit;
-                res
-            }
-            Err(e) => {
-                warnings.push(format!(
-                    "refit after adding {}: {e}; the traced values are kept, without intervals",
-                    id.id()
+        // The acceptance rule (`accept`): refit each candidate in turn with
+        // the effects already added; the first that earns its place is added.
+        clock.lap("tracing");
+        let base = accept::Baseline {
+            model: &model,
+            declared,
+            nrmse: channel_nrmse(&model, &p),
+            floors: floors.clone(),
+            p: &p,
+            holdout: opts.holdout,
+        };
+        let mut accepted: Option<(EffectId, ValveRig, EffectReport, ParamList, lm::LmResult)> =
+            None;
+        for (id, _, _) in eligible.iter().skip(MAX_REFITS_PER_ROUND) {
+            if let Some(r) = last.get_mut(id) {
+                r.reason = Some(format!(
+                    "not refitted: {MAX_REFITS_PER_ROUND} candidates explaining more were refitted first in its round"
                 ));
-                lm::LmResult {
-                    x: free
-                        .iter()
-                        .map(|(eid, n)| get(&model, *eid, n).unwrap_or(f64::NAN))
-                        .collect(),
-                    ci95: vec![f64::NAN; free.len()],
-                    rss: f64::NAN,
-                    m: 0,
-                    iterations: 0,
-                    evaluations: 0,
-                    at_bound: vec![false; free.len()],
+            }
+        }
+        for (id, trial, rep) in eligible.into_iter().take(MAX_REFITS_PER_ROUND) {
+            progress(&format!("refit {}", id.id()), round + 1, total);
+            let joint: ParamList = free
+                .iter()
+                .copied()
+                .chain(id.params().iter().map(|q| (id, q.name)))
+                .collect();
+            let mut refit = trial;
+            let verdict = match fit(&mut refit, &joint, &p, opts.holdout, Part::All) {
+                Ok(res) => accept::verdict(id, &joint, &res, &refit, &base).map(|()| res),
+                Err(e) => Err(format!("refit failed: {e}")),
+            };
+            match verdict {
+                Ok(res) => {
+                    accepted = Some((id, refit, rep, joint, res));
+                    break;
+                }
+                Err(why) => {
+                    if let Some(r) = last.get_mut(&id) {
+                        r.reason = Some(why);
+                    }
                 }
             }
+        }
+        let Some((id, refit, rep, joint, res)) = accepted else {
+            break;
         };
+        model = refit;
+        free = joint;
         last.remove(&id);
         added.push(rep);
         for ((eid, n), (x, ci)) in free.iter().zip(res.x.iter().zip(&res.ci95)) {
@@ -1130,6 +1338,7 @@ pub fn diagnose_valve_traced(
             }
         }
     }
+    clock.lap("refits");
     // Backward step: an effect whose refitted size became negligible once
     // later effects were added was standing in for them; drop it and refit.
     let stale: Vec<EffectId> = added
@@ -1185,6 +1394,7 @@ pub fn diagnose_valve_traced(
         }
     }
     progress("report", total, total);
+    clock.lap("backward step");
     let sims_after = simulate(&model, &p).unwrap_or_default();
     let nrmse_after = nrmse_of(&p, &sims_after);
     let rss_after = rss(&model, &p, opts.holdout, Part::All);
@@ -1204,6 +1414,7 @@ pub fn diagnose_valve_traced(
         rig_kind: "valve-cylinder".into(),
         records: vec![rec.source.clone()],
         samples: rec.len(),
+        data_problems,
         smoother: info.clone(),
         smoother_windows: vec![info.half_window],
         initial_state: "velocity and chamber pressures at the first sample from the smoother's local cubic fit (not the raw noisy sample), initial position and velocity fitted first on the declared model and again with every refit (the rig integrates flow into position; the smoother's one-sided derivative at the first sample is noisy); spool at the first command; the rig's steady pressures where p1/p2 are not measured".into(),
@@ -1217,7 +1428,10 @@ pub fn diagnose_valve_traced(
         effects_not_applicable: EffectId::ALL
             .iter()
             .filter(|e| !candidates.contains(e))
-            .map(|e| e.id().to_string())
+            .map(|e| NotApplicable {
+                id: e.id().to_string(),
+                why: not_applicable_why(*e, declared, opts),
+            })
             .collect(),
         unexplained_share: rss_after / rss_before.max(1e-300),
         unexplained_resembles: resembles,
@@ -1228,6 +1442,7 @@ pub fn diagnose_valve_traced(
             100.0 * opts.min_share,
             50.0 * opts.min_share
         ),
+        wall_times_s: clock.finish(),
         elapsed_s: start.elapsed().as_secs_f64(),
     };
     Ok(ValveOutcome {

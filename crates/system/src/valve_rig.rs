@@ -8,7 +8,9 @@ use crate::rig::{gauge_pressure_problem, GaugePressure, RigError};
 use crate::run::{run, Run, RunOptions, SimError};
 use crate::signal::Signal;
 use hydrocyl_actuator::Cylinder;
-use hydrocyl_friction::{CoulombViscous, FrictionInput, FrictionLaw, FrictionModel};
+use hydrocyl_friction::{
+    CoulombViscous, FrictionInput, FrictionLaw, FrictionModel, SealTerms, WithSealTerms,
+};
 use hydrocyl_ports::{Area, Density, Force, Position, Pressure, Velocity};
 use hydrocyl_valves::orifice::Orifice;
 use hydrocyl_valves::servovalve::{Metering, Spool, SpoolDynamics};
@@ -189,6 +191,11 @@ pub struct ValveRig {
     /// Friction: any law of the friction crate, tagged by `model`
     /// (`coulomb-viscous`, `stribeck`, `karnopp`, `dahl`, `lugre`, `wang`).
     pub friction: FrictionLaw,
+    /// The seal terms `K (p1 − p2)² v` (eq 5.4) and `K H a` (eq 5.12) added
+    /// to the friction law (absent = off; catalog `pressure_viscous`,
+    /// `acceleration_friction`).
+    #[serde(default, skip_serializing_if = "SealTerms::is_off")]
+    pub friction_terms: SealTerms,
     /// Initial state.
     pub initial: InitialSpec,
     /// Sensors (absent = ideal).
@@ -252,6 +259,7 @@ impl ValveRig {
                 external_force_n: 0.0,
             },
             friction: FrictionLaw::CoulombViscous(CoulombViscous::leaney_moog()),
+            friction_terms: SealTerms::default(),
             initial: InitialSpec {
                 position: 0.0,
                 velocity: 0.0,
@@ -386,6 +394,12 @@ impl ValveRig {
             path: "friction".into(),
             why: e.to_string(),
         })?;
+        self.friction_terms
+            .validate()
+            .map_err(|e| RigError::Invalid {
+                path: "friction_terms".into(),
+                why: e.to_string(),
+            })?;
         let i = &self.initial;
         check(
             "initial.position",
@@ -411,7 +425,14 @@ impl ValveRig {
 
     /// The friction model.
     pub fn friction_model(&self) -> Box<dyn FrictionModel> {
-        Box::new(self.friction)
+        if self.friction_terms.is_off() {
+            Box::new(self.friction)
+        } else {
+            Box::new(WithSealTerms {
+                inner: self.friction,
+                terms: self.friction_terms,
+            })
+        }
     }
 
     /// The cylinder model.

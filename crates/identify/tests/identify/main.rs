@@ -2,5 +2,6 @@
 //! the loop on generated records with planted effects, on the friction bench
 //! and on the valve rig.
 
+mod checks;
 mod planted;
 mod valve;

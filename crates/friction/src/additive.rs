@@ -1,0 +1,169 @@
+//! The thesis's seal terms as additive terms on **any** friction law: the
+//! pressure term `K (p1 − p2)² v` (eq 5.4) and the acceleration term
+//! `K H a` (eq 5.12). Wang's law (eq 5.14) has them inside a LuGre law;
+//! [`WithSealTerms`] puts them on top of a Coulomb-viscous, Stribeck,
+//! Karnopp, Dahl or LuGre law without switching bristle dynamics on, so the
+//! measured-data loop can offer `pressure_viscous` and
+//! `acceleration_friction` on every rig.
+//!
+//! `K H a` is linear in the acceleration: as in [`crate::Wang`] it is not
+//! part of [`FrictionModel::force`] but reported as
+//! [`FrictionModel::acceleration_coefficient`] `c = K H` \[kg\] (added mass).
+
+use hydrocyl_ports::{Energy, Force, Mass, Power};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{non_negative, FrictionError};
+use crate::model::{FrictionInput, FrictionJacobian, FrictionMode, FrictionModel};
+
+/// The additive seal terms (both 0 = off).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SealTerms {
+    /// Seal gain K of `K (p1 − p2)² v` \[m³·s·N⁻¹\], ≥ 0.
+    #[serde(default)]
+    pub k_pressure: f64,
+    /// Acceleration gain H of `K H a` \[N²·s·m⁻⁴\], ≥ 0.
+    #[serde(default)]
+    pub h_acceleration: f64,
+}
+
+impl SealTerms {
+    /// `true` when both terms are zero.
+    pub fn is_off(&self) -> bool {
+        self.k_pressure == 0.0 && self.h_acceleration == 0.0
+    }
+
+    /// Checks the parameters (finite, non-negative).
+    pub fn validate(&self) -> Result<(), FrictionError> {
+        const M: &str = "seal terms";
+        non_negative(M, "K (k_pressure)", self.k_pressure)?;
+        non_negative(M, "H (h_acceleration)", self.h_acceleration)
+    }
+
+    /// `K (p1 − p2)² v` \[N\].
+    fn pressure_force(&self, input: &FrictionInput) -> f64 {
+        let dp = input.p1.si() - input.p2.si();
+        self.k_pressure * dp * dp * input.velocity.si()
+    }
+}
+
+/// A friction law with the [`SealTerms`] added.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WithSealTerms<M> {
+    /// The law the terms are added to.
+    pub inner: M,
+    /// The terms.
+    pub terms: SealTerms,
+}
+
+impl<M: FrictionModel> FrictionModel for WithSealTerms<M> {
+    fn n_states(&self) -> usize {
+        self.inner.n_states()
+    }
+    fn force(&self, input: &FrictionInput, state: &[f64]) -> Force {
+        self.inner.force(input, state) + Force::new(self.terms.pressure_force(input))
+    }
+    fn acceleration_coefficient(&self, input: &FrictionInput) -> Mass {
+        self.inner.acceleration_coefficient(input)
+            + Mass::new(self.terms.k_pressure * self.terms.h_acceleration)
+    }
+    fn state_derivative(&self, input: &FrictionInput, state: &[f64], dstate: &mut [f64]) {
+        self.inner.state_derivative(input, state, dstate)
+    }
+    fn steady_state(&self, input: &FrictionInput, state: &mut [f64]) {
+        self.inner.steady_state(input, state)
+    }
+    fn steady_force(&self, input: &FrictionInput) -> Force {
+        self.inner.steady_force(input) + Force::new(self.terms.pressure_force(input))
+    }
+    fn state_scales(&self, scales: &mut [f64]) {
+        self.inner.state_scales(scales)
+    }
+    fn validate(&self) -> Result<(), FrictionError> {
+        self.inner.validate()?;
+        self.terms.validate()
+    }
+    fn jacobian(&self, input: &FrictionInput, state: &[f64]) -> FrictionJacobian {
+        let mut j = self.inner.jacobian(input, state);
+        let k = self.terms.k_pressure;
+        let dp = input.p1.si() - input.p2.si();
+        let v = input.velocity.si();
+        j.df_dv += k * dp * dp;
+        j.df_dp1 += 2.0 * k * dp * v;
+        j.df_dp2 -= 2.0 * k * dp * v;
+        j
+    }
+    fn stored_energy(&self, state: &[f64]) -> Energy {
+        self.inner.stored_energy(state)
+    }
+    fn dissipated_power(&self, input: &FrictionInput, state: &[f64]) -> Power {
+        self.inner.dissipated_power(input, state)
+            + Power::new(self.terms.pressure_force(input) * input.velocity.si())
+    }
+    fn n_events(&self) -> usize {
+        self.inner.n_events()
+    }
+    fn events(&self, input: &FrictionInput, drive: Force, state: &[f64], g: &mut [f64]) {
+        self.inner.events(input, drive, state, g)
+    }
+    fn on_event(
+        &mut self,
+        which: usize,
+        input: &FrictionInput,
+        drive: Force,
+        state: &mut [f64],
+    ) -> FrictionMode {
+        self.inner.on_event(which, input, drive, state)
+    }
+    fn initialise_mode(&mut self, input: &FrictionInput, drive: Force) -> FrictionMode {
+        self.inner.initialise_mode(input, drive)
+    }
+    fn mode(&self) -> FrictionMode {
+        self.inner.mode()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{finite_difference_jacobian, CoulombViscous, FrictionLaw};
+    use hydrocyl_ports::{Pressure, Velocity};
+
+    #[test]
+    fn the_terms_add_to_any_law_and_their_jacobian_is_right() {
+        let inner = FrictionLaw::CoulombViscous(CoulombViscous::leaney_moog());
+        let terms = SealTerms {
+            k_pressure: 1e-9,
+            h_acceleration: 3e9,
+        };
+        let m = WithSealTerms { inner, terms };
+        let input = FrictionInput {
+            velocity: Velocity::new(0.05),
+            p1: Pressure::new(5e6),
+            p2: Pressure::new(2e6),
+            ..FrictionInput::default()
+        };
+        let extra = 1e-9 * 9e12 * 0.05;
+        let f = m.force(&input, &[]).si();
+        assert!((f - inner.force(&input, &[]).si() - extra).abs() < 1e-9);
+        assert!((m.acceleration_coefficient(&input).si() - 3.0).abs() < 1e-12);
+        let (a, b) = (
+            m.jacobian(&input, &[]),
+            finite_difference_jacobian(&m, &input, &[]),
+        );
+        for (x, y) in [
+            (a.df_dv, b.df_dv),
+            (a.df_dp1, b.df_dp1),
+            (a.df_dp2, b.df_dp2),
+        ] {
+            assert!((x - y).abs() <= 1e-5 * y.abs().max(1.0), "{x} vs {y}");
+        }
+        assert!(SealTerms::default().is_off());
+        let bad = SealTerms {
+            k_pressure: -1.0,
+            h_acceleration: 0.0,
+        };
+        assert!(bad.validate().is_err());
+    }
+}

@@ -1,0 +1,465 @@
+//! Data problems named before any fit (`spec/measured-data.md`): a channel
+//! that is constant, clipped or quantised far coarser than the others; a
+//! unit that contradicts the rig (a position range beyond the stroke,
+//! pressures above the supply or below vacuum, or far below the supply, a
+//! command-to-velocity gain far from the rig's); a sign that contradicts
+//! the rig (command up, piston down).
+//!
+//! The checks read the record and a few facts about the rig ([`RigFacts`]),
+//! not the rig itself, so they do not depend on how a rig is declared. Each
+//! problem names its channel, a kind and a one-line message that says what
+//! to check; the loop leaves the channel out of the fit
+//! ([`DataProblem::channel`]) and goes on with the others.
+
+use serde::Serialize;
+
+use crate::data::{Record, Signal};
+use crate::smooth::noise_sigma;
+
+/// What the checks need to know about the rig (SI units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RigFacts {
+    /// Piston stroke \[m\]: the position stays within ±stroke/2.
+    pub stroke: f64,
+    /// Supply pressure, gauge \[Pa\].
+    pub supply: f64,
+    /// Steady piston velocity per unit command near full demand
+    /// \[m·s⁻¹ per unit command\] (the mean of the extending and retracting
+    /// gains), if the rig has one.
+    pub velocity_gain: Option<f64>,
+}
+
+/// The kind of a data problem.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProblemKind {
+    /// The channel never changes (a stuck or disconnected sensor).
+    Constant,
+    /// The channel sits at its extreme value for many samples (saturated
+    /// transducer or acquisition range).
+    Clipped,
+    /// The channel has few distinct levels, far coarser than the others.
+    Quantised,
+    /// The values contradict the rig's units or ranges.
+    Units,
+    /// The sign contradicts the rig.
+    Sign,
+}
+
+/// One data problem (`data_problems` in the JSON report).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DataProblem {
+    /// The channel left out of the fit (`position`, `p1`, ...).
+    pub channel: String,
+    /// What is wrong.
+    pub kind: ProblemKind,
+    /// One line: what was seen and what to check.
+    pub message: String,
+}
+
+/// Channels the checks look at (the measured ones; the command is the
+/// input and may legitimately hold few levels).
+const MEASURED: [Signal; 7] = [
+    Signal::Position,
+    Signal::Velocity,
+    Signal::P1,
+    Signal::P2,
+    Signal::Ps,
+    Signal::Flow,
+    Signal::Force,
+];
+
+/// Least share of the samples at one extreme that counts as clipping.
+const CLIP_SHARE: f64 = 0.02;
+/// Fewer distinct levels than this over the channel's range is coarse.
+const COARSE_LEVELS: f64 = 100.0;
+/// A coarse channel is flagged when its resolution is this many times
+/// coarser than the finest other measured channel's.
+const COARSER_THAN_NEIGHBOURS: f64 = 20.0;
+/// A measured command-to-velocity gain this many times off the rig's (either
+/// way) contradicts the units of the position.
+const GAIN_FACTOR: f64 = 20.0;
+
+fn range(y: &[f64]) -> (f64, f64) {
+    y.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(*v), hi.max(*v))
+        })
+}
+
+/// Resolution of a channel: its smallest step between distinct values that
+/// is not a rounding artefact (the 5th percentile of the steps between
+/// sorted distinct values), as a share of its range; with its level count.
+fn resolution(y: &[f64]) -> Option<(f64, usize)> {
+    let (lo, hi) = range(y);
+    let r = hi - lo;
+    if r <= 0.0 {
+        return None;
+    }
+    let mut v = y.to_vec();
+    v.sort_by(f64::total_cmp);
+    v.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * r);
+    if v.len() < 2 {
+        return None;
+    }
+    let mut steps: Vec<f64> = v.windows(2).map(|w| w[1] - w[0]).collect();
+    let k = steps.len() / 20;
+    let q = *steps.select_nth_unstable_by(k, f64::total_cmp).1;
+    Some((q / r, v.len()))
+}
+
+/// SI unit of a channel for messages.
+fn unit(s: Signal) -> &'static str {
+    match s {
+        Signal::Position => "m",
+        Signal::Velocity => "m/s",
+        Signal::P1 | Signal::P2 | Signal::Ps => "Pa",
+        Signal::Flow => "m^3/s",
+        Signal::Force => "N",
+        _ => "",
+    }
+}
+
+fn problem(ch: Signal, kind: ProblemKind, message: String) -> DataProblem {
+    DataProblem {
+        channel: ch.name().into(),
+        kind,
+        message,
+    }
+}
+
+/// Checks the record against the rig; one entry per problem (a channel at
+/// most once, its first problem). `facts` `None`: only the checks that need
+/// no rig (constant, clipped, quantised).
+pub fn check_record(rec: &Record, facts: Option<&RigFacts>) -> Vec<DataProblem> {
+    let mut out: Vec<DataProblem> = Vec::new();
+    let present: Vec<(Signal, &[f64])> = MEASURED
+        .iter()
+        .filter_map(|&s| rec.get(s).map(|y| (s, y)))
+        .collect();
+    let resolutions: Vec<(Signal, Option<(f64, usize)>)> =
+        present.iter().map(|(s, y)| (*s, resolution(y))).collect();
+    for (s, y) in &present {
+        if let Some(p) = channel_problem(*s, y, facts, &resolutions) {
+            out.push(p);
+        }
+    }
+    if let Some(f) = facts {
+        let bad = |out: &[DataProblem], s: Signal| out.iter().any(|p| p.channel == s.name());
+        if !bad(&out, Signal::Position) {
+            if let Some(p) = gain_problem(rec, f) {
+                out.push(p);
+            }
+        }
+    }
+    out
+}
+
+/// The first problem of one channel, if any.
+fn channel_problem(
+    s: Signal,
+    y: &[f64],
+    facts: Option<&RigFacts>,
+    resolutions: &[(Signal, Option<(f64, usize)>)],
+) -> Option<DataProblem> {
+    let name = s.name();
+    let u = unit(s);
+    let (lo, hi) = range(y);
+    let r = hi - lo;
+    // a supply pressure logged as the constant set-point is a stiff supply
+    let stiff_supply =
+        s == Signal::Ps && facts.is_some_and(|f| (lo - f.supply).abs() <= 0.05 * f.supply);
+    if y.len() >= 2 && r <= 1e-12 * lo.abs().max(hi.abs()) && !stiff_supply {
+        return Some(problem(
+            s,
+            ProblemKind::Constant,
+            format!("{name} reads {lo:.6e} {u} in every sample: a stuck or disconnected sensor? check the transducer, its wiring and the logged column"),
+        ));
+    }
+    let sigma = noise_sigma(y);
+    // Unit and range checks against the rig.
+    if let Some(f) = facts {
+        match s {
+            Signal::Position => {
+                let allowed = f.stroke + 10.0 * sigma;
+                if r > 1.05 * allowed {
+                    return Some(problem(
+                        s,
+                        ProblemKind::Units,
+                        format!("position spans {r:.4} m but the rig's stroke is {:.4} m: check the unit of the position column (mm written as m?) and the rig", f.stroke),
+                    ));
+                }
+                let half = 0.5 * f.stroke + 5.0 * sigma + 0.02 * f.stroke;
+                if lo < -half || hi > half {
+                    return Some(problem(
+                        s,
+                        ProblemKind::Units,
+                        format!("position reaches [{lo:.4}, {hi:.4}] m, outside the stroke ±{:.4} m: position must be measured from mid-stroke; check the transducer's zero and unit", 0.5 * f.stroke),
+                    ));
+                }
+            }
+            Signal::P1 | Signal::P2 | Signal::Ps => {
+                // a pressure at the supply or tank reads a little past it in
+                // a real record: allow 5 % of the supply and 5 noise sigmas
+                let margin = 0.05 * f.supply + 5.0 * sigma;
+                if hi > f.supply + margin {
+                    return Some(problem(
+                        s,
+                        ProblemKind::Units,
+                        format!("{name} reaches {:.4e} Pa, above the supply {:.4e} Pa: check the unit of the column (Pa written as bar?) and the rig's supply pressure", hi, f.supply),
+                    ));
+                }
+                if lo < -1.0e5 - margin {
+                    return Some(problem(
+                        s,
+                        ProblemKind::Units,
+                        format!("{name} falls to {lo:.4e} Pa, below vacuum (-1e5 Pa gauge): check the unit and that the pressure is gauge, not absolute with an offset"),
+                    ));
+                }
+                if hi.abs().max(lo.abs()) < 1e-3 * f.supply {
+                    return Some(problem(
+                        s,
+                        ProblemKind::Units,
+                        format!("{name} never exceeds {:.3e} Pa, a thousandth of the {:.3e} Pa supply: check the unit of the column (bar written as Pa?)", hi.abs().max(lo.abs()), f.supply),
+                    ));
+                }
+            }
+            _ => {}
+        }
+    }
+    // Clipping: many samples exactly at an extreme that is not a physical
+    // limit of the rig (an end stop, the supply, the tank).
+    let tol = 1e-9 * r;
+    let n = y.len() as f64;
+    let at_hi = y.iter().filter(|v| (hi - **v).abs() <= tol).count() as f64;
+    let at_lo = y.iter().filter(|v| (**v - lo).abs() <= tol).count() as f64;
+    let physical = |v: f64| -> bool {
+        facts.is_some_and(|f| match s {
+            Signal::Position => (v.abs() - 0.5 * f.stroke).abs() <= 0.01 * f.stroke,
+            Signal::P1 | Signal::P2 | Signal::Ps => {
+                (v - f.supply).abs() <= 0.05 * f.supply || v.abs() <= 0.05 * f.supply
+            }
+            Signal::Velocity => v.abs() <= 1e-9,
+            _ => false,
+        })
+    };
+    let coarse = resolutions
+        .iter()
+        .find(|(c, _)| *c == s)
+        .and_then(|(_, r)| *r);
+    let many_levels = coarse.is_some_and(|(_, levels)| levels as f64 >= COARSE_LEVELS);
+    for (count, v, which) in [(at_hi, hi, "maximum"), (at_lo, lo, "minimum")] {
+        if many_levels && count >= (CLIP_SHARE * n).max(5.0) && !physical(v) {
+            return Some(problem(
+                s,
+                ProblemKind::Clipped,
+                format!("{name} sits at its {which} {v:.6e} {u} in {:.0} % of the samples: a saturated transducer or acquisition range? check the sensor's range and the logger's scaling", 100.0 * count / n),
+            ));
+        }
+    }
+    // Quantisation far coarser than the other measured channels.
+    if let Some((q, levels)) = coarse {
+        let finest_other = resolutions
+            .iter()
+            .filter(|(c, _)| *c != s)
+            .filter_map(|(_, r)| r.map(|(q, _)| q))
+            .fold(f64::INFINITY, f64::min);
+        if (levels as f64) < COARSE_LEVELS
+            && q > COARSER_THAN_NEIGHBOURS * finest_other
+            && finest_other.is_finite()
+        {
+            return Some(problem(
+                s,
+                ProblemKind::Quantised,
+                format!("{name} has {levels} distinct levels ({:.2} % of its range per step, the other channels {:.4} %): check the sensor's resolution and the logged column's precision", 100.0 * q, 100.0 * finest_other),
+            ));
+        }
+    }
+    None
+}
+
+/// The command-to-velocity gain of the record against the rig's: the sign
+/// (command up, piston down) and the magnitude (a position logged in the
+/// wrong unit moves the piston 1000 times too little per unit command).
+fn gain_problem(rec: &Record, f: &RigFacts) -> Option<DataProblem> {
+    let g_rig = f.velocity_gain?;
+    let (u, x) = (rec.get(Signal::Command)?, rec.get(Signal::Position)?);
+    let t = &rec.time;
+    let n = t.len();
+    if n < 10 || !(g_rig.is_finite() && g_rig > 0.0) {
+        return None;
+    }
+    let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
+    // central differences over about 50 ms (at least one sample each side)
+    let k = ((0.025 / dt).round() as usize).clamp(1, n / 4);
+    let (mut suv, mut suu, mut svv, mut su, mut sv, mut m) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for i in k..n - k {
+        // away from the stops, where the command does not move the piston
+        if x[i].abs() > 0.45 * f.stroke {
+            continue;
+        }
+        let v = (x[i + k] - x[i - k]) / (t[i + k] - t[i - k]);
+        let ui = u[i];
+        suv += ui * v;
+        suu += ui * ui;
+        svv += v * v;
+        su += ui;
+        sv += v;
+        m += 1.0;
+    }
+    if m < 10.0 || suu <= 0.0 || svv <= 0.0 {
+        return None;
+    }
+    let cov = suv / m - su * sv / (m * m);
+    let var_u = suu / m - (su / m).powi(2);
+    let var_v = svv / m - (sv / m).powi(2);
+    if var_u <= 0.0 || var_v <= 0.0 {
+        return None;
+    }
+    let corr = cov / (var_u * var_v).sqrt();
+    let gain = cov / var_u;
+    if corr < -0.3 {
+        return Some(problem(
+            Signal::Position,
+            ProblemKind::Sign,
+            format!("the piston moves against the command (correlation {corr:.2} of command and velocity; command up, piston down): check the sign of the command and of the position transducer"),
+        ));
+    }
+    let ratio = gain / g_rig;
+    if corr > 0.3 && !(1.0 / GAIN_FACTOR..=GAIN_FACTOR).contains(&ratio) {
+        return Some(problem(
+            Signal::Position,
+            ProblemKind::Units,
+            format!("the piston moves {ratio:.3e} times as fast per unit command as the rig predicts ({gain:.3e} vs {g_rig:.3e} m/s): check the unit of the position column (m written under [mm]?) and the rig's valve size"),
+        ));
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeMap;
+
+    fn rec(cols: &[(Signal, Vec<f64>)]) -> Record {
+        let n = cols[0].1.len();
+        Record {
+            source: "test".into(),
+            time: (0..n).map(|i| i as f64 * 1e-3).collect(),
+            signals: cols.iter().cloned().collect::<BTreeMap<_, _>>(),
+            ignored: vec![],
+        }
+    }
+
+    fn facts() -> RigFacts {
+        RigFacts {
+            stroke: 0.5,
+            supply: 7e6,
+            velocity_gain: Some(0.2),
+        }
+    }
+
+    fn moving(n: usize) -> (Vec<f64>, Vec<f64>) {
+        // command a sine, position its integral at gain 0.2 m/s
+        let u: Vec<f64> = (0..n)
+            .map(|i| (i as f64 * 1e-3 * 2.0 * std::f64::consts::PI).sin())
+            .collect();
+        let x: Vec<f64> = (0..n)
+            .map(|i| {
+                let t = i as f64 * 1e-3;
+                -0.2 * (2.0 * std::f64::consts::PI * t).cos() / (2.0 * std::f64::consts::PI)
+            })
+            .collect();
+        (u, x)
+    }
+
+    fn pressure(n: usize, mean: f64) -> Vec<f64> {
+        let e = crate::smooth::gaussian_noise(n, 3);
+        (0..n)
+            .map(|i| mean + 5e5 * (i as f64 * 3e-3).sin() + 2e4 * e[i])
+            .collect()
+    }
+
+    #[test]
+    fn a_clean_record_has_no_problems() {
+        let (u, x) = moving(2000);
+        let r = rec(&[
+            (Signal::Command, u),
+            (Signal::Position, x),
+            (Signal::P1, pressure(2000, 3e6)),
+            (Signal::P2, pressure(2000, 4e6)),
+        ]);
+        assert_eq!(check_record(&r, Some(&facts())), vec![]);
+    }
+
+    #[test]
+    fn each_problem_is_named() {
+        let (u, x) = moving(2000);
+        let kinds = |cols: &[(Signal, Vec<f64>)]| -> Vec<(String, ProblemKind)> {
+            check_record(&rec(cols), Some(&facts()))
+                .into_iter()
+                .map(|p| (p.channel, p.kind))
+                .collect()
+        };
+        // stuck p1
+        let k = kinds(&[
+            (Signal::Command, u.clone()),
+            (Signal::Position, x.clone()),
+            (Signal::P1, vec![2e6; 2000]),
+        ]);
+        assert_eq!(k, [("p1".to_string(), ProblemKind::Constant)]);
+        // pressures in Pa under [bar]: 1e5 times too large
+        let big: Vec<f64> = pressure(2000, 3e6).iter().map(|p| p * 1e5).collect();
+        let k = kinds(&[
+            (Signal::Command, u.clone()),
+            (Signal::Position, x.clone()),
+            (Signal::P1, big),
+        ]);
+        assert_eq!(k, [("p1".to_string(), ProblemKind::Units)]);
+        // bar under [Pa]: 1e5 times too small
+        let small: Vec<f64> = pressure(2000, 3e6).iter().map(|p| p * 1e-5).collect();
+        let k = kinds(&[(Signal::Command, u.clone()), (Signal::P2, small)]);
+        assert_eq!(k, [("p2".to_string(), ProblemKind::Units)]);
+        // position in m under [mm]: 1000 times too small
+        let xs: Vec<f64> = x.iter().map(|v| v * 1e-3).collect();
+        let k = kinds(&[(Signal::Command, u.clone()), (Signal::Position, xs)]);
+        assert_eq!(k, [("position".to_string(), ProblemKind::Units)]);
+        // position in mm under [m]: beyond the stroke
+        let xl: Vec<f64> = x.iter().map(|v| v * 1e3).collect();
+        let k = kinds(&[(Signal::Command, u.clone()), (Signal::Position, xl)]);
+        assert_eq!(k, [("position".to_string(), ProblemKind::Units)]);
+        // command sign flipped
+        let un: Vec<f64> = u.iter().map(|v| -v).collect();
+        let k = kinds(&[(Signal::Command, un), (Signal::Position, x.clone())]);
+        assert_eq!(k, [("position".to_string(), ProblemKind::Sign)]);
+        // a pressure clipped at 5 MPa (the supply is 7 MPa)
+        let clipped: Vec<f64> = pressure(2000, 4.8e6).iter().map(|p| p.min(5e6)).collect();
+        let k = kinds(&[
+            (Signal::Command, u.clone()),
+            (Signal::Position, x.clone()),
+            (Signal::P1, clipped),
+        ]);
+        assert_eq!(k, [("p1".to_string(), ProblemKind::Clipped)]);
+        // p2 in 1 bar steps while p1 resolves pascals
+        let coarse: Vec<f64> = pressure(2000, 3e6)
+            .iter()
+            .map(|p| (p / 2e5).round() * 2e5)
+            .collect();
+        let k = kinds(&[
+            (Signal::Command, u.clone()),
+            (Signal::Position, x.clone()),
+            (Signal::P1, pressure(2000, 3e6)),
+            (Signal::P2, coarse),
+        ]);
+        assert_eq!(k, [("p2".to_string(), ProblemKind::Quantised)]);
+    }
+
+    #[test]
+    fn a_piston_resting_on_its_stop_is_not_clipping() {
+        let n = 2000;
+        let u = vec![1.0; n];
+        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 1e-3 * 0.2).min(0.25)).collect();
+        let r = rec(&[(Signal::Command, u), (Signal::Position, x)]);
+        assert_eq!(check_record(&r, Some(&facts())), vec![]);
+    }
+}

@@ -144,6 +144,9 @@ impl ValveRig {
             }),
         };
         v["components"]["friction"] = friction_component(&self.friction);
+        let t = self.friction_terms;
+        sets.push(("friction.seal.k_pressure".into(), t.k_pressure));
+        sets.push(("friction.seal.h_acceleration".into(), t.h_acceleration));
         for (path, x) in sets {
             netlist::set(&mut v, &path, Value::from(x))?;
         }
@@ -309,6 +312,7 @@ impl ValveRig {
                 external_force_n: load.get("external_force"),
             },
             friction: law,
+            friction_terms: crate::netlist::catalog_friction_terms(friction),
             initial: InitialSpec {
                 position: motion("position"),
                 velocity: motion("velocity"),

@@ -47,6 +47,7 @@ use crate::rig::RigError;
 use crate::run::{run, Run, RunOptions, SimError};
 use crate::signal::Signal;
 pub(crate) use catalog::friction_law_of as catalog_friction_law;
+pub(crate) use catalog::friction_terms_of as catalog_friction_terms;
 pub use reader::{read, NetlistError, Schematic};
 use serde_json::{Map, Value};
 

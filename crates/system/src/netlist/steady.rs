@@ -5,11 +5,11 @@
 //! supply and tank ports, the spool feeding it, and the mass and friction on
 //! the rod.
 
-use super::catalog::{cylinder_of, friction_law_of, metering_of};
+use super::catalog::{cylinder_of, friction_law_of, friction_terms_of, metering_of};
 use super::reader::{NetlistError, Schematic};
 use super::registry::{Instance, Role};
 use crate::valve_rig::{steady_pressures_at_rest, SteadyDrive};
-use hydrocyl_friction::{FrictionInput, FrictionModel};
+use hydrocyl_friction::{FrictionInput, FrictionModel, WithSealTerms};
 use hydrocyl_ports::{Pressure, Velocity};
 
 /// The instance that owns node `node`.
@@ -62,7 +62,11 @@ fn drive(
                 path: format!("components.{}", f.name),
                 why,
             })?;
-            friction += law
+            let model = WithSealTerms {
+                inner: law,
+                terms: friction_terms_of(f),
+            };
+            friction += model
                 .steady_force(&FrictionInput::at_velocity(Velocity::new(v0)))
                 .si();
         }

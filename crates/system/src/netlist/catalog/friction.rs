@@ -9,7 +9,9 @@ use super::super::registry::{
 use super::{built, port};
 use crate::circuit::Component;
 use crate::components::Friction;
-use hydrocyl_friction::{CoulombViscous, Dahl, FrictionLaw, Karnopp, LuGre, Stribeck, Wang};
+use hydrocyl_friction::{
+    CoulombViscous, Dahl, FrictionLaw, Karnopp, LuGre, SealTerms, Stribeck, Wang, WithSealTerms,
+};
 use serde::de::DeserializeOwned;
 
 const PORTS: &[PortSpec] = &[
@@ -119,7 +121,26 @@ const SIGMA1: ParamSpec = param(
     "bristle damping σ1",
 );
 
-const COULOMB_VISCOUS: &[ParamSpec] = &[
+/// The additive seal terms every law may carry (catalog
+/// `pressure_viscous`, `acceleration_friction`; 0 = off).
+const SEAL: [ParamSpec; 2] = [
+    param(
+        "seal.k_pressure",
+        "m^3 s/N",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "additive seal term K (p1 − p2)² v (eq 5.4); needs ports A and B",
+    ),
+    param(
+        "seal.h_acceleration",
+        "N^2 s/m^4",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "additive acceleration term K H a (eq 5.12), with K above",
+    ),
+];
+
+const COULOMB_VISCOUS_LAW: [ParamSpec; 3] = [
     param(
         "coulomb",
         "N",
@@ -143,7 +164,9 @@ const COULOMB_VISCOUS: &[ParamSpec] = &[
     ),
 ];
 
-const STRIBECK: [ParamSpec; 11] = join(
+const COULOMB_VISCOUS: [ParamSpec; 5] = join(COULOMB_VISCOUS_LAW, SEAL);
+
+const STRIBECK_LAW: [ParamSpec; 11] = join(
     join::<4, 4, 8>(curve!("extending.curve"), curve!("retracting.curve")),
     [
         SIGMA2_E,
@@ -158,7 +181,9 @@ const STRIBECK: [ParamSpec; 11] = join(
     ],
 );
 
-const KARNOPP: [ParamSpec; 5] = join(
+const STRIBECK: [ParamSpec; 13] = join(STRIBECK_LAW, SEAL);
+
+const KARNOPP_LAW: [ParamSpec; 5] = join(
     curve!("curve"),
     [param(
         "sigma2",
@@ -169,7 +194,7 @@ const KARNOPP: [ParamSpec; 5] = join(
     )],
 );
 
-const DAHL: &[ParamSpec] = &[
+const DAHL_LAW: [ParamSpec; 3] = [
     param(
         "coulomb",
         "N",
@@ -186,8 +211,10 @@ const DAHL: &[ParamSpec] = &[
         "viscous coefficient σ2",
     ),
 ];
+const DAHL: [ParamSpec; 5] = join(DAHL_LAW, SEAL);
+const KARNOPP: [ParamSpec; 7] = join(KARNOPP_LAW, SEAL);
 
-const LUGRE: [ParamSpec; 12] = join(
+const LUGRE_LAW: [ParamSpec; 12] = join(
     [SIGMA0, SIGMA1],
     join::<8, 2, 10>(
         join::<4, 4, 8>(curve!("extending.curve"), curve!("retracting.curve")),
@@ -195,7 +222,7 @@ const LUGRE: [ParamSpec; 12] = join(
     ),
 );
 
-const WANG: [ParamSpec; 14] = join(
+const WANG_LAW: [ParamSpec; 14] = join(
     [SIGMA0, SIGMA1],
     join::<8, 4, 12>(
         join::<4, 4, 8>(curve!("extending.curve"), curve!("retracting.curve")),
@@ -232,28 +259,50 @@ const WANG: [ParamSpec; 14] = join(
     ),
 );
 
+const LUGRE: [ParamSpec; 14] = join(LUGRE_LAW, SEAL);
+const WANG: [ParamSpec; 16] = join(WANG_LAW, SEAL);
+
+/// The additive seal terms of an instance of one of these types.
+pub(crate) fn terms_of(inst: &Instance) -> SealTerms {
+    SealTerms {
+        k_pressure: inst.opt("seal.k_pressure").unwrap_or(0.0),
+        h_acceleration: inst.opt("seal.h_acceleration").unwrap_or(0.0),
+    }
+}
+
 fn build_with<T: DeserializeOwned>(
     inst: &Instance,
     wrap: fn(T) -> FrictionLaw,
 ) -> Result<Box<dyn Component>, String> {
-    let law = wrap(inst.law::<T>("")?);
+    let mut params = inst.clone();
+    params.params.retain(|k, _| !k.starts_with("seal."));
+    let law = wrap(params.law::<T>("")?);
     hydrocyl_friction::FrictionModel::validate(&law).map_err(|e| e.to_string())?;
     let chambers =
         (inst.connected("A") && inst.connected("B")).then(|| (inst.node("A"), inst.node("B")));
     if inst.connected("A") != inst.connected("B") {
         return Err("connect both chamber ports `A` and `B`, or neither".into());
     }
-    built(Friction::new(
-        &inst.name,
-        inst.node("rod"),
-        chambers,
-        Box::new(law),
-    ))
+    let terms = terms_of(inst);
+    if terms.k_pressure > 0.0 && chambers.is_none() {
+        return Err(
+            "the seal term K (p1 − p2)² v needs the chamber ports `A` and `B` connected".into(),
+        );
+    }
+    let model: Box<dyn hydrocyl_friction::FrictionModel> = if terms.is_off() {
+        Box::new(law)
+    } else {
+        Box::new(WithSealTerms { inner: law, terms })
+    };
+    built(Friction::new(&inst.name, inst.node("rod"), chambers, model))
 }
 
 /// The friction law of an instance of one of these types (`None` for
 /// another type).
 pub(crate) fn law_of(inst: &Instance) -> Option<Result<FrictionLaw, String>> {
+    let mut without = inst.clone();
+    without.params.retain(|k, _| !k.starts_with("seal."));
+    let inst = &without;
     Some(match inst.ty.name {
         "friction_coulomb_viscous" => inst
             .law::<CoulombViscous>("")
@@ -287,7 +336,7 @@ pub const TYPES: &[ComponentType] = &[
     friction_type!(
         "friction_coulomb_viscous",
         "Coulomb + viscous friction, Fc tanh(v/v_t) + b v",
-        COULOMB_VISCOUS,
+        &COULOMB_VISCOUS,
         CoulombViscous,
         FrictionLaw::CoulombViscous
     ),
@@ -308,7 +357,7 @@ pub const TYPES: &[ComponentType] = &[
     friction_type!(
         "friction_dahl",
         "Dahl bristle friction (eq 2.34)",
-        DAHL,
+        &DAHL,
         Dahl,
         FrictionLaw::Dahl
     ),

@@ -113,6 +113,7 @@
 pub mod chapter3;
 pub mod circuit;
 pub mod components;
+pub mod external;
 pub mod hybrid;
 pub mod netlist;
 pub mod rig;

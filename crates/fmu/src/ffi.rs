@@ -77,15 +77,16 @@ fn log_with(cb: &CallbackFunctions, name: &CStr, status: Status, message: &str) 
     } else {
         c"logAll"
     };
-    let msg = CString::new(message.replace('\0', " ")).unwrap_or_default();
-    // the message goes through "%s": a `%` in it is not a format directive
+    // the message is the format string, `%` doubled: hosts that format it
+    // (printf-style, as the standard says) and hosts that print it as is
+    // (FMPy's default callbacks) both show it whole
+    let msg = CString::new(message.replace('\0', " ").replace('%', "%%")).unwrap_or_default();
     unsafe {
         logger(
             cb.component_environment,
             name.as_ptr(),
             status,
             category.as_ptr(),
-            c"%s".as_ptr(),
             msg.as_ptr(),
         )
     };

@@ -411,3 +411,47 @@ impl Slave {
         self.phase = Phase::Failed;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn vr(s: &Slave, name: &str) -> u32 {
+        s.variables()
+            .list
+            .iter()
+            .position(|v| v.name == name)
+            .unwrap() as u32
+    }
+
+    #[test]
+    fn solver_failure_is_an_error_with_time_and_state() {
+        let mut s = Slave::new(rig::preset("leaney-moog").unwrap()).unwrap();
+        // a tolerance no step can meet: the step size falls below its minimum
+        s.set_real(vr(&s, "solver.rtol"), 1e-300).unwrap();
+        s.enter_initialization().unwrap();
+        s.exit_initialization().unwrap();
+        s.set_real(vr(&s, "command"), 0.5).unwrap();
+        let e = s.do_step(0.0, 1.0).unwrap_err();
+        assert!(e.contains("solver dp45") && e.contains("t = 0 s"), "{e}");
+        assert!(e.contains("load.") && e.contains("cylinder."), "{e}");
+        assert_eq!(s.phase(), Phase::Failed);
+        assert!(s.do_step(0.0, 1e-3).is_err());
+        s.reset();
+        assert_eq!(s.phase(), Phase::Instantiated);
+    }
+
+    #[test]
+    fn parameters_are_checked_by_the_rig_and_outputs_follow_them() {
+        let mut s = Slave::new(rig::preset("leaney-moog").unwrap()).unwrap();
+        let e = s.set_real(vr(&s, "cylinder.area_1_m2"), 0.0).unwrap_err();
+        assert!(e.contains("cylinder.area_1_m2"), "{e}");
+        // a null parameter takes a number and goes back to null with NaN
+        s.set_real(vr(&s, "initial.p1"), 2e6).unwrap();
+        s.enter_initialization().unwrap();
+        assert_eq!(s.get_real(vr(&s, "p1")).unwrap(), 2e6);
+        s.set_real(vr(&s, "initial.p1"), f64::NAN).unwrap();
+        assert_ne!(s.get_real(vr(&s, "p1")).unwrap(), 2e6);
+        assert!(s.set_real(vr(&s, "load.mass_kg"), f64::NAN).is_err());
+    }
+}

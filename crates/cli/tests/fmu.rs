@@ -31,7 +31,10 @@ fn a_missing_library_is_one_line_exit_2_and_no_file() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8(out.stderr).unwrap();
     assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(err.contains("nope.so") && err.contains("--library"), "{err}");
+    assert!(
+        err.contains("nope.so") && err.contains("--library"),
+        "{err}"
+    );
     assert!(!out_path.exists());
     // the same through the environment variable
     let out = hydrocyl()
@@ -61,16 +64,27 @@ fn a_file_that_is_not_the_library_and_a_bad_set_are_refused() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8(out.stderr).unwrap().contains("fmi2DoStep"));
+    assert!(String::from_utf8(out.stderr)
+        .unwrap()
+        .contains("fmi2DoStep"));
     assert!(!out_path.exists());
     let out = hydrocyl()
-        .args(["fmu", "--rig", "leaney-moog", "--set", "load.mass_kg=-1", "--out"])
+        .args([
+            "fmu",
+            "--rig",
+            "leaney-moog",
+            "--set",
+            "load.mass_kg=-1",
+            "--out",
+        ])
         .arg(&out_path)
         .arg("--library")
         .arg(&fake)
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8(out.stderr).unwrap().contains("load.mass_kg"));
+    assert!(String::from_utf8(out.stderr)
+        .unwrap()
+        .contains("load.mass_kg"));
     assert!(!out_path.exists());
 }

@@ -37,14 +37,8 @@ pub const CO_SIMULATION: c_int = 1;
 pub const LAST_SUCCESSFUL_TIME: c_int = 2;
 
 /// `fmi2CallbackLogger`: `void (*)(env, instanceName, status, category, message, ...)`.
-pub type Logger = unsafe extern "C" fn(
-    *mut c_void,
-    *const c_char,
-    Status,
-    *const c_char,
-    *const c_char,
-    ...
-);
+pub type Logger =
+    unsafe extern "C" fn(*mut c_void, *const c_char, Status, *const c_char, *const c_char, ...);
 
 /// `fmi2CallbackFunctions`.
 #[repr(C)]
@@ -166,27 +160,29 @@ pub fn resource_dir(location: &str) -> Result<PathBuf, String> {
             let slash = auth.find('/').unwrap_or(auth.len());
             match &auth[..slash] {
                 "" | "localhost" => &auth[slash..],
-                host => return Err(format!("fmuResourceLocation `{location}`: remote host `{host}`")),
+                host => {
+                    return Err(format!(
+                        "fmuResourceLocation `{location}`: remote host `{host}`"
+                    ))
+                }
             }
         }
         None => rest,
     };
     if !path.starts_with('/') {
-        return Err(format!("fmuResourceLocation `{location}` is not an absolute file URI"));
+        return Err(format!(
+            "fmuResourceLocation `{location}` is not an absolute file URI"
+        ));
     }
     let bytes: Vec<u8> = percent_encoding::percent_decode_str(path).collect();
     use std::os::unix::ffi::OsStringExt;
     Ok(PathBuf::from(std::ffi::OsString::from_vec(bytes)))
 }
 
-fn instantiate(
-    guid_given: &str,
-    location: Option<&str>,
-) -> Result<Slave, String> {
+fn instantiate(guid_given: &str, location: Option<&str>) -> Result<Slave, String> {
     let location = location.ok_or("no fmuResourceLocation: the rig is in resources/rig.json")?;
     let path = resource_dir(location)?.join("rig.json");
-    let text = std::fs::read_to_string(&path)
-        .map_err(|e| format!("{}: {e}", path.display()))?;
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
     let expected = guid(&text);
     if guid_given != expected {
         return Err(format!(
@@ -497,7 +493,11 @@ pub unsafe extern "C" fn fmi2DoStep(
     step: f64,
     _no_set_prior_state: c_int,
 ) -> Status {
-    unsafe { with(c, "fmi2DoStep", |i| i.slave.do_step(current, step).map(|_| OK)) }
+    unsafe {
+        with(c, "fmi2DoStep", |i| {
+            i.slave.do_step(current, step).map(|_| OK)
+        })
+    }
 }
 
 /// An unsupported optional function: `fmi2Error` with a message.
@@ -593,7 +593,11 @@ pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
 
 /// `fmi2GetStatus` (no asynchronous step: nothing to report).
 #[no_mangle]
-pub unsafe extern "C" fn fmi2GetStatus(c: *mut c_void, _kind: c_int, _value: *mut Status) -> Status {
+pub unsafe extern "C" fn fmi2GetStatus(
+    c: *mut c_void,
+    _kind: c_int,
+    _value: *mut Status,
+) -> Status {
     unsafe { with(c, "fmi2GetStatus", |_| Ok(DISCARD)) }
 }
 

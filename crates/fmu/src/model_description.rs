@@ -158,7 +158,11 @@ pub fn model_description(
         } else {
             String::new()
         };
-        let kinds = if *ft { r#" dependenciesKind="fixed""# } else { "" };
+        let kinds = if *ft {
+            r#" dependenciesKind="fixed""#
+        } else {
+            ""
+        };
         let _ = writeln!(
             w,
             r#"      <Unknown index="{i}" dependencies="{deps}"{kinds}/>"#

@@ -10,7 +10,9 @@
 //! the input's slope may change. The circuit itself (component modes:
 //! friction stick/slip, stops, valve states) lives on between steps.
 
-use crate::variables::{circuit_with_input, output_channels, Role, SolverParam, Variables, METHODS};
+use crate::variables::{
+    circuit_with_input, output_channels, Role, SolverParam, Variables, METHODS,
+};
 use hydrocyl_integrators::{solve, Options};
 use hydrocyl_system::external::ExternalInput;
 use hydrocyl_system::rig;

@@ -84,11 +84,7 @@ pub struct Variables {
 pub fn output_channels(circuit: &Circuit) -> Vec<Probe> {
     const ORDER: [&str; 4] = ["position", "velocity", "p1", "p2"];
     let probes = circuit.probes();
-    let mut out: Vec<Probe> = probes
-        .iter()
-        .filter(|p| p.name != INPUT)
-        .cloned()
-        .collect();
+    let mut out: Vec<Probe> = probes.iter().filter(|p| p.name != INPUT).cloned().collect();
     for k in ["p1", "p2"] {
         let sensor = out.iter().position(|p| p.name == format!("{k}_sensor"));
         let chamber = out.iter().position(|p| p.name == k);

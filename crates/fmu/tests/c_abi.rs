@@ -95,7 +95,11 @@ fn instantiate_set_step_get_reset_free() {
     assert!(x > 1e-3, "the rod extends on a positive command: {x}");
     // after a reset the same run gives the same result, bit for bit
     unsafe { assert_eq!(fmi2Reset(c), OK) };
-    assert_eq!(get(c, f.vr("load.mass_kg")), 100.0, "reset restores the start");
+    assert_eq!(
+        get(c, f.vr("load.mass_kg")),
+        100.0,
+        "reset restores the start"
+    );
     assert_eq!(set(c, f.vr("load.mass_kg"), 50.0), OK);
     start(c);
     assert_eq!(run(c, &f, 0.1, 100, 1e-3), x);
@@ -180,6 +184,9 @@ fn resource_locations_are_file_uris_or_paths() {
         resource_dir("file://localhost/x").unwrap(),
         std::path::PathBuf::from("/x")
     );
-    assert_eq!(resource_dir("file:/x").unwrap(), std::path::PathBuf::from("/x"));
+    assert_eq!(
+        resource_dir("file:/x").unwrap(),
+        std::path::PathBuf::from("/x")
+    );
     assert!(resource_dir("file://server/x").is_err());
 }

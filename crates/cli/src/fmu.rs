@@ -1,7 +1,7 @@
 //! `hydrocyl fmu`: export a rig as an FMI 2.0 Co-Simulation FMU (linux64).
 //!
 //! ```text
-//! hydrocyl fmu --rig leaney-moog --out drive.fmu [--set load.mass_kg=50] [--library PATH]
+//! hydrocyl fmu --rig leaney-moog --out drive.fmu [--set load.mass=50] [--library PATH]
 //! hydrocyl fmu --list-presets
 //! ```
 //!

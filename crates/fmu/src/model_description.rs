@@ -87,7 +87,7 @@ pub fn model_description(
             let _ = write!(w, r#"    <Unit name="{}">"#, esc(u));
             if let Some(e) = base_units(u) {
                 let _ = write!(w, "<BaseUnit");
-                for (name, k) in ["kg", "m", "s", "rad"].iter().zip(e) {
+                for (name, k) in ["kg", "m", "s", "A", "rad"].iter().zip(e) {
                     if k != 0 {
                         let _ = write!(w, r#" {name}="{k}""#);
                     }
@@ -195,9 +195,9 @@ mod tests {
         assert!(xml.contains(&format!(r#"guid="{g}""#)));
         assert_eq!(guid(&r.to_string()), g);
         let mut r2 = r.clone();
-        rig::apply_set(&mut r2, "load.mass_kg=50").unwrap();
+        rig::apply_set(&mut r2, "load.mass=50").unwrap();
         assert_ne!(guid(&r2.to_string()), g);
-        assert!(xml.contains(r#"name="load.mass_kg""#));
+        assert!(xml.contains(r#"name="load.mass""#));
         assert!(xml.contains(r#"<Real unit="kg" start="100.0"/>"#));
         assert!(xml.contains(r#"<Unit name="Pa"><BaseUnit kg="1" m="-1" s="-2"/></Unit>"#));
     }

@@ -4,7 +4,7 @@
 //! both make this table from the same rig, so their value references agree
 //! (the GUID checks it: [`crate::model_description`]).
 
-use crate::units::parameter_unit;
+use crate::units::{parameter_unit, unit_name};
 use hydrocyl_system::external::ExternalInput;
 use hydrocyl_system::rig::{self, RigError};
 use hydrocyl_system::run::{RunOptions, Solver};
@@ -77,24 +77,16 @@ pub struct Variables {
 }
 
 /// The circuit's output channels in the order of a run's channels
-/// (position, velocity, p1, p2, then the others in component order),
-/// without the command (it is the FMU's input). A valve rig with pressure
-/// sensor lag reports what the sensors read as `p1`/`p2` and the chamber
-/// pressures as `p1_chamber`/`p2_chamber`, as `ValveRig::simulate` does.
+/// (position, velocity, p1, p2, then the others in component order, as
+/// `hydrocyl_system::run::run` orders them), without the command (it is the
+/// FMU's input).
 pub fn output_channels(circuit: &Circuit) -> Vec<Probe> {
     const ORDER: [&str; 4] = ["position", "velocity", "p1", "p2"];
-    let probes = circuit.probes();
-    let mut out: Vec<Probe> = probes.iter().filter(|p| p.name != INPUT).cloned().collect();
-    for k in ["p1", "p2"] {
-        let sensor = out.iter().position(|p| p.name == format!("{k}_sensor"));
-        let chamber = out.iter().position(|p| p.name == k);
-        if let (Some(s), Some(c)) = (sensor, chamber) {
-            let (ws, wc) = (out[s].wire, out[c].wire);
-            out[c].wire = ws;
-            out[s].wire = wc;
-            out[s].name = format!("{k}_chamber");
-        }
-    }
+    let mut out: Vec<Probe> = circuit
+        .probes()
+        .into_iter()
+        .filter(|p| p.name != INPUT)
+        .collect();
     out.sort_by_key(|p| {
         ORDER
             .iter()
@@ -142,7 +134,7 @@ impl Variables {
                 role: Role::Output(i),
                 integer: false,
                 start: f64::NAN,
-                unit: (p.unit != "-").then_some(p.unit),
+                unit: unit_name(p.unit),
                 description: format!("output channel `{}`", p.name),
                 feedthrough: lo[i] != hi[i],
             });
@@ -195,7 +187,7 @@ impl Variables {
                     ),
                 },
                 name: p.path.clone(),
-                unit: parameter_unit(&p.path),
+                unit: parameter_unit(&p),
                 role: Role::Parameter(p.path),
                 integer: false,
                 start: p.value.unwrap_or(f64::NAN),
@@ -227,58 +219,36 @@ mod tests {
     use super::*;
 
     #[test]
-    fn leaney_moog_has_the_channels_of_a_run_and_every_parameter() {
-        let rig = rig::preset("leaney-moog").unwrap();
-        let v = Variables::of(&rig).unwrap();
-        assert_eq!(v.list[0].role, Role::Input);
-        // the outputs are the run's channels without the command, same order
-        let t: Vec<f64> = vec![0.0, 0.01];
-        let run = rig::simulate(
-            &rig,
-            Signal::Constant { value: 0.1 },
-            &t,
-            &RunOptions::default(),
-        )
-        .unwrap();
-        let names: Vec<&str> = run
-            .channels
-            .iter()
-            .map(|c| c.name.as_str())
-            .filter(|n| *n != INPUT)
-            .collect();
-        let ours: Vec<&str> = v.outputs.iter().map(|(n, _)| n.as_str()).collect();
-        assert_eq!(ours, names);
-        let n_par = v
-            .list
-            .iter()
-            .filter(|x| matches!(x.role, Role::Parameter(_)))
-            .count();
-        assert_eq!(n_par, rig::parameters(&rig).len());
+    fn outputs_are_the_channels_of_a_run_and_parameters_are_the_rigs() {
+        for preset in rig::PRESETS {
+            let rig = (preset.json)();
+            let v = Variables::of(&rig).unwrap();
+            assert_eq!(v.list[0].role, Role::Input);
+            // the outputs are the run's channels without the command, same order
+            let run = rig::simulate(
+                &rig,
+                Signal::Constant { value: 0.1 },
+                &[0.0, 0.01],
+                &RunOptions::default(),
+            )
+            .unwrap();
+            let names: Vec<&str> = run
+                .channels
+                .iter()
+                .map(|c| c.name.as_str())
+                .filter(|n| *n != INPUT)
+                .collect();
+            let ours: Vec<&str> = v.outputs.iter().map(|(n, _)| n.as_str()).collect();
+            assert_eq!(ours, names, "{}", preset.name);
+            let n_par = v
+                .list
+                .iter()
+                .filter(|x| matches!(x.role, Role::Parameter(_)))
+                .count();
+            assert_eq!(n_par, rig::parameters(&rig).len(), "{}", preset.name);
+        }
         // the spool lags the command: nothing feeds through
+        let v = Variables::of(&rig::preset("leaney-moog").unwrap()).unwrap();
         assert!(v.list.iter().all(|x| !x.feedthrough));
-    }
-
-    #[test]
-    fn sensor_lag_renames_like_a_run() {
-        let mut rig = rig::preset("leaney-moog").unwrap();
-        rig::apply_set(&mut rig, "sensors.pressure_lag_s=0.002").unwrap();
-        let v = Variables::of(&rig).unwrap();
-        let run = rig::simulate(
-            &rig,
-            Signal::Constant { value: 0.1 },
-            &[0.0, 0.01],
-            &RunOptions::default(),
-        )
-        .unwrap();
-        let mut names: Vec<&str> = run
-            .channels
-            .iter()
-            .map(|c| c.name.as_str())
-            .filter(|n| *n != INPUT)
-            .collect();
-        let mut ours: Vec<&str> = v.outputs.iter().map(|(n, _)| n.as_str()).collect();
-        names.sort_unstable();
-        ours.sort_unstable();
-        assert_eq!(ours, names);
     }
 }

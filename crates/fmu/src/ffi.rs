@@ -334,6 +334,46 @@ pub unsafe extern "C" fn fmi2Reset(c: *mut c_void) -> Status {
     }
 }
 
+/// Reads `nvr` values through `get`, one per value reference.
+unsafe fn get_each<T>(
+    c: *mut c_void,
+    what: &str,
+    vr: *const c_uint,
+    nvr: usize,
+    value: *mut T,
+    get: impl Fn(&mut Slave, u32) -> Result<T, String>,
+) -> Status {
+    unsafe {
+        with(c, what, |i| {
+            let (vr, out) = (slice(vr, nvr)?, slice_mut(value, nvr)?);
+            for (r, o) in vr.iter().zip(out) {
+                *o = get(&mut i.slave, *r)?;
+            }
+            Ok(OK)
+        })
+    }
+}
+
+/// Writes `nvr` values through `set`, one per value reference; stops at the
+/// first refused one.
+unsafe fn set_each<T: Copy>(
+    c: *mut c_void,
+    what: &str,
+    vr: *const c_uint,
+    nvr: usize,
+    value: *const T,
+    set: impl Fn(&mut Slave, u32, T) -> Result<(), String>,
+) -> Status {
+    unsafe {
+        with(c, what, |i| {
+            for (r, v) in slice(vr, nvr)?.iter().zip(slice(value, nvr)?) {
+                set(&mut i.slave, *r, *v)?;
+            }
+            Ok(OK)
+        })
+    }
+}
+
 /// `fmi2GetReal`.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetReal(
@@ -342,15 +382,7 @@ pub unsafe extern "C" fn fmi2GetReal(
     nvr: usize,
     value: *mut f64,
 ) -> Status {
-    unsafe {
-        with(c, "fmi2GetReal", |i| {
-            let (vr, out) = (slice(vr, nvr)?, slice_mut(value, nvr)?);
-            for (r, o) in vr.iter().zip(out) {
-                *o = i.slave.get_real(*r)?;
-            }
-            Ok(OK)
-        })
-    }
+    unsafe { get_each(c, "fmi2GetReal", vr, nvr, value, Slave::get_real) }
 }
 
 /// `fmi2SetReal`: the input, or a parameter (checked with the rig's rules;
@@ -362,14 +394,7 @@ pub unsafe extern "C" fn fmi2SetReal(
     nvr: usize,
     value: *const f64,
 ) -> Status {
-    unsafe {
-        with(c, "fmi2SetReal", |i| {
-            for (r, v) in slice(vr, nvr)?.iter().zip(slice(value, nvr)?) {
-                i.slave.set_real(*r, *v)?;
-            }
-            Ok(OK)
-        })
-    }
+    unsafe { set_each(c, "fmi2SetReal", vr, nvr, value, Slave::set_real) }
 }
 
 /// `fmi2GetInteger` (`solver.method`).
@@ -380,15 +405,7 @@ pub unsafe extern "C" fn fmi2GetInteger(
     nvr: usize,
     value: *mut c_int,
 ) -> Status {
-    unsafe {
-        with(c, "fmi2GetInteger", |i| {
-            let (vr, out) = (slice(vr, nvr)?, slice_mut(value, nvr)?);
-            for (r, o) in vr.iter().zip(out) {
-                *o = i.slave.get_integer(*r)?;
-            }
-            Ok(OK)
-        })
-    }
+    unsafe { get_each(c, "fmi2GetInteger", vr, nvr, value, |s, r| s.get_integer(r)) }
 }
 
 /// `fmi2SetInteger` (`solver.method`).
@@ -399,14 +416,7 @@ pub unsafe extern "C" fn fmi2SetInteger(
     nvr: usize,
     value: *const c_int,
 ) -> Status {
-    unsafe {
-        with(c, "fmi2SetInteger", |i| {
-            for (r, v) in slice(vr, nvr)?.iter().zip(slice(value, nvr)?) {
-                i.slave.set_integer(*r, *v)?;
-            }
-            Ok(OK)
-        })
-    }
+    unsafe { set_each(c, "fmi2SetInteger", vr, nvr, value, Slave::set_integer) }
 }
 
 /// No Boolean or String variables: any value reference is unknown.

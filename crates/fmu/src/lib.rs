@@ -21,6 +21,23 @@
 //! * [`ffi`]: the C API, written by hand (the only module with `unsafe`);
 //! * [`package`]: the `.fmu` archive and where the library is found.
 //!
+//! The variables and the model description of a preset's FMU:
+//!
+//! ```
+//! use hydrocyl_fmu::model_description::{guid, model_description};
+//! use hydrocyl_fmu::variables::{Role, Variables};
+//! use hydrocyl_system::rig;
+//!
+//! let r = rig::preset("leaney-moog").unwrap();
+//! let vars = Variables::of(&r).unwrap();
+//! assert_eq!(vars.list[0].name, "command"); // the input, value reference 0
+//! assert!(vars.outputs.iter().any(|(name, unit)| name == "p1" && *unit == "Pa"));
+//! let n_par = vars.list.iter().filter(|v| matches!(v.role, Role::Parameter(_))).count();
+//! assert_eq!(n_par, rig::parameters(&r).len()); // every rig parameter
+//! let xml = model_description(&vars, "leaney-moog", "a valve rig", &guid(&r.to_string()));
+//! assert!(xml.contains(r#"<ScalarVariable name="load.mass""#));
+//! ```
+//!
 //! The crate implements no thesis equation: the physics is the rig's
 //! (`hydrocyl-system`), the numerics the integrators'. The ABI is written by
 //! hand: the FMI 2.0 C API is ~35 functions over `void*`, `int`, `double`

@@ -7,6 +7,7 @@ mod bench_sim;
 mod components;
 mod diagnose;
 mod error;
+mod fmu;
 mod simulate;
 mod xfactor;
 
@@ -14,7 +15,7 @@ use clap::{Parser, Subcommand};
 use error::CliError;
 
 /// hydrocyl: simulate asymmetric hydraulic cylinder drives, compute X factors,
-/// diagnose measured data.
+/// diagnose measured data, export FMUs.
 #[derive(Parser)]
 #[command(name = "hydrocyl", version, about)]
 struct Cli {
@@ -33,6 +34,8 @@ enum Command {
     /// List the component types a netlist can use: ports, parameters (unit,
     /// default, range), initial states and outputs.
     Components(components::Args),
+    /// Export a rig as an FMI 2.0 Co-Simulation FMU (linux64).
+    Fmu(fmu::Args),
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
@@ -41,6 +44,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Simulate(a) => simulate::run(a),
         Command::Diagnose(a) => diagnose::run(a),
         Command::Components(a) => components::run(a),
+        Command::Fmu(a) => fmu::run(a),
     }
 }
 

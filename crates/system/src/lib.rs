@@ -128,6 +128,7 @@ mod binding;
 pub mod chapter3;
 pub mod circuit;
 pub mod components;
+pub mod external;
 pub mod hybrid;
 pub mod netlist;
 pub mod rig;

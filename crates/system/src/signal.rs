@@ -1,6 +1,8 @@
 //! Command signals: square with bias, sine, sawtooth, step, ramp and a
-//! sampled table with first-order hold (the CSV-given command).
+//! sampled table with first-order hold (the CSV-given command), and a value
+//! set from outside between solver calls (a co-simulation input).
 
+use crate::external::ExternalInput;
 use serde::{Deserialize, Serialize};
 use std::cell::Cell;
 use thiserror::Error;
@@ -96,6 +98,11 @@ pub enum Signal {
         /// Sample values.
         value: Vec<f64>,
     },
+    /// A value the host sets between solver calls (an FMU's input), linear
+    /// inside a step; see [`ExternalInput`]. Not part of rig or command
+    /// files (never serialised).
+    #[serde(skip)]
+    External(ExternalInput),
 }
 
 impl Signal {
@@ -133,6 +140,7 @@ impl Signal {
         };
         match self {
             Signal::Constant { value } => fin("value", *value),
+            Signal::External(_) => Ok(()),
             Signal::Step {
                 time_s,
                 before,
@@ -232,6 +240,7 @@ impl Signal {
     pub fn value_hinted(&self, t: f64, hint: &Cell<usize>) -> f64 {
         match self {
             Signal::Constant { value } => *value,
+            Signal::External(input) => input.value(t),
             Signal::Step {
                 time_s,
                 before,

@@ -1,0 +1,75 @@
+//! `hydrocyl fmu`: export a rig as an FMI 2.0 Co-Simulation FMU (linux64).
+//!
+//! ```text
+//! hydrocyl fmu --rig leaney-moog --out drive.fmu [--set load.mass=50] [--library PATH]
+//! hydrocyl fmu --list-presets
+//! ```
+//!
+//! The FMU holds `modelDescription.xml`, the rig after `--set` as
+//! `resources/rig.json`, and the slave library `libhydrocyl_fmu.so` (crate
+//! `hydrocyl-fmu`) as `binaries/linux64/<modelIdentifier>.so`. The library
+//! is found by `--library`, else `$HYDROCYL_FMU_LIBRARY`, else next to the
+//! `hydrocyl` executable (where `cargo build -p hydrocyl-fmu` puts it);
+//! see `docs/fmu.md`.
+
+use crate::error::CliError;
+use hydrocyl_fmu::package::{find_library, write_fmu};
+use hydrocyl_system::rig;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `hydrocyl fmu`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A preset name (leaney-moog, ...) or a rig JSON file.
+    #[arg(long, required_unless_present = "list_presets")]
+    rig: Option<String>,
+    /// The FMU file to write.
+    #[arg(long, required_unless_present = "list_presets")]
+    out: Option<PathBuf>,
+    /// Override a rig parameter by its JSON path before export (repeatable);
+    /// it becomes the parameter's start value.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    set: Vec<String>,
+    /// The slave library (`libhydrocyl_fmu.so`); default: $HYDROCYL_FMU_LIBRARY,
+    /// else next to this executable.
+    #[arg(long)]
+    library: Option<PathBuf>,
+    /// Print the preset names (one per line) and exit.
+    #[arg(long)]
+    list_presets: bool,
+}
+
+/// Runs `hydrocyl fmu`.
+pub fn run(args: Args) -> Result<(), CliError> {
+    if args.list_presets {
+        for p in rig::PRESETS {
+            println!("{}", p.name);
+        }
+        return Ok(());
+    }
+    let (Some(rig_arg), Some(out)) = (args.rig, args.out) else {
+        return Err(CliError::Input("--rig and --out are required".into()));
+    };
+    let input = |e: &dyn std::fmt::Display| CliError::Input(e.to_string());
+    let mut value = rig::load(&rig_arg).map_err(|e| input(&e))?;
+    for s in &args.set {
+        rig::apply_set(&mut value, s).map_err(|e| input(&e))?;
+    }
+    rig::check(&value).map_err(|e| input(&e))?;
+    let library = find_library(args.library.as_deref()).map_err(|e| input(&e))?;
+    let name = if rig::preset(&rig_arg).is_some() {
+        rig_arg.clone()
+    } else {
+        Path::new(&rig_arg)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "rig".into())
+    };
+    write_fmu(&value, &name, &library, &out).map_err(|e| input(&e))?;
+    eprintln!(
+        "hydrocyl: wrote {} (rig {name}, library {})",
+        out.display(),
+        library.display()
+    );
+    Ok(())
+}

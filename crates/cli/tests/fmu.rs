@@ -1,0 +1,66 @@
+//! `hydrocyl fmu` end to end without the slave library: one-line errors,
+//! exit code 2, no file written. (Exports with the library, checked by
+//! FMPy, are in `crates/fmu/tests/python`, run by `crates/fmu/tests/run_fmpy_tests.sh`.)
+
+use std::path::Path;
+use std::process::Command;
+
+fn hydrocyl() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_hydrocyl"))
+}
+
+/// `hydrocyl fmu --rig leaney-moog [extra] --out <out>` with `library` as
+/// `--library` (or none), checked to fail with exit code 2 and no file;
+/// returns stderr.
+fn refused(out: &Path, extra: &[&str], library: Option<&Path>, env: Option<&Path>) -> String {
+    let mut cmd = hydrocyl();
+    cmd.args(["fmu", "--rig", "leaney-moog"])
+        .args(extra)
+        .arg("--out")
+        .arg(out);
+    if let Some(l) = library {
+        cmd.arg("--library").arg(l);
+    }
+    if let Some(e) = env {
+        cmd.env("HYDROCYL_FMU_LIBRARY", e);
+    }
+    let o = cmd.output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!out.exists());
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    err
+}
+
+#[test]
+fn lists_the_presets() {
+    let out = hydrocyl().args(["fmu", "--list-presets"]).output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.lines().any(|l| l == "leaney-moog"), "{text}");
+}
+
+#[test]
+fn a_missing_library_is_one_line_exit_2_and_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("drive.fmu");
+    let missing = dir.path().join("nope.so");
+    let err = refused(&out, &[], Some(&missing), None);
+    assert!(
+        err.contains("nope.so") && err.contains("--library"),
+        "{err}"
+    );
+    let err = refused(&out, &[], None, Some(&missing));
+    assert!(err.contains("HYDROCYL_FMU_LIBRARY"), "{err}");
+}
+
+#[test]
+fn a_file_that_is_not_the_library_and_a_bad_set_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("drive.fmu");
+    let fake = dir.path().join("fake.so");
+    std::fs::write(&fake, b"not a library").unwrap();
+    assert!(refused(&out, &[], Some(&fake), None).contains("fmi2DoStep"));
+    let err = refused(&out, &["--set", "load.mass=-1"], Some(&fake), None);
+    assert!(err.contains("load.mass"), "{err}");
+}

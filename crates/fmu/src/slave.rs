@@ -1,0 +1,459 @@
+//! The co-simulation slave in safe Rust: one instance of an FMU. It holds
+//! the rig, the variable values, and (from initialisation on) the rig's
+//! circuit, its state and the communication time; [`Slave::do_step`]
+//! integrates the circuit over one communication step with the rig's solver.
+//!
+//! The integrator is restarted at every communication point (its step-size
+//! estimate and FSAL stage are not carried over): a step costs the
+//! starting-step heuristic (two right-hand sides) more than one long solve
+//! would, and no step of the solver straddles a communication point, where
+//! the input's slope may change. The circuit itself (component modes:
+//! friction stick/slip, stops, valve states) lives on between steps.
+
+use crate::variables::{
+    circuit_with_input, output_channels, Role, SolverParam, Variables, METHODS,
+};
+use hydrocyl_integrators::{solve, Options};
+use hydrocyl_system::external::ExternalInput;
+use hydrocyl_system::rig;
+use hydrocyl_system::run::Solver;
+use hydrocyl_system::{Circuit, Wire};
+use serde_json::Value;
+
+/// Where the slave is in the FMI 2.0 co-simulation state machine.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// After `fmi2Instantiate` / `fmi2Reset`: parameters may be set.
+    Instantiated,
+    /// Between `fmi2EnterInitializationMode` and `fmi2ExitInitializationMode`.
+    Initializing,
+    /// Stepping (`fmi2DoStep`).
+    Stepping,
+    /// After `fmi2Terminate`.
+    Terminated,
+    /// After an error: only reset and free are allowed.
+    Failed,
+}
+
+/// The running circuit.
+struct Sim {
+    circuit: Circuit,
+    input: ExternalInput,
+    wires: Vec<Wire>,
+    x: Vec<f64>,
+    t: f64,
+}
+
+/// One FMU instance.
+pub struct Slave {
+    base: Value,
+    rig: Value,
+    vars: Variables,
+    values: Vec<f64>,
+    slope: f64,
+    t_start: f64,
+    sim: Option<Sim>,
+    phase: Phase,
+}
+
+/// A rejected call: the message to log (names the variable, time, state).
+pub type SlaveError = String;
+
+impl Slave {
+    /// A new instance of the FMU of `rig` (the rig is checked).
+    pub fn new(rig: Value) -> Result<Self, SlaveError> {
+        let vars = Variables::of(&rig).map_err(|e| format!("rig.json: {e}"))?;
+        let values = vars.list.iter().map(|v| v.start).collect();
+        Ok(Self {
+            base: rig.clone(),
+            rig,
+            vars,
+            values,
+            slope: 0.0,
+            t_start: 0.0,
+            sim: None,
+            phase: Phase::Instantiated,
+        })
+    }
+
+    /// The variable table.
+    pub fn variables(&self) -> &Variables {
+        &self.vars
+    }
+
+    /// The current phase.
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// The rig with the parameters set so far.
+    pub fn rig(&self) -> &Value {
+        &self.rig
+    }
+
+    /// The communication time reached (the start time before the first step).
+    pub fn time(&self) -> f64 {
+        self.sim.as_ref().map_or(self.t_start, |s| s.t)
+    }
+
+    /// Back to the state right after instantiation (`fmi2Reset`).
+    pub fn reset(&mut self) {
+        self.rig = self.base.clone();
+        self.values = self.vars.list.iter().map(|v| v.start).collect();
+        self.slope = 0.0;
+        self.t_start = 0.0;
+        self.sim = None;
+        self.phase = Phase::Instantiated;
+    }
+
+    /// `fmi2SetupExperiment`: the start time.
+    pub fn setup_experiment(&mut self, start: f64) -> Result<(), SlaveError> {
+        self.expect(&[Phase::Instantiated], "fmi2SetupExperiment")?;
+        if !start.is_finite() {
+            return Err(format!("start time {start} is not finite"));
+        }
+        self.t_start = start;
+        Ok(())
+    }
+
+    /// `fmi2EnterInitializationMode`.
+    pub fn enter_initialization(&mut self) -> Result<(), SlaveError> {
+        self.expect(&[Phase::Instantiated], "fmi2EnterInitializationMode")?;
+        self.phase = Phase::Initializing;
+        Ok(())
+    }
+
+    /// `fmi2ExitInitializationMode`: assembles the circuit with the
+    /// parameters set, at the rig's initial state.
+    pub fn exit_initialization(&mut self) -> Result<(), SlaveError> {
+        self.expect(&[Phase::Initializing], "fmi2ExitInitializationMode")?;
+        self.ensure_sim()?;
+        self.phase = Phase::Stepping;
+        Ok(())
+    }
+
+    /// `fmi2Terminate`.
+    pub fn terminate(&mut self) -> Result<(), SlaveError> {
+        self.expect(&[Phase::Stepping, Phase::Initializing], "fmi2Terminate")?;
+        self.phase = Phase::Terminated;
+        Ok(())
+    }
+
+    fn expect(&self, phases: &[Phase], what: &str) -> Result<(), SlaveError> {
+        if phases.contains(&self.phase) {
+            Ok(())
+        } else {
+            Err(format!("{what} is not allowed in phase {:?}", self.phase))
+        }
+    }
+
+    fn var(&self, vr: u32) -> Result<&crate::variables::Variable, SlaveError> {
+        self.vars
+            .get(vr)
+            .ok_or_else(|| format!("unknown value reference {vr}"))
+    }
+
+    fn ensure_sim(&mut self) -> Result<(), SlaveError> {
+        if self.sim.is_some() {
+            return Ok(());
+        }
+        let (mut circuit, input) =
+            circuit_with_input(&self.rig).map_err(|e| format!("assembling the rig: {e}"))?;
+        let probes = output_channels(&circuit);
+        let mut wires = Vec::with_capacity(self.vars.outputs.len());
+        for (name, _) in &self.vars.outputs {
+            let p = probes.iter().find(|p| &p.name == name).ok_or_else(|| {
+                format!("output `{name}` does not exist with the parameters set (a parameter changed the rig's structure)")
+            })?;
+            wires.push(p.wire);
+        }
+        circuit.set_quadratures(false);
+        circuit.set_ledger(false);
+        let x = circuit.initial_state();
+        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+            return Err(format!(
+                "initial state {} = {} is not finite",
+                circuit.state_names()[i],
+                x[i]
+            ));
+        }
+        let t = self.t_start;
+        input.set(t, self.values[0], self.slope);
+        circuit.reset(t, &x);
+        self.sim = Some(Sim {
+            circuit,
+            input,
+            wires,
+            x,
+            t,
+        });
+        Ok(())
+    }
+
+    /// `fmi2GetReal` of one variable.
+    pub fn get_real(&mut self, vr: u32) -> Result<f64, SlaveError> {
+        let v = self.var(vr)?;
+        match v.role {
+            Role::Output(i) => {
+                if self.phase == Phase::Instantiated {
+                    return Err(format!(
+                        "output `{}` is not known before fmi2EnterInitializationMode",
+                        v.name
+                    ));
+                }
+                self.ensure_sim()?;
+                let s = self.sim.as_ref().ok_or("no circuit")?;
+                let mut out = [0.0];
+                s.circuit
+                    .read_wires(s.t, &s.x, &s.wires[i..i + 1], &mut out);
+                Ok(out[0])
+            }
+            _ if v.integer => Err(format!("`{}` is an Integer", v.name)),
+            _ => Ok(self.values[vr as usize]),
+        }
+    }
+
+    /// `fmi2GetInteger` of one variable.
+    pub fn get_integer(&self, vr: u32) -> Result<i32, SlaveError> {
+        let v = self.var(vr)?;
+        if !v.integer {
+            return Err(format!("`{}` is not an Integer", v.name));
+        }
+        Ok(self.values[vr as usize] as i32)
+    }
+
+    /// `fmi2SetInteger` of one variable (`solver.method`).
+    pub fn set_integer(&mut self, vr: u32, value: i32) -> Result<(), SlaveError> {
+        let v = self.var(vr)?;
+        if !v.integer {
+            return Err(format!("`{}` is not an Integer", v.name));
+        }
+        self.set(vr, value as f64)
+    }
+
+    /// `fmi2SetReal` of one variable: the input at any time; a parameter
+    /// before the end of initialisation, checked by re-checking the rig (the
+    /// message names the parameter and the rule it breaks).
+    pub fn set_real(&mut self, vr: u32, value: f64) -> Result<(), SlaveError> {
+        let v = self.var(vr)?;
+        if v.integer {
+            return Err(format!("`{}` is an Integer", v.name));
+        }
+        self.set(vr, value)
+    }
+
+    fn set(&mut self, vr: u32, value: f64) -> Result<(), SlaveError> {
+        let v = self.var(vr)?.clone();
+        let name = &v.name;
+        match &v.role {
+            Role::Output(_) => return Err(format!("`{name}` is an output: it cannot be set")),
+            Role::Input => {
+                if !value.is_finite() {
+                    return Err(format!("input `{name}` = {value} is not finite"));
+                }
+                if self.phase == Phase::Failed || self.phase == Phase::Terminated {
+                    return Err(format!("setting `{name}` in phase {:?}", self.phase));
+                }
+                self.values[vr as usize] = value;
+                // a new value starts a step without slope until
+                // fmi2SetRealInputDerivatives says otherwise
+                self.slope = 0.0;
+                if let Some(s) = &self.sim {
+                    s.input.set(s.t, value, 0.0);
+                }
+                return Ok(());
+            }
+            Role::Solver(sp) => {
+                self.expect(
+                    &[Phase::Instantiated, Phase::Initializing],
+                    &format!("setting fixed parameter `{name}`"),
+                )?;
+                let ok = match sp {
+                    SolverParam::Method => {
+                        value >= 0.0 && value < METHODS.len() as f64 && value.fract() == 0.0
+                    }
+                    SolverParam::Rtol => value > 0.0 && value < 1.0,
+                    SolverParam::HMax | SolverParam::Rk4Step => value.is_finite() && value > 0.0,
+                };
+                if !ok {
+                    return Err(format!(
+                        "parameter `{name}` = {value} rejected: {}",
+                        v.description
+                    ));
+                }
+            }
+            Role::Parameter(path) => {
+                self.expect(
+                    &[Phase::Instantiated, Phase::Initializing],
+                    &format!("setting fixed parameter `{name}`"),
+                )?;
+                let text = if value.is_nan() && v.start.is_nan() {
+                    "null".to_string()
+                } else if value.is_finite() {
+                    format!("{value:?}")
+                } else {
+                    return Err(format!(
+                        "parameter `{name}` = {value} rejected: must be finite"
+                    ));
+                };
+                let mut r = self.rig.clone();
+                let checked = rig::apply_set(&mut r, &format!("{path}={text}"))
+                    .and_then(|_| rig::check(&r))
+                    .and_then(|_| circuit_with_input(&r).map(|_| ()));
+                if let Err(e) = checked {
+                    return Err(format!("parameter `{name}` = {value} rejected: {e}"));
+                }
+                self.rig = r;
+            }
+        }
+        self.values[vr as usize] = value;
+        self.sim = None;
+        Ok(())
+    }
+
+    /// `fmi2SetRealInputDerivatives` of order 1: the input's slope over the
+    /// next step (the input is linear inside it).
+    pub fn set_input_derivative(
+        &mut self,
+        vr: u32,
+        order: i32,
+        value: f64,
+    ) -> Result<(), SlaveError> {
+        let v = self.var(vr)?;
+        if v.role != Role::Input {
+            return Err(format!("`{}` is not an input", v.name));
+        }
+        if order != 1 {
+            return Err(format!(
+                "input derivative of order {order} for `{}`: only order 1 is supported",
+                v.name
+            ));
+        }
+        if !value.is_finite() {
+            return Err(format!("input derivative of `{}` = {value}", v.name));
+        }
+        self.slope = value;
+        if let Some(s) = &self.sim {
+            s.input.set(s.t, self.values[0], value);
+        }
+        Ok(())
+    }
+
+    /// `fmi2DoStep`: integrates from `t` (the time reached) to `t + h`.
+    pub fn do_step(&mut self, t: f64, h: f64) -> Result<(), SlaveError> {
+        self.expect(&[Phase::Stepping], "fmi2DoStep")?;
+        if !(h > 0.0 && h.is_finite()) {
+            return Err(format!("communication step {h} s is not positive"));
+        }
+        let method = METHODS[self.values[self.index(SolverParam::Method)] as usize];
+        let rtol = self.values[self.index(SolverParam::Rtol)];
+        let h_max = self.values[self.index(SolverParam::HMax)];
+        let rk4_step = self.values[self.index(SolverParam::Rk4Step)];
+        let (u, slope) = (self.values[0], self.slope);
+        let s = self.sim.as_mut().ok_or("no circuit")?;
+        let tol = 1e-9 * s.t.abs().max(1.0);
+        if (t - s.t).abs() > tol {
+            return Err(format!(
+                "fmi2DoStep from t = {t} s but the FMU is at t = {} s",
+                s.t
+            ));
+        }
+        let t_end = t + h;
+        s.input.set(t, u, slope);
+        let opts = Options {
+            rtol,
+            atol: s.circuit.atol(rtol),
+            h0: (method == Solver::Rk4).then_some(rk4_step.min(h)),
+            h_max,
+            t_eval: Some(vec![t, t_end]),
+            ..Options::default()
+        };
+        let result = solve(method.method(), &mut s.circuit, t, &s.x, t_end, &opts);
+        let failure = match result {
+            Ok(sol) if sol.t.last() == Some(&t_end) => {
+                let last = sol.last().ok_or("empty solution")?;
+                let n = s.x.len();
+                s.x.copy_from_slice(&last[..n]);
+                s.t = t_end;
+                // the input value at the new communication point
+                self.values[0] = u + slope * h;
+                s.input.set(t_end, self.values[0], slope);
+                return Ok(());
+            }
+            Ok(sol) => format!(
+                "the rig stopped the run at t = {} s",
+                sol.t.last().copied().unwrap_or(t)
+            ),
+            Err(e) => format!("solver {}: {e}", method.name()),
+        };
+        let state: Vec<String> = s
+            .circuit
+            .state_names()
+            .iter()
+            .zip(&s.x)
+            .map(|(n, v)| format!("{n} = {v:e}"))
+            .collect();
+        self.phase = Phase::Failed;
+        Err(format!(
+            "step from t = {t} s to {t_end} s failed: {failure}; state at t = {t} s: {}",
+            state.join(", ")
+        ))
+    }
+
+    fn index(&self, sp: SolverParam) -> usize {
+        self.vars
+            .list
+            .iter()
+            .position(|v| v.role == Role::Solver(sp))
+            .unwrap_or(0)
+    }
+
+    /// Marks the instance failed (after a caught panic).
+    pub fn fail(&mut self) {
+        self.phase = Phase::Failed;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn vr(s: &Slave, name: &str) -> u32 {
+        s.variables()
+            .list
+            .iter()
+            .position(|v| v.name == name)
+            .unwrap() as u32
+    }
+
+    #[test]
+    fn solver_failure_is_an_error_with_time_and_state() {
+        let mut s = Slave::new(rig::preset("leaney-moog").unwrap()).unwrap();
+        // a tolerance no step can meet: the step size falls below its minimum
+        s.set_real(vr(&s, "solver.rtol"), 1e-300).unwrap();
+        s.enter_initialization().unwrap();
+        s.exit_initialization().unwrap();
+        s.set_real(vr(&s, "command"), 0.5).unwrap();
+        let e = s.do_step(0.0, 1.0).unwrap_err();
+        assert!(e.contains("solver dp45") && e.contains("t = 0 s"), "{e}");
+        assert!(e.contains("load.") && e.contains("cylinder."), "{e}");
+        assert_eq!(s.phase(), Phase::Failed);
+        assert!(s.do_step(0.0, 1e-3).is_err());
+        s.reset();
+        assert_eq!(s.phase(), Phase::Instantiated);
+    }
+
+    #[test]
+    fn parameters_are_checked_by_the_rig_and_outputs_follow_them() {
+        let mut s = Slave::new(rig::preset("leaney-moog").unwrap()).unwrap();
+        let e = s.set_real(vr(&s, "cylinder.area_1"), 0.0).unwrap_err();
+        assert!(e.contains("cylinder.area_1"), "{e}");
+        // an initial state is a parameter; the output at the start follows it
+        s.set_real(vr(&s, "cylinder.initial.p1"), 2e6).unwrap();
+        s.enter_initialization().unwrap();
+        assert_eq!(s.get_real(vr(&s, "p1")).unwrap(), 2e6);
+        s.set_real(vr(&s, "cylinder.initial.p1"), 3e6).unwrap();
+        assert_eq!(s.get_real(vr(&s, "p1")).unwrap(), 3e6);
+        assert!(s.set_real(vr(&s, "load.mass"), f64::NAN).is_err());
+    }
+}

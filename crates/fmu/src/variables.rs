@@ -1,0 +1,254 @@
+//! The FMU's variables, made from a rig: the command input, one output per
+//! output channel of the rig's circuit, the solver parameters and one
+//! parameter per numeric rig parameter. The model description and the slave
+//! both make this table from the same rig, so their value references agree
+//! (the GUID checks it: [`crate::model_description`]).
+
+use crate::units::{parameter_unit, unit_name};
+use hydrocyl_system::external::ExternalInput;
+use hydrocyl_system::rig::{self, RigError};
+use hydrocyl_system::run::{RunOptions, Solver};
+use hydrocyl_system::signal::Signal;
+use hydrocyl_system::{Circuit, Probe};
+use serde_json::Value;
+
+/// The name of the input variable (and of the circuit's command signal,
+/// whose own output channel the input replaces).
+pub const INPUT: &str = "command";
+
+/// The solver methods by their `solver.method` number.
+pub const METHODS: [Solver; 3] = [Solver::Dp45, Solver::Rosenbrock, Solver::Rk4];
+
+/// A solver setting exposed as a parameter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SolverParam {
+    /// `solver.method`: index into [`METHODS`].
+    Method,
+    /// `solver.rtol`: relative tolerance.
+    Rtol,
+    /// `solver.h_max`: largest step \[s\].
+    HMax,
+    /// `solver.rk4_step`: fixed step of RK4 \[s\].
+    Rk4Step,
+}
+
+/// What a variable is.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Role {
+    /// The command (causality input).
+    Input,
+    /// Output channel `i` of [`Variables::outputs`].
+    Output(usize),
+    /// A solver setting.
+    Solver(SolverParam),
+    /// A rig parameter by its `--set` path.
+    Parameter(String),
+}
+
+/// One scalar variable; its value reference is its index in
+/// [`Variables::list`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Variable {
+    /// Name (a rig parameter's path, an output channel's name, ...).
+    pub name: String,
+    /// What it is.
+    pub role: Role,
+    /// `Integer` instead of `Real` (only `solver.method`).
+    pub integer: bool,
+    /// Start value (inputs and parameters); `NaN` for a rig parameter left
+    /// `null` (computed by the rig, e.g. a steady initial pressure).
+    pub start: f64,
+    /// Unit name (see [`crate::units`]).
+    pub unit: Option<&'static str>,
+    /// One line for the model description.
+    pub description: String,
+    /// For an output: it changes with the input at the same instant
+    /// (direct feedthrough); found by evaluating the circuit.
+    pub feedthrough: bool,
+}
+
+/// All variables of the FMU of one rig.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Variables {
+    /// The variables, value reference = index.
+    pub list: Vec<Variable>,
+    /// Output channel names and units, in output order.
+    pub outputs: Vec<(String, &'static str)>,
+}
+
+/// The circuit's output channels in the order of a run's channels
+/// (position, velocity, p1, p2, then the others in component order, as
+/// `hydrocyl_system::run::run` orders them), without the command (it is the
+/// FMU's input).
+pub fn output_channels(circuit: &Circuit) -> Vec<Probe> {
+    const ORDER: [&str; 4] = ["position", "velocity", "p1", "p2"];
+    let mut out: Vec<Probe> = circuit
+        .probes()
+        .into_iter()
+        .filter(|p| p.name != INPUT)
+        .collect();
+    out.sort_by_key(|p| {
+        ORDER
+            .iter()
+            .position(|o| *o == p.name)
+            .unwrap_or(ORDER.len())
+    });
+    out
+}
+
+/// The circuit of `rig` driven by an external input (whose handle is returned).
+pub fn circuit_with_input(rig: &Value) -> Result<(Circuit, ExternalInput), RigError> {
+    let input = ExternalInput::new();
+    let c = rig::circuit(rig, Signal::External(input.clone()))?;
+    Ok((c, input))
+}
+
+impl Variables {
+    /// The variables of the FMU of `rig` (checked here).
+    pub fn of(rig: &Value) -> Result<Self, RigError> {
+        rig::check(rig)?;
+        let (circuit, input) = circuit_with_input(rig)?;
+        let probes = output_channels(&circuit);
+        // direct feedthrough: does the output change with the input at a fixed state?
+        let x0 = circuit.initial_state();
+        let wires: Vec<_> = probes.iter().map(|p| p.wire).collect();
+        let read = |u: f64| {
+            input.set(0.0, u, 0.0);
+            let mut row = vec![0.0; wires.len()];
+            circuit.read_wires(0.0, &x0, &wires, &mut row);
+            row
+        };
+        let (lo, hi) = (read(-0.5), read(0.5));
+        let mut list = vec![Variable {
+            name: INPUT.into(),
+            role: Role::Input,
+            integer: false,
+            start: 0.0,
+            unit: None,
+            description: "the rig's command (normalised spool demand of a valve rig, drive voltage of a pump rig); linear inside a step with fmi2SetRealInputDerivatives".into(),
+            feedthrough: false,
+        }];
+        for (i, p) in probes.iter().enumerate() {
+            list.push(Variable {
+                name: p.name.clone(),
+                role: Role::Output(i),
+                integer: false,
+                start: f64::NAN,
+                unit: unit_name(p.unit),
+                description: format!("output channel `{}`", p.name),
+                feedthrough: lo[i] != hi[i],
+            });
+        }
+        let d = RunOptions::default();
+        let solver = |name: &str, sp, start, unit, description: &str| Variable {
+            name: name.into(),
+            role: Role::Solver(sp),
+            integer: sp == SolverParam::Method,
+            start,
+            unit,
+            description: description.into(),
+            feedthrough: false,
+        };
+        list.push(solver(
+            "solver.method",
+            SolverParam::Method,
+            0.0,
+            None,
+            "integration method: 0 dp45 (Dormand-Prince 5(4)), 1 rosenbrock (stiff Rodas4), 2 rk4 (fixed step)",
+        ));
+        list.push(solver(
+            "solver.rtol",
+            SolverParam::Rtol,
+            d.rtol,
+            None,
+            "relative tolerance of the adaptive methods (absolute: rtol times each state's scale)",
+        ));
+        list.push(solver(
+            "solver.h_max",
+            SolverParam::HMax,
+            d.h_max,
+            Some("s"),
+            "largest internal step of the adaptive methods",
+        ));
+        list.push(solver(
+            "solver.rk4_step",
+            SolverParam::Rk4Step,
+            d.rk4_step,
+            Some("s"),
+            "fixed internal step of rk4",
+        ));
+        for p in rig::parameters(rig) {
+            list.push(Variable {
+                description: match p.value {
+                    Some(_) => format!("rig parameter `{}`", p.path),
+                    None => format!(
+                        "rig parameter `{}`; NaN (the start) leaves it to the rig (null in the rig file)",
+                        p.path
+                    ),
+                },
+                name: p.path.clone(),
+                unit: parameter_unit(&p),
+                role: Role::Parameter(p.path),
+                integer: false,
+                start: p.value.unwrap_or(f64::NAN),
+                feedthrough: false,
+            });
+        }
+        let mut names: Vec<&str> = list.iter().map(|v| v.name.as_str()).collect();
+        names.sort_unstable();
+        if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+            return Err(RigError::Invalid {
+                path: w[0].into(),
+                why: "two FMU variables would have this name".into(),
+            });
+        }
+        Ok(Self {
+            list,
+            outputs: probes.iter().map(|p| (p.name.clone(), p.unit)).collect(),
+        })
+    }
+
+    /// The variable with value reference `vr`.
+    pub fn get(&self, vr: u32) -> Option<&Variable> {
+        self.list.get(vr as usize)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_are_the_channels_of_a_run_and_parameters_are_the_rigs() {
+        for preset in rig::PRESETS {
+            let rig = (preset.json)();
+            let v = Variables::of(&rig).unwrap();
+            assert_eq!(v.list[0].role, Role::Input);
+            // the outputs are the run's channels without the command, same order
+            let run = rig::simulate(
+                &rig,
+                Signal::Constant { value: 0.1 },
+                &[0.0, 0.01],
+                &RunOptions::default(),
+            )
+            .unwrap();
+            let names: Vec<&str> = run
+                .channels
+                .iter()
+                .map(|c| c.name.as_str())
+                .filter(|n| *n != INPUT)
+                .collect();
+            let ours: Vec<&str> = v.outputs.iter().map(|(n, _)| n.as_str()).collect();
+            assert_eq!(ours, names, "{}", preset.name);
+            let n_par = v
+                .list
+                .iter()
+                .filter(|x| matches!(x.role, Role::Parameter(_)))
+                .count();
+            assert_eq!(n_par, rig::parameters(&rig).len(), "{}", preset.name);
+        }
+        // the spool lags the command: nothing feeds through
+        let v = Variables::of(&rig::preset("leaney-moog").unwrap()).unwrap();
+        assert!(v.list.iter().all(|x| !x.feedthrough));
+    }
+}

@@ -54,6 +54,7 @@ pub mod catalog;
 pub mod data;
 pub mod diagnose;
 pub mod lm;
+pub mod plaincsv;
 pub mod smooth;
 pub mod synth;
 pub mod valve;

@@ -9,6 +9,7 @@
 //! Every section prints only what it measured in this run.
 
 mod bench;
+mod bench_solve;
 mod energy;
 mod report;
 mod validate;

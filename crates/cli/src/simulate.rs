@@ -4,7 +4,7 @@
 //! ```text
 //! hydrocyl simulate --rig leaney-moog --command cmd.csv --out run.csv \
 //!     [--set load.mass=50] [--set cylinder.initial.p1=2e6] \
-//!     [--solver dp45|rosenbrock|rk4] [--rtol 1e-6] [--print-rig]
+//!     [--solver auto|dp45|rosenbrock|rk4] [--rtol 1e-6] [--print-rig] [--fsync]
 //! ```
 //!
 //! The command file is CSV with a `time` column (`time`, `time [s]` or
@@ -16,11 +16,14 @@
 //! its motion instead: see [`crate::bench_sim`]. A `hybrid-variant` rig file
 //! (chapter 8's circuit improvements) runs on its base rig with the variant's
 //! components swapped in. It is written to a temporary file in
-//! the output's folder and renamed into place, so a failed run leaves no file.
+//! the output's folder and renamed into place, so a failed run leaves no file
+//! (`--fsync` also flushes it to the disk first; without it the operating
+//! system writes it back when it likes, as for any ordinary file).
 
 use crate::error::CliError;
 use hydrocyl_energy::variant::{self, HybridVariant};
 use hydrocyl_identify::bench::{self, FrictionBench};
+use hydrocyl_identify::plaincsv::{run_columns, write_columns_in_parts, PlainCsv};
 use hydrocyl_system::hybrid::WangHybrid;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{self as runner, Run, RunOptions, Solver};
@@ -45,8 +48,9 @@ pub struct Args {
     /// or `--set initial.p1=2.5e6` (repeatable).
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
-    /// Integration method: dp45 (default), rosenbrock or rk4.
-    #[arg(long, default_value = "dp45")]
+    /// Integration method: auto (default: dp45 while the run is not stiff,
+    /// rosenbrock while it is), dp45, rosenbrock or rk4.
+    #[arg(long, default_value = "auto")]
     solver: String,
     /// Relative tolerance of the adaptive methods.
     #[arg(long, default_value_t = 1e-6)]
@@ -57,25 +61,20 @@ pub struct Args {
     /// Print the rig (after --set) as JSON and exit.
     #[arg(long)]
     print_rig: bool,
+    /// Flush the output to the disk (fsync) before it is renamed into place.
+    #[arg(long)]
+    fsync: bool,
 }
 
-/// Reads the command CSV: `(time [s], command)`; errors name file, row and column.
-pub fn read_command(path: &Path) -> Result<(Vec<f64>, Vec<f64>), CliError> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| CliError::Io {
-        path: file.clone(),
-        source,
-    })?;
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
-    let headers = rdr
-        .headers()
-        .map_err(|e| CliError::Input(format!("{file}: row 1: {e}")))?
-        .clone();
+/// The `time` column (index, factor to seconds) and the `command` column
+/// among `headers`.
+fn command_columns<'a>(
+    file: &str,
+    headers: impl Iterator<Item = &'a str>,
+) -> Result<(usize, f64, usize), CliError> {
     let mut time_col = None;
     let mut cmd_col = None;
-    for (i, h) in headers.iter().enumerate() {
+    for (i, h) in headers.enumerate() {
         let (name, unit) = match h.find('[') {
             Some(o) if h.ends_with(']') => (h[..o].trim(), Some(h[o + 1..h.len() - 1].trim())),
             _ => (h.trim(), None),
@@ -99,6 +98,45 @@ pub fn read_command(path: &Path) -> Result<(Vec<f64>, Vec<f64>), CliError> {
     }
     let (ti, tf) = time_col.ok_or_else(|| CliError::Input(format!("{file}: no `time` column")))?;
     let ci = cmd_col.ok_or_else(|| CliError::Input(format!("{file}: no `command` column")))?;
+    Ok((ti, tf, ci))
+}
+
+/// The fast path of [`read_command`] for plain numeric CSV
+/// ([`hydrocyl_identify::plaincsv`]); `None` sends the text to the full
+/// reader, which also reports every error.
+fn read_command_plain(file: &str, text: &str) -> Option<(Vec<f64>, Vec<f64>)> {
+    let csv = PlainCsv::new(text)?;
+    let (ti, tf, ci) = command_columns(file, csv.headers()).ok()?;
+    let mut cols = csv.columns(&[ti, ci])?;
+    let u = cols.pop()?;
+    let mut t = cols.pop()?;
+    if tf != 1.0 {
+        t.iter_mut().for_each(|v| *v *= tf);
+    }
+    if t.len() < 2 || t.windows(2).any(|w| w[1] <= w[0]) {
+        return None;
+    }
+    Some((t, u))
+}
+
+/// Reads the command CSV: `(time [s], command)`; errors name file, row and column.
+pub fn read_command(path: &Path) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| CliError::Io {
+        path: file.clone(),
+        source,
+    })?;
+    if let Some(r) = read_command_plain(&file, &text) {
+        return Ok(r);
+    }
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let headers = rdr
+        .headers()
+        .map_err(|e| CliError::Input(format!("{file}: row 1: {e}")))?
+        .clone();
+    let (ti, tf, ci) = command_columns(&file, headers.iter())?;
     let (mut t, mut u) = (Vec::new(), Vec::new());
     for (k, rec) in rdr.records().enumerate() {
         let row = k + 2;
@@ -137,26 +175,24 @@ pub fn read_command(path: &Path) -> Result<(Vec<f64>, Vec<f64>), CliError> {
     Ok((t, u))
 }
 
-/// The run as CSV text in the measured-data format.
-pub fn to_csv(run: &Run) -> String {
-    let mut s = String::from("time");
-    for c in &run.channels {
-        s.push(',');
-        s.push_str(&c.name);
-    }
-    s.push('\n');
-    for (k, t) in run.time.iter().enumerate() {
-        s.push_str(&format!("{t:?}"));
-        for c in &run.channels {
-            s.push_str(&format!(",{:?}", c.values[k]));
-        }
-        s.push('\n');
-    }
-    s
+/// The run as CSV text in the measured-data format (shortest round-trip
+/// numbers, [`hydrocyl_identify::plaincsv::write_columns`]), in consecutive
+/// parts formatted in parallel on the machine's cores.
+pub fn to_csv(run: &Run) -> Vec<Vec<u8>> {
+    let (names, columns) = run_columns(run);
+    // threads pay for themselves from a few thousand rows on
+    let parts = if run.time.len() < 4096 {
+        1
+    } else {
+        std::thread::available_parallelism().map_or(1, |n| n.get().min(8))
+    };
+    write_columns_in_parts(&names, &columns, parts)
 }
 
-/// Writes `text` to `path` through a temporary file in the same folder.
-fn write_atomic(path: &Path, text: &str) -> Result<(), CliError> {
+/// Writes `parts` (one after the other) to `path` through a temporary file in
+/// the same folder (renamed into place, so a failure leaves no half-written
+/// file); with `fsync` the data is flushed to the disk before the rename.
+fn write_atomic(path: &Path, parts: &[&[u8]], fsync: bool) -> Result<(), CliError> {
     let io = |source| CliError::Io {
         path: path.display().to_string(),
         source,
@@ -170,7 +206,15 @@ fn write_atomic(path: &Path, text: &str) -> Result<(), CliError> {
         std::process::id()
     ));
     let result = std::fs::File::create(&tmp)
-        .and_then(|mut f| f.write_all(text.as_bytes()).and_then(|_| f.sync_all()))
+        .and_then(|mut f| {
+            for p in parts {
+                f.write_all(p)?;
+            }
+            if fsync {
+                f.sync_all()?;
+            }
+            Ok(())
+        })
         .and_then(|_| std::fs::rename(&tmp, path));
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
@@ -235,7 +279,7 @@ fn run_bench(args: &Args, value: &serde_json::Value) -> Result<(), CliError> {
         return Err(CliError::Input("--command and --out are required".into()));
     };
     let text = crate::bench_sim::simulate(&bench, input)?;
-    write_atomic(out, &text)?;
+    write_atomic(out, &[text.as_bytes()], args.fsync)?;
     eprintln!(
         "hydrocyl: simulated the friction bench on {} samples of {}",
         text.lines().count() - 1,
@@ -280,7 +324,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let solver = Solver::parse(&args.solver).ok_or_else(|| {
         CliError::Input(format!(
-            "--solver: unknown method `{}` (use dp45, rosenbrock or rk4)",
+            "--solver: unknown method `{}` (use auto, dp45, rosenbrock or rk4)",
             args.solver
         ))
     })?;
@@ -312,12 +356,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
         None => rig::simulate(&value, signal, &t, &opts).map_err(rig_err)?,
         Some((base, v)) => simulate_variant(&base, &v, signal, &t, &opts)?,
     };
-    write_atomic(&out, &to_csv(&run))?;
+    let parts = to_csv(&run);
+    let parts: Vec<&[u8]> = parts.iter().map(Vec::as_slice).collect();
+    write_atomic(&out, &parts, args.fsync)?;
     let cav = run.cavitation_entries();
     eprintln!(
-        "hydrocyl: simulated {:.4} s in {:.3} s ({} steps, {} rejected, {} rhs); {}",
+        "hydrocyl: simulated {:.4} s in {:.3} s ({} {}: {} steps, {} rejected, {} rhs); {}",
         t[t.len() - 1] - t[0],
         run.wall.as_secs_f64(),
+        solver.name(),
+        run.stats.choice(),
         run.stats.steps,
         run.stats.rejected,
         run.stats.rhs_evals,

@@ -72,7 +72,7 @@ mod closed_forms {
             let opts = RunOptions {
                 ledger: true,
                 rtol: 1e-8,
-                ..RunOptions::default()
+                ..RunOptions::dp45()
             };
             let x0 = c.initial_state();
             let r = run(&mut c, &x0, &t, &opts).unwrap();
@@ -123,7 +123,7 @@ mod closed_forms {
             .unwrap();
             let t: Vec<f64> = (0..=100).map(|k| k as f64 * 5e-3).collect();
             let x0 = c.initial_state();
-            let r = run(&mut c, &x0, &t, &RunOptions::default()).unwrap();
+            let r = run(&mut c, &x0, &t, &RunOptions::dp45()).unwrap();
             let pv = *r.channel("pv").unwrap().last().unwrap();
             if charges {
                 assert!(
@@ -497,7 +497,7 @@ mod bad_input {
         let mut c = charging_circuit(1e6, 1e-4, 7e8, Box::new(orifice));
         let t = [0.0, 0.01, 0.02];
         let x0 = c.initial_state();
-        let r = run(&mut c, &x0, &t, &RunOptions::default()).unwrap();
+        let r = run(&mut c, &x0, &t, &RunOptions::dp45()).unwrap();
         let e = ledger(&c, &r, 0, 2, &RodSide::default()).unwrap_err();
         assert!(e.to_string().contains("ledger: true"), "{e}");
     }

@@ -11,6 +11,8 @@ use std::fmt;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
+
+use crate::plaincsv::PlainCsv;
 use thiserror::Error;
 
 /// A signal of the measured-data format.
@@ -258,6 +260,67 @@ fn split_header(h: &str) -> (String, Option<String>) {
     (h.to_string(), None)
 }
 
+/// The columns of a header: which signal each holds and its SI factor.
+struct Columns {
+    /// Column index → (signal, SI factor).
+    cols: Vec<Option<(Signal, f64)>>,
+    /// Signal → column index.
+    seen: BTreeMap<Signal, usize>,
+    /// Headers of the columns that are not signals.
+    ignored: Vec<String>,
+}
+
+/// Finds the signals among `headers` (trimmed), directly or through `map`.
+fn map_columns(file: &str, headers: &[&str], map: &ColumnMap) -> Result<Columns, DataError> {
+    let mut cols: Vec<Option<(Signal, f64)>> = vec![None; headers.len()];
+    let mut seen: BTreeMap<Signal, usize> = BTreeMap::new();
+    let mut ignored = Vec::new();
+    // Mapped signals first: header name → (signal, unit).
+    let mut mapped: BTreeMap<String, (Signal, Option<String>)> = BTreeMap::new();
+    for (sig, spec) in &map.0 {
+        let (name, unit) = split_header(spec);
+        mapped.insert(name, (*sig, unit));
+    }
+    for (j, h) in headers.iter().enumerate() {
+        let (name, unit) = split_header(h);
+        let hit = if let Some((sig, munit)) = mapped.get(h.trim()).or_else(|| mapped.get(&name)) {
+            // A mapped header: the map's unit wins, else the header's own.
+            Some((*sig, munit.clone().or(unit)))
+        } else {
+            Signal::from_name(&name)
+                .filter(|s| !map.0.contains_key(s))
+                .map(|s| (s, unit))
+        };
+        match hit {
+            Some((sig, unit)) => {
+                let factor = match &unit {
+                    None => 1.0,
+                    Some(u) => sig.unit_factor(u).ok_or_else(|| DataError::UnknownUnit {
+                        file: file.to_string(),
+                        column: h.to_string(),
+                        unit: u.clone(),
+                        accepted: sig.accepted_units().to_string(),
+                    })?,
+                };
+                if seen.insert(sig, j).is_some() {
+                    return Err(DataError::DuplicateSignal {
+                        file: file.to_string(),
+                        column: h.to_string(),
+                        signal: sig.name().to_string(),
+                    });
+                }
+                cols[j] = Some((sig, factor));
+            }
+            None => ignored.push(h.to_string()),
+        }
+    }
+    Ok(Columns {
+        cols,
+        seen,
+        ignored,
+    })
+}
+
 /// Minimum number of samples of a usable record.
 pub const MIN_SAMPLES: usize = 8;
 
@@ -277,8 +340,13 @@ impl Record {
         Self::parse(&file, &text, map)
     }
 
-    /// Parses CSV text; `file` names it in errors.
+    /// Parses CSV text; `file` names it in errors. Plain numeric text takes
+    /// the fast path of [`crate::plaincsv`]; anything else (and every error)
+    /// goes through the full CSV reader.
     pub fn parse(file: &str, text: &str, map: &ColumnMap) -> Result<Record, DataError> {
+        if let Some(r) = Self::parse_plain(file, text, map) {
+            return Ok(r);
+        }
         let mut rdr = csv::ReaderBuilder::new()
             .has_headers(true)
             .trim(csv::Trim::All)
@@ -298,50 +366,12 @@ impl Record {
                 reason: "empty header".into(),
             });
         }
-        // Column index → (signal, SI factor).
-        let mut cols: Vec<Option<(Signal, f64)>> = vec![None; headers.len()];
-        let mut seen: BTreeMap<Signal, usize> = BTreeMap::new();
-        let mut ignored = Vec::new();
-        // Mapped signals first: header name → (signal, unit).
-        let mut mapped: BTreeMap<String, (Signal, Option<String>)> = BTreeMap::new();
-        for (sig, spec) in &map.0 {
-            let (name, unit) = split_header(spec);
-            mapped.insert(name, (*sig, unit));
-        }
-        for (j, h) in headers.iter().enumerate() {
-            let (name, unit) = split_header(h);
-            let hit = if let Some((sig, munit)) = mapped.get(h.trim()).or_else(|| mapped.get(&name))
-            {
-                // A mapped header: the map's unit wins, else the header's own.
-                Some((*sig, munit.clone().or(unit)))
-            } else {
-                Signal::from_name(&name)
-                    .filter(|s| !map.0.contains_key(s))
-                    .map(|s| (s, unit))
-            };
-            match hit {
-                Some((sig, unit)) => {
-                    let factor = match &unit {
-                        None => 1.0,
-                        Some(u) => sig.unit_factor(u).ok_or_else(|| DataError::UnknownUnit {
-                            file: file.to_string(),
-                            column: h.to_string(),
-                            unit: u.clone(),
-                            accepted: sig.accepted_units().to_string(),
-                        })?,
-                    };
-                    if seen.insert(sig, j).is_some() {
-                        return Err(DataError::DuplicateSignal {
-                            file: file.to_string(),
-                            column: h.to_string(),
-                            signal: sig.name().to_string(),
-                        });
-                    }
-                    cols[j] = Some((sig, factor));
-                }
-                None => ignored.push(h.to_string()),
-            }
-        }
+        let header_list: Vec<&str> = headers.iter().collect();
+        let Columns {
+            cols,
+            seen,
+            ignored,
+        } = map_columns(file, &header_list, map)?;
         let time_col = match seen.get(&Signal::Time) {
             Some(&j) => j,
             None => {
@@ -419,6 +449,46 @@ impl Record {
             });
         }
         Ok(Record {
+            source: file.to_string(),
+            time,
+            signals,
+            ignored,
+        })
+    }
+
+    /// The fast path of [`Record::parse`]: `None` whenever the text is not
+    /// plain numeric CSV or anything is wrong with it (the full reader then
+    /// reports what).
+    fn parse_plain(file: &str, text: &str, map: &ColumnMap) -> Option<Record> {
+        let csv = PlainCsv::new(text)?;
+        let headers: Vec<&str> = csv.headers().collect();
+        let Columns {
+            cols,
+            seen,
+            ignored,
+        } = map_columns(file, &headers, map).ok()?;
+        let time_col = *seen.get(&Signal::Time)?;
+        let wanted: Vec<usize> = std::iter::once(time_col)
+            .chain(seen.values().copied().filter(|&j| j != time_col))
+            .collect();
+        let mut values = csv.columns(&wanted)?.into_iter();
+        let scale = |j: usize, mut v: Vec<f64>| {
+            let factor = cols[j].map_or(1.0, |(_, f)| f);
+            if factor != 1.0 {
+                v.iter_mut().for_each(|x| *x *= factor);
+            }
+            v
+        };
+        let time = scale(time_col, values.next()?);
+        if time.len() < MIN_SAMPLES || time.windows(2).any(|w| w[1] <= w[0]) {
+            return None;
+        }
+        let mut signals = BTreeMap::new();
+        for (&j, v) in wanted[1..].iter().zip(values) {
+            let (sig, _) = cols[j]?;
+            signals.insert(sig, scale(j, v));
+        }
+        Some(Record {
             source: file.to_string(),
             time,
             signals,

@@ -57,6 +57,7 @@ pub mod data;
 pub mod data_checks;
 pub mod diagnose;
 pub mod lm;
+pub mod plaincsv;
 pub mod smooth;
 pub mod synth;
 pub mod valve;

@@ -375,7 +375,7 @@ pub fn valve_record_with(
             &t,
             &hydrocyl_system::run::RunOptions {
                 rtol: 1e-8,
-                ..Default::default()
+                ..hydrocyl_system::run::RunOptions::dp45()
             },
         )
         .map_err(|e| e.to_string())?;

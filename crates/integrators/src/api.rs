@@ -74,6 +74,12 @@ pub enum Method {
     Rosenbrock,
     /// Classical Runge–Kutta 4 with a fixed step (`Options::h0`).
     Rk4,
+    /// Automatic choice: Dormand–Prince 5(4) while the problem is not stiff,
+    /// Rodas4 while it is, switched by the stiffness the run shows (DP45's
+    /// step held by its stability region; the Jacobian's spectral radius
+    /// against the Rosenbrock step). [`Stats::stiff_steps`] and
+    /// [`Stats::switches`] say what it chose.
+    Auto,
 }
 
 /// Solver settings.
@@ -128,6 +134,30 @@ pub struct Stats {
     pub lu_decomps: usize,
     /// Events located and handled.
     pub events: usize,
+    /// Accepted steps taken by the stiff method (all of them for
+    /// [`Method::Rosenbrock`], none for the explicit methods, the stiff share
+    /// for [`Method::Auto`]).
+    pub stiff_steps: usize,
+    /// Switches between the explicit and the stiff method ([`Method::Auto`]).
+    pub switches: usize,
+}
+
+impl Stats {
+    /// What the solve used: `explicit`, `stiff`, or `explicit+stiff` with
+    /// the number of switches and the stiff share of the steps.
+    pub fn choice(&self) -> String {
+        if self.stiff_steps == 0 {
+            "explicit".into()
+        } else if self.stiff_steps == self.steps && self.switches == 0 {
+            "stiff".into()
+        } else {
+            format!(
+                "explicit+stiff ({} switches, {:.0} % of the steps stiff)",
+                self.switches,
+                100.0 * self.stiff_steps as f64 / self.steps.max(1) as f64
+            )
+        }
+    }
 }
 
 /// One located event.

@@ -66,6 +66,29 @@ impl DormandPrince {
     }
 }
 
+impl DormandPrince {
+    /// `‖f(y₇) − f(y₆)‖ / ‖y₇ − y₆‖` of the last attempted step, over the
+    /// first `w.len()` states weighted by `w`: both stages sit at `t + h`, so
+    /// the ratio estimates the Jacobian's dominant eigenvalue magnitude
+    /// (Hairer, Nørsett & Wanner I, §II.10). Call before [`Stepper::accept`]
+    /// (which moves the last stage to the first for FSAL). 0 when `y₇ = y₆`.
+    pub(crate) fn stiffness_ratio(&self, x_new: &[f64], w: &[f64]) -> f64 {
+        let (k6, k7, y6) = (&self.k[5], &self.k[6], &self.y);
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..w.len() {
+            let df = (k7[i] - k6[i]) * w[i];
+            let dy = (x_new[i] - y6[i]) * w[i];
+            num += df * df;
+            den += dy * dy;
+        }
+        if den > 0.0 {
+            (num / den).sqrt()
+        } else {
+            0.0
+        }
+    }
+}
+
 impl Stepper for DormandPrince {
     fn adaptive(&self) -> bool {
         true

@@ -58,6 +58,14 @@ pub(crate) trait Stepper {
 
     /// The dense output at `theta = (τ - t)/h ∈ [0, 1]` of the last accepted step.
     fn dense(&self, theta: f64, out: &mut [f64]);
+
+    /// A stepper that changes its method between steps (the automatic
+    /// choice) returns, once, after deciding to: the step-size controller of
+    /// the method now in use and the largest step to continue with. Asked
+    /// before every step.
+    fn switch(&mut self) -> Option<(Controller, f64)> {
+        None
+    }
 }
 
 /// How a step attempt went.
@@ -70,7 +78,7 @@ pub(crate) enum Attempt {
 }
 
 /// Step-size controller of an adaptive method.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Controller {
     /// Proportional–integral controller (Hairer, Nørsett & Wanner I, §II.4):
     /// `h_new = h · safe · err^(-α) · err_prev^(β)`, `α = 1/q − 0.75 β`,
@@ -478,6 +486,11 @@ pub(crate) fn run<S: OdeSystem + ?Sized, St: Stepper>(
                 t,
                 max: opts.max_steps,
             });
+        }
+        if let Some((c, h_cap)) = stepper.switch() {
+            ctrl = ControlState::new(c);
+            stats.switches += 1;
+            h = h.min(h_cap);
         }
         if fresh {
             stepper.restart();

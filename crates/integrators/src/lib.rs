@@ -18,6 +18,13 @@
 //!   differences otherwise;
 //! * [`Method::Rk4`] — classical fixed-step Runge–Kutta 4 (`Options::h0` is
 //!   the step), with a cubic Hermite interpolant, for cross-checks;
+//! * [`Method::Auto`] — DP45 while the problem is not stiff, Rodas4 while it
+//!   is: DP45's step held on its stability boundary (Hairer's test,
+//!   `h ‖f(y₇) − f(y₆)‖ / ‖y₇ − y₆‖ > 3.25` for 15 steps) switches to
+//!   Rodas4; a Rosenbrock step at which DP45 would be stable (power-iteration
+//!   spectral radius of the Jacobian, `h ρ(J) ≤ 2` for 25 steps) switches
+//!   back. [`Stats::stiff_steps`] and [`Stats::switches`] report the choice;
+//!   a run that never switches is the DP45 run exactly;
 //!
 //! and **event location**: the model declares switching functions
 //! ([`OdeSystem::events`]); the solver finds each sign change to
@@ -133,6 +140,7 @@
 #![warn(missing_docs)]
 
 mod api;
+mod auto;
 
 pub use api::*;
 mod dopri;
@@ -172,7 +180,7 @@ pub fn solve<S: OdeSystem + ?Sized>(
     match method {
         Method::DormandPrince45 => driver::run(
             dopri::DormandPrince::new(n),
-            Controller::Pi { q: 5.0, beta: 0.04 },
+            auto::DP_CONTROLLER,
             5.0,
             sys,
             t0,
@@ -182,8 +190,18 @@ pub fn solve<S: OdeSystem + ?Sized>(
         ),
         Method::Rosenbrock => driver::run(
             rodas::Rodas4::new(n, sys.n_quadratures().min(n)),
-            Controller::Predictive { q: 4.0 },
+            auto::RODAS_CONTROLLER,
             4.0,
+            sys,
+            t0,
+            x0,
+            t_end,
+            opts,
+        ),
+        Method::Auto => driver::run(
+            auto::Auto::new(n, sys.n_quadratures().min(n)),
+            auto::DP_CONTROLLER,
+            5.0,
             sys,
             t0,
             x0,

@@ -150,6 +150,17 @@ impl Rodas4 {
         }
     }
 
+    /// Number of states.
+    pub(crate) fn dim(&self) -> usize {
+        self.n
+    }
+
+    /// The Jacobian at the start of the last attempted step, row-major
+    /// (`dim × dim`; the quadrature columns are zero).
+    pub(crate) fn jacobian(&self) -> &[f64] {
+        &self.jac
+    }
+
     /// `f(t, x)`, `∂f/∂t` and `∂f/∂x` at the step start.
     fn linearise<S: OdeSystem + ?Sized>(
         &mut self,
@@ -342,8 +353,9 @@ impl Stepper for Rodas4 {
         x: &[f64],
         _h: f64,
         x_new: &[f64],
-        _stats: &mut Stats,
+        stats: &mut Stats,
     ) {
+        stats.stiff_steps += 1;
         let [k1, k2, k3, k4, k5, _] = &self.k;
         let [c1, c2, c3, c4] = &mut self.cont;
         for i in 0..self.n {

@@ -1,5 +1,6 @@
 //! hydrocyl-integrators' integration tests, in one binary to save link time.
 
+mod auto;
 mod common;
 mod convergence;
 mod dense;

@@ -118,7 +118,7 @@
 //! let (bias, amplitude) = rig.open_loop_square(0.09).unwrap();
 //! let cmd = Signal::Square { amplitude, period_s: 2.0, bias };
 //! let t: Vec<f64> = (0..=100).map(|k| k as f64 * 0.01).collect();
-//! let run = rig.simulate(cmd, &t, &RunOptions::default()).unwrap();
+//! let run = rig.simulate(cmd, &t, &RunOptions::default()).unwrap(); // automatic solver choice
 //! let v = run.channel("velocity").unwrap();
 //! assert!((v[90] - 0.09).abs() < 0.005); // extending at 90 mm/s after 0.9 s
 //! ```

@@ -28,7 +28,12 @@ pub enum SimError {
 /// The integration method, by the names the CLI accepts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Solver {
-    /// Dormand–Prince 5(4) (default; Simulink's ode45, the thesis's solver).
+    /// Automatic (default): Dormand–Prince 5(4) while the problem is not
+    /// stiff, Rosenbrock while it is, switched by the stiffness the run shows
+    /// ([`Method::Auto`]; the choice is in [`Stats::stiff_steps`] and
+    /// [`Stats::switches`]).
+    Auto,
+    /// Dormand–Prince 5(4) (Simulink's ode45, the thesis's solver).
     Dp45,
     /// Stiff Rosenbrock.
     Rosenbrock,
@@ -40,6 +45,7 @@ impl Solver {
     /// The integrator crate's method.
     pub fn method(self) -> Method {
         match self {
+            Solver::Auto => Method::Auto,
             Solver::Dp45 => Method::DormandPrince45,
             Solver::Rosenbrock => Method::Rosenbrock,
             Solver::Rk4 => Method::Rk4,
@@ -48,14 +54,16 @@ impl Solver {
     /// The CLI name.
     pub fn name(self) -> &'static str {
         match self {
+            Solver::Auto => "auto",
             Solver::Dp45 => "dp45",
             Solver::Rosenbrock => "rosenbrock",
             Solver::Rk4 => "rk4",
         }
     }
-    /// Parses a CLI name (`dp45`, `rosenbrock`, `rk4`).
+    /// Parses a CLI name (`auto`, `dp45`, `rosenbrock`, `rk4`).
     pub fn parse(s: &str) -> Option<Self> {
         match s {
+            "auto" => Some(Solver::Auto),
             "dp45" => Some(Solver::Dp45),
             "rosenbrock" => Some(Solver::Rosenbrock),
             "rk4" => Some(Solver::Rk4),
@@ -84,12 +92,23 @@ pub struct RunOptions {
 impl Default for RunOptions {
     fn default() -> Self {
         Self {
-            solver: Solver::Dp45,
+            solver: Solver::Auto,
             rtol: 1e-6,
             h_max: 1e-2,
             rk4_step: 2e-5,
             quadratures: false,
             ledger: false,
+        }
+    }
+}
+
+impl RunOptions {
+    /// The defaults with Dormand–Prince 5(4) named: for results that must
+    /// stay those of the thesis's solver whatever the default choice is.
+    pub fn dp45() -> Self {
+        Self {
+            solver: Solver::Dp45,
+            ..Self::default()
         }
     }
 }

@@ -300,17 +300,55 @@ impl Signal {
                 if t >= time_s[n - 1] {
                     return value[n - 1];
                 }
-                let mut i = hint.get().min(n - 2);
-                if !(time_s[i] <= t && t < time_s[i + 1]) {
-                    // binary search: largest i with time_s[i] <= t
-                    i = time_s.partition_point(|&s| s <= t) - 1;
-                    hint.set(i);
-                }
+                let i = table_interval(time_s, t, hint.get().min(n - 2));
+                hint.set(i);
                 let (t0, t1) = (time_s[i], time_s[i + 1]);
                 value[i] + (value[i + 1] - value[i]) * (t - t0) / (t1 - t0)
             }
         }
     }
+}
+
+/// The interval `i` of a table with `time_s[i] <= t < time_s[i + 1]`, for
+/// `time_s[0] < t < time_s[n − 1]`, searched outwards from the interval
+/// `from` (the last one used): doubling steps bracket `t`, a binary search
+/// inside the bracket finishes. Costs `O(log d)` for a distance of `d`
+/// intervals — constant for an integrator marching through the table,
+/// whatever its length (a search from the start would cost `O(log n)` with a
+/// cache miss a probe, and made the cost per step grow with the record).
+#[inline]
+fn table_interval(time_s: &[f64], t: f64, from: usize) -> usize {
+    let n = time_s.len();
+    if time_s[from] <= t && t < time_s[from + 1] {
+        return from;
+    }
+    let (lo, hi) = if t >= time_s[from + 1] {
+        // forward: time_s[lo] <= t < time_s[hi]
+        let (mut lo, mut step) = (from + 1, 1);
+        loop {
+            let hi = lo + step;
+            if hi >= n - 1 {
+                break (lo, n - 1);
+            }
+            if time_s[hi] > t {
+                break (lo, hi);
+            }
+            lo = hi;
+            step *= 2;
+        }
+    } else {
+        // backward: time_s[lo] <= t < time_s[hi]
+        let (mut hi, mut step) = (from, 1);
+        loop {
+            let lo = hi.saturating_sub(step);
+            if lo == 0 || time_s[lo] <= t {
+                break (lo, hi);
+            }
+            hi = lo;
+            step *= 2;
+        }
+    };
+    lo + time_s[lo..hi].partition_point(|&s| s <= t) - 1
 }
 
 #[cfg(test)]
@@ -378,6 +416,16 @@ mod tests {
             let hint = Cell::new(h);
             let expect = 3.0 * t.clamp(ts[0], ts[10]) - 2.0;
             prop_assert!((s.value_hinted(t, &hint) - expect).abs() < 1e-12);
+        }
+
+        /// The search from the last interval finds the interval a binary
+        /// search from the start finds, from any starting interval.
+        #[test]
+        fn interval_search_from_the_hint(t in 0.0f64..1000.0, from in 0usize..1000) {
+            let ts: Vec<f64> = (0..1001).map(|i| i as f64 + 0.5 * ((i * 7) % 3) as f64 / 3.0).collect();
+            prop_assume!(t > ts[0] && t < ts[1000]);
+            let expect = ts.partition_point(|&s| s <= t) - 1;
+            prop_assert_eq!(table_interval(&ts, t, from), expect);
         }
     }
 }

@@ -164,7 +164,7 @@ fn closed_form_rest_state_in_the_underlap_is_stationary() {
         .simulate(
             Signal::Constant { value: u },
             &times(1.0, 0.01),
-            &RunOptions::default(),
+            &RunOptions::dp45(),
         )
         .unwrap();
     let v = run.channel("velocity").unwrap();
@@ -194,7 +194,7 @@ fn open_loop_bias_gives_symmetric_velocity() {
     );
     let r = case
         .rig
-        .simulate(case.command.clone(), &case.times, &RunOptions::default())
+        .simulate(case.command.clone(), &case.times, &RunOptions::dp45())
         .unwrap();
     let v = r.channel("velocity").unwrap();
     // end of each half period: steady ±90 mm/s
@@ -215,7 +215,7 @@ fn chamber_mass_balance_closes() {
     let x0 = c.initial_state();
     let opts = RunOptions {
         quadratures: true,
-        ..RunOptions::default()
+        ..RunOptions::dp45()
     };
     let r = run(&mut c, &x0, &case.times, &opts).unwrap();
     let cyl = case.rig.cylinder_model();
@@ -257,7 +257,7 @@ fn power_terms_balance_at_every_state_of_a_run() {
     let t = times(2.0, 0.05);
     let mut c = rig.circuit(cmd.clone()).unwrap();
     let x0 = c.initial_state();
-    let r = run(&mut c, &x0, &t, &RunOptions::default()).unwrap();
+    let r = run(&mut c, &x0, &t, &RunOptions::dp45()).unwrap();
     for k in 0..r.time.len() {
         let p = c.power_terms(r.time[k], r.state(k));
         let src: f64 = p.iter().map(|p| p.source).sum();
@@ -275,7 +275,7 @@ fn formulations_agree_on_the_square_wave() {
     let case = chapter3::square_wave().unwrap();
     let opts = RunOptions {
         rtol: 1e-8,
-        ..RunOptions::default()
+        ..RunOptions::dp45()
     };
     let cmp = chapter3::Comparison::run(&case, &opts).unwrap();
     for ch in chapter3::COMPARED {
@@ -294,7 +294,7 @@ fn swapping_spool_order_and_friction_keeps_the_steady_velocity() {
     let cmd = Signal::Constant { value: 0.2 };
     let base = ValveRig::leaney_moog();
     let v0 = *base
-        .simulate(cmd.clone(), &t, &RunOptions::default())
+        .simulate(cmd.clone(), &t, &RunOptions::dp45())
         .unwrap()
         .channel("velocity")
         .unwrap()
@@ -306,7 +306,7 @@ fn swapping_spool_order_and_friction_keeps_the_steady_velocity() {
         damping_ratio: 0.7,
     };
     let r2 = second
-        .simulate(cmd.clone(), &t, &RunOptions::default())
+        .simulate(cmd.clone(), &t, &RunOptions::dp45())
         .unwrap();
     assert!(
         (r2.channel("velocity").unwrap().last().unwrap() - v0).abs() < 1e-6 * v0.abs().max(1.0)
@@ -321,7 +321,7 @@ fn swapping_spool_order_and_friction_keeps_the_steady_velocity() {
     );
     let mut lugre = base.clone();
     lugre.friction = FrictionLaw::LuGre(LuGre::table_5_11());
-    let r3 = lugre.simulate(cmd, &t, &RunOptions::default()).unwrap();
+    let r3 = lugre.simulate(cmd, &t, &RunOptions::dp45()).unwrap();
     let v3 = *r3.channel("velocity").unwrap().last().unwrap();
     let vs = lugre.steady_velocity(xs).unwrap();
     assert!((v3 / vs - 1.0).abs() < 1e-3, "LuGre: {v3} vs steady {vs}");
@@ -374,7 +374,7 @@ fn cavitation_is_reported() {
         .simulate(
             Signal::Constant { value: 0.0 },
             &times(0.3, 1e-3),
-            &RunOptions::default(),
+            &RunOptions::dp45(),
         )
         .unwrap();
     assert!(r.min_chamber_pressure() < 0.0);
@@ -384,7 +384,7 @@ fn cavitation_is_reported() {
         .simulate(
             Signal::Constant { value: 0.1 },
             &times(0.3, 1e-3),
-            &RunOptions::default(),
+            &RunOptions::dp45(),
         )
         .unwrap();
     assert_eq!(q.cavitation_entries(), 0);
@@ -397,11 +397,9 @@ fn generalised_form_is_exact_outside_the_underlap_at_steady_state() {
     let t = times(1.0, 0.01);
     let cmd = Signal::Constant { value: 0.15 };
     let mut rig = ValveRig::leaney_moog();
-    let f = rig
-        .simulate(cmd.clone(), &t, &RunOptions::default())
-        .unwrap();
+    let f = rig.simulate(cmd.clone(), &t, &RunOptions::dp45()).unwrap();
     rig.cylinder.formulation = Formulation::GeneralisedAnalytical;
-    let g = rig.simulate(cmd, &t, &RunOptions::default()).unwrap();
+    let g = rig.simulate(cmd, &t, &RunOptions::dp45()).unwrap();
     let n = t.len() - 1;
     for ch in ["p1", "p2", "velocity"] {
         let (a, b) = (f.channel(ch).unwrap()[n], g.channel(ch).unwrap()[n]);
@@ -420,23 +418,23 @@ fn bad_run_inputs_are_errors_not_panics() {
     let rig = ValveRig::leaney_moog();
     let cmd = Signal::Constant { value: 0.1 };
     assert!(rig
-        .simulate(cmd.clone(), &[0.0], &RunOptions::default())
+        .simulate(cmd.clone(), &[0.0], &RunOptions::dp45())
         .is_err());
     assert!(rig
-        .simulate(cmd.clone(), &[0.0, 0.1, 0.1], &RunOptions::default())
+        .simulate(cmd.clone(), &[0.0, 0.1, 0.1], &RunOptions::dp45())
         .is_err());
     let e = rig
         .simulate(
             Signal::Constant { value: f64::NAN },
             &[0.0, 0.1],
-            &RunOptions::default(),
+            &RunOptions::dp45(),
         )
         .unwrap_err();
     assert!(e.to_string().contains("command"), "{e}");
     let mut c = rig.circuit(cmd).unwrap();
     assert_eq!(c.dim(), c.n_states());
     let x0 = vec![0.0; 2];
-    assert!(run(&mut c, &x0, &[0.0, 1.0], &RunOptions::default()).is_err());
+    assert!(run(&mut c, &x0, &[0.0, 1.0], &RunOptions::dp45()).is_err());
 }
 
 mod invariants {
@@ -517,7 +515,7 @@ fn sine_run(rig: &ValveRig) -> hydrocyl_system::run::Run {
         bias: 0.0,
         phase_rad: 0.0,
     };
-    rig.simulate(cmd, &times(1.0, 1e-3), &RunOptions::default())
+    rig.simulate(cmd, &times(1.0, 1e-3), &RunOptions::dp45())
         .unwrap()
 }
 
@@ -579,7 +577,7 @@ fn power_terms_balance_with_supply_droop() {
     let t = times(1.0, 0.05);
     let mut c = rig.circuit(cmd).unwrap();
     let x0 = c.initial_state();
-    let r = run(&mut c, &x0, &t, &RunOptions::default()).unwrap();
+    let r = run(&mut c, &x0, &t, &RunOptions::dp45()).unwrap();
     for k in 0..r.time.len() {
         let p = c.power_terms(r.time[k], r.state(k));
         let src: f64 = p.iter().map(|p| p.source).sum();

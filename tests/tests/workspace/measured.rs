@@ -64,7 +64,7 @@ fn simulate_leaney_moog(amplitude: f64, period_s: f64, bias: f64) -> hydrocyl_sy
         bias,
         phase_rad: 0.0,
     };
-    rig::simulate(&v, cmd, &t, &RunOptions::default()).unwrap()
+    rig::simulate(&v, cmd, &t, &RunOptions::dp45()).unwrap()
 }
 
 proptest! {

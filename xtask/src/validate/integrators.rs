@@ -104,6 +104,7 @@ fn name(method: Method) -> &'static str {
         Method::DormandPrince45 => "Dormand-Prince 5(4)",
         Method::Rosenbrock => "Rodas4",
         Method::Rk4 => "RK4",
+        Method::Auto => "automatic (DP45/Rodas4)",
     }
 }
 

@@ -44,7 +44,7 @@ pub fn section() -> Section {
     }
     let opts = RunOptions {
         rtol: RTOL,
-        ..RunOptions::default()
+        ..RunOptions::dp45()
     };
     let cases = [
         chapter3::square_wave(),
@@ -241,7 +241,7 @@ fn run_sweep(sweep_s: f64) -> Result<Sweep, String> {
     let case = chapter3::underlap_sweep(sweep_s).map_err(|e| e.to_string())?;
     let opts = RunOptions {
         rtol: RTOL,
-        ..RunOptions::default()
+        ..RunOptions::dp45()
     };
     let r = case
         .rig
@@ -390,7 +390,7 @@ fn balances(s: &mut Section) {
         rtol: RTOL,
         quadratures: true,
         ledger: true,
-        ..RunOptions::default()
+        ..RunOptions::dp45()
     };
     let r = match run(&mut c, &x0, &case.times, &opts) {
         Ok(r) => r,
@@ -470,7 +470,7 @@ fn regularisation(s: &mut Section) {
     let case = chapter3::end_stop();
     let opts = RunOptions {
         rtol: RTOL,
-        ..RunOptions::default()
+        ..RunOptions::dp45()
     };
     let sim = |dpt: f64| {
         let mut rig = case.rig.clone();

@@ -1,0 +1,280 @@
+//! The fast path for reading and writing numeric CSV: one pass over the
+//! bytes, no allocation per row, shortest round-trip float text.
+//!
+//! Measured records and command files are almost always *plain*: no quotes,
+//! one header line, then rows of numbers separated by commas. [`PlainCsv`]
+//! reads exactly those and gives up (returns `None`) at the first thing it
+//! does not handle — a quote, a byte-order mark, a blank line inside the data,
+//! a row with the wrong number of cells, a cell that is not a finite number.
+//! The caller then re-reads the text with the full CSV reader (the `csv`
+//! crate), which accepts everything else and writes the error messages (file,
+//! row, column). So the fast path changes speed only: the values it returns
+//! are the ones `str::parse::<f64>` gives for the trimmed cells, as on the
+//! full path, and every error comes from the full path.
+//!
+//! Numbers are parsed with the standard library's `f64::from_str`, which is
+//! the Eisel–Lemire / `fast_float` algorithm; they are written with
+//! [`zmij`] (shortest text that parses back to the same `f64`).
+
+/// A CSV text without quoting, split into its header and its data lines.
+#[derive(Clone, Debug)]
+pub struct PlainCsv<'a> {
+    header: &'a str,
+    body: &'a str,
+}
+
+/// One line without its terminator (`\n` or `\r\n`).
+fn strip_cr(line: &str) -> &str {
+    line.strip_suffix('\r').unwrap_or(line)
+}
+
+impl<'a> PlainCsv<'a> {
+    /// The text as plain CSV, or `None` when it needs the full reader
+    /// (quotes, a byte-order mark, a lone `\r`, no header line).
+    pub fn new(text: &'a str) -> Option<Self> {
+        if text.starts_with('\u{feff}') {
+            return None;
+        }
+        // one pass: no quote, no lone carriage return (a line end to the full reader)
+        let bytes = text.as_bytes();
+        for (i, &b) in bytes.iter().enumerate() {
+            if b == b'"' || (b == b'\r' && bytes.get(i + 1) != Some(&b'\n')) {
+                return None;
+            }
+        }
+        let (header, body) = match text.find('\n') {
+            Some(i) => (strip_cr(&text[..i]), &text[i + 1..]),
+            None => (strip_cr(text), ""),
+        };
+        if header.trim().is_empty() {
+            return None;
+        }
+        Some(Self { header, body })
+    }
+
+    /// The header cells, trimmed.
+    pub fn headers(&self) -> impl Iterator<Item = &'a str> {
+        self.header.split(',').map(str::trim)
+    }
+
+    /// Number of header cells.
+    pub fn width(&self) -> usize {
+        self.header.split(',').count()
+    }
+
+    /// Reads the columns `wanted` (indices into the header; each becomes one
+    /// output vector, in the order given) from every data row. `None` when a
+    /// row has a number of cells other than the header's, a blank line
+    /// precedes more data, or a wanted cell is not a finite number.
+    pub fn columns(&self, wanted: &[usize]) -> Option<Vec<Vec<f64>>> {
+        let width = self.width();
+        // column index → output slot
+        let mut slot = vec![usize::MAX; width];
+        for (k, &j) in wanted.iter().enumerate() {
+            *slot.get_mut(j)? = k;
+        }
+        let rows_hint = self.body.len() / (8 * width).max(1) + 1;
+        let mut out: Vec<Vec<f64>> = wanted
+            .iter()
+            .map(|_| Vec::with_capacity(rows_hint))
+            .collect();
+        // one pass over the bytes; `,` and `\n` are ASCII, so every cut is
+        // on a character boundary
+        let (text, b) = (self.body, self.body.as_bytes());
+        let len = b.len();
+        let mut pos = 0;
+        while pos < len {
+            if b[pos] == b'\n' || b[pos] == b'\r' {
+                // the full reader skips blank lines, which shifts its row
+                // numbers away from the line numbers: only a blank end is plain
+                if b[pos..].iter().all(|&c| c == b'\n' || c == b'\r') {
+                    break;
+                }
+                return None;
+            }
+            let mut n = 0;
+            loop {
+                let start = pos;
+                while pos < len && b[pos] != b',' && b[pos] != b'\n' {
+                    pos += 1;
+                }
+                let at_line_end = pos == len || b[pos] == b'\n';
+                let end = if at_line_end && pos > start && b[pos - 1] == b'\r' {
+                    pos - 1
+                } else {
+                    pos
+                };
+                let k = *slot.get(n)?;
+                if k != usize::MAX {
+                    let v: f64 = text[start..end].trim().parse().ok()?;
+                    if !v.is_finite() {
+                        return None;
+                    }
+                    out[k].push(v);
+                }
+                n += 1;
+                pos += 1;
+                if at_line_end {
+                    break;
+                }
+            }
+            if n != width {
+                return None;
+            }
+        }
+        Some(out)
+    }
+}
+
+/// Appends `v` as the shortest decimal text that parses back to `v`.
+#[inline]
+pub fn push_f64(out: &mut Vec<u8>, buf: &mut zmij::Buffer, v: f64) {
+    out.extend_from_slice(buf.format(v).as_bytes());
+}
+
+/// The columns of a run in the measured-data format: `time`, then every
+/// channel, names and values.
+pub fn run_columns(run: &hydrocyl_system::run::Run) -> (Vec<&str>, Vec<&[f64]>) {
+    let names = std::iter::once("time")
+        .chain(run.channels.iter().map(|c| c.name.as_str()))
+        .collect();
+    let columns = std::iter::once(run.time.as_slice())
+        .chain(run.channels.iter().map(|c| c.values.as_slice()))
+        .collect();
+    (names, columns)
+}
+
+/// Appends rows `rows` of `columns` as CSV lines (shortest round-trip text).
+fn write_rows(columns: &[&[f64]], rows: std::ops::Range<usize>, out: &mut Vec<u8>) {
+    out.reserve(rows.len() * columns.len() * 22);
+    let mut buf = zmij::Buffer::new();
+    for k in rows {
+        for (j, c) in columns.iter().enumerate() {
+            if j > 0 {
+                out.push(b',');
+            }
+            push_f64(out, &mut buf, c[k]);
+        }
+        out.push(b'\n');
+    }
+}
+
+/// CSV text of a table: the header `names` (comma-separated), then one row
+/// per entry of `columns[0]`, each value as its shortest round-trip text.
+/// All columns must have the same length.
+pub fn write_columns(names: &[&str], columns: &[&[f64]]) -> Vec<u8> {
+    write_columns_in_parts(names, columns, 1)
+        .pop()
+        .unwrap_or_default()
+}
+
+/// [`write_columns`] formatted by `parts` threads, each a contiguous block of
+/// rows (the header goes with the first): the parts, in order, are the text.
+/// Writing them one after the other spares the copy of a concatenation.
+pub fn write_columns_in_parts(names: &[&str], columns: &[&[f64]], parts: usize) -> Vec<Vec<u8>> {
+    let rows = columns.first().map_or(0, |c| c.len());
+    let parts = parts.clamp(1, rows.max(1));
+    let mut head = names.join(",").into_bytes();
+    head.push(b'\n');
+    let bounds: Vec<usize> = (0..=parts).map(|i| i * rows / parts).collect();
+    let mut out: Vec<Vec<u8>> = vec![Vec::new(); parts];
+    out[0] = head;
+    if parts == 1 {
+        write_rows(columns, 0..rows, &mut out[0]);
+        return out;
+    }
+    std::thread::scope(|s| {
+        for (i, o) in out.iter_mut().enumerate() {
+            let range = bounds[i]..bounds[i + 1];
+            s.spawn(move || write_rows(columns, range, o));
+        }
+    });
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The full reader's view of the same text (trimmed cells, numbers).
+    fn full(text: &str, wanted: &[usize]) -> Option<Vec<Vec<f64>>> {
+        let mut rdr = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes());
+        let mut out = vec![Vec::new(); wanted.len()];
+        for rec in rdr.records() {
+            let rec = rec.ok()?;
+            for (k, &j) in wanted.iter().enumerate() {
+                let v: f64 = rec.get(j)?.parse().ok()?;
+                if !v.is_finite() {
+                    return None;
+                }
+                out[k].push(v);
+            }
+        }
+        Some(out)
+    }
+
+    #[test]
+    fn reads_plain_and_declines_the_rest() {
+        let t = "time [s], command ,x\r\n0,1.5,a\n0.001, -2e-3 ,b\n\n";
+        let p = PlainCsv::new(t).unwrap();
+        assert_eq!(
+            p.headers().collect::<Vec<_>>(),
+            ["time [s]", "command", "x"]
+        );
+        let c = p.columns(&[1, 0]).unwrap();
+        assert_eq!(c, vec![vec![1.5, -2e-3], vec![0.0, 0.001]]);
+        assert!(PlainCsv::new("\"time\",u\n0,1\n").is_none());
+        assert!(PlainCsv::new("time,u\r0,1\r").is_none());
+        let p = PlainCsv::new("time,u\n0,1\n\n1,2\n").unwrap();
+        assert!(p.columns(&[0, 1]).is_none(), "blank line inside the data");
+        let p = PlainCsv::new("time,u\n0,1\n1\n").unwrap();
+        assert!(p.columns(&[0]).is_none(), "ragged row");
+        let p = PlainCsv::new("time,u\n0,NaN\n").unwrap();
+        assert!(p.columns(&[1]).is_none(), "not finite");
+        assert!(p.columns(&[0]).is_some(), "unwanted cells are not parsed");
+    }
+
+    #[test]
+    fn written_text_reads_back_exactly() {
+        let a = [0.0, 1e-300, -3.25, 1.0 / 3.0, 6.02e23];
+        let b = [f64::MIN_POSITIVE, -0.0, 7e6, 2.5e-9, 1e16];
+        let text = String::from_utf8(write_columns(&["a", "b"], &[&a, &b])).unwrap();
+        for parts in 1..=4 {
+            let p = write_columns_in_parts(&["a", "b"], &[&a, &b], parts).concat();
+            assert_eq!(String::from_utf8(p).unwrap(), text, "{parts} parts");
+        }
+        let c = PlainCsv::new(&text).unwrap().columns(&[0, 1]).unwrap();
+        assert_eq!(c[0], a);
+        assert_eq!(
+            c[1].iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            b.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+        );
+    }
+
+    proptest! {
+        /// Wherever the fast path answers, it answers what the full reader does.
+        #[test]
+        fn agrees_with_the_full_reader(
+            rows in proptest::collection::vec(
+                (-1e9f64..1e9, prop_oneof![Just(" "), Just(""), Just("\t")], 0u8..8), 0..20),
+            crlf in any::<bool>(),
+        ) {
+            let nl = if crlf { "\r\n" } else { "\n" };
+            let mut text = format!("time, u{nl}");
+            for (v, pad, kind) in &rows {
+                match kind {
+                    0 => text.push_str(&format!("{v}{nl}")),            // ragged
+                    1 => text.push_str(&format!("{v},x{nl}")),          // not a number
+                    2 => text.push_str(nl),                             // blank line
+                    _ => text.push_str(&format!("{pad}{v:e}{pad},{v}{nl}")),
+                }
+            }
+            if let Some(fast) = PlainCsv::new(&text).and_then(|p| p.columns(&[0, 1])) {
+                prop_assert_eq!(Some(fast), full(&text, &[0, 1]));
+            }
+        }
+    }
+}

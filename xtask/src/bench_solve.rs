@@ -1,0 +1,438 @@
+//! `cargo xtask bench`, the user-facing speed of issue 19: the valve rig's
+//! work-precision table, the cost per step against the simulated time, the
+//! automatic solver choice on the hybrid rig, CSV reading and writing against
+//! the previous per-row implementation, and the whole `hydrocyl simulate`
+//! process. Every ratio is against a reference run in the same run.
+
+use hydrocyl_identify::plaincsv::{run_columns, write_columns, PlainCsv};
+use hydrocyl_integrators::Method;
+use hydrocyl_system::hybrid::chapter7::{Chapter7Test, Load, Shape};
+use hydrocyl_system::run::{nrmse, Run, RunOptions, Solver};
+use hydrocyl_system::signal::Signal;
+use hydrocyl_system::valve_rig::ValveRig;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+/// The issue's case: `leaney-moog`, open-loop square ±90 mm/s (period 2 s)
+/// as a 1 kHz command table, output at the same 1 kHz times.
+struct SquareCase {
+    rig: ValveRig,
+    times: Vec<f64>,
+    command: Signal,
+}
+
+fn square_case(t_end: f64) -> Result<SquareCase, String> {
+    let rig = ValveRig::leaney_moog();
+    let (bias, amplitude) = rig.open_loop_square(0.09).map_err(|e| e.to_string())?;
+    let n = (t_end * 1e3).round() as usize;
+    let times: Vec<f64> = (0..=n).map(|k| k as f64 * 1e-3).collect();
+    let values = times
+        .iter()
+        .map(|t| {
+            if (t / 2.0).rem_euclid(1.0) < 0.5 {
+                bias + amplitude
+            } else {
+                bias - amplitude
+            }
+        })
+        .collect();
+    let command = Signal::table(times.clone(), values).map_err(|e| e.to_string())?;
+    Ok(SquareCase {
+        rig,
+        times,
+        command,
+    })
+}
+
+impl SquareCase {
+    fn run(&self, solver: Solver, rtol: f64) -> Result<Run, String> {
+        let opts = RunOptions {
+            solver,
+            rtol,
+            ..RunOptions::default()
+        };
+        self.rig
+            .simulate(self.command.clone(), &self.times, &opts)
+            .map_err(|e| e.to_string())
+    }
+
+    /// The fastest of `reps` runs (the solve's own wall time).
+    fn best(&self, solver: Solver, rtol: f64, reps: usize) -> Result<Run, String> {
+        let mut best: Option<Run> = None;
+        for _ in 0..reps {
+            let r = self.run(solver, rtol)?;
+            if best.as_ref().is_none_or(|b| r.wall < b.wall) {
+                best = Some(r);
+            }
+        }
+        best.ok_or_else(|| "no run".into())
+    }
+}
+
+/// Work-precision table of the valve rig, 10 s: wall time, steps and the
+/// NRMSE of every channel against a DP45 run at rtol 1e-11 in this run.
+fn work_precision() -> Result<(), String> {
+    let case = square_case(10.0)?;
+    let reference = case.run(Solver::Dp45, 1e-11)?;
+    let names: Vec<&str> = reference
+        .channels
+        .iter()
+        .map(|c| c.name.as_str())
+        .filter(|n| *n != "command" && *n != "ps")
+        .collect();
+    println!(
+        "valve rig work-precision, leaney-moog 10 s open-loop square, 1 kHz command and output; NRMSE against DP45 at rtol 1e-11 ({} steps):",
+        reference.stats.steps
+    );
+    let mut head = format!(
+        "  {:<10} {:>6} {:>8} {:>7} {:>6}",
+        "solver", "rtol", "ms", "steps", "stiff"
+    );
+    for n in &names {
+        head.push_str(&format!(" {:>9}", truncate(n, 9)));
+    }
+    println!("{head}");
+    let mut goal: Option<(f64, f64)> = None;
+    for solver in [Solver::Auto, Solver::Dp45, Solver::Rosenbrock] {
+        for k in 3..=9 {
+            let rtol = 10f64.powi(-k);
+            let reps = if k <= 7 { 5 } else { 2 };
+            let r = case.best(solver, rtol, reps)?;
+            let ms = r.wall.as_secs_f64() * 1e3;
+            let mut line = format!(
+                "  {:<10} {:>6.0e} {:>8.3} {:>7} {:>6}",
+                solver.name(),
+                rtol,
+                ms,
+                r.stats.steps,
+                r.stats.stiff_steps
+            );
+            for n in &names {
+                let e = match (r.channel(n), reference.channel(n)) {
+                    (Some(a), Some(b)) => nrmse(a, b),
+                    _ => f64::NAN,
+                };
+                line.push_str(&format!(" {e:>9.1e}"));
+            }
+            println!("{line}");
+            let v = nrmse(
+                r.channel("velocity").unwrap_or(&[]),
+                reference.channel("velocity").unwrap_or(&[]),
+            );
+            if solver == Solver::Dp45 && v <= 1e-4 && goal.is_none_or(|(m, _)| ms < m) {
+                goal = Some((ms, rtol));
+            }
+        }
+    }
+    match goal {
+        Some((ms, rtol)) => println!(
+            "  fastest DP45 run at velocity NRMSE <= 1e-4: {ms:.3} ms (rtol {rtol:.0e}; goal <= 1 ms)"
+        ),
+        None => println!("  no DP45 run reached velocity NRMSE <= 1e-4"),
+    }
+    Ok(())
+}
+
+fn truncate(s: &str, n: usize) -> &str {
+    &s[..s.len().min(n)]
+}
+
+/// Minor page faults of this process so far (`/proc/self/stat`, field 10),
+/// `None` where there is no procfs.
+fn minor_faults() -> Option<u64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // the command name may hold spaces: count fields after its closing ')'
+    let rest = &stat[stat.rfind(')')? + 2..];
+    rest.split(' ').nth(7)?.parse().ok()
+}
+
+/// Cost per step (solve wall / attempted steps) in records of 1, 10, 100
+/// and 1000 s, DP45 at rtol 1e-5 on the 1 kHz square with 1 kHz output. Each
+/// length runs 1000 simulated seconds in all (1000 runs of 1 s, ..., one of
+/// 1000 s), so every row does the same work; the ratio to the 1 s cost says
+/// whether anything grows with the record. The page faults per step show
+/// the cost of first touching the output's memory, which a long record
+/// cannot reuse from an earlier run.
+fn cost_per_step() -> Result<(), String> {
+    println!("valve rig cost per step, DP45 rtol 1e-5, 1 kHz command and output, 1000 s simulated per row:");
+    let mut base = None;
+    for t_end in [1.0, 10.0, 100.0, 1000.0] {
+        let case = square_case(t_end)?;
+        let runs = (1000.0 / t_end) as usize;
+        case.run(Solver::Dp45, 1e-5)?; // warm-up
+        let (mut wall, mut steps) = (0.0, 0usize);
+        let f0 = minor_faults();
+        for _ in 0..runs {
+            let r = case.run(Solver::Dp45, 1e-5)?;
+            wall += r.wall.as_secs_f64();
+            steps += r.stats.steps + r.stats.rejected;
+        }
+        let faults = match (f0, minor_faults()) {
+            (Some(a), Some(b)) => format!("{:.3}", (b - a) as f64 / steps as f64),
+            _ => "?".into(),
+        };
+        let us = wall * 1e6 / steps as f64;
+        let b = *base.get_or_insert(us);
+        println!(
+            "  {t_end:>6.0} s x {runs:>4}: {:>8.1} ms, {steps:>7} steps, {us:.3} µs/step, / 1 s {:.2} (goal <= 1.10); page faults/step {faults}",
+            wall * 1e3,
+            us / b
+        );
+    }
+    Ok(())
+}
+
+/// The chapter-7 0.2 Hz square of the hybrid rig (15 s) with each method:
+/// the automatic choice against the best fixed one.
+fn hybrid_solver_choice() -> Result<(), String> {
+    let test = Chapter7Test::new(Shape::Square, Load::None);
+    let mut rows = Vec::new();
+    for (name, method, reps) in [
+        ("auto", Method::Auto, 3),
+        ("rosenbrock", Method::Rosenbrock, 3),
+        ("dp45", Method::DormandPrince45, 1),
+    ] {
+        let mut best = f64::INFINITY;
+        let mut outcome = Err(String::new());
+        for _ in 0..reps {
+            let t0 = Instant::now();
+            outcome = test
+                .run_with(method)
+                .map(|r| r.stats)
+                .map_err(|e| e.to_string());
+            best = best.min(t0.elapsed().as_secs_f64());
+        }
+        rows.push((name, best, outcome));
+    }
+    let fixed = rows[1..]
+        .iter()
+        .filter(|r| r.2.is_ok())
+        .map(|r| r.1)
+        .fold(f64::INFINITY, f64::min);
+    println!("hybrid rig chapter-7 square (15 s), each method (incl. measuring the phenomena):");
+    for (name, wall, outcome) in &rows {
+        match outcome {
+            Ok(s) => println!(
+                "  {name:<10} {:>8.1} ms  {:>7} steps  {:<45}  / best fixed {:.2}{}",
+                wall * 1e3,
+                s.steps,
+                s.choice(),
+                wall / fixed,
+                if *name == "auto" {
+                    " (goal <= 1.5)"
+                } else {
+                    ""
+                }
+            ),
+            Err(e) => println!("  {name:<10} {:>8.1} ms  fails: {e}", wall * 1e3),
+        }
+    }
+    Ok(())
+}
+
+/// Median of `f`'s per-call time \[ns\] over 7 repetitions after a warm-up.
+fn median_ns(mut f: impl FnMut() -> usize) -> f64 {
+    std::hint::black_box(f());
+    let mut v: Vec<f64> = (0..7)
+        .map(|_| {
+            let t0 = Instant::now();
+            std::hint::black_box(f());
+            t0.elapsed().as_secs_f64() * 1e9
+        })
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v[3]
+}
+
+/// CSV per row: the plain-CSV path against the previous implementation
+/// (the `csv` crate's records with `str::parse`; `format!("{:?}")` per cell).
+fn csv_per_row() -> Result<(), String> {
+    let case = square_case(10.0)?;
+    let run = case.run(Solver::Dp45, 1e-5)?;
+    let (names, columns) = run_columns(&run);
+    let rows = run.time.len() as f64;
+    let write_new = median_ns(|| write_columns(&names, &columns).len()) / rows;
+    let write_old = median_ns(|| {
+        let mut s = names.join(",");
+        s.push('\n');
+        for k in 0..run.time.len() {
+            s.push_str(&format!("{:?}", columns[0][k]));
+            for c in &columns[1..] {
+                s.push_str(&format!(",{:?}", c[k]));
+            }
+            s.push('\n');
+        }
+        s.len()
+    }) / rows;
+    let text = String::from_utf8(write_columns(&names, &columns)).map_err(|e| e.to_string())?;
+    let wanted: Vec<usize> = (0..names.len()).collect();
+    let read_new = median_ns(|| {
+        PlainCsv::new(&text)
+            .and_then(|p| p.columns(&wanted))
+            .map_or(0, |c| c.len())
+    }) / rows;
+    let read_old = median_ns(|| {
+        let mut rdr = csv_reader(&text);
+        let mut cols = vec![Vec::new(); wanted.len()];
+        for rec in rdr.records().flatten() {
+            for (j, c) in cols.iter_mut().enumerate() {
+                c.push(rec[j].parse::<f64>().unwrap_or(f64::NAN));
+            }
+        }
+        cols.len()
+    }) / rows;
+    let Signal::Table { time_s, value } = &case.command else {
+        return Err("not a table".into());
+    };
+    let cmd = String::from_utf8(write_columns(&["time", "command"], &[time_s, value]))
+        .map_err(|e| e.to_string())?;
+    let cmd_rows = time_s.len() as f64;
+    let cmd_new = median_ns(|| {
+        PlainCsv::new(&cmd)
+            .and_then(|p| p.columns(&[0, 1]))
+            .map_or(0, |c| c.len())
+    }) / cmd_rows;
+    let cmd_old = median_ns(|| {
+        let mut rdr = csv_reader(&cmd);
+        let (mut t, mut u) = (Vec::new(), Vec::new());
+        for rec in rdr.records().flatten() {
+            t.push(rec[0].parse::<f64>().unwrap_or(f64::NAN));
+            u.push(rec[1].parse::<f64>().unwrap_or(f64::NAN));
+        }
+        t.len() + u.len()
+    }) / cmd_rows;
+    println!(
+        "CSV, 1 kHz command file (time, command): read {cmd_new:.0} ns/row (previous {cmd_old:.0}, {:.1}x faster); goal >= 10x",
+        cmd_old / cmd_new
+    );
+    println!(
+        "CSV, {} columns: write {write_new:.0} ns/row (previous {write_old:.0}, {:.1}x faster); read {read_new:.0} ns/row (previous {read_old:.0}, {:.1}x faster); goal >= 10x",
+        names.len(),
+        write_old / write_new,
+        read_old / read_new
+    );
+    Ok(())
+}
+
+fn csv_reader(text: &str) -> csv::Reader<&[u8]> {
+    csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes())
+}
+
+/// The `hydrocyl` binary: `$HYDROCYL_BIN`, else built now in this profile.
+fn hydrocyl_binary() -> Result<PathBuf, String> {
+    if let Ok(p) = std::env::var("HYDROCYL_BIN") {
+        return Ok(PathBuf::from(p));
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .ok_or("no workspace root")?;
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let st = Command::new(cargo)
+        .args([
+            "build",
+            "--quiet",
+            "-p",
+            "hydrocyl-cli",
+            "--bin",
+            "hydrocyl",
+        ])
+        .current_dir(root)
+        .status()
+        .map_err(|e| e.to_string())?;
+    if !st.success() {
+        return Err("cargo build -p hydrocyl-cli failed".into());
+    }
+    let target = std::env::var("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| root.join("target"));
+    Ok(target.join("debug").join("hydrocyl"))
+}
+
+/// The whole `hydrocyl simulate` process on the 1 kHz 10 s and 100 s
+/// command files (1 kHz output), against the process doing nothing
+/// (`hydrocyl --version`): median and fastest of 21 runs.
+fn whole_process() -> Result<(), String> {
+    let bin = hydrocyl_binary()?;
+    let dir = std::env::temp_dir().join(format!("hydrocyl-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let time = |args: &[&str]| -> Result<(f64, f64), String> {
+        let mut v = Vec::new();
+        for _ in 0..21 {
+            let t0 = Instant::now();
+            let out = Command::new(&bin)
+                .args(args)
+                .output()
+                .map_err(|e| e.to_string())?;
+            v.push(t0.elapsed().as_secs_f64() * 1e3);
+            if !out.status.success() {
+                return Err(String::from_utf8_lossy(&out.stderr).into_owned());
+            }
+        }
+        v.sort_by(f64::total_cmp);
+        Ok((v[10], v[0]))
+    };
+    let (idle, idle_min) = time(&["--version"])?;
+    println!(
+        "hydrocyl simulate, whole process ({}): process start {idle:.2} ms (fastest {idle_min:.2})",
+        bin.display()
+    );
+    for t_end in [10.0, 100.0] {
+        let case = square_case(t_end)?;
+        let Signal::Table { time_s, value } = &case.command else {
+            return Err("not a table".into());
+        };
+        let cmd = dir.join(format!("cmd{t_end}.csv"));
+        std::fs::write(&cmd, write_columns(&["time", "command"], &[time_s, value]))
+            .map_err(|e| e.to_string())?;
+        let out = dir.join("out.csv");
+        let (cmd_s, out_s) = (cmd.display().to_string(), out.display().to_string());
+        for (label, extra) in [
+            ("default (auto, rtol 1e-6)", None),
+            (
+                "dp45 rtol 1e-5",
+                Some(["--solver", "dp45", "--rtol", "1e-5"]),
+            ),
+        ] {
+            let mut args = vec![
+                "simulate",
+                "--rig",
+                "leaney-moog",
+                "--command",
+                &cmd_s,
+                "--out",
+                &out_s,
+            ];
+            if let Some(e) = extra {
+                args.extend(e);
+            }
+            let (med, min) = time(&args)?;
+            println!(
+                "  {t_end:>4.0} s, 1 kHz in and out, {label:<26}: median {med:7.2} ms, fastest {min:7.2} ms{}",
+                if t_end == 10.0 { " (goal < 6 ms)" } else { "" }
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok(())
+}
+
+/// Runs the issue-19 benchmarks; `false` when one could not run.
+pub fn run() -> bool {
+    let mut ok = true;
+    for (name, r) in [
+        ("csv", csv_per_row()),
+        ("cost per step", cost_per_step()),
+        ("work-precision", work_precision()),
+        ("hybrid solver choice", hybrid_solver_choice()),
+        ("whole process", whole_process()),
+    ] {
+        if let Err(e) = r {
+            eprintln!("cargo xtask bench: {name}: {e}");
+            ok = false;
+        }
+    }
+    ok
+}

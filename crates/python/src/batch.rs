@@ -30,6 +30,14 @@ pub struct PyBatch {
     stats: Vec<(&'static str, Py<PyArray1<f64>>)>,
     ok: Py<PyArray1<bool>>,
     errors: Vec<Option<String>>,
+    interval: (f64, f64),
+}
+
+/// Seconds since the Unix epoch (Python's `time.time()` scale).
+fn unix_now() -> f64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(f64::NAN, |d| d.as_secs_f64())
 }
 
 /// The parameter sets: paths and, per path, N values.
@@ -161,7 +169,8 @@ pub fn simulate_batch(
     let base = &rig.value;
     let keep = channels.as_deref();
     let sets = &sets;
-    let rows: Vec<Outcome<Row>> = detached(py, || {
+    let (rows, interval): (Vec<Outcome<Row>>, (f64, f64)) = detached(py, || {
+        let start = unix_now();
         let opts = sim::options(solver, rtol, rk4_step, h_max, false)?;
         let cmd = sim::command(&t, &u)?;
         let work = || {
@@ -170,16 +179,19 @@ pub fn simulate_batch(
                 .map(|i| crate::errors::guard(|| one(base, sets, i, &cmd, &t, &opts, keep)))
                 .collect::<Vec<_>>()
         };
-        Ok(match threads {
+        let rows = match threads {
             None => work(),
             Some(k) => rayon::ThreadPoolBuilder::new()
                 .num_threads(k)
                 .build()
                 .map_err(|e| Failure::Input(format!("threads: {e}")))?
                 .install(work),
-        })
+        };
+        Ok((rows, (start, unix_now())))
     })?;
-    stack(py, t, rows, sets, keep, raise)
+    let mut b = stack(py, t, rows, sets, keep, raise)?;
+    b.interval = interval;
+    Ok(b)
 }
 
 /// Stacks the rows into `(N, T)` arrays (failed rows NaN), or raises the
@@ -266,6 +278,7 @@ fn stack(
         ],
         ok: PyArray1::from_vec(py, ok).unbind(),
         errors,
+        interval: (f64::NAN, f64::NAN),
     })
 }
 
@@ -320,6 +333,14 @@ impl PyBatch {
     #[getter]
     fn errors(&self) -> Vec<Option<String>> {
         self.errors.clone()
+    }
+
+    /// When the runs started and ended, in seconds since the Unix epoch
+    /// (`time.time()`), measured with the GIL released: two batches whose
+    /// intervals overlap ran at the same time.
+    #[getter]
+    fn interval_s(&self) -> (f64, f64) {
+        self.interval
     }
 
     fn __len__(&self) -> usize {

@@ -65,7 +65,15 @@ struct Row {
     stats: [f64; 4],
 }
 
-fn one(base: &Value, sets: &Sets, i: usize, cmd: &hydrocyl_system::signal::Signal, t: &[f64], opts: &hydrocyl_system::run::RunOptions, keep: Option<&[String]>) -> Outcome<Row> {
+fn one(
+    base: &Value,
+    sets: &Sets,
+    i: usize,
+    cmd: &hydrocyl_system::signal::Signal,
+    t: &[f64],
+    opts: &hydrocyl_system::run::RunOptions,
+    keep: Option<&[String]>,
+) -> Outcome<Row> {
     let ctx = |e: Failure| e.context(&format!("run {i} ({})", sets.assignments(i).join(", ")));
     let mut v = base.clone();
     for a in sets.assignments(i) {
@@ -73,7 +81,10 @@ fn one(base: &Value, sets: &Sets, i: usize, cmd: &hydrocyl_system::signal::Signa
     }
     rig::check(&v).map_err(|e| ctx(Failure::Input(e.to_string())))?;
     let Run {
-        channels, stats, wall, ..
+        channels,
+        stats,
+        wall,
+        ..
     } = sim::simulate(&v, cmd, t, opts).map_err(ctx)?.run;
     let mut names = Vec::new();
     let mut values = Vec::new();

@@ -31,7 +31,9 @@ fn read_record(obj: &Bound<'_, PyAny>) -> PyResult<Record> {
         for (k, v) in d.iter() {
             header.push(k.extract::<String>()?);
             cols.push(vector(v.extract().map_err(|_| {
-                PyValueError::new_err(format!("{DICT_RECORD}: column {k}: not a 1-D array of numbers"))
+                PyValueError::new_err(format!(
+                    "{DICT_RECORD}: column {k}: not a 1-D array of numbers"
+                ))
             })?));
         }
         let csv_err = |e: csv::Error| PyValueError::new_err(format!("{DICT_RECORD}: {e}"));
@@ -44,13 +46,18 @@ fn read_record(obj: &Bound<'_, PyAny>) -> PyResult<Record> {
             )));
         }
         for i in 0..n {
-            w.write_record(cols.iter().map(|c| format!("{:?}", c[i]))).map_err(csv_err)?;
+            w.write_record(cols.iter().map(|c| format!("{:?}", c[i])))
+                .map_err(csv_err)?;
         }
         let text = w
             .into_inner()
             .map_err(|e| PyValueError::new_err(format!("{DICT_RECORD}: {e}")))?;
-        return Record::parse(DICT_RECORD, &String::from_utf8_lossy(&text), &ColumnMap::default())
-            .map_err(input);
+        return Record::parse(
+            DICT_RECORD,
+            &String::from_utf8_lossy(&text),
+            &ColumnMap::default(),
+        )
+        .map_err(input);
     }
     let path: std::path::PathBuf = obj.extract().map_err(|_| {
         PyValueError::new_err("record: a CSV path or a dict of arrays by column name")

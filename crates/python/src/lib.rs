@@ -40,14 +40,19 @@ use pyo3::prelude::*;
 /// rather than unwinding into the interpreter.
 #[pyfunction]
 fn _panic_for_test(py: Python<'_>) -> PyResult<()> {
-    errors::detached(py, || -> errors::Outcome<()> { panic!("deliberate test panic") })
+    errors::detached(py, || -> errors::Outcome<()> {
+        panic!("deliberate test panic")
+    })
 }
 
 /// The `hydrocyl` module.
 #[pymodule]
 fn hydrocyl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
-    m.add("SimulationError", m.py().get_type::<errors::SimulationError>())?;
+    m.add(
+        "SimulationError",
+        m.py().get_type::<errors::SimulationError>(),
+    )?;
     m.add_class::<rig::Rig>()?;
     m.add_class::<run::PyRun>()?;
     m.add_class::<batch::PyBatch>()?;

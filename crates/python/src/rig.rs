@@ -149,8 +149,12 @@ impl Rig {
 
     /// The rig as the JSON text of a rig file (what `--print-rig` prints).
     fn to_json(&self) -> PyResult<String> {
-        serde_json::to_string_pretty(&self.value)
-            .map_err(|e| input(rig::RigError::Invalid { path: "rig".into(), why: e.to_string() }))
+        serde_json::to_string_pretty(&self.value).map_err(|e| {
+            input(rig::RigError::Invalid {
+                path: "rig".into(),
+                why: e.to_string(),
+            })
+        })
     }
 
     /// A copy (edits of the copy leave this rig alone).
@@ -167,7 +171,10 @@ impl Rig {
     }
 
     /// Pickles as its JSON text (for multiprocessing and Dask workers).
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let ctor = py.get_type::<Rig>().getattr("from_json")?;
         Ok((ctor, PyTuple::new(py, [self.value.to_string()])?))
     }

@@ -57,7 +57,8 @@ pub fn command(t: &[f64], u: &[f64]) -> Outcome<Signal> {
             t.len()
         )));
     }
-    Signal::table(t.to_vec(), u.to_vec()).map_err(|e| Failure::Input(format!("command (t, u): {e}")))
+    Signal::table(t.to_vec(), u.to_vec())
+        .map_err(|e| Failure::Input(format!("command (t, u): {e}")))
 }
 
 /// A run and, when the options ask for it, its energy ledger over the whole
@@ -70,7 +71,12 @@ pub struct Simulated {
 }
 
 /// Simulates the rig value (checked or not) on `command` sampled at `t`.
-pub fn simulate(value: &Value, command: &Signal, t: &[f64], opts: &RunOptions) -> Outcome<Simulated> {
+pub fn simulate(
+    value: &Value,
+    command: &Signal,
+    t: &[f64],
+    opts: &RunOptions,
+) -> Outcome<Simulated> {
     let run = rig::simulate(value, command.clone(), t, opts).map_err(|e| match e {
         RigError::Sim(_) => locate_failure(value, command, t, opts, e.to_string()),
         other => Failure::Input(other.to_string()),
@@ -101,7 +107,13 @@ fn failure_time(e: &SolveError) -> Option<f64> {
 /// Turns a failed run into a [`Failure::Solver`]: the rig's run is repeated
 /// on its circuit to get the solver's time, then integrated up to that time
 /// for the state there. The message is the CLI's, with the state appended.
-fn locate_failure(value: &Value, command: &Signal, t: &[f64], opts: &RunOptions, message: String) -> Failure {
+fn locate_failure(
+    value: &Value,
+    command: &Signal,
+    t: &[f64],
+    opts: &RunOptions,
+    message: String,
+) -> Failure {
     let located = (|| {
         let mut c = rig::circuit(value, command.clone()).ok()?;
         let x0 = c.initial_state();
@@ -118,7 +130,10 @@ fn locate_failure(value: &Value, command: &Signal, t: &[f64], opts: &RunOptions,
         } else {
             x0[..n].to_vec()
         };
-        Some((time, names.into_iter().take(n).zip(state).collect::<Vec<_>>()))
+        Some((
+            time,
+            names.into_iter().take(n).zip(state).collect::<Vec<_>>(),
+        ))
     })();
     let (time, state) = located.unwrap_or((f64::NAN, Vec::new()));
     let listed = state

@@ -72,6 +72,19 @@ fn layout() -> Result<(PathBuf, PathBuf), String> {
     Ok((path("workspace_root")?, path("target_directory")?))
 }
 
+/// `python -m pip install --quiet`.
+fn pip_install(python: &Path) -> Command {
+    let mut c = Command::new(python);
+    c.args([
+        "-m",
+        "pip",
+        "install",
+        "--quiet",
+        "--disable-pip-version-check",
+    ]);
+    c
+}
+
 /// The virtual environment's interpreter, creating the environment (with
 /// the tools) when it is missing or `fresh`.
 fn venv(target: &Path, fresh: bool) -> Result<PathBuf, String> {
@@ -89,15 +102,7 @@ fn venv(target: &Path, fresh: bool) -> Result<PathBuf, String> {
     }
     run(
         &format!("pip install {}", PY_TOOLS.join(" ")),
-        Command::new(&python)
-            .args([
-                "-m",
-                "pip",
-                "install",
-                "--quiet",
-                "--disable-pip-version-check",
-            ])
-            .args(PY_TOOLS),
+        pip_install(&python).args(PY_TOOLS),
     )?;
     Ok(python)
 }
@@ -140,16 +145,8 @@ fn python(opts: &Options) -> Result<(), String> {
         .ok_or_else(|| format!("maturin left no wheel in {}", wheels.display()))?;
     run(
         &format!("pip install {}", wheel.display()),
-        Command::new(&python)
-            .args([
-                "-m",
-                "pip",
-                "install",
-                "--quiet",
-                "--disable-pip-version-check",
-                "--force-reinstall",
-                "--no-deps",
-            ])
+        pip_install(&python)
+            .args(["--force-reinstall", "--no-deps"])
             .arg(&wheel),
     )?;
     let mut pytest = Command::new(&python);

@@ -3,10 +3,9 @@
 //! `(N, len(t))` arrays in parameter-set order, so they do not depend on
 //! the number of threads (each run is sequential and deterministic).
 
-use crate::convert::{array, vector};
+use crate::convert::{array, no_channel, vector, Named};
 use crate::errors::{detached, Failure, Outcome};
 use crate::rig::Rig;
-use crate::run::no_channel;
 use crate::sim;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::Run;
@@ -24,8 +23,7 @@ use serde_json::Value;
 #[pyclass(module = "hydrocyl", name = "BatchRun", frozen)]
 pub struct PyBatch {
     time: Py<PyArray1<f64>>,
-    names: Vec<String>,
-    values: Vec<Py<PyArray2<f64>>>,
+    channels: Named<PyArray2<f64>>,
     params: Py<PyDict>,
     stats: Vec<(&'static str, Py<PyArray1<f64>>)>,
     ok: Py<PyArray1<bool>>,
@@ -278,8 +276,7 @@ fn stack(
     let ok: Vec<bool> = errors.iter().map(Option::is_none).collect();
     Ok(PyBatch {
         time: array(py, t).unbind(),
-        names,
-        values,
+        channels: Named { names, values },
         params: params.unbind(),
         stats: vec![
             ("steps", array(py, steps).unbind()),
@@ -304,17 +301,13 @@ impl PyBatch {
     /// Channel names (units as in `Run.units`).
     #[getter]
     fn names(&self) -> Vec<String> {
-        self.names.clone()
+        self.channels.names.clone()
     }
 
     /// `{channel: (N, len(time)) array}`; row i is parameter set i.
     #[getter]
     fn channels<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        for (n, v) in self.names.iter().zip(&self.values) {
-            d.set_item(n, v.clone_ref(py))?;
-        }
-        Ok(d)
+        self.channels.dict(py)
     }
 
     /// The parameter sets: `{path: (N,) array}` as given.
@@ -359,20 +352,16 @@ impl PyBatch {
     }
 
     fn __getitem__(&self, py: Python<'_>, name: &str) -> PyResult<Py<PyArray2<f64>>> {
-        self.names
-            .iter()
-            .position(|n| n == name)
-            .map(|i| self.values[i].clone_ref(py))
-            .ok_or_else(|| no_channel(name, &self.names))
+        self.channels.get(py, name)
     }
 
     fn __contains__(&self, name: &str) -> bool {
-        self.names.iter().any(|n| n == name)
+        self.channels.contains(name)
     }
 
     /// The channel names.
     fn keys(&self) -> Vec<String> {
-        self.names.clone()
+        self.channels.names.clone()
     }
 
     fn __repr__(&self) -> String {
@@ -380,7 +369,7 @@ impl PyBatch {
             "BatchRun({} runs ({} failed), channels: {})",
             self.errors.len(),
             self.errors.iter().filter(|e| e.is_some()).count(),
-            self.names.join(", ")
+            self.channels.names.join(", ")
         )
     }
 }

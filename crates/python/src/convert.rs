@@ -2,7 +2,7 @@
 //! objects, Python values as the text `--set path=value` takes, arrays.
 
 use numpy::{AllowTypeChange, PyArray1, PyArrayLike1};
-use pyo3::exceptions::PyTypeError;
+use pyo3::exceptions::{PyKeyError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
 use serde_json::Value;
@@ -71,4 +71,45 @@ pub fn vector(x: PyArrayLike1<'_, f64, AllowTypeChange>) -> Vec<f64> {
 /// A 1-D numpy array owning `v`.
 pub fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
     PyArray1::from_vec(py, v)
+}
+
+/// Named arrays (the channels of a run or a batch), in order.
+pub struct Named<T> {
+    /// Names, in order.
+    pub names: Vec<String>,
+    /// One array per name.
+    pub values: Vec<Py<T>>,
+}
+
+impl<T: pyo3::PyTypeInfo> Named<T> {
+    /// `{name: array}` (the arrays themselves, not copies).
+    pub fn dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (n, v) in self.names.iter().zip(&self.values) {
+            d.set_item(n, v.clone_ref(py))?;
+        }
+        Ok(d)
+    }
+
+    /// The array named `name`; a KeyError naming the others if none is.
+    pub fn get(&self, py: Python<'_>, name: &str) -> PyResult<Py<T>> {
+        self.names
+            .iter()
+            .position(|n| n == name)
+            .map(|i| self.values[i].clone_ref(py))
+            .ok_or_else(|| no_channel(name, &self.names))
+    }
+
+    /// Whether there is an array named `name`.
+    pub fn contains(&self, name: &str) -> bool {
+        self.names.iter().any(|n| n == name)
+    }
+}
+
+/// A `KeyError` naming the channels there are.
+pub fn no_channel(name: &str, names: &[String]) -> PyErr {
+    PyKeyError::new_err(format!(
+        "no channel `{name}` (channels: {})",
+        names.join(", ")
+    ))
 }

@@ -2,11 +2,11 @@
 //! simulate` writes), solver statistics, component counters and the energy
 //! ledger.
 
-use crate::convert::array;
+use crate::convert::{array, Named};
 use crate::sim::Simulated;
 use hydrocyl_energy::ledger::{Ledger, Term};
 use numpy::PyArray1;
-use pyo3::exceptions::{PyImportError, PyKeyError, PyValueError};
+use pyo3::exceptions::{PyImportError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -17,20 +17,11 @@ use pyo3::types::PyDict;
 pub struct PyRun {
     time: Py<PyArray1<f64>>,
     n: usize,
-    names: Vec<String>,
+    channels: Named<PyArray1<f64>>,
     units: Vec<&'static str>,
-    values: Vec<Py<PyArray1<f64>>>,
     stats: Vec<(&'static str, f64)>,
     diagnostics: Vec<(String, f64)>,
     ledger: Option<Result<Ledger, String>>,
-}
-
-/// A `KeyError` naming the channels there are.
-pub fn no_channel(name: &str, names: &[String]) -> PyErr {
-    PyKeyError::new_err(format!(
-        "no channel `{name}` (channels: {})",
-        names.join(", ")
-    ))
 }
 
 /// `{name: energy [J]}` of ledger terms.
@@ -67,13 +58,15 @@ impl PyRun {
         Ok(Self {
             n: r.time.len(),
             time: array(py, r.time).unbind(),
-            names: r.channels.iter().map(|c| c.name.clone()).collect(),
             units: r.channels.iter().map(|c| c.unit).collect(),
-            values: r
-                .channels
-                .into_iter()
-                .map(|c| array(py, c.values).unbind())
-                .collect(),
+            channels: Named {
+                names: r.channels.iter().map(|c| c.name.clone()).collect(),
+                values: r
+                    .channels
+                    .into_iter()
+                    .map(|c| array(py, c.values).unbind())
+                    .collect(),
+            },
             stats: vec![
                 ("steps", st.steps as f64),
                 ("rejected", st.rejected as f64),
@@ -100,24 +93,20 @@ impl PyRun {
     /// Channel names, in the CLI's column order.
     #[getter]
     fn names(&self) -> Vec<String> {
-        self.names.clone()
+        self.channels.names.clone()
     }
 
     /// `{channel: numpy array}` (the arrays themselves, not copies).
     #[getter]
     fn channels<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        for (n, v) in self.names.iter().zip(&self.values) {
-            d.set_item(n, v.clone_ref(py))?;
-        }
-        Ok(d)
+        self.channels.dict(py)
     }
 
     /// `{channel: SI unit}` (`Pa` is gauge pressure, `1` dimensionless).
     #[getter]
     fn units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (n, u) in self.names.iter().zip(&self.units) {
+        for (n, u) in self.channels.names.iter().zip(&self.units) {
             d.set_item(n, *u)?;
         }
         Ok(d)
@@ -169,20 +158,16 @@ impl PyRun {
         if name == "time" {
             return Ok(self.time.clone_ref(py));
         }
-        self.names
-            .iter()
-            .position(|n| n == name)
-            .map(|i| self.values[i].clone_ref(py))
-            .ok_or_else(|| no_channel(name, &self.names))
+        self.channels.get(py, name)
     }
 
     fn __contains__(&self, name: &str) -> bool {
-        name == "time" || self.names.iter().any(|n| n == name)
+        name == "time" || self.channels.contains(name)
     }
 
     /// The channel names (`time` is `run.time`).
     fn keys(&self) -> Vec<String> {
-        self.names.clone()
+        self.channels.names.clone()
     }
 
     /// A pandas DataFrame with `time` and every channel as columns (the
@@ -196,9 +181,7 @@ impl PyRun {
         })?;
         let d = PyDict::new(py);
         d.set_item("time", self.time.clone_ref(py))?;
-        for (n, v) in self.names.iter().zip(&self.values) {
-            d.set_item(n, v.clone_ref(py))?;
-        }
+        d.update(self.channels.dict(py)?.as_mapping())?;
         pd.getattr("DataFrame")?.call1((d,))
     }
 
@@ -206,7 +189,7 @@ impl PyRun {
         format!(
             "Run({} samples, channels: {})",
             self.n,
-            self.names.join(", ")
+            self.channels.names.join(", ")
         )
     }
 }

@@ -110,11 +110,15 @@ fn venv(target: &Path, fresh: bool) -> Result<PathBuf, String> {
 /// The Python half: wheel, install, pytest.
 fn python(opts: &Options) -> Result<(), String> {
     let (root, target) = layout()?;
-    run(
-        "cargo build -p hydrocyl-cli (the binary the tests compare with)",
-        cargo().args(["build", "-p", "hydrocyl-cli"]),
-    )?;
+    // The binary the tests compare with: `cargo test --workspace` has just
+    // built it; alone, build it (its own feature set may rebuild a little).
     let cli = target.join("debug").join("hydrocyl");
+    if opts.python_only || !cli.exists() {
+        run(
+            "cargo build -p hydrocyl-cli",
+            cargo().args(["build", "-p", "hydrocyl-cli"]),
+        )?;
+    }
     let python = venv(&target, opts.fresh)?;
     let wheels = target.join("wheels");
     if wheels.exists() {

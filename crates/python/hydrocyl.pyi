@@ -56,6 +56,9 @@ class Rig:
         dict/list for an inner path)."""
     def parameters(self) -> dict[str, Optional[float]]:
         """Every numeric parameter, ``{path: value}`` (SI; None for null)."""
+    def describe(self) -> dict[str, dict[str, Any]]:
+        """Every parameter: ``{path: {"value", "unit", "doc"}}`` (netlists
+        declare the SI unit and meaning; other kinds give None)."""
     def to_json(self) -> str:
         """The rig as rig-file JSON text (``--print-rig``)."""
     def copy(self) -> Rig: ...

@@ -10,7 +10,6 @@ use hydrocyl_identify::data::{ColumnMap, Record};
 use hydrocyl_identify::diagnose::DiagnoseOptions;
 use hydrocyl_identify::valve::diagnose_valve;
 use hydrocyl_system::rig::valve_rig_from;
-use hydrocyl_system::valve_rig;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -65,7 +64,8 @@ fn read_record(obj: &Bound<'_, PyAny>) -> PyResult<Record> {
     Record::read(&path).map_err(input)
 }
 
-/// Diagnoses `rig` (a valve-cylinder rig) against one measured `record` as
+/// Diagnoses `rig` (the valve-cylinder circuit: its netlist, e.g. the
+/// `leaney-moog` preset, or a `valve-cylinder` rig file) against one measured `record` as
 /// `hydrocyl diagnose --rig ... --data ...` does and returns its report as
 /// a dict (NRMSEs before/after, effects added and rejected with their
 /// parameters in SI, declared parameters refitted, warnings).
@@ -108,13 +108,6 @@ pub fn diagnose<'py>(
                 .collect::<PyResult<Vec<_>>>()
         })
         .transpose()?;
-    let kind = rig.value.get("kind").and_then(|k| k.as_str()).unwrap_or("");
-    if kind != valve_rig::KIND {
-        return bad(format!(
-            "rig kind '{kind}' cannot be diagnosed from Python (kinds: {})",
-            valve_rig::KIND
-        ));
-    }
     let valve = valve_rig_from(&rig.value).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let rec = read_record(record)?;
     let opts = DiagnoseOptions {

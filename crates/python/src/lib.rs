@@ -10,11 +10,11 @@
 //! ```python
 //! import numpy as np, hydrocyl
 //! rig = hydrocyl.Rig.load("leaney-moog")            # preset or rig file
-//! rig.set("load.mass_kg", 50)                        # a --set path
+//! rig.set("load.mass", 50)                           # a --set path
 //! t = np.linspace(0, 0.5, 501); u = np.where(t < 0.05, 0.0, 0.5)
 //! run = rig.simulate(t, u, solver="dp45", rtol=1e-6)
 //! run["position"]                                    # numpy array [m]
-//! batch = hydrocyl.simulate_batch(rig, t, u, {"load.mass_kg": np.linspace(50, 150, 64)})
+//! batch = hydrocyl.simulate_batch(rig, t, u, {"load.mass": np.linspace(50, 150, 64)})
 //! ```
 //!
 //! Errors: ValueError with the CLI's one-line message for bad input,

@@ -39,14 +39,22 @@ impl Rig {
         Ok(Self { value })
     }
 
-    /// The value at a dotted path (the rules of `rig::apply_set`: object
-    /// keys, array indices), or the error `--set` gives for that path.
-    fn at(&self, path: &str) -> Result<&Value, rig::RigError> {
+    /// The value at a parameter path: a parameter `rig::parameters` lists
+    /// (every `--set` path of a netlist), else a JSON path of an older rig
+    /// kind (object keys, array indices); or the error `--set` gives for it.
+    fn at(&self, path: &str) -> Result<Value, rig::RigError> {
+        if let Some(p) = rig::parameters(&self.value)
+            .into_iter()
+            .find(|p| p.path == path)
+        {
+            return Ok(p.value.map_or(Value::Null, Value::from));
+        }
         let mut cur = &self.value;
+        let netlist = self.kind() == hydrocyl_system::netlist::KIND;
         for seg in path.split('.') {
             let next = match cur {
-                Value::Object(m) => m.get(seg),
-                Value::Array(a) => seg.parse::<usize>().ok().and_then(|i| a.get(i)),
+                Value::Object(m) if !netlist => m.get(seg),
+                Value::Array(a) if !netlist => seg.parse::<usize>().ok().and_then(|i| a.get(i)),
                 _ => None,
             };
             match next {
@@ -63,7 +71,7 @@ impl Rig {
                 }
             }
         }
-        Ok(cur)
+        Ok(cur.clone())
     }
 }
 
@@ -75,7 +83,9 @@ impl Rig {
     /// unreadable or malformed file or a parameter out of range.
     #[staticmethod]
     fn load(name_or_path: &str) -> PyResult<Self> {
-        Self::checked(rig::load(name_or_path).map_err(input)?)
+        let value = rig::load(name_or_path).map_err(input)?;
+        rig::check(&value).map_err(|e| input(rig::at_line(e, name_or_path)))?;
+        Ok(Self { value })
     }
 
     /// A rig from the text of a rig JSON file (as `to_json` writes it).
@@ -134,7 +144,7 @@ impl Rig {
     /// such as an initial pressure the rig computes, or a dict/list for an
     /// inner path). ValueError for a path the rig does not have.
     fn get<'py>(&self, py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyAny>> {
-        json_to_py(py, self.at(path).map_err(input)?)
+        json_to_py(py, &self.at(path).map_err(input)?)
     }
 
     /// Every numeric (or `null`) parameter: `{path: value}` in sorted path

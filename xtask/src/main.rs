@@ -5,6 +5,8 @@
 //! * `xfactor` — Tables 3-3 and 3-4 recomputed, with the exact root-branch split.
 //! * `energy` — the chapter-8 efficiency matrix.
 //! * `bench` — speed ratios against reference runs in the same run.
+//! * `test` — `cargo test --workspace`, then the Python package's pytest suite
+//!   on a wheel built by maturin into a virtual environment.
 //!
 //! Every section prints only what it measured in this run.
 
@@ -12,6 +14,7 @@ mod bench;
 mod bench_solve;
 mod energy;
 mod report;
+mod test;
 mod validate;
 mod xfactor;
 
@@ -38,6 +41,25 @@ enum Task {
     Energy,
     /// Speed ratios against reference runs on this machine, in the same run.
     Bench,
+    /// Every test: `cargo test --workspace`, then the Python package (wheel
+    /// built by maturin into target/py-venv, pytest).
+    Test {
+        /// Only the Python package's tests.
+        #[arg(long, conflicts_with = "rust_only")]
+        python_only: bool,
+        /// Only `cargo test --workspace`.
+        #[arg(long)]
+        rust_only: bool,
+        /// Build the wheel with the release profile (as users get it).
+        #[arg(long)]
+        release: bool,
+        /// Recreate the virtual environment.
+        #[arg(long)]
+        fresh: bool,
+        /// Arguments passed on to pytest (after `--`).
+        #[arg(last = true)]
+        pytest_args: Vec<String>,
+    },
 }
 
 fn main() {
@@ -47,6 +69,19 @@ fn main() {
         Task::Xfactor => xfactor::run(),
         Task::Energy => energy::run(),
         Task::Bench => bench::run(),
+        Task::Test {
+            python_only,
+            rust_only,
+            release,
+            fresh,
+            pytest_args,
+        } => test::run_all(&test::Options {
+            python_only,
+            rust_only,
+            release,
+            fresh,
+            pytest_args,
+        }),
     };
     if !ok {
         std::process::exit(1);

@@ -47,7 +47,7 @@ fn readme_layout_table_names_every_crate_folder_and_no_other() {
 fn ci_runs_the_readme_commands() {
     let text = readme();
     let ci = std::fs::read_to_string(root().join(".ci/run")).unwrap();
-    for cmd in ["cargo xtask validate", "cargo test --workspace"] {
+    for cmd in ["cargo xtask validate", "cargo xtask test"] {
         assert!(text.contains(cmd), "README lacks `{cmd}`");
         assert!(ci.contains(cmd), ".ci/run lacks `{cmd}`");
     }
@@ -67,11 +67,19 @@ fn every_crate_opens_its_docs_with_a_title_and_a_compiled_example() {
             "{} does not open with its crate title",
             lib.display()
         );
+        // A Python extension module (cdylib only) has no Rust API: its
+        // example is Python, run by its pytest suite (`cargo xtask test`).
+        let manifest = std::fs::read_to_string(dir.join("Cargo.toml")).unwrap();
+        let opening: &[&str] = if manifest.contains(r#"crate-type = ["cdylib"]"#) {
+            &["//! ```python"]
+        } else {
+            &["//! ```", "//! ```rust"]
+        };
         let examples = text
             .lines()
-            .filter(|l| l.trim_end() == "//! ```" || l.trim_end() == "//! ```rust")
+            .filter(|l| l.trim_end() == "//! ```" || opening.contains(&l.trim_end()))
             .count();
         // an opening and a closing fence at least; `text` diagrams are not examples
-        assert!(examples >= 2, "{} has no compiled example", lib.display());
+        assert!(examples >= 2, "{} has no example", lib.display());
     }
 }

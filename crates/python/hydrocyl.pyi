@@ -1,0 +1,176 @@
+"""hydrocyl: hydraulic single-rod cylinder drives from Python.
+
+Rigs (presets or rig JSON files) edited by the same parameter paths as the
+CLI's ``--set``, runs as named numpy arrays in SI units (pressures in Pa
+gauge), batch runs on all cores, Leaney's X factor and the measured-data
+diagnosis. Bad input raises ValueError with the CLI's one-line message; a
+solver failure raises SimulationError.
+"""
+
+import os
+from typing import Any, Literal, Mapping, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+PRESETS: list[str]
+"""Names of the built-in rigs (``Rig.load(name)``)."""
+
+ArrayLike = npt.ArrayLike
+Solver = Literal["dp45", "rosenbrock", "rk4"]
+ParamValue = Union[float, int, str, bool, None]
+
+class SimulationError(Exception):
+    """The solver failed (step size too small, too many steps, a non-finite
+    state). The message names the method, the time and the state."""
+
+    time: float
+    """Time the solver reached [s] (NaN if it could not be located)."""
+    state: dict[str, float]
+    """State at ``time``: state name -> value (SI)."""
+
+class Rig:
+    """A rig: kind and parameters as in its JSON file (SI units, pressures
+    in Pa gauge), checked after every edit. Picklable (as its JSON)."""
+
+    @staticmethod
+    def load(name_or_path: str) -> Rig:
+        """A preset by name or a rig JSON file by path (``--rig``)."""
+    @staticmethod
+    def from_json(text: str) -> Rig:
+        """A rig from rig-file JSON text (as ``to_json`` writes it)."""
+    @staticmethod
+    def presets() -> list[str]:
+        """Names of the built-in presets."""
+    @property
+    def kind(self) -> str:
+        """The rig kind: ``valve-cylinder``, ``wang-hybrid``, ..."""
+    def set(self, path: str, value: ParamValue) -> None:
+        """Sets one parameter as ``--set path=value`` does, then checks the
+        rig; on error (ValueError) the rig is unchanged. SI units."""
+    def update(self, values: Mapping[str, ParamValue]) -> None:
+        """Sets several parameters, then checks the rig once."""
+    def get(self, path: str) -> Any:
+        """The value at a parameter path (number, string, None, or a
+        dict/list for an inner path)."""
+    def parameters(self) -> dict[str, Optional[float]]:
+        """Every numeric parameter, ``{path: value}`` (SI; None for null)."""
+    def describe(self) -> dict[str, dict[str, Any]]:
+        """Every parameter: ``{path: {"value", "unit", "doc"}}`` (netlists
+        declare the SI unit and meaning; other kinds give None)."""
+    def to_json(self) -> str:
+        """The rig as rig-file JSON text (``--print-rig``)."""
+    def copy(self) -> Rig: ...
+    def simulate(
+        self,
+        t: ArrayLike,
+        u: ArrayLike,
+        *,
+        solver: Solver = "dp45",
+        rtol: float = 1e-6,
+        rk4_step: float = 2e-5,
+        h_max: Optional[float] = None,
+        ledger: bool = False,
+    ) -> Run:
+        """Simulates on the command ``u`` at times ``t`` [s] (linear between
+        samples) and samples the run at ``t``. ``u``: normalised spool
+        demand (valve rigs) or drive voltage [V] (pump rigs). ``rk4_step``
+        and ``h_max`` (default 0.01) in s. ``ledger=True`` adds
+        ``run.ledger``. Releases the GIL."""
+
+class Run:
+    """One run: ``time`` [s] and channels in SI (``units``): ``command``,
+    ``position`` [m], ``velocity`` [m/s], ``p1``, ``p2`` [Pa gauge], then
+    the rig's other outputs. ``run["position"]`` is a channel."""
+
+    @property
+    def time(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def names(self) -> list[str]: ...
+    @property
+    def channels(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    @property
+    def units(self) -> dict[str, str]: ...
+    @property
+    def stats(self) -> dict[str, Union[int, float]]:
+        """``steps``, ``rejected``, ``rhs_evals``, ``jac_evals``,
+        ``lu_decomps``, ``events`` and ``wall_s`` [s]."""
+    @property
+    def diagnostics(self) -> dict[str, float]:
+        """Component counters: cavitation entries, end-stop impacts, ..."""
+    @property
+    def ledger(self) -> Optional[dict[str, Any]]:
+        """Energy ledger over the run (``ledger=True``), else None: energies
+        in J (``energy_in_j``, ``cylinder_out_j``, ``losses_j`` by
+        component, ...), ``error``/``storage_error`` as fractions of the
+        energy in, ``efficiency``."""
+    def __getitem__(self, name: str) -> npt.NDArray[np.float64]: ...
+    def __contains__(self, name: str) -> bool: ...
+    def keys(self) -> list[str]: ...
+    def to_pandas(self) -> Any:
+        """A pandas DataFrame (``time`` and the channels); ImportError
+        without pandas, which hydrocyl does not require."""
+
+class BatchRun:
+    """Runs of ``simulate_batch``: per channel an ``(N, len(time))`` array,
+    row i from parameter set i (SI units as in ``Run.units``)."""
+
+    @property
+    def time(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def names(self) -> list[str]: ...
+    @property
+    def channels(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    @property
+    def params(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    @property
+    def stats(self) -> dict[str, npt.NDArray[np.float64]]:
+        """Per run: ``steps``, ``rejected``, ``rhs_evals``, ``wall_s`` [s]."""
+    @property
+    def ok(self) -> npt.NDArray[np.bool_]: ...
+    @property
+    def errors(self) -> list[Optional[str]]: ...
+    @property
+    def interval_s(self) -> tuple[float, float]:
+        """Start and end of the runs, ``time.time()`` scale [s], measured
+        with the GIL released."""
+    def __len__(self) -> int: ...
+    def __getitem__(self, name: str) -> npt.NDArray[np.float64]: ...
+    def __contains__(self, name: str) -> bool: ...
+    def keys(self) -> list[str]: ...
+
+def simulate_batch(
+    rig: Rig,
+    t: ArrayLike,
+    u: ArrayLike,
+    params: Mapping[str, ArrayLike],
+    *,
+    solver: Solver = "dp45",
+    rtol: float = 1e-6,
+    rk4_step: float = 2e-5,
+    h_max: Optional[float] = None,
+    channels: Optional[Sequence[str]] = None,
+    threads: Optional[int] = None,
+    on_error: Literal["raise", "nan"] = "raise",
+) -> BatchRun:
+    """Runs ``rig`` once per parameter set (``params``: path -> N values,
+    SI) in parallel with the GIL released; results in set order,
+    independent of ``threads``."""
+
+def xfactor(gamma: float, travel: ArrayLike) -> npt.NDArray[np.float64]:
+    """Leaney's X factor (dimensionless) for area ratio ``gamma`` = A1/A2
+    at each normalised spool travel (spool position / underlap)."""
+
+def diagnose(
+    rig: Rig,
+    record: Union[str, os.PathLike[str], Mapping[str, ArrayLike]],
+    *,
+    min_share: float = 0.03,
+    holdout: float = 0.3,
+    window: Optional[int] = None,
+    effects: Optional[Sequence[str]] = None,
+) -> dict[str, Any]:
+    """``hydrocyl diagnose`` on a valve rig and one measured record (CSV
+    path or dict of arrays by column name, SI or with unit suffixes); the
+    report as a dict."""

@@ -1,0 +1,375 @@
+//! `hydrocyl.simulate_batch`: N parameter sets of one rig on one command,
+//! run in parallel (rayon) with the GIL released; results stacked as
+//! `(N, len(t))` arrays in parameter-set order, so they do not depend on
+//! the number of threads (each run is sequential and deterministic).
+
+use crate::convert::{array, no_channel, vector, Named};
+use crate::errors::{detached, Failure, Outcome};
+use crate::rig::Rig;
+use crate::sim;
+use hydrocyl_system::rig;
+use hydrocyl_system::run::Run;
+use numpy::ndarray::Array2;
+use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rayon::prelude::*;
+use serde_json::Value;
+
+/// Runs of a batch: `time` [s] and per channel a `(N, len(time))` array
+/// (row i is parameter set i), the parameter sets, per-run statistics and,
+/// with `on_error="nan"`, which runs failed and why.
+#[pyclass(module = "hydrocyl", name = "BatchRun", frozen)]
+pub struct PyBatch {
+    time: Py<PyArray1<f64>>,
+    channels: Named<PyArray2<f64>>,
+    params: Py<PyDict>,
+    stats: Vec<(&'static str, Py<PyArray1<f64>>)>,
+    ok: Py<PyArray1<bool>>,
+    errors: Vec<Option<String>>,
+    interval: (f64, f64),
+}
+
+/// Seconds since the Unix epoch (Python's `time.time()` scale).
+fn unix_now() -> f64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(f64::NAN, |d| d.as_secs_f64())
+}
+
+/// The parameter sets: paths and, per path, N values.
+struct Sets {
+    paths: Vec<String>,
+    columns: Vec<Vec<f64>>,
+    n: usize,
+}
+
+impl Sets {
+    /// The `--set` assignments of set `i`.
+    fn assignments(&self, i: usize) -> Vec<String> {
+        self.paths
+            .iter()
+            .zip(&self.columns)
+            .map(|(p, c)| format!("{p}={:?}", c[i]))
+            .collect()
+    }
+}
+
+/// What one run leaves: its channels (the selected ones) and statistics.
+struct Row {
+    names: Vec<String>,
+    values: Vec<Vec<f64>>,
+    stats: [f64; 4],
+}
+
+fn one(
+    base: &Value,
+    sets: &Sets,
+    i: usize,
+    cmd: &hydrocyl_system::signal::Signal,
+    t: &[f64],
+    opts: &hydrocyl_system::run::RunOptions,
+    keep: Option<&[String]>,
+) -> Outcome<Row> {
+    let ctx = |e: Failure| e.context(&format!("run {i} ({})", sets.assignments(i).join(", ")));
+    let mut v = base.clone();
+    for a in sets.assignments(i) {
+        rig::apply_set(&mut v, &a).map_err(|e| ctx(Failure::Input(e.to_string())))?;
+    }
+    rig::check(&v).map_err(|e| ctx(Failure::Input(e.to_string())))?;
+    let Run {
+        channels,
+        stats,
+        wall,
+        ..
+    } = sim::simulate(&v, cmd, t, opts).map_err(ctx)?.run;
+    let mut names = Vec::new();
+    let mut values = Vec::new();
+    for c in channels {
+        if keep.is_none_or(|k| k.contains(&c.name)) {
+            names.push(c.name);
+            values.push(c.values);
+        }
+    }
+    Ok(Row {
+        names,
+        values,
+        stats: [
+            stats.steps as f64,
+            stats.rejected as f64,
+            stats.rhs_evals as f64,
+            wall.as_secs_f64(),
+        ],
+    })
+}
+
+/// Runs the rig once per parameter set, in parallel on all cores (or on
+/// `threads` threads), with the GIL released.
+///
+/// `params` maps parameter paths (as `Rig.set` and `--set` take them, see
+/// `rig.parameters()`) to equal-length 1-D arrays of values (SI): set i
+/// applies element i of every array to a copy of `rig`. `t` [s], `u` and
+/// the solver settings are those of `Rig.simulate`. `channels` (default:
+/// all) limits the channels returned.
+///
+/// `on_error="raise"` (default) raises the error of the first failing set
+/// (ValueError for an invalid set, SimulationError for a solver failure,
+/// both naming the set); `on_error="nan"` fills its rows with NaN and
+/// reports it in `batch.ok` / `batch.errors`.
+#[pyfunction]
+#[pyo3(signature = (rig, t, u, params, *, solver = "dp45", rtol = 1e-6, rk4_step = 2e-5, h_max = None, channels = None, threads = None, on_error = "raise"))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_batch(
+    py: Python<'_>,
+    rig: &Rig,
+    t: PyArrayLike1<'_, f64, AllowTypeChange>,
+    u: PyArrayLike1<'_, f64, AllowTypeChange>,
+    params: &Bound<'_, PyDict>,
+    solver: &str,
+    rtol: f64,
+    rk4_step: f64,
+    h_max: Option<f64>,
+    channels: Option<Vec<String>>,
+    threads: Option<usize>,
+    on_error: &str,
+) -> PyResult<PyBatch> {
+    let raise = match on_error {
+        "raise" => true,
+        "nan" => false,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "on_error: `{other}` is not `raise` or `nan`"
+            )))
+        }
+    };
+    if threads == Some(0) {
+        return Err(PyValueError::new_err("threads: must be at least 1"));
+    }
+    let (t, u) = (vector(t), vector(u));
+    let mut sets = Sets {
+        paths: Vec::new(),
+        columns: Vec::new(),
+        n: 0,
+    };
+    for (k, v) in params.iter() {
+        let path: String = k.extract()?;
+        let col = vector(v.extract().map_err(|_| {
+            PyValueError::new_err(format!("params[{path:?}]: not a 1-D array of numbers"))
+        })?);
+        if sets.paths.is_empty() {
+            sets.n = col.len();
+        } else if col.len() != sets.n {
+            return Err(PyValueError::new_err(format!(
+                "params[{path:?}]: {} values, but params[{:?}] has {}",
+                col.len(),
+                sets.paths[0],
+                sets.n
+            )));
+        }
+        sets.paths.push(path);
+        sets.columns.push(col);
+    }
+    if sets.n == 0 {
+        return Err(PyValueError::new_err(
+            "params: no parameter sets (give {path: array of N values}, N >= 1)",
+        ));
+    }
+    let base = &rig.value;
+    let keep = channels.as_deref();
+    let sets = &sets;
+    let (rows, interval): (Vec<Outcome<Row>>, (f64, f64)) = detached(py, || {
+        let start = unix_now();
+        let opts = sim::options(solver, rtol, rk4_step, h_max, false)?;
+        let cmd = sim::command(&t, &u)?;
+        let work = || {
+            (0..sets.n)
+                .into_par_iter()
+                .map(|i| crate::errors::guard(|| one(base, sets, i, &cmd, &t, &opts, keep)))
+                .collect::<Vec<_>>()
+        };
+        let rows = match threads {
+            None => work(),
+            Some(k) => rayon::ThreadPoolBuilder::new()
+                .num_threads(k)
+                .build()
+                .map_err(|e| Failure::Input(format!("threads: {e}")))?
+                .install(work),
+        };
+        Ok((rows, (start, unix_now())))
+    })?;
+    let mut b = stack(py, t, rows, sets, keep, raise)?;
+    b.interval = interval;
+    Ok(b)
+}
+
+/// Stacks the rows into `(N, T)` arrays (failed rows NaN), or raises the
+/// first failure when `raise`.
+fn stack(
+    py: Python<'_>,
+    t: Vec<f64>,
+    rows: Vec<Outcome<Row>>,
+    sets: &Sets,
+    keep: Option<&[String]>,
+    raise: bool,
+) -> PyResult<PyBatch> {
+    if raise {
+        if let Some(Err(e)) = rows.iter().find(|r| r.is_err()) {
+            return Err(e.clone().into_pyerr(py));
+        }
+    }
+    let Some(first) = rows.iter().find_map(|r| r.as_ref().ok()) else {
+        let e = rows.into_iter().find_map(Result::err);
+        return Err(e
+            .map(|e| e.context("every run failed; the first"))
+            .unwrap_or_else(|| Failure::Input("no runs".into()))
+            .into_pyerr(py));
+    };
+    let names = first.names.clone();
+    if let Some(k) = keep {
+        if let Some(missing) = k.iter().find(|c| !names.contains(c)) {
+            return Err(no_channel(missing, &first.names));
+        }
+    }
+    let (n, m) = (rows.len(), t.len());
+    let mut data = vec![vec![f64::NAN; n * m]; names.len()];
+    let mut stats = [(); 4].map(|_| vec![f64::NAN; n]);
+    let mut errors = Vec::with_capacity(n);
+    for (i, r) in rows.into_iter().enumerate() {
+        match r {
+            Ok(row) if row.names == names => {
+                for (d, v) in data.iter_mut().zip(&row.values) {
+                    d[i * m..(i + 1) * m].copy_from_slice(v);
+                }
+                for (s, v) in stats.iter_mut().zip(row.stats) {
+                    s[i] = v;
+                }
+                errors.push(None);
+            }
+            Ok(row) => {
+                let e = Failure::Input(format!(
+                    "run {i}: channels {} differ from the first run's {}",
+                    row.names.join(", "),
+                    names.join(", ")
+                ));
+                if raise {
+                    return Err(e.into_pyerr(py));
+                }
+                errors.push(Some(e.message().to_string()));
+            }
+            Err(e) => errors.push(Some(e.message().to_string())),
+        }
+    }
+    let values = data
+        .into_iter()
+        .map(|d| {
+            Array2::from_shape_vec((n, m), d)
+                .map(|a| a.into_pyarray(py).unbind())
+                .map_err(|e| PyValueError::new_err(e.to_string()))
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    let params = PyDict::new(py);
+    for (p, c) in sets.paths.iter().zip(&sets.columns) {
+        params.set_item(p, array(py, c.clone()))?;
+    }
+    let [steps, rejected, rhs, wall] = stats;
+    let ok: Vec<bool> = errors.iter().map(Option::is_none).collect();
+    Ok(PyBatch {
+        time: array(py, t).unbind(),
+        channels: Named { names, values },
+        params: params.unbind(),
+        stats: vec![
+            ("steps", array(py, steps).unbind()),
+            ("rejected", array(py, rejected).unbind()),
+            ("rhs_evals", array(py, rhs).unbind()),
+            ("wall_s", array(py, wall).unbind()),
+        ],
+        ok: PyArray1::from_vec(py, ok).unbind(),
+        errors,
+        interval: (f64::NAN, f64::NAN),
+    })
+}
+
+#[pymethods]
+impl PyBatch {
+    /// Output times [s].
+    #[getter]
+    fn time(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.time.clone_ref(py)
+    }
+
+    /// Channel names (units as in `Run.units`).
+    #[getter]
+    fn names(&self) -> Vec<String> {
+        self.channels.names.clone()
+    }
+
+    /// `{channel: (N, len(time)) array}`; row i is parameter set i.
+    #[getter]
+    fn channels<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        self.channels.dict(py)
+    }
+
+    /// The parameter sets: `{path: (N,) array}` as given.
+    #[getter]
+    fn params(&self, py: Python<'_>) -> Py<PyDict> {
+        self.params.clone_ref(py)
+    }
+
+    /// Per-run solver statistics: `{steps, rejected, rhs_evals, wall_s}`,
+    /// each an (N,) float array (NaN for a failed run).
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, v) in &self.stats {
+            d.set_item(k, v.clone_ref(py))?;
+        }
+        Ok(d)
+    }
+
+    /// (N,) bool array: which runs succeeded.
+    #[getter]
+    fn ok(&self, py: Python<'_>) -> Py<PyArray1<bool>> {
+        self.ok.clone_ref(py)
+    }
+
+    /// Per run: None, or the one-line error of a failed run.
+    #[getter]
+    fn errors(&self) -> Vec<Option<String>> {
+        self.errors.clone()
+    }
+
+    /// When the runs started and ended, in seconds since the Unix epoch
+    /// (`time.time()`), measured with the GIL released: two batches whose
+    /// intervals overlap ran at the same time.
+    #[getter]
+    fn interval_s(&self) -> (f64, f64) {
+        self.interval
+    }
+
+    fn __len__(&self) -> usize {
+        self.errors.len()
+    }
+
+    fn __getitem__(&self, py: Python<'_>, name: &str) -> PyResult<Py<PyArray2<f64>>> {
+        self.channels.get(py, name)
+    }
+
+    fn __contains__(&self, name: &str) -> bool {
+        self.channels.contains(name)
+    }
+
+    /// The channel names.
+    fn keys(&self) -> Vec<String> {
+        self.channels.names.clone()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "BatchRun({} runs ({} failed), channels: {})",
+            self.errors.len(),
+            self.errors.iter().filter(|e| e.is_some()).count(),
+            self.channels.names.join(", ")
+        )
+    }
+}

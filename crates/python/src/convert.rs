@@ -1,0 +1,115 @@
+//! Values between Python and the rig JSON / numpy: JSON values as Python
+//! objects, Python values as the text `--set path=value` takes, arrays.
+
+use numpy::{AllowTypeChange, PyArray1, PyArrayLike1};
+use pyo3::exceptions::{PyKeyError, PyTypeError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
+use serde_json::Value;
+
+/// A JSON value as a Python object (`null` → `None`, objects → `dict`,
+/// arrays → `list`, integers → `int`, other numbers → `float`).
+pub fn json_to_py<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match v {
+        Value::Null => py.None().into_bound(py),
+        Value::Bool(b) => PyBool::new(py, *b).to_owned().into_any(),
+        Value::Number(n) => match (n.as_i64(), n.as_u64()) {
+            (Some(i), _) => i.into_pyobject(py)?.into_any(),
+            (None, Some(u)) => u.into_pyobject(py)?.into_any(),
+            _ => PyFloat::new(py, n.as_f64().unwrap_or(f64::NAN)).into_any(),
+        },
+        Value::String(s) => PyString::new(py, s).into_any(),
+        Value::Array(a) => {
+            let l = PyList::empty(py);
+            for x in a {
+                l.append(json_to_py(py, x)?)?;
+            }
+            l.into_any()
+        }
+        Value::Object(m) => {
+            let d = PyDict::new(py);
+            for (k, x) in m {
+                d.set_item(k, json_to_py(py, x)?)?;
+            }
+            d.into_any()
+        }
+    })
+}
+
+/// A Python value as the text after `=` of a CLI `--set path=value`, so that
+/// `Rig.set` parses it exactly as the CLI does: `True` → `true`, `None` →
+/// `null`, an int as itself, a float at full precision (`nan` stays `NaN`
+/// and is refused like `--set x=NaN`), a string as given.
+pub fn set_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
+    if v.is_none() {
+        return Ok("null".into());
+    }
+    if let Ok(b) = v.cast::<PyBool>() {
+        return Ok(if b.is_true() { "true" } else { "false" }.into());
+    }
+    if v.is_instance_of::<PyInt>() {
+        return Ok(v.str()?.to_string());
+    }
+    if let Ok(s) = v.cast::<PyString>() {
+        return Ok(s.to_string());
+    }
+    if let Ok(x) = v.extract::<f64>() {
+        return Ok(format!("{x:?}"));
+    }
+    Err(PyTypeError::new_err(format!(
+        "a rig parameter is a number, a string, a bool or None, not {}",
+        v.get_type().name()?
+    )))
+}
+
+/// A 1-D float array from any array-like (list, numpy array of any real
+/// dtype), copied.
+pub fn vector(x: PyArrayLike1<'_, f64, AllowTypeChange>) -> Vec<f64> {
+    x.as_array().to_vec()
+}
+
+/// A 1-D numpy array owning `v`.
+pub fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_vec(py, v)
+}
+
+/// Named arrays (the channels of a run or a batch), in order.
+pub struct Named<T> {
+    /// Names, in order.
+    pub names: Vec<String>,
+    /// One array per name.
+    pub values: Vec<Py<T>>,
+}
+
+impl<T: pyo3::PyTypeInfo> Named<T> {
+    /// `{name: array}` (the arrays themselves, not copies).
+    pub fn dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (n, v) in self.names.iter().zip(&self.values) {
+            d.set_item(n, v.clone_ref(py))?;
+        }
+        Ok(d)
+    }
+
+    /// The array named `name`; a KeyError naming the others if none is.
+    pub fn get(&self, py: Python<'_>, name: &str) -> PyResult<Py<T>> {
+        self.names
+            .iter()
+            .position(|n| n == name)
+            .map(|i| self.values[i].clone_ref(py))
+            .ok_or_else(|| no_channel(name, &self.names))
+    }
+
+    /// Whether there is an array named `name`.
+    pub fn contains(&self, name: &str) -> bool {
+        self.names.iter().any(|n| n == name)
+    }
+}
+
+/// A `KeyError` naming the channels there are.
+pub fn no_channel(name: &str, names: &[String]) -> PyErr {
+    PyKeyError::new_err(format!(
+        "no channel `{name}` (channels: {})",
+        names.join(", ")
+    ))
+}

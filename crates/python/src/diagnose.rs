@@ -1,0 +1,126 @@
+//! `hydrocyl.diagnose`: `hydrocyl diagnose` on a valve rig and one measured
+//! record (crate `hydrocyl-identify`): residuals, the missing effects,
+//! refits, before/after; the report as a dict (the CLI's `--report` JSON).
+
+use crate::convert::{json_to_py, vector};
+use crate::errors::{detached, Failure};
+use crate::rig::Rig;
+use hydrocyl_identify::catalog::EffectId;
+use hydrocyl_identify::data::{ColumnMap, Record};
+use hydrocyl_identify::diagnose::DiagnoseOptions;
+use hydrocyl_identify::valve::diagnose_valve;
+use hydrocyl_system::rig::valve_rig_from;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Name of a record given as a dict, in messages (its CSV rows: row 2 is
+/// element 0).
+const DICT_RECORD: &str = "record (dict; row 2 = element 0)";
+
+/// The measured record: a CSV path (str or path-like), or a dict of
+/// equal-length arrays keyed by measured-data column names (`time`,
+/// `command`, `position`, `p1 [bar]`, ...), checked by the same rules.
+fn read_record(obj: &Bound<'_, PyAny>) -> PyResult<Record> {
+    let input = |e: hydrocyl_identify::data::DataError| PyValueError::new_err(e.to_string());
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let mut cols = Vec::new();
+        let mut header = Vec::new();
+        for (k, v) in d.iter() {
+            header.push(k.extract::<String>()?);
+            cols.push(vector(v.extract().map_err(|_| {
+                PyValueError::new_err(format!(
+                    "{DICT_RECORD}: column {k}: not a 1-D array of numbers"
+                ))
+            })?));
+        }
+        let csv_err = |e: csv::Error| PyValueError::new_err(format!("{DICT_RECORD}: {e}"));
+        w.write_record(&header).map_err(csv_err)?;
+        let n = cols.iter().map(Vec::len).max().unwrap_or(0);
+        if let Some((h, c)) = header.iter().zip(&cols).find(|(_, c)| c.len() != n) {
+            return Err(PyValueError::new_err(format!(
+                "{DICT_RECORD}: column `{h}` has {} values, another {n}",
+                c.len()
+            )));
+        }
+        for i in 0..n {
+            w.write_record(cols.iter().map(|c| format!("{:?}", c[i])))
+                .map_err(csv_err)?;
+        }
+        let text = w
+            .into_inner()
+            .map_err(|e| PyValueError::new_err(format!("{DICT_RECORD}: {e}")))?;
+        return Record::parse(
+            DICT_RECORD,
+            &String::from_utf8_lossy(&text),
+            &ColumnMap::default(),
+        )
+        .map_err(input);
+    }
+    let path: std::path::PathBuf = obj.extract().map_err(|_| {
+        PyValueError::new_err("record: a CSV path or a dict of arrays by column name")
+    })?;
+    Record::read(&path).map_err(input)
+}
+
+/// Diagnoses `rig` (the valve-cylinder circuit: its netlist, e.g. the
+/// `leaney-moog` preset, or a `valve-cylinder` rig file) against one measured `record` as
+/// `hydrocyl diagnose --rig ... --data ...` does and returns its report as
+/// a dict (NRMSEs before/after, effects added and rejected with their
+/// parameters in SI, declared parameters refitted, warnings).
+///
+/// `record`: a CSV path or a dict of arrays by column name (measured-data
+/// format: `time` [s], `command`, `position` [m], optionally `velocity`,
+/// `p1`, `p2` [Pa gauge]; unit suffixes such as `p1 [bar]` convert).
+/// `min_share`, `holdout`, `window`, `effects` are the CLI's options.
+/// The GIL is released while it runs. ValueError with the CLI's message
+/// for bad input.
+#[pyfunction]
+#[pyo3(signature = (rig, record, *, min_share = 0.03, holdout = 0.3, window = None, effects = None))]
+pub fn diagnose<'py>(
+    py: Python<'py>,
+    rig: &Rig,
+    record: &Bound<'py, PyAny>,
+    min_share: f64,
+    holdout: f64,
+    window: Option<usize>,
+    effects: Option<Vec<String>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let bad = |m: String| Err(PyValueError::new_err(m));
+    if !(0.0..1.0).contains(&min_share) {
+        return bad(format!("min_share {min_share}: must be in [0, 1)"));
+    }
+    if !(0.05..=0.5).contains(&holdout) {
+        return bad(format!("holdout {holdout}: must be in [0.05, 0.5]"));
+    }
+    if window == Some(0) {
+        return bad("window 0: must be at least 1".into());
+    }
+    let candidates = effects
+        .map(|ids| {
+            ids.iter()
+                .map(|id| {
+                    EffectId::from_id(id.trim()).ok_or_else(|| {
+                        PyValueError::new_err(format!("effects: unknown effect '{id}'"))
+                    })
+                })
+                .collect::<PyResult<Vec<_>>>()
+        })
+        .transpose()?;
+    let valve = valve_rig_from(&rig.value).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let rec = read_record(record)?;
+    let opts = DiagnoseOptions {
+        min_share,
+        holdout,
+        half_window: window,
+        candidates,
+        ..DiagnoseOptions::default()
+    };
+    let report = detached(py, || {
+        let r = diagnose_valve(&valve, &rec, &opts, &mut |_, _, _| {})
+            .map_err(|e| Failure::Input(e.to_string()))?;
+        serde_json::to_value(&r).map_err(|e| Failure::Input(format!("report: {e}")))
+    })?;
+    json_to_py(py, &report)
+}

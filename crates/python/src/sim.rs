@@ -1,0 +1,154 @@
+//! One run of a rig on a sampled command, as `hydrocyl simulate` makes it:
+//! run settings checked with the CLI's messages, the command a
+//! piecewise-linear table over the output times, the energy ledger when
+//! asked for, and a solver failure located (time and state).
+
+use crate::errors::{Failure, Outcome};
+use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
+use hydrocyl_integrators::SolveError;
+use hydrocyl_system::rig::{self, RigError};
+use hydrocyl_system::run::{self as runner, Run, RunOptions, SimError, Solver};
+use hydrocyl_system::signal::Signal;
+use serde_json::Value;
+
+/// The run settings `simulate` and `simulate_batch` take, checked with the
+/// CLI's rules and messages (named by the Python argument).
+pub fn options(
+    solver: &str,
+    rtol: f64,
+    rk4_step: f64,
+    h_max: Option<f64>,
+    ledger: bool,
+) -> Outcome<RunOptions> {
+    let solver = Solver::parse(solver).ok_or_else(|| {
+        Failure::Input(format!(
+            "solver: unknown method `{solver}` (use dp45, rosenbrock or rk4)"
+        ))
+    })?;
+    if !(rtol > 0.0 && rtol < 1.0) {
+        return Err(Failure::Input(format!("rtol: {rtol} is not in (0, 1)")));
+    }
+    if !(rk4_step > 0.0 && rk4_step.is_finite()) {
+        return Err(Failure::Input(format!(
+            "rk4_step: {rk4_step} is not positive"
+        )));
+    }
+    let defaults = RunOptions::default();
+    let h_max = h_max.unwrap_or(defaults.h_max);
+    if !(h_max > 0.0 && h_max.is_finite()) {
+        return Err(Failure::Input(format!("h_max: {h_max} is not positive")));
+    }
+    Ok(RunOptions {
+        solver,
+        rtol,
+        rk4_step,
+        h_max,
+        ledger,
+        ..defaults
+    })
+}
+
+/// The command: a first-order-hold table of `u` over `t` (the CLI's command
+/// CSV), at least two samples. The run is sampled at the same `t`.
+pub fn command(t: &[f64], u: &[f64]) -> Outcome<Signal> {
+    if t.len() < 2 {
+        return Err(Failure::Input(format!(
+            "command (t, u): needs at least two samples, found {}",
+            t.len()
+        )));
+    }
+    Signal::table(t.to_vec(), u.to_vec())
+        .map_err(|e| Failure::Input(format!("command (t, u): {e}")))
+}
+
+/// A run and, when the options ask for it, its energy ledger over the whole
+/// run (or why there is none).
+pub struct Simulated {
+    /// The run (channels as `hydrocyl simulate` writes them).
+    pub run: Run,
+    /// The ledger (`None` unless `RunOptions::ledger`).
+    pub ledger: Option<Result<Ledger, String>>,
+}
+
+/// Simulates the rig value (checked or not) on `command` sampled at `t`.
+pub fn simulate(
+    value: &Value,
+    command: &Signal,
+    t: &[f64],
+    opts: &RunOptions,
+) -> Outcome<Simulated> {
+    let run = rig::simulate(value, command.clone(), t, opts).map_err(|e| match e {
+        RigError::Sim(_) => locate_failure(value, command, t, opts, e.to_string()),
+        other => Failure::Input(other.to_string()),
+    })?;
+    let ledger = opts.ledger.then(|| whole_run_ledger(value, command, &run));
+    Ok(Simulated { run, ledger })
+}
+
+/// The ledger of `run` over all its samples, on a fresh circuit of the same
+/// rig (the ledger reads only the circuit's structure and the run's states).
+fn whole_run_ledger(value: &Value, command: &Signal, run: &Run) -> Result<Ledger, String> {
+    let mut c = rig::circuit(value, command.clone()).map_err(|e| e.to_string())?;
+    c.set_ledger(true);
+    ledger(&c, run, 0, run.time.len() - 1, &RodSide::default()).map_err(|e| e.to_string())
+}
+
+/// The time a solver error names.
+fn failure_time(e: &SolveError) -> Option<f64> {
+    match e {
+        SolveError::StepTooSmall { t, .. }
+        | SolveError::TooManySteps { t, .. }
+        | SolveError::NonFinite { t, .. }
+        | SolveError::Singular { t } => Some(*t),
+        SolveError::InvalidInput(_) => None,
+    }
+}
+
+/// Turns a failed run into a [`Failure::Solver`]: the rig's run is repeated
+/// on its circuit to get the solver's time, then integrated up to that time
+/// for the state there. The message is the CLI's, with the state appended.
+fn locate_failure(
+    value: &Value,
+    command: &Signal,
+    t: &[f64],
+    opts: &RunOptions,
+    message: String,
+) -> Failure {
+    let located = (|| {
+        let mut c = rig::circuit(value, command.clone()).ok()?;
+        let x0 = c.initial_state();
+        let n = c.n_states();
+        let names = c.state_names();
+        let time = match runner::run(&mut c, &x0, t, opts) {
+            Err(SimError::Solve { source, .. }) => failure_time(&source)?,
+            _ => return None,
+        };
+        let state: Vec<f64> = if time > t[0] {
+            let mut c = rig::circuit(value, command.clone()).ok()?;
+            let r = runner::run(&mut c, &x0, &[t[0], time], opts).ok()?;
+            r.state(1)[..n].to_vec()
+        } else {
+            x0[..n].to_vec()
+        };
+        Some((
+            time,
+            names.into_iter().take(n).zip(state).collect::<Vec<_>>(),
+        ))
+    })();
+    let (time, state) = located.unwrap_or((f64::NAN, Vec::new()));
+    let listed = state
+        .iter()
+        .map(|(k, v)| format!("{k} = {v:e}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let message = if state.is_empty() {
+        message
+    } else {
+        format!("{message}; state at t = {time} s: {listed}")
+    };
+    Failure::Solver {
+        message,
+        time,
+        state,
+    }
+}

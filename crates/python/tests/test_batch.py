@@ -1,0 +1,131 @@
+"""simulate_batch: equal to a loop of single runs, independent of the thread
+count, errors naming the set, and the GIL released while it runs."""
+
+import threading
+
+import numpy as np
+import pytest
+
+import hydrocyl
+from conftest import path_of
+
+
+@pytest.fixture
+def sets():
+    rig = hydrocyl.Rig.load("leaney-moog")
+    mass, beta = path_of(rig, "mass"), path_of(rig, "bulk_modulus")
+    n = 12
+    return rig, {
+        mass: np.linspace(0.5, 1.5, n) * rig.get(mass),
+        beta: np.linspace(1.2, 0.8, n) * rig.get(beta),
+    }
+
+
+def test_batch_equals_a_loop_of_single_runs(step, sets):
+    t, u = step
+    rig, params = sets
+    batch = hydrocyl.simulate_batch(rig, t, u, params)
+    assert len(batch) == 12 and batch.ok.all() and batch.errors == [None] * 12
+    np.testing.assert_array_equal(batch.time, t)
+    for i in range(12):
+        one = rig.copy()
+        for path, values in params.items():
+            one.set(path, float(values[i]))
+        run = one.simulate(t, u)
+        assert batch.names == run.names
+        for name in run.names:
+            np.testing.assert_array_equal(batch[name][i], run[name])
+        assert batch.stats["steps"][i] == run.stats["steps"]
+    # the runs differ: the parameters matter
+    assert np.ptp(batch["position"][:, -1]) > 0.0
+
+
+def test_batch_does_not_depend_on_the_thread_count(step, sets):
+    t, u = step
+    rig, params = sets
+    one = hydrocyl.simulate_batch(rig, t, u, params, threads=1)
+    many = hydrocyl.simulate_batch(rig, t, u, params, threads=3)
+    default = hydrocyl.simulate_batch(rig, t, u, params)
+    for name in one.names:
+        np.testing.assert_array_equal(one[name], many[name])
+        np.testing.assert_array_equal(one[name], default[name])
+
+
+def test_channel_selection(step, sets):
+    t, u = step
+    rig, params = sets
+    batch = hydrocyl.simulate_batch(rig, t, u, params, channels=["position", "p1"])
+    assert batch.names == ["position", "p1"] and batch["p1"].shape == (12, len(t))
+    with pytest.raises(KeyError, match="no channel `nope`"):
+        hydrocyl.simulate_batch(rig, t, u, params, channels=["nope"])
+
+
+def test_a_bad_set_names_its_run(step, sets):
+    t, u = step
+    rig, params = sets
+    mass = path_of(rig, "mass")
+    params[mass][3] = -1.0
+    with pytest.raises(ValueError, match=r"^run 3 \(.*=-1\.0.*\): .*out of range"):
+        hydrocyl.simulate_batch(rig, t, u, params)
+    kept = hydrocyl.simulate_batch(rig, t, u, params, on_error="nan")
+    assert list(kept.ok) == [i != 3 for i in range(12)]
+    assert kept.errors[3].startswith("run 3") and np.isnan(kept["position"][3]).all()
+    assert np.isfinite(kept["position"][2]).all()
+
+
+def test_a_solver_failure_in_a_batch_is_a_simulation_error(step, sets):
+    """Set 5 starts from a chamber pressure of 1e30 Pa, which no step size
+    gets away from (see test_simulate)."""
+    t, u = step
+    rig, params = sets
+    p1 = path_of(rig, "p1")
+    params[p1] = np.full(12, 2e6)
+    params[p1][5] = 1e30
+    with pytest.raises(hydrocyl.SimulationError, match=r"^run 5 \(.*\): simulation: solver dp45: .*state at t") as e:
+        hydrocyl.simulate_batch(rig, t, u, params)
+    assert e.value.time == 0.0 and 1e30 in e.value.state.values()
+    kept = hydrocyl.simulate_batch(rig, t, u, params, on_error="nan")
+    assert list(kept.ok) == [i != 5 for i in range(12)]
+
+
+def test_bad_batch_inputs(step, sets):
+    t, u = step
+    rig, params = sets
+    (a, va), (b, vb) = params.items()
+    with pytest.raises(ValueError, match="values, but"):
+        hydrocyl.simulate_batch(rig, t, u, {a: va, b: vb[:-1]})
+    with pytest.raises(ValueError, match="no parameter sets"):
+        hydrocyl.simulate_batch(rig, t, u, {})
+    with pytest.raises(ValueError, match="unknown rig parameter `no.such`"):
+        hydrocyl.simulate_batch(rig, t, u, {"no.such": [1.0]})
+    with pytest.raises(ValueError, match="solver: unknown method"):
+        hydrocyl.simulate_batch(rig, t, u, params, solver="euler")
+    with pytest.raises(ValueError, match="threads"):
+        hydrocyl.simulate_batch(rig, t, u, params, threads=0)
+
+
+def test_two_python_threads_run_batches_at_the_same_time(sets):
+    """With the GIL released, two threads' batches overlap in time (each
+    batch reports the interval it computed in, measured in Rust); with the
+    GIL held they could only run one after the other."""
+    rig, params = sets
+    t = np.linspace(0.0, 1.0, 2001)
+    u = 0.4 * np.sin(2 * np.pi * 5 * t)
+    big = {k: np.repeat(v, 20) for k, v in params.items()}  # 240 runs, ~0.1-1 s
+    barrier = threading.Barrier(2)
+    out = [None, None]
+
+    def work(k):
+        barrier.wait()
+        out[k] = hydrocyl.simulate_batch(rig, t, u, big, threads=1, channels=["position"])
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(2)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    (a0, a1), (b0, b1) = out[0].interval_s, out[1].interval_s
+    overlap = min(a1, b1) - max(a0, b0)
+    shorter = min(a1 - a0, b1 - b0)
+    assert overlap > 0.5 * shorter, (out[0].interval_s, out[1].interval_s)
+    np.testing.assert_array_equal(out[0]["position"], out[1]["position"])

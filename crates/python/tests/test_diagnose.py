@@ -1,0 +1,54 @@
+"""diagnose: the report `hydrocyl diagnose --report` writes, from a CSV path
+or a dict of arrays."""
+
+import json
+
+import numpy as np
+import pytest
+
+import hydrocyl
+from conftest import run_cli
+
+RECORD = "fixtures/measured/valve-internal_leakage.csv"
+
+
+def comparable(report):
+    return {k: v for k, v in report.items() if k not in ("elapsed_s", "records")}
+
+
+@pytest.fixture(scope="module")
+def report(repo):
+    return hydrocyl.diagnose(hydrocyl.Rig.load("leaney-moog"), str(repo / RECORD), effects=["internal_leakage"])
+
+
+def test_diagnose_equals_the_cli_report(cli, repo, tmp_path, report):
+    out = tmp_path / "report.json"
+    run_cli(cli, "diagnose", "--rig", "leaney-moog", "--data", repo / RECORD, "--effects", "internal_leakage",
+            "--report", out, "--quiet")
+    assert comparable(report) == comparable(json.loads(out.read_text()))
+    assert [e["id"] for e in report["effects_added"]] == ["internal_leakage"]
+    assert report["nrmse_after"]["position"] < report["nrmse_before"]["position"]
+
+
+def test_a_dict_record_gives_the_same_report(repo, report):
+    path = repo / RECORD
+    header = path.read_text().splitlines()[0].split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=1)
+    record = {h: data[:, i] for i, h in enumerate(header)}
+    got = hydrocyl.diagnose(hydrocyl.Rig.load("leaney-moog"), record, effects=["internal_leakage"])
+    assert comparable(got) == comparable(report)
+
+
+def test_diagnose_errors(repo):
+    rig = hydrocyl.Rig.load("leaney-moog")
+    with pytest.raises(ValueError, match="min_share 2: must be in"):
+        hydrocyl.diagnose(rig, str(repo / RECORD), min_share=2)
+    with pytest.raises(ValueError, match="effects: unknown effect 'gremlins'"):
+        hydrocyl.diagnose(rig, str(repo / RECORD), effects=["gremlins"])
+    with pytest.raises(ValueError):  # not the valve-cylinder circuit
+        hydrocyl.diagnose(hydrocyl.Rig.load("wang-hybrid"), str(repo / RECORD))
+    t = np.linspace(0, 1, 50)
+    with pytest.raises(ValueError, match="position"):
+        hydrocyl.diagnose(rig, {"time": t, "command": 0 * t})
+    with pytest.raises(ValueError, match="no-such.csv"):
+        hydrocyl.diagnose(rig, str(repo / "no-such.csv"))

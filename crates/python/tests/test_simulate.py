@@ -1,0 +1,143 @@
+"""Rig.simulate: equal to `hydrocyl simulate` on the same rig and command,
+the energy ledger, pandas as an optional extra, and errors."""
+
+import sys
+import types
+
+import numpy as np
+import pytest
+
+import hydrocyl
+from conftest import path_of, read_csv, run_cli, write_command
+
+
+def assert_equal_to_cli(run, csv):
+    assert ["time", *run.names] == list(csv)
+    np.testing.assert_array_equal(run.time, csv["time"])
+    for name in run.names:
+        scale = max(1.0, float(np.abs(csv[name]).max()))
+        diff = float(np.abs(run[name] - csv[name]).max())
+        assert diff <= 1e-12 * scale, (name, diff)
+
+
+@pytest.mark.parametrize(
+    "preset, level, solver",
+    [("leaney-moog", 0.4, "dp45"), ("leaney-moog", -0.3, "rosenbrock"), ("wang-hybrid", 2.0, "dp45")],
+)
+def test_simulate_equals_the_cli(cli, tmp_path, preset, level, solver):
+    t = np.linspace(0.0, 0.2, 401)
+    u = np.where(t < 0.01, 0.0, level)
+    cmd, out = tmp_path / "cmd.csv", tmp_path / "out.csv"
+    write_command(cmd, t, u)
+    run_cli(cli, "simulate", "--rig", preset, "--command", cmd, "--out", out, "--solver", solver)
+    run = hydrocyl.Rig.load(preset).simulate(t, u, solver=solver)
+    assert_equal_to_cli(run, read_csv(out))
+    assert run.stats["steps"] > 0 and run.units["position"] == "m"
+
+
+def test_simulate_with_set_equals_the_cli(cli, tmp_path, step):
+    t, u = step
+    rig = hydrocyl.Rig.load("leaney-moog")
+    mass = path_of(rig, "mass")
+    rig.set(mass, 60.5)
+    cmd, out = tmp_path / "cmd.csv", tmp_path / "out.csv"
+    write_command(cmd, t, u)
+    run_cli(cli, "simulate", "--rig", "leaney-moog", "--set", f"{mass}=60.5", "--rtol", "1e-8",
+            "--command", cmd, "--out", out)
+    assert_equal_to_cli(rig.simulate(t, u, rtol=1e-8), read_csv(out))
+
+
+def test_channels_are_numpy_arrays_by_name(step):
+    t, u = step
+    run = hydrocyl.Rig.load("leaney-moog").simulate(list(t), list(u))
+    assert set(run.channels) == set(run.names) and "position" in run
+    assert run["position"].shape == t.shape and run["position"].dtype == np.float64
+    assert run.channels["position"] is run["position"] or np.array_equal(run.channels["position"], run["position"])
+    assert run["position"][-1] > 0.0  # a positive command extends the rod
+    with pytest.raises(KeyError, match="channels: command, position"):
+        run["nope"]
+
+
+def test_ledger_closes_and_is_absent_unless_asked(step):
+    t, u = step
+    rig = hydrocyl.Rig.load("leaney-moog")
+    assert rig.simulate(t, u).ledger is None
+    led = rig.simulate(t, u, ledger=True).ledger
+    assert led["energy_in_j"] > 0.0
+    assert abs(led["error"]) < 1e-3
+    assert 0.0 < led["efficiency"] < 1.0
+    assert sum(led["losses_j"].values()) < led["energy_in_j"]
+
+
+def test_to_pandas_uses_pandas_when_there_and_says_so_when_not(step, monkeypatch):
+    t, u = step
+    run = hydrocyl.Rig.load("leaney-moog").simulate(t, u)
+    monkeypatch.setitem(sys.modules, "pandas", None)  # import pandas fails
+    with pytest.raises(ImportError, match="needs pandas"):
+        run.to_pandas()
+    fake = types.ModuleType("pandas")
+    fake.DataFrame = lambda columns: ("frame", columns)
+    monkeypatch.setitem(sys.modules, "pandas", fake)
+    kind, columns = run.to_pandas()
+    assert kind == "frame" and list(columns) == ["time", *run.names]
+    np.testing.assert_array_equal(columns["position"], run["position"])
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"solver": "euler"}, "solver: unknown method `euler` (use dp45, rosenbrock or rk4)"),
+        ({"rtol": 0.0}, "rtol: 0 is not in (0, 1)"),
+        ({"rk4_step": -1.0}, "rk4_step: -1 is not positive"),
+    ],
+)
+def test_bad_settings(step, kwargs, message):
+    t, u = step
+    with pytest.raises(ValueError) as e:
+        hydrocyl.Rig.load("leaney-moog").simulate(t, u, **kwargs)
+    assert str(e.value) == message
+
+
+def test_bad_commands(step):
+    t, u = step
+    rig = hydrocyl.Rig.load("leaney-moog")
+    u_nan = u.copy()
+    u_nan[7] = np.nan
+    with pytest.raises(ValueError, match="command sample 7: .*not finite"):
+        rig.simulate(t, u_nan)
+    t_back = t.copy()
+    t_back[5] = t_back[4]
+    with pytest.raises(ValueError, match="command sample 5: time .* does not increase"):
+        rig.simulate(t_back, u)
+    with pytest.raises(ValueError, match="401 times but 400 values"):
+        rig.simulate(t, u[:-1])
+    with pytest.raises(ValueError, match="at least two samples"):
+        rig.simulate(t[:1], u[:1])
+
+
+def test_solver_failure_is_a_simulation_error_with_time_and_state(cli, tmp_path, step):
+    """An initial chamber pressure of 1e30 Pa is finite (the rig accepts it)
+    but no step size meets the tolerance from there."""
+    t, u = step
+    rig = hydrocyl.Rig.load("leaney-moog")
+    p1 = path_of(rig, "p1")
+    rig.set(p1, 1e30)
+    with pytest.raises(hydrocyl.SimulationError) as e:
+        rig.simulate(t, u)
+    err = e.value
+    assert err.time == t[0]
+    assert err.state and all(np.isfinite(v) for v in err.state.values())
+    assert 1e30 in err.state.values()
+    assert f"at t = {err.time:g} s" in str(err) and "state at t" in str(err)
+    # the CLI's line comes first
+    cmd = tmp_path / "cmd.csv"
+    write_command(cmd, t, u)
+    code, _, line = run_cli(cli, "simulate", "--rig", "leaney-moog", "--set", f"{p1}=1e30", "--command", cmd,
+                            "--out", tmp_path / "o.csv", expect_ok=False)
+    assert code == 2 and line.startswith("simulation: solver dp45") and str(err).startswith(line)
+    assert not isinstance(err, ValueError)
+
+
+def test_a_panic_becomes_a_runtime_error():
+    with pytest.raises(RuntimeError, match="internal error .*deliberate test panic"):
+        hydrocyl._panic_for_test()

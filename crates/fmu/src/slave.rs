@@ -17,7 +17,7 @@ use hydrocyl_integrators::{solve, Options};
 use hydrocyl_system::external::ExternalInput;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::Solver;
-use hydrocyl_system::{Circuit, Wire};
+use hydrocyl_system::{AnyWire, Circuit};
 use serde_json::Value;
 
 /// Where the slave is in the FMI 2.0 co-simulation state machine.
@@ -39,7 +39,7 @@ pub enum Phase {
 struct Sim {
     circuit: Circuit,
     input: ExternalInput,
-    wires: Vec<Wire>,
+    wires: Vec<AnyWire>,
     x: Vec<f64>,
     t: f64,
 }

@@ -187,7 +187,7 @@ pub fn run_all(opts: &Options) -> bool {
             // the FMU checked by a real importer (FMPy from PyPI, its own venv)
             run(
                 "crates/fmu/tests/run_fmpy_tests.sh",
-                &mut Command::new("bash").arg("crates/fmu/tests/run_fmpy_tests.sh"),
+                Command::new("bash").arg("crates/fmu/tests/run_fmpy_tests.sh"),
             )?;
         }
         Ok::<(), String>(())

@@ -151,7 +151,7 @@ fn one_parameter_path_scheme() {
             &v,
             Signal::Constant { value: 0.0 },
             &[0.0, 0.001],
-            &RunOptions::default(),
+            &RunOptions::dp45(),
         )
         .unwrap();
         assert_eq!(
@@ -246,13 +246,7 @@ fn meter_out_needle_sets_the_extending_speed() {
         1.0,
     );
     let t = times(3.0, 0.005);
-    let run = rig::simulate(
-        &v,
-        Signal::Constant { value: 1.0 },
-        &t,
-        &RunOptions::default(),
-    )
-    .unwrap();
+    let run = rig::simulate(&v, Signal::Constant { value: 1.0 }, &t, &RunOptions::dp45()).unwrap();
     let got = steady_speed(&run, "velocity", 2.0, 3.0);
     assert!(
         (got - expected).abs() < 2e-3 * expected,
@@ -270,7 +264,7 @@ fn meter_out_needle_sets_the_extending_speed() {
         &v,
         Signal::Constant { value: -1.0 },
         &times(0.5, 0.005),
-        &RunOptions::default(),
+        &RunOptions::dp45(),
     )
     .unwrap();
     assert!(back
@@ -379,13 +373,7 @@ fn pump_closed_circuit_meets_its_steady_state() {
         q_pump / a1,
     );
     let t = times(3.0, 0.005);
-    let run = rig::simulate(
-        &v,
-        Signal::Constant { value: 2.0 },
-        &t,
-        &RunOptions::default(),
-    )
-    .unwrap();
+    let run = rig::simulate(&v, Signal::Constant { value: 2.0 }, &t, &RunOptions::dp45()).unwrap();
     let got = steady_speed(&run, "velocity", 2.0, 3.0);
     assert!(
         (got - expected).abs() < 2e-3 * expected,
@@ -490,7 +478,7 @@ fn bad_netlists_are_refused_by_path() {
         edit(&mut v);
         let err = rig::check(&v)
             .and_then(|_| {
-                rig::simulate(&v, square(), &[0.0, 0.01], &RunOptions::default()).map(|_| ())
+                rig::simulate(&v, square(), &[0.0, 0.01], &RunOptions::dp45()).map(|_| ())
             })
             .expect_err(what)
             .to_string();
@@ -532,7 +520,7 @@ fn declared_probes_are_the_published_ones() {
             &v,
             Signal::Constant { value: 0.0 },
             &[0.0, 1e-4],
-            &RunOptions::default(),
+            &RunOptions::dp45(),
         )
         .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
         let mut want: Vec<String> = Vec::new();

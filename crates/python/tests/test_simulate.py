@@ -133,8 +133,8 @@ def test_solver_failure_is_a_simulation_error_with_time_and_state(cli, tmp_path,
     cmd = tmp_path / "cmd.csv"
     write_command(cmd, t, u)
     code, _, line = run_cli(cli, "simulate", "--rig", "leaney-moog", "--set", f"{p1}=1e30", "--command", cmd,
-                            "--out", tmp_path / "o.csv", expect_ok=False)
-    assert code == 2 and line.startswith("simulation: solver ") and str(err).startswith(line)
+                            "--solver", "dp45", "--out", tmp_path / "o.csv", expect_ok=False)
+    assert code == 2 and line.startswith("simulation: solver dp45") and str(err).startswith(line)
     assert not isinstance(err, ValueError)
 
 

@@ -6,7 +6,7 @@
 use super::super::registry::{
     param, ComponentType, Default::*, Instance, ParamSpec, PortSpec, Range, Role,
 };
-use super::{built, port};
+use super::{built, join, port};
 use crate::circuit::Component;
 use crate::components::Friction;
 use hydrocyl_friction::{
@@ -73,23 +73,6 @@ macro_rules! curve {
             ),
         ]
     };
-}
-
-const fn join<const A: usize, const B: usize, const N: usize>(
-    a: [ParamSpec; A],
-    b: [ParamSpec; B],
-) -> [ParamSpec; N] {
-    let mut out = [a[0]; N];
-    let mut i = 0;
-    while i < A {
-        out[i] = a[i];
-        i += 1;
-    }
-    while i < N {
-        out[i] = b[i - A];
-        i += 1;
-    }
-    out
 }
 
 const SIGMA2_E: ParamSpec = param(

@@ -6,7 +6,7 @@ use super::super::registry::{
     param, ComponentType, Default::*, Instance, ParamSpec, Range, Role, StateSpec,
 };
 use super::servo::{metering, METERING};
-use super::{built, port, HYD, MECH, SIG};
+use super::{built, join, port, HYD, MECH, SIG};
 use crate::circuit::Component;
 use crate::components::{GeneralisedCylinder, Mass, TwoChamberCylinder};
 use hydrocyl_actuator::generalised::XMethod;
@@ -133,35 +133,16 @@ const MOTION: [StateSpec; 2] = [
     },
 ];
 
-const GENERALISED: [ParamSpec; 18] = {
-    let (c, m) = (CYLINDER, METERING);
-    [
-        c[0],
-        c[1],
-        c[2],
-        c[3],
-        c[4],
-        c[5],
-        c[6],
-        c[7],
-        c[8],
-        c[9],
-        m[0],
-        m[1],
-        m[2],
-        m[3],
-        m[4],
-        m[5],
-        m[6],
-        param(
-            "x_tolerance",
-            "-",
-            Value(0.0),
-            Range::NON_NEGATIVE,
-            "absolute tolerance of a bracketing X root; 0 = the exact analytical root",
-        ),
-    ]
-};
+const GENERALISED: [ParamSpec; 18] = join(
+    join::<10, 7, 17>(CYLINDER, METERING),
+    [param(
+        "x_tolerance",
+        "-",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "absolute tolerance of a bracketing X root; 0 = the exact analytical root",
+    )],
+);
 
 fn generalised(i: &Instance) -> Result<Box<dyn Component>, String> {
     let p_le = i

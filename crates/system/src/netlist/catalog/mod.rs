@@ -1,6 +1,6 @@
 //! The component types of the registry, one file per family.
 
-use super::registry::{ComponentType, Domain, PortSpec, Role};
+use super::registry::{ComponentType, Domain, ParamSpec, PortSpec, Role};
 use crate::circuit::Component;
 use std::sync::LazyLock;
 
@@ -29,6 +29,26 @@ pub(super) const fn port(
         optional,
         doc,
     }
+}
+
+/// The parameter table `a` followed by `b` (`N = A + B`), for tables that
+/// share rows (a metering's, a cylinder's, the seal terms).
+pub(super) const fn join<const A: usize, const B: usize, const N: usize>(
+    a: [ParamSpec; A],
+    b: [ParamSpec; B],
+) -> [ParamSpec; N] {
+    assert!(A + B == N && A > 0, "N = A + B, A > 0");
+    let mut out = [a[0]; N];
+    let mut i = 0;
+    while i < A {
+        out[i] = a[i];
+        i += 1;
+    }
+    while i < N {
+        out[i] = b[i - A];
+        i += 1;
+    }
+    out
 }
 
 /// Boxes a built component.

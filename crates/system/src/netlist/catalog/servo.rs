@@ -5,7 +5,7 @@ use super::super::registry::{
     param, ComponentType, Default::*, Instance, ParamSpec, Range, Role, StateSpec,
 };
 use super::hydraulic::orifice_params;
-use super::{built, port, HYD, SIG};
+use super::{built, join, port, HYD, SIG};
 use crate::circuit::Component;
 use crate::components::{CommandInput, FourWayValve, ServoSpool};
 use hydrocyl_ports::{Density, Position, Pressure};
@@ -67,25 +67,16 @@ pub(crate) fn metering(i: &Instance) -> Result<Metering, String> {
     Ok(m)
 }
 
-const FOUR_WAY: [ParamSpec; 8] = {
-    let m = METERING;
-    [
-        m[0],
-        m[1],
-        m[2],
-        m[3],
-        m[4],
-        m[5],
-        m[6],
-        param(
-            "supply_resistance",
-            "Pa s/m^3",
-            Value(0.0),
-            Range::NON_NEGATIVE,
-            "supply droop Rs: the valve sees Ps = P − Rs Q_P (catalog `supply_droop`)",
-        ),
-    ]
-};
+const FOUR_WAY: [ParamSpec; 8] = join(
+    METERING,
+    [param(
+        "supply_resistance",
+        "Pa s/m^3",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "supply droop Rs: the valve sees Ps = P − Rs Q_P (catalog `supply_droop`)",
+    )],
+);
 
 const SPOOL_PORTS: &[super::PortSpec] = &[
     port(

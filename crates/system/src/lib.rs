@@ -135,6 +135,7 @@ pub mod rig;
 pub mod run;
 pub mod sensor;
 pub mod signal;
+pub mod simulation;
 pub mod valve_netlist;
 pub mod valve_rig;
 mod wires;

@@ -118,14 +118,13 @@ fn netlist_preset(text: &str) -> Value {
     serde_json::from_str(text).unwrap_or(Value::Null)
 }
 
-/// A rig kind: how a checked JSON value of that kind is simulated.
+/// A rig kind: how a JSON value of that kind is checked and assembled (a
+/// [`Simulation`](crate::simulation::Simulation) then runs any of them).
 pub struct RigKind {
     /// The `kind` field's value.
     pub kind: &'static str,
     /// Deserialises and validates the rig (errors name the JSON path).
     pub check: fn(&Value) -> Result<(), RigError>,
-    /// Simulates the rig on a command, output at the given times.
-    pub simulate: fn(&Value, Signal, &[f64], &RunOptions) -> Result<Run, RigError>,
     /// Assembles the rig's circuit driven by a command (for callers that
     /// step the circuit themselves, e.g. a co-simulation export).
     pub circuit: fn(&Value, Signal) -> Result<crate::Circuit, RigError>,
@@ -136,19 +135,16 @@ pub const RIG_KINDS: &[RigKind] = &[
     RigKind {
         kind: valve_rig::KIND,
         check: |v| valve_rig_from(v).map(|_| ()),
-        simulate: |v, cmd, t, o| valve_rig_from(v)?.simulate(cmd, t, o),
         circuit: |v, cmd| valve_rig_from(v)?.circuit(cmd),
     },
     RigKind {
         kind: crate::hybrid::KIND,
         check: |v| crate::hybrid::WangHybrid::from_value(v).map(|_| ()),
-        simulate: |v, cmd, t, o| crate::hybrid::WangHybrid::from_value(v)?.simulate(cmd, t, o),
         circuit: |v, cmd| Ok(crate::hybrid::WangHybrid::from_value(v)?.build(cmd)?),
     },
     RigKind {
         kind: crate::netlist::KIND,
         check: |v| crate::netlist::read(v).map(|_| ()).map_err(RigError::from),
-        simulate: crate::netlist::simulate,
         circuit: crate::netlist::circuit,
     },
 ];
@@ -264,14 +260,17 @@ pub fn check(v: &Value) -> Result<(), RigError> {
     (kind_of(v)?.check)(v)
 }
 
-/// Simulates a rig value of any kind.
+/// Simulates a rig value of any kind: [`Simulation::new`](crate::simulation::Simulation::new)
+/// then [`Simulation::run`](crate::simulation::Simulation::run).
 pub fn simulate(
     v: &Value,
     command: Signal,
     t_eval: &[f64],
     opts: &RunOptions,
 ) -> Result<Run, RigError> {
-    (kind_of(v)?.simulate)(v, command, t_eval, opts)
+    crate::simulation::Simulation::new(v, command)?
+        .options(opts.clone())
+        .run(t_eval)
 }
 
 /// Assembles the circuit of a rig value of any kind, driven by `command`.

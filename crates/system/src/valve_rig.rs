@@ -5,7 +5,7 @@
 
 use crate::circuit::Circuit;
 use crate::rig::{gauge_pressure_problem, GaugePressure, RigError};
-use crate::run::{run, Run, RunOptions, SimError};
+use crate::run::{Run, RunOptions};
 use crate::signal::Signal;
 use hydrocyl_actuator::Cylinder;
 use hydrocyl_friction::{
@@ -533,12 +533,9 @@ impl ValveRig {
         t_eval: &[f64],
         opts: &RunOptions,
     ) -> Result<Run, RigError> {
-        let mut c = self.circuit(command)?;
-        let x0 = c.initial_state();
-        run(&mut c, &x0, t_eval, opts).map_err(|e| match e {
-            SimError::Build(b) => RigError::from(b),
-            other => RigError::Sim(other.to_string()),
-        })
+        crate::simulation::Simulation::of_circuit(self.circuit(command)?)
+            .options(opts.clone())
+            .run(t_eval)
     }
 
     /// Steady piston velocity at spool position `xs` \[m·s⁻¹\]: the exact

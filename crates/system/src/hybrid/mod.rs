@@ -41,7 +41,7 @@ pub use components::{CheckComponent, PumpComponent, ReliefComponent, ReturnNodes
 use crate::circuit::{BuildError, Circuit, Component};
 use crate::components::{CommandInput, Friction, Mass, PressureSource, TwoChamberCylinder, Volume};
 use crate::rig::RigError;
-use crate::run::{run, Run, RunOptions, SimError};
+use crate::run::{Run, RunOptions};
 use crate::signal::Signal;
 use hydrocyl_actuator::Cylinder;
 use hydrocyl_friction::{FrictionLaw, FrictionModel, Wang};
@@ -197,13 +197,9 @@ impl WangHybrid {
         t_eval: &[f64],
         opts: &RunOptions,
     ) -> Result<Run, RigError> {
-        let mut c = self.build(command)?;
-        let x0 = c.initial_state();
-        c.reset(t_eval.first().copied().unwrap_or(0.0), &x0);
-        run(&mut c, &x0, t_eval, opts).map_err(|e| match e {
-            SimError::Build(b) => RigError::from(b),
-            other => RigError::Sim(other.to_string()),
-        })
+        crate::simulation::Simulation::of_circuit(self.build(command)?)
+            .options(opts.clone())
+            .run(t_eval)
     }
 
     /// Checks the parameters that no component checks on its own.

@@ -44,7 +44,7 @@ pub mod steady;
 
 use crate::circuit::{BuildError, Circuit};
 use crate::rig::RigError;
-use crate::run::{run, Run, RunOptions, SimError};
+use crate::run::{Run, RunOptions};
 use crate::signal::Signal;
 pub(crate) use catalog::friction_law_of as catalog_friction_law;
 pub(crate) use catalog::friction_terms_of as catalog_friction_terms;
@@ -164,12 +164,9 @@ pub fn simulate(
     t_eval: &[f64],
     opts: &RunOptions,
 ) -> Result<Run, RigError> {
-    let mut c = circuit(v, command)?;
-    let x0 = c.initial_state();
-    run(&mut c, &x0, t_eval, opts).map_err(|e| match e {
-        SimError::Build(b) => RigError::from(b),
-        other => RigError::Sim(other.to_string()),
-    })
+    crate::simulation::Simulation::of_circuit(circuit(v, command)?)
+        .options(opts.clone())
+        .run(t_eval)
 }
 
 /// One parameter of a netlist: its path, value, unit and meaning.

@@ -3,7 +3,7 @@
 //! the energy ledger's quadratures).
 //!
 //! Every caller that simulates a rig goes through [`Simulation`]:
-//! [`rig::simulate`](crate::rig::simulate), the CLI's `simulate`, the studies
+//! [`rig::simulate`], the CLI's `simulate`, the studies
 //! (chapter 3, 7 and 8), identification, the Python package and the benches.
 //! A rig value is read, checked and assembled once, in [`Simulation::new`];
 //! [`Simulation::run`] then integrates it and maps every failure to one

@@ -7,8 +7,8 @@
 //! `target/energy/energy.json`, a power-in/out SVG per scenario and a stacked
 //! bar of where the energy went, and reports its wall time.
 
-use hydrocyl_energy::scenario::{run_scenario, scenarios_for, Drive, Outcome, Plan, Scenario};
 use hydrocyl_energy::variant::HybridVariant;
+use hydrocyl_studies::chapter8::{run_scenario, scenarios_for, Drive, Outcome, Plan, Scenario};
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{json, Value};
@@ -77,7 +77,7 @@ pub fn run() -> bool {
     }
     // why the matrix runs without the seal term: the fold of eq 5.4's K term
     {
-        use hydrocyl_system::hybrid::chapter7::{extend_fold_speed, extend_reserve_minimum};
+        use hydrocyl_studies::chapter7::{extend_fold_speed, extend_reserve_minimum};
         let rig = hydrocyl_system::hybrid::WangHybrid::preset();
         let w = hydrocyl_friction::Wang::table_5_8();
         let (v, r) = extend_reserve_minimum(&rig, &w);
@@ -86,7 +86,7 @@ pub fn run() -> bool {
         });
         println!(
             "with Table 5-8's seal gain K the hybrid drive's steady-extension force reserve falls to \
-             {r:.2} N at {:.1} mm/s ({fold}; hydrocyl_system::hybrid::chapter7), so a transient \
+             {r:.2} N at {:.1} mm/s ({fold}; hydrocyl_studies::chapter7), so a transient \
              locks it; the matrix runs eq 5.14 with K = 0 (docs/energy.md)",
             1e3 * v
         );

@@ -1,7 +1,7 @@
 //! # hydrocyl-energy — where the energy of a drive goes
 //!
-//! The energy ledger of a run and the thesis's chapter-8 comparison of the
-//! valve-controlled and the hybrid pump-controlled drive.
+//! The energy ledger of a run (thesis chapter 8, eqs 8.1–8.8) and the
+//! hybrid drive's variants of sections 8.2 and 9.2.
 //!
 //! ```text
 //!        source power                         load power
@@ -30,30 +30,16 @@
 //! * efficiency = ∫output dt / ∫input dt over whole periods (signed
 //!   integrals: "the area between the power curves and time axis").
 //!
-//! Tables 8-2 and 8-3 are in [`scenario::thesis_efficiency`]; the scenario
-//! matrix in [`scenario::base_matrix`]; the improvements of sections 8.2 and
-//! 9.2 in [`variant`]. Units: SI (J, W, s) everywhere, speeds in mm/s only in
-//! scenario labels.
-//!
-//! ```
-//! use hydrocyl_energy::scenario::{run_scenario, Drive, Plan, Scenario, Wave};
-//!
-//! let drive = Drive::wang_valve_c10().unwrap();
-//! let sc = Scenario { system: "valve".into(), speed_mm_s: 100.0, wave: Wave::Square, load_kg: 0.0 };
-//! let plan = Plan { measured_periods: 1, sample_s: 5e-3, ..Plan::default() };
-//! let out = run_scenario(&drive, &sc, &plan).unwrap();
-//! assert!(out.ledger.error.abs() < 1e-3);        // the ledger closes
-//! assert!(out.efficiency > 0.0 && out.efficiency < 0.5);
-//! ```
+//! The chapter-8 scenario matrix (Tables 8-2 and 8-3) is a study on this
+//! ledger and lives in `hydrocyl-studies` (`chapter8`); the improvements of
+//! sections 8.2 and 9.2 are in [`variant`]. Units: SI (J, W, s) everywhere.
 #![warn(missing_docs)]
 
 pub mod error;
 pub mod ledger;
-pub mod scenario;
 pub mod switched;
 pub mod variant;
 
 pub use error::EnergyError;
 pub use ledger::{Ledger, RodSide, Term};
-pub use scenario::{run_scenario, Drive, Outcome, Plan, Scenario, Trace, Wave};
 pub use variant::HybridVariant;

@@ -12,7 +12,7 @@
 //! * SVG plots (velocity, p1, p2, pump lines, friction) in `target/validate/hybrid/`.
 
 use crate::report::Section;
-use hydrocyl_system::hybrid::chapter7::{
+use hydrocyl_studies::chapter7::{
     extend_force_reserve, extend_pressure_roots, Chapter7Run, Chapter7Test, Load, Shape,
 };
 use hydrocyl_system::hybrid::WangHybrid;

@@ -32,7 +32,6 @@
 //! Every value is a field of [`WangHybrid`], whose `Default` is the rigs.md
 //! preset and whose JSON form is `fixtures/rigs/wang-hybrid.json`.
 
-pub mod chapter7;
 pub mod components;
 mod netlist;
 

@@ -15,9 +15,9 @@
 //!   (cylinder vertical, rod up); the moving mass is the rig's 20 kg in both
 //!   load cases (Table 8-1: "20 kg, include tray and piston rod").
 
-use crate::error::EnergyError;
-use crate::ledger::{ledger, trapezoid, Ledger, RodSide};
-use crate::variant::HybridVariant;
+use hydrocyl_energy::error::EnergyError;
+use hydrocyl_energy::ledger::{ledger, trapezoid, Ledger, RodSide};
+use hydrocyl_energy::variant::HybridVariant;
 use hydrocyl_friction::FrictionLaw;
 use hydrocyl_ports::Pressure;
 use hydrocyl_system::hybrid::{nodes, ReturnPath, WangHybrid};
@@ -221,7 +221,7 @@ pub enum FrictionCase {
     /// removes the acceleration term `K H a`): the bristle and Stribeck curve
     /// only. With K of Table 5-8 the valve drive has no steady retraction
     /// above ≈ 19 mm/s and the hybrid's extension reserve is a few newtons
-    /// (the fold of `hydrocyl_system::hybrid::chapter7`), so a transient
+    /// (the fold of `hydrocyl_studies::chapter7`), so a transient
     /// locks it; see docs/energy.md.
     WithoutSealTerm,
 }

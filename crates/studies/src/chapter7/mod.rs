@@ -148,6 +148,8 @@ pub struct Chapter7Test {
     /// Keep the friction model's acceleration term `K H a` (eq 5.12/5.14).
     /// Off by default: see the module docs ("the fold").
     pub acceleration_term: bool,
+    /// Step budget of the run ([`MAX_STEPS`] by default).
+    pub max_steps: usize,
 }
 
 impl Chapter7Test {
@@ -162,6 +164,7 @@ impl Chapter7Test {
             initial_position: -0.07,
             sample_interval: 1.0e-3,
             acceleration_term: false,
+            max_steps: MAX_STEPS,
         }
     }
 
@@ -214,7 +217,14 @@ impl Chapter7Test {
 
     /// Simulates the test with `method` and measures it.
     pub fn run_with(&self, method: Method) -> Result<Chapter7Run, RunError> {
-        let rig = self.rig();
+        self.run_on(self.rig(), method)
+    }
+
+    /// Simulates the test on `rig` as given (its own mass and friction, e.g.
+    /// the `wang-hybrid` preset as shipped) from this test's initial
+    /// position, with `method`, and measures it.
+    pub fn run_on(&self, mut rig: WangHybrid, method: Method) -> Result<Chapter7Run, RunError> {
+        rig.initial_position = self.initial_position;
         let mut c = rig.build(self.command(&rig))?;
         c.set_quadratures(true);
         let x0 = c.initial_state();
@@ -226,7 +236,7 @@ impl Chapter7Test {
             rtol,
             atol: c.atol(rtol),
             h_max: 1.0e-2,
-            max_steps: MAX_STEPS,
+            max_steps: self.max_steps,
             t_eval: Some((0..=n).map(|k| k as f64 * self.sample_interval).collect()),
             ..Options::default()
         };

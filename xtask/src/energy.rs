@@ -8,7 +8,9 @@
 //! bar of where the energy went, and reports its wall time.
 
 use hydrocyl_energy::variant::HybridVariant;
-use hydrocyl_studies::chapter8::{run_scenario, scenarios_for, Drive, Outcome, Plan, Scenario};
+use hydrocyl_studies::chapter8::{
+    run_scenario, scenarios_for, Drive, FrictionCase, Outcome, Plan, Scenario,
+};
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{json, Value};
@@ -51,6 +53,23 @@ pub fn run() -> bool {
         }
     }
     drives.push(("hybrid".into(), Drive::wang_hybrid(), Plan::default()));
+    // the same two drives with the presets' own friction: Table 5-8 with the
+    // seal term bounded to its identification range (hydrocyl_friction::seal)
+    let with_seal = Plan {
+        friction: FrictionCase::AsRig,
+        ..Plan::default()
+    };
+    if let Some((_, valve, _)) = drives.first().cloned() {
+        drives.push(("valve-seal".into(), valve, with_seal.clone()));
+    }
+    drives.push(("hybrid-seal".into(), Drive::wang_hybrid(), with_seal));
+    // and without the K H a term, which drives the hybrid's chambers below
+    // vapour pressure at the reversals (docs/hybrid.md)
+    let seal_no_h = Plan {
+        friction: FrictionCase::WithoutAccelerationTerm,
+        ..Plan::default()
+    };
+    drives.push(("hybrid-seal-h0".into(), Drive::wang_hybrid(), seal_no_h));
     for f in VARIANTS {
         match HybridVariant::load(&root.join("fixtures/rigs").join(f)) {
             Ok((base, v)) => {
@@ -87,7 +106,8 @@ pub fn run() -> bool {
         println!(
             "with Table 5-8's seal gain K the hybrid drive's steady-extension force reserve falls to \
              {r:.2} N at {:.1} mm/s ({fold}; hydrocyl_studies::chapter7), so a transient \
-             locks it; the matrix runs eq 5.14 with K = 0 (docs/energy.md)",
+             locks it; `valve`/`hybrid` run eq 5.14 with K = 0, `valve-seal`/`hybrid-seal` with K bounded \
+             to 5.03 bar (hydrocyl_friction::seal; docs/energy.md)",
             1e3 * v
         );
     }

@@ -135,6 +135,21 @@ mod tests {
     use crate::{finite_difference_jacobian, CoulombViscous, FrictionLaw};
     use hydrocyl_ports::{Pressure, Velocity};
 
+    /// The analytic Jacobian against finite differences.
+    fn assert_jacobian(m: &impl FrictionModel, input: &FrictionInput) {
+        let (a, b) = (
+            m.jacobian(input, &[]),
+            finite_difference_jacobian(m, input, &[]),
+        );
+        for (x, y) in [
+            (a.df_dv, b.df_dv),
+            (a.df_dp1, b.df_dp1),
+            (a.df_dp2, b.df_dp2),
+        ] {
+            assert!((x - y).abs() <= 1e-5 * y.abs().max(1.0), "{x} vs {y}");
+        }
+    }
+
     #[test]
     fn the_terms_add_to_any_law_and_their_jacobian_is_right() {
         let inner = FrictionLaw::CoulombViscous(CoulombViscous::leaney_moog());
@@ -154,17 +169,7 @@ mod tests {
         let f = m.force(&input, &[]).si();
         assert!((f - inner.force(&input, &[]).si() - extra).abs() < 1e-9);
         assert!((m.acceleration_coefficient(&input).si() - 3.0).abs() < 1e-12);
-        let (a, b) = (
-            m.jacobian(&input, &[]),
-            finite_difference_jacobian(&m, &input, &[]),
-        );
-        for (x, y) in [
-            (a.df_dv, b.df_dv),
-            (a.df_dp1, b.df_dp1),
-            (a.df_dp2, b.df_dp2),
-        ] {
-            assert!((x - y).abs() <= 1e-5 * y.abs().max(1.0), "{x} vs {y}");
-        }
+        assert_jacobian(&m, &input);
         assert!(SealTerms::default().is_off());
         let bad = SealTerms {
             k_pressure: -1.0,
@@ -183,16 +188,6 @@ mod tests {
         };
         let f = bounded.force(&input, &[]).si() - inner.force(&input, &[]).si();
         assert!((f - 1e-9 * 4e12 * 0.05).abs() < 1e-9, "{f}");
-        let (a, b) = (
-            bounded.jacobian(&input, &[]),
-            finite_difference_jacobian(&bounded, &input, &[]),
-        );
-        for (x, y) in [
-            (a.df_dv, b.df_dv),
-            (a.df_dp1, b.df_dp1),
-            (a.df_dp2, b.df_dp2),
-        ] {
-            assert!((x - y).abs() <= 1e-5 * y.abs().max(1.0), "{x} vs {y}");
-        }
+        assert_jacobian(&bounded, &input);
     }
 }

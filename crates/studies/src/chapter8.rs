@@ -224,6 +224,9 @@ pub enum FrictionCase {
     /// (the fold of `hydrocyl_studies::chapter7`), so a transient
     /// locks it; see docs/energy.md.
     WithoutSealTerm,
+    /// The rig's own law without the acceleration term `K H a` (H = 0, eq
+    /// 5.4; the seal term stays, bounded as the rig bounds it).
+    WithoutAccelerationTerm,
 }
 
 impl FrictionCase {
@@ -232,14 +235,19 @@ impl FrictionCase {
         match self {
             FrictionCase::AsRig => "as-rig",
             FrictionCase::WithoutSealTerm => "without-seal-term",
+            FrictionCase::WithoutAccelerationTerm => "without-acceleration-term",
         }
     }
 
     fn apply(self, law: &mut FrictionLaw) {
-        if self == FrictionCase::WithoutSealTerm {
-            if let FrictionLaw::Wang(w) = law {
-                w.extending.k_pressure = 0.0;
-                w.retracting.k_pressure = 0.0;
+        if let FrictionLaw::Wang(w) = law {
+            match self {
+                FrictionCase::AsRig => {}
+                FrictionCase::WithoutSealTerm => {
+                    w.extending.k_pressure = 0.0;
+                    w.retracting.k_pressure = 0.0;
+                }
+                FrictionCase::WithoutAccelerationTerm => *w = w.without_acceleration_term(),
             }
         }
     }

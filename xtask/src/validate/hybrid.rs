@@ -13,7 +13,7 @@
 
 use crate::report::Section;
 use hydrocyl_studies::chapter7::{
-    extend_force_reserve, extend_pressure_roots, Chapter7Run, Chapter7Test, Load, Shape,
+    extend_force_reserve, extend_pressure_roots, Chapter7Run, Chapter7Test, Load, Phenomena, Shape,
 };
 use hydrocyl_system::hybrid::WangHybrid;
 use plotters::prelude::*;
@@ -154,18 +154,7 @@ fn preset_as_shipped(s: &mut Section) {
             "> 0.5 ms each".into(),
             p.stall_to_retract > 5e-4 && p.stall_to_extend > 5e-4,
         );
-        s.check(
-            &format!("{label}: drift per period"),
-            format!("{:+.2} mm", p.drift_per_period * 1e3),
-            "> 0 (towards extension)".into(),
-            p.drift_per_period > 0.0,
-        );
-        s.check(
-            &format!("{label}: friction extending / retracting at 50 mm/s"),
-            format!("{:.1} N / {:.1} N", p.friction_extend, p.friction_retract),
-            "|extending| > |retracting|".into(),
-            p.friction_extend > -p.friction_retract && p.friction_retract < 0.0,
-        );
+        drift_and_friction(s, &label, &p);
         s.check(
             &format!("{label}: mass balance"),
             format!("{:.1e}", r.worst_balance()),
@@ -273,18 +262,7 @@ fn report_run(s: &mut Section, rig: &WangHybrid, r: &Chapter7Run, wall: f64) {
             p.lag_retract >= p.lag_extend
         },
     );
-    s.check(
-        &format!("{l}: drift per period"),
-        format!("{:+.2} mm", p.drift_per_period * 1e3),
-        "> 0, towards extended end (Fig 7-6)".into(),
-        p.drift_per_period > 0.0,
-    );
-    s.check(
-        &format!("{l}: friction at +/-50 mm/s ext / ret"),
-        format!("{:.1} / {:.1} N", p.friction_extend, p.friction_retract),
-        "|ext| > |ret| (Fig 7-8)".into(),
-        p.friction_extend > -p.friction_retract && p.friction_retract < 0.0,
-    );
+    drift_and_friction(s, &l, &p);
     if r.test.load == Load::None {
         let (fe, fr) = (220.0, -162.2);
         let ok = (p.friction_extend / fe - 1.0).abs() < 0.25
@@ -335,6 +313,22 @@ fn report_run(s: &mut Section, rig: &WangHybrid, r: &Chapter7Run, wall: f64) {
         format!("{} / {}", bar(e.pp1 - e.p1), bar(t.pp2 - t.p2)),
         format!("> relief cracking {}, Pp < 200 bar", bar(pc)),
         e.pp1 - e.p1 > pc && t.pp2 - t.p2 > pc && e.pp1 < 200e5 && t.pp2 < 200e5,
+    );
+}
+
+/// The drift (Fig 7-6) and the friction asymmetry (Fig 7-8) of a run.
+fn drift_and_friction(s: &mut Section, l: &str, p: &Phenomena) {
+    s.check(
+        &format!("{l}: drift per period"),
+        format!("{:+.2} mm", p.drift_per_period * 1e3),
+        "> 0, towards extended end (Fig 7-6)".into(),
+        p.drift_per_period > 0.0,
+    );
+    s.check(
+        &format!("{l}: friction at +/-50 mm/s ext / ret"),
+        format!("{:.1} / {:.1} N", p.friction_extend, p.friction_retract),
+        "|ext| > |ret| (Fig 7-8)".into(),
+        p.friction_extend > -p.friction_retract && p.friction_retract < 0.0,
     );
 }
 

@@ -303,7 +303,7 @@ fn bound_seal(law: FrictionLaw, inst: &Instance) -> FrictionLaw {
 pub(crate) fn law_of(inst: &Instance) -> Option<Result<FrictionLaw, String>> {
     let mut without = inst.clone();
     without.params.retain(|k, _| !k.starts_with("seal."));
-    let bounded = |law: FrictionLaw| bound_seal(law, &without);
+    let bounded = |law: FrictionLaw| bound_seal(law, inst);
     let inst = &without;
     Some(match inst.ty.name {
         "friction_coulomb_viscous" => inst

@@ -33,6 +33,35 @@
 //! The chapter-8 scenario matrix (Tables 8-2 and 8-3) is a study on this
 //! ledger and lives in `hydrocyl-studies` (`chapter8`); the improvements of
 //! sections 8.2 and 9.2 are in [`variant`]. Units: SI (J, W, s) everywhere.
+//! Charging a closed volume from a 70-bar source through an orifice loses
+//! half the energy drawn, whatever the orifice:
+//!
+//! ```
+//! use hydrocyl_energy::ledger::{ledger, RodSide};
+//! use hydrocyl_ports::{Area, Density, Pressure};
+//! use hydrocyl_system::components::{FixedOrifice, PressureSource, Volume};
+//! use hydrocyl_system::run::{run, RunOptions};
+//! use hydrocyl_system::Circuit;
+//! use hydrocyl_valves::orifice::Orifice;
+//!
+//! let (ps, v, b) = (7.0e6, 1.0e-4, 7.0e8);
+//! let oil = Orifice { cd: 0.65, density: Density::new(900.0), dp_transition: Pressure::new(1000.0) };
+//! let mut c = Circuit::build(vec![
+//!     Box::new(PressureSource::new("supply", "P", Pressure::new(ps), None)),
+//!     Box::new(FixedOrifice::new("orifice", "P", "V", Area::new(1e-6), oil)),
+//!     Box::new(Volume::new("volume", "V", v, b, 0.0, Some("pv"))),
+//! ])
+//! .unwrap();
+//! let t: Vec<f64> = (0..=100).map(|k| k as f64 * 1e-2).collect();
+//! let opts = RunOptions { ledger: true, rtol: 1e-8, ..RunOptions::dp45() };
+//! let x0 = c.initial_state();
+//! let r = run(&mut c, &x0, &t, &opts).unwrap();
+//! let rod = RodSide { node: "none".into(), components: vec![] };
+//! let l = ledger(&c, &r, 0, t.len() - 1, &rod).unwrap();
+//! let e_in = v * ps * ps / b; // V Ps² / B
+//! assert!((l.loss("orifice") / e_in - 0.5).abs() < 1e-4);
+//! assert!(l.error.abs() < 1e-3); // the ledger closes
+//! ```
 #![warn(missing_docs)]
 
 pub mod error;

@@ -107,7 +107,7 @@ fn best_of(reps: usize, mut f: impl FnMut() -> Result<f64, String>) -> Result<f6
 /// simulated seconds per wall second, and each formulation's time as a ratio
 /// to the fundamental model's in the same run.
 fn valve_rig_real_time() -> Result<(), String> {
-    use hydrocyl_system::chapter3;
+    use hydrocyl_studies::chapter3;
     use hydrocyl_system::run::RunOptions;
     use hydrocyl_system::valve_rig::Formulation;
     let case = chapter3::square_wave().map_err(|e| e.to_string())?;

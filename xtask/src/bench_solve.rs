@@ -6,7 +6,7 @@
 
 use hydrocyl_identify::plaincsv::{run_columns, write_columns, PlainCsv};
 use hydrocyl_integrators::Method;
-use hydrocyl_system::hybrid::chapter7::{Chapter7Test, Load, Shape};
+use hydrocyl_studies::chapter7::{Chapter7Test, Load, Shape};
 use hydrocyl_system::run::{nrmse, Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::valve_rig::ValveRig;

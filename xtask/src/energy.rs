@@ -7,8 +7,10 @@
 //! `target/energy/energy.json`, a power-in/out SVG per scenario and a stacked
 //! bar of where the energy went, and reports its wall time.
 
-use hydrocyl_energy::scenario::{run_scenario, scenarios_for, Drive, Outcome, Plan, Scenario};
 use hydrocyl_energy::variant::HybridVariant;
+use hydrocyl_studies::chapter8::{
+    run_scenario, scenarios_for, Drive, FrictionCase, Outcome, Plan, Scenario,
+};
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{json, Value};
@@ -51,6 +53,23 @@ pub fn run() -> bool {
         }
     }
     drives.push(("hybrid".into(), Drive::wang_hybrid(), Plan::default()));
+    // the same two drives with the presets' own friction: Table 5-8 with the
+    // seal term bounded to its identification range (hydrocyl_friction::seal)
+    let with_seal = Plan {
+        friction: FrictionCase::AsRig,
+        ..Plan::default()
+    };
+    if let Some((_, valve, _)) = drives.first().cloned() {
+        drives.push(("valve-seal".into(), valve, with_seal.clone()));
+    }
+    drives.push(("hybrid-seal".into(), Drive::wang_hybrid(), with_seal));
+    // and without the K H a term, which drives the hybrid's chambers below
+    // vapour pressure at the reversals (docs/hybrid.md)
+    let seal_no_h = Plan {
+        friction: FrictionCase::WithoutAccelerationTerm,
+        ..Plan::default()
+    };
+    drives.push(("hybrid-seal-h0".into(), Drive::wang_hybrid(), seal_no_h));
     for f in VARIANTS {
         match HybridVariant::load(&root.join("fixtures/rigs").join(f)) {
             Ok((base, v)) => {
@@ -77,7 +96,7 @@ pub fn run() -> bool {
     }
     // why the matrix runs without the seal term: the fold of eq 5.4's K term
     {
-        use hydrocyl_system::hybrid::chapter7::{extend_fold_speed, extend_reserve_minimum};
+        use hydrocyl_studies::chapter7::{extend_fold_speed, extend_reserve_minimum};
         let rig = hydrocyl_system::hybrid::WangHybrid::preset();
         let w = hydrocyl_friction::Wang::table_5_8();
         let (v, r) = extend_reserve_minimum(&rig, &w);
@@ -86,8 +105,9 @@ pub fn run() -> bool {
         });
         println!(
             "with Table 5-8's seal gain K the hybrid drive's steady-extension force reserve falls to \
-             {r:.2} N at {:.1} mm/s ({fold}; hydrocyl_system::hybrid::chapter7), so a transient \
-             locks it; the matrix runs eq 5.14 with K = 0 (docs/energy.md)",
+             {r:.2} N at {:.1} mm/s ({fold}; hydrocyl_studies::chapter7), so a transient \
+             locks it; `valve`/`hybrid` run eq 5.14 with K = 0, `valve-seal`/`hybrid-seal` with K bounded \
+             to 5.03 bar (hydrocyl_friction::seal; docs/energy.md)",
             1e3 * v
         );
     }

@@ -1,7 +1,7 @@
 //! # hydrocyl-energy — where the energy of a drive goes
 //!
-//! The energy ledger of a run and the thesis's chapter-8 comparison of the
-//! valve-controlled and the hybrid pump-controlled drive.
+//! The energy ledger of a run (thesis chapter 8, eqs 8.1–8.8) and the
+//! hybrid drive's variants of sections 8.2 and 9.2.
 //!
 //! ```text
 //!        source power                         load power
@@ -30,30 +30,45 @@
 //! * efficiency = ∫output dt / ∫input dt over whole periods (signed
 //!   integrals: "the area between the power curves and time axis").
 //!
-//! Tables 8-2 and 8-3 are in [`scenario::thesis_efficiency`]; the scenario
-//! matrix in [`scenario::base_matrix`]; the improvements of sections 8.2 and
-//! 9.2 in [`variant`]. Units: SI (J, W, s) everywhere, speeds in mm/s only in
-//! scenario labels.
+//! The chapter-8 scenario matrix (Tables 8-2 and 8-3) is a study on this
+//! ledger and lives in `hydrocyl-studies` (`chapter8`); the improvements of
+//! sections 8.2 and 9.2 are in [`variant`]. Units: SI (J, W, s) everywhere.
+//! Charging a closed volume from a 70-bar source through an orifice loses
+//! half the energy drawn, whatever the orifice:
 //!
 //! ```
-//! use hydrocyl_energy::scenario::{run_scenario, Drive, Plan, Scenario, Wave};
+//! use hydrocyl_energy::ledger::{ledger, RodSide};
+//! use hydrocyl_ports::{Area, Density, Pressure};
+//! use hydrocyl_system::components::{FixedOrifice, PressureSource, Volume};
+//! use hydrocyl_system::run::{run, RunOptions};
+//! use hydrocyl_system::Circuit;
+//! use hydrocyl_valves::orifice::Orifice;
 //!
-//! let drive = Drive::wang_valve_c10().unwrap();
-//! let sc = Scenario { system: "valve".into(), speed_mm_s: 100.0, wave: Wave::Square, load_kg: 0.0 };
-//! let plan = Plan { measured_periods: 1, sample_s: 5e-3, ..Plan::default() };
-//! let out = run_scenario(&drive, &sc, &plan).unwrap();
-//! assert!(out.ledger.error.abs() < 1e-3);        // the ledger closes
-//! assert!(out.efficiency > 0.0 && out.efficiency < 0.5);
+//! let (ps, v, b) = (7.0e6, 1.0e-4, 7.0e8);
+//! let oil = Orifice { cd: 0.65, density: Density::new(900.0), dp_transition: Pressure::new(1000.0) };
+//! let mut c = Circuit::build(vec![
+//!     Box::new(PressureSource::new("supply", "P", Pressure::new(ps), None)),
+//!     Box::new(FixedOrifice::new("orifice", "P", "V", Area::new(1e-6), oil)),
+//!     Box::new(Volume::new("volume", "V", v, b, 0.0, Some("pv"))),
+//! ])
+//! .unwrap();
+//! let t: Vec<f64> = (0..=100).map(|k| k as f64 * 1e-2).collect();
+//! let opts = RunOptions { ledger: true, rtol: 1e-8, ..RunOptions::dp45() };
+//! let x0 = c.initial_state();
+//! let r = run(&mut c, &x0, &t, &opts).unwrap();
+//! let rod = RodSide { node: "none".into(), components: vec![] };
+//! let l = ledger(&c, &r, 0, t.len() - 1, &rod).unwrap();
+//! let e_in = v * ps * ps / b; // V Ps² / B
+//! assert!((l.loss("orifice") / e_in - 0.5).abs() < 1e-4);
+//! assert!(l.error.abs() < 1e-3); // the ledger closes
 //! ```
 #![warn(missing_docs)]
 
 pub mod error;
 pub mod ledger;
-pub mod scenario;
 pub mod switched;
 pub mod variant;
 
 pub use error::EnergyError;
 pub use ledger::{Ledger, RodSide, Term};
-pub use scenario::{run_scenario, Drive, Outcome, Plan, Scenario, Trace, Wave};
 pub use variant::HybridVariant;

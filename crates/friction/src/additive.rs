@@ -26,6 +26,10 @@ pub struct SealTerms {
     /// Acceleration gain H of `K H a` \[N²·s·m⁻⁴\], ≥ 0.
     #[serde(default)]
     pub h_acceleration: f64,
+    /// Bound Δp_max of the pressure difference in `K min(|p1 − p2|, Δp_max)² v`
+    /// \[Pa\] (module [`crate::seal`]); 0 = unbounded, the thesis's eq 5.4.
+    #[serde(default)]
+    pub dp_max: f64,
 }
 
 impl SealTerms {
@@ -38,12 +42,13 @@ impl SealTerms {
     pub fn validate(&self) -> Result<(), FrictionError> {
         const M: &str = "seal terms";
         non_negative(M, "K (k_pressure)", self.k_pressure)?;
-        non_negative(M, "H (h_acceleration)", self.h_acceleration)
+        non_negative(M, "H (h_acceleration)", self.h_acceleration)?;
+        non_negative(M, "dp_max", self.dp_max)
     }
 
-    /// `K (p1 − p2)² v` \[N\].
+    /// `K min(|p1 − p2|, Δp_max)² v` \[N\].
     fn pressure_force(&self, input: &FrictionInput) -> f64 {
-        let dp = input.p1.si() - input.p2.si();
+        let (dp, _) = crate::seal::bounded(input.p1.si() - input.p2.si(), self.dp_max);
         self.k_pressure * dp * dp * input.velocity.si()
     }
 }
@@ -87,11 +92,11 @@ impl<M: FrictionModel> FrictionModel for WithSealTerms<M> {
     fn jacobian(&self, input: &FrictionInput, state: &[f64]) -> FrictionJacobian {
         let mut j = self.inner.jacobian(input, state);
         let k = self.terms.k_pressure;
-        let dp = input.p1.si() - input.p2.si();
+        let (dp, slope) = crate::seal::bounded(input.p1.si() - input.p2.si(), self.terms.dp_max);
         let v = input.velocity.si();
         j.df_dv += k * dp * dp;
-        j.df_dp1 += 2.0 * k * dp * v;
-        j.df_dp2 -= 2.0 * k * dp * v;
+        j.df_dp1 += 2.0 * k * dp * slope * v;
+        j.df_dp2 -= 2.0 * k * dp * slope * v;
         j
     }
     fn stored_energy(&self, state: &[f64]) -> Energy {
@@ -130,12 +135,28 @@ mod tests {
     use crate::{finite_difference_jacobian, CoulombViscous, FrictionLaw};
     use hydrocyl_ports::{Pressure, Velocity};
 
+    /// The analytic Jacobian against finite differences.
+    fn assert_jacobian(m: &impl FrictionModel, input: &FrictionInput) {
+        let (a, b) = (
+            m.jacobian(input, &[]),
+            finite_difference_jacobian(m, input, &[]),
+        );
+        for (x, y) in [
+            (a.df_dv, b.df_dv),
+            (a.df_dp1, b.df_dp1),
+            (a.df_dp2, b.df_dp2),
+        ] {
+            assert!((x - y).abs() <= 1e-5 * y.abs().max(1.0), "{x} vs {y}");
+        }
+    }
+
     #[test]
     fn the_terms_add_to_any_law_and_their_jacobian_is_right() {
         let inner = FrictionLaw::CoulombViscous(CoulombViscous::leaney_moog());
         let terms = SealTerms {
             k_pressure: 1e-9,
             h_acceleration: 3e9,
+            dp_max: 0.0,
         };
         let m = WithSealTerms { inner, terms };
         let input = FrictionInput {
@@ -148,22 +169,25 @@ mod tests {
         let f = m.force(&input, &[]).si();
         assert!((f - inner.force(&input, &[]).si() - extra).abs() < 1e-9);
         assert!((m.acceleration_coefficient(&input).si() - 3.0).abs() < 1e-12);
-        let (a, b) = (
-            m.jacobian(&input, &[]),
-            finite_difference_jacobian(&m, &input, &[]),
-        );
-        for (x, y) in [
-            (a.df_dv, b.df_dv),
-            (a.df_dp1, b.df_dp1),
-            (a.df_dp2, b.df_dp2),
-        ] {
-            assert!((x - y).abs() <= 1e-5 * y.abs().max(1.0), "{x} vs {y}");
-        }
+        assert_jacobian(&m, &input);
         assert!(SealTerms::default().is_off());
         let bad = SealTerms {
             k_pressure: -1.0,
             h_acceleration: 0.0,
+            dp_max: 0.0,
         };
         assert!(bad.validate().is_err());
+        // bounded to 2 MPa: the 3 MPa difference counts as 2 MPa, and the
+        // Jacobian follows (no pressure slope beyond the bound)
+        let bounded = WithSealTerms {
+            inner,
+            terms: SealTerms {
+                dp_max: 2e6,
+                ..terms
+            },
+        };
+        let f = bounded.force(&input, &[]).si() - inner.force(&input, &[]).si();
+        assert!((f - 1e-9 * 4e12 * 0.05).abs() < 1e-9, "{f}");
+        assert_jacobian(&bounded, &input);
     }
 }

@@ -70,6 +70,7 @@ mod karnopp;
 mod law;
 mod lugre;
 mod model;
+pub mod seal;
 mod stribeck;
 mod wang;
 

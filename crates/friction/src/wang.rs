@@ -70,6 +70,11 @@ pub struct Wang {
     pub extending: WangSet,
     /// Parameters while retracting (v < 0), magnitudes.
     pub retracting: WangSet,
+    /// Bound Δp_max of the pressure difference in the seal term,
+    /// `K min(|p1 − p2|, Δp_max)² v` \[Pa\] (module [`crate::seal`]);
+    /// 0 = unbounded, the thesis's eq 5.4.
+    #[serde(default, skip_serializing_if = "crate::seal::is_unbounded")]
+    pub seal_dp_max: f64,
 }
 
 fn set(fc: f64, fs: f64, delta: f64, k: f64, h: f64) -> WangSet {
@@ -95,6 +100,7 @@ impl Wang {
             sigma1: 0.1,
             extending: set(110.0, 180.0, 0.1087, 2.5e-8, 3.05e9),
             retracting: set(80.0, 188.0, 0.1138, 4.0e-9, 9.0e9),
+            seal_dp_max: 0.0,
         }
     }
 
@@ -125,6 +131,19 @@ impl Wang {
         self
     }
 
+    /// The same model with the seal term bounded to `dp_max` \[Pa\]
+    /// (0 = unbounded; module [`crate::seal`]).
+    pub fn with_seal_bound(mut self, dp_max: f64) -> Self {
+        self.seal_dp_max = dp_max;
+        self
+    }
+
+    /// The pressure difference the seal term sees and its slope
+    /// `d(bounded)/d(p1 − p2)` (0 or 1).
+    fn seal_dp(&self, input: &FrictionInput) -> (f64, f64) {
+        crate::seal::bounded(input.p1.si() - input.p2.si(), self.seal_dp_max)
+    }
+
     /// The set for velocity `v`; at v = 0 the acceleration's sign decides
     /// (extending for a ≥ 0), so a start from rest takes the set of the
     /// direction it is starting in.
@@ -136,11 +155,12 @@ impl Wang {
         }
     }
 
-    /// The static curve, eq 5.8/5.11: `sgn(v) g(v) + K (p1 − p2)² v` \[N\].
+    /// The static curve, eq 5.8/5.11: `sgn(v) g(v) + K (p1 − p2)² v` \[N\]
+    /// (with the pressure difference bounded when [`Wang::seal_dp_max`] > 0).
     pub fn static_curve(&self, input: &FrictionInput) -> f64 {
         let v = input.velocity.si();
         let s = self.set_for(v, 0.0);
-        let pd = input.p1.si() - input.p2.si();
+        let (pd, _) = self.seal_dp(input);
         sgn(v) * s.curve.g(v) + s.k_pressure * pd * pd * v
     }
 }
@@ -153,7 +173,7 @@ impl FrictionModel for Wang {
     fn force(&self, input: &FrictionInput, state: &[f64]) -> Force {
         let v = input.velocity.si();
         let s = self.set_for(v, input.acceleration.si());
-        let pd = input.p1.si() - input.p2.si();
+        let (pd, _) = self.seal_dp(input);
         let z = state[0];
         let zdot = bristle_rate(self.sigma0, v, z, s.curve.g(v));
         Force::new(self.sigma0 * z + self.sigma1 * zdot + s.k_pressure * pd * pd * v)
@@ -177,6 +197,7 @@ impl FrictionModel for Wang {
 
     fn validate(&self) -> Result<(), FrictionError> {
         positive("wang", "sigma0", self.sigma0)?;
+        non_negative("wang", "seal_dp_max", self.seal_dp_max)?;
         non_negative("wang", "sigma1", self.sigma1)?;
         self.extending.validate("wang (extending)")?;
         self.retracting.validate("wang (retracting)")
@@ -185,15 +206,15 @@ impl FrictionModel for Wang {
     fn jacobian(&self, input: &FrictionInput, state: &[f64]) -> FrictionJacobian {
         let v = input.velocity.si();
         let s = self.set_for(v, input.acceleration.si());
-        let pd = input.p1.si() - input.p2.si();
+        let (pd, slope) = self.seal_dp(input);
         let (dz, dv) = bristle_partials(self.sigma0, v, state[0], s.curve.g(v), s.curve.v_dg_dv(v));
         FrictionJacobian {
             dzdot_dz: dz,
             dzdot_dv: dv,
             df_dz: self.sigma0 + self.sigma1 * dz,
             df_dv: self.sigma1 * dv + s.k_pressure * pd * pd,
-            df_dp1: 2.0 * s.k_pressure * pd * v,
-            df_dp2: -2.0 * s.k_pressure * pd * v,
+            df_dp1: 2.0 * s.k_pressure * pd * slope * v,
+            df_dp2: -2.0 * s.k_pressure * pd * slope * v,
         }
     }
 

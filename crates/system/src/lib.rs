@@ -125,7 +125,6 @@
 #![warn(missing_docs)]
 
 mod binding;
-pub mod chapter3;
 pub mod circuit;
 pub mod components;
 pub mod external;

@@ -24,18 +24,24 @@ fn template(text: &str) -> Value {
     serde_json::from_str(text).expect("the embedded netlist is valid JSON (tested)")
 }
 
-/// A friction law as a netlist component object (`friction_<model>`).
-fn friction_component(law: &FrictionLaw) -> Value {
+/// A friction law as a netlist component object (`friction_<model>`), and
+/// the bound of its seal term (Wang's `seal_dp_max`, which the netlist
+/// names `seal.dp_max`; 0 = unbounded).
+fn friction_component(law: &FrictionLaw) -> (Value, f64) {
     let mut v = serde_json::to_value(law).expect("a friction law serialises");
     let obj = v.as_object_mut().expect("a tagged object");
     obj.remove("model");
+    let bound = obj
+        .remove("seal_dp_max")
+        .and_then(|b| b.as_f64())
+        .unwrap_or(0.0);
     let mut out = serde_json::Map::new();
     out.insert(
         "type".into(),
         Value::from(format!("friction_{}", law.name().replace('-', "_"))),
     );
     out.extend(obj.clone());
-    Value::Object(out)
+    (Value::Object(out), bound)
 }
 
 impl ValveRig {
@@ -143,10 +149,13 @@ impl ValveRig {
                 "initial": { "position": i.spool }
             }),
         };
-        v["components"]["friction"] = friction_component(&self.friction);
+        let (friction, bound) = friction_component(&self.friction);
+        v["components"]["friction"] = friction;
         let t = self.friction_terms;
         sets.push(("friction.seal.k_pressure".into(), t.k_pressure));
         sets.push(("friction.seal.h_acceleration".into(), t.h_acceleration));
+        // one bound for every seal term of the component
+        sets.push(("friction.seal.dp_max".into(), t.dp_max.max(bound)));
         for (path, x) in sets {
             netlist::set(&mut v, &path, Value::from(x))?;
         }

@@ -13,7 +13,7 @@
 use crate::report::Section;
 use hydrocyl_friction::FrictionInput;
 use hydrocyl_ports::{Force, Pressure, Velocity};
-use hydrocyl_system::chapter3::{self, Case, Comparison, COMPARED};
+use hydrocyl_studies::chapter3::{self, Case, Comparison, COMPARED};
 use hydrocyl_system::run::{nrmse, run, Run, RunOptions, Solver};
 use hydrocyl_system::valve_rig::ValveRig;
 use plotters::prelude::*;

@@ -58,6 +58,7 @@ pub fn wang_from(p: &[f64; 6]) -> Wang {
         sigma1: 0.1,
         extending: set(1.0),
         retracting: set(0.8),
+        seal_dp_max: 0.0,
     }
 }
 

@@ -32,7 +32,6 @@
 //! Every value is a field of [`WangHybrid`], whose `Default` is the rigs.md
 //! preset and whose JSON form is `fixtures/rigs/wang-hybrid.json`.
 
-pub mod chapter7;
 pub mod components;
 mod netlist;
 
@@ -139,7 +138,8 @@ pub fn c10_cylinder(bulk_modulus: f64) -> Cylinder {
 }
 
 impl WangHybrid {
-    /// The rigs.md preset: 20 kg load (chapter 8), Table 5-8 friction.
+    /// The rigs.md preset: 20 kg load (chapter 8), Table 5-8 friction with the
+    /// seal term bounded to its identification range (`hydrocyl_friction::seal`).
     pub fn preset() -> Self {
         let b = 7.0e8;
         Self {
@@ -155,7 +155,9 @@ impl WangHybrid {
             cylinder: c10_cylinder(b),
             mass: 20.0,
             external_force: 0.0,
-            friction: FrictionLaw::Wang(Wang::table_5_8()),
+            friction: FrictionLaw::Wang(
+                Wang::table_5_8().with_seal_bound(hydrocyl_friction::seal::TABLE_5_8_DP_MAX),
+            ),
             tank_pressure: 0.0,
             vapour_pressure: -0.99e5,
             initial_position: 0.0,

@@ -106,7 +106,7 @@ const SIGMA1: ParamSpec = param(
 
 /// The additive seal terms every law may carry (catalog
 /// `pressure_viscous`, `acceleration_friction`; 0 = off).
-const SEAL: [ParamSpec; 2] = [
+const SEAL: [ParamSpec; 3] = [
     param(
         "seal.k_pressure",
         "m^3 s/N",
@@ -120,6 +120,13 @@ const SEAL: [ParamSpec; 2] = [
         Value(0.0),
         Range::NON_NEGATIVE,
         "additive acceleration term K H a (eq 5.12), with K above",
+    ),
+    param(
+        "seal.dp_max",
+        "Pa",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "bound of |p1 − p2| in every seal term, K min(|p1 − p2|, Δp_max)² v; 0 = unbounded (eq 5.4)",
     ),
 ];
 
@@ -147,7 +154,7 @@ const COULOMB_VISCOUS_LAW: [ParamSpec; 3] = [
     ),
 ];
 
-const COULOMB_VISCOUS: [ParamSpec; 5] = join(COULOMB_VISCOUS_LAW, SEAL);
+const COULOMB_VISCOUS: [ParamSpec; 6] = join(COULOMB_VISCOUS_LAW, SEAL);
 
 const STRIBECK_LAW: [ParamSpec; 11] = join(
     join::<4, 4, 8>(curve!("extending.curve"), curve!("retracting.curve")),
@@ -164,7 +171,7 @@ const STRIBECK_LAW: [ParamSpec; 11] = join(
     ],
 );
 
-const STRIBECK: [ParamSpec; 13] = join(STRIBECK_LAW, SEAL);
+const STRIBECK: [ParamSpec; 14] = join(STRIBECK_LAW, SEAL);
 
 const KARNOPP_LAW: [ParamSpec; 5] = join(
     curve!("curve"),
@@ -194,8 +201,8 @@ const DAHL_LAW: [ParamSpec; 3] = [
         "viscous coefficient σ2",
     ),
 ];
-const DAHL: [ParamSpec; 5] = join(DAHL_LAW, SEAL);
-const KARNOPP: [ParamSpec; 7] = join(KARNOPP_LAW, SEAL);
+const DAHL: [ParamSpec; 6] = join(DAHL_LAW, SEAL);
+const KARNOPP: [ParamSpec; 8] = join(KARNOPP_LAW, SEAL);
 
 const LUGRE_LAW: [ParamSpec; 12] = join(
     [SIGMA0, SIGMA1],
@@ -242,14 +249,15 @@ const WANG_LAW: [ParamSpec; 14] = join(
     ),
 );
 
-const LUGRE: [ParamSpec; 14] = join(LUGRE_LAW, SEAL);
-const WANG: [ParamSpec; 16] = join(WANG_LAW, SEAL);
+const LUGRE: [ParamSpec; 15] = join(LUGRE_LAW, SEAL);
+const WANG: [ParamSpec; 17] = join(WANG_LAW, SEAL);
 
 /// The additive seal terms of an instance of one of these types.
 pub(crate) fn terms_of(inst: &Instance) -> SealTerms {
     SealTerms {
         k_pressure: inst.opt("seal.k_pressure").unwrap_or(0.0),
         h_acceleration: inst.opt("seal.h_acceleration").unwrap_or(0.0),
+        dp_max: inst.opt("seal.dp_max").unwrap_or(0.0),
     }
 }
 
@@ -259,7 +267,7 @@ fn build_with<T: DeserializeOwned>(
 ) -> Result<Box<dyn Component>, String> {
     let mut params = inst.clone();
     params.params.retain(|k, _| !k.starts_with("seal."));
-    let law = wrap(params.law::<T>("")?);
+    let law = bound_seal(wrap(params.law::<T>("")?), inst);
     hydrocyl_friction::FrictionModel::validate(&law).map_err(|e| e.to_string())?;
     let chambers =
         (inst.connected("A") && inst.connected("B")).then(|| (inst.node("A"), inst.node("B")));
@@ -280,11 +288,22 @@ fn build_with<T: DeserializeOwned>(
     built(Friction::new(&inst.name, inst.node("rod"), chambers, model))
 }
 
+/// Wang's own seal term takes the component's `seal.dp_max` bound too.
+fn bound_seal(law: FrictionLaw, inst: &Instance) -> FrictionLaw {
+    match law {
+        FrictionLaw::Wang(w) => {
+            FrictionLaw::Wang(w.with_seal_bound(inst.opt("seal.dp_max").unwrap_or(0.0)))
+        }
+        other => other,
+    }
+}
+
 /// The friction law of an instance of one of these types (`None` for
 /// another type).
 pub(crate) fn law_of(inst: &Instance) -> Option<Result<FrictionLaw, String>> {
     let mut without = inst.clone();
     without.params.retain(|k, _| !k.starts_with("seal."));
+    let bounded = |law: FrictionLaw| bound_seal(law, inst);
     let inst = &without;
     Some(match inst.ty.name {
         "friction_coulomb_viscous" => inst
@@ -294,7 +313,7 @@ pub(crate) fn law_of(inst: &Instance) -> Option<Result<FrictionLaw, String>> {
         "friction_karnopp" => inst.law::<Karnopp>("").map(FrictionLaw::Karnopp),
         "friction_dahl" => inst.law::<Dahl>("").map(FrictionLaw::Dahl),
         "friction_lugre" => inst.law::<LuGre>("").map(FrictionLaw::LuGre),
-        "friction_wang" => inst.law::<Wang>("").map(FrictionLaw::Wang),
+        "friction_wang" => inst.law::<Wang>("").map(|w| bounded(FrictionLaw::Wang(w))),
         _ => return None,
     })
 }

@@ -4,7 +4,7 @@
 //! and without the mass-balance quadratures. The goal is 500× real time.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use hydrocyl_system::hybrid::chapter7::{Chapter7Test, Load, Shape};
+use hydrocyl_studies::chapter7::{Chapter7Test, Load, Shape};
 use hydrocyl_system::run::{run, RunOptions, Solver};
 use std::hint::black_box;
 

@@ -15,9 +15,9 @@
 //!   (cylinder vertical, rod up); the moving mass is the rig's 20 kg in both
 //!   load cases (Table 8-1: "20 kg, include tray and piston rod").
 
-use crate::error::EnergyError;
-use crate::ledger::{ledger, trapezoid, Ledger, RodSide};
-use crate::variant::HybridVariant;
+use hydrocyl_energy::error::EnergyError;
+use hydrocyl_energy::ledger::{ledger, trapezoid, Ledger, RodSide};
+use hydrocyl_energy::variant::HybridVariant;
 use hydrocyl_friction::FrictionLaw;
 use hydrocyl_ports::Pressure;
 use hydrocyl_system::hybrid::{nodes, ReturnPath, WangHybrid};
@@ -221,9 +221,12 @@ pub enum FrictionCase {
     /// removes the acceleration term `K H a`): the bristle and Stribeck curve
     /// only. With K of Table 5-8 the valve drive has no steady retraction
     /// above ≈ 19 mm/s and the hybrid's extension reserve is a few newtons
-    /// (the fold of `hydrocyl_system::hybrid::chapter7`), so a transient
+    /// (the fold of `hydrocyl_studies::chapter7`), so a transient
     /// locks it; see docs/energy.md.
     WithoutSealTerm,
+    /// The rig's own law without the acceleration term `K H a` (H = 0, eq
+    /// 5.4; the seal term stays, bounded as the rig bounds it).
+    WithoutAccelerationTerm,
 }
 
 impl FrictionCase {
@@ -232,14 +235,19 @@ impl FrictionCase {
         match self {
             FrictionCase::AsRig => "as-rig",
             FrictionCase::WithoutSealTerm => "without-seal-term",
+            FrictionCase::WithoutAccelerationTerm => "without-acceleration-term",
         }
     }
 
     fn apply(self, law: &mut FrictionLaw) {
-        if self == FrictionCase::WithoutSealTerm {
-            if let FrictionLaw::Wang(w) = law {
-                w.extending.k_pressure = 0.0;
-                w.retracting.k_pressure = 0.0;
+        if let FrictionLaw::Wang(w) = law {
+            match self {
+                FrictionCase::AsRig => {}
+                FrictionCase::WithoutSealTerm => {
+                    w.extending.k_pressure = 0.0;
+                    w.retracting.k_pressure = 0.0;
+                }
+                FrictionCase::WithoutAccelerationTerm => *w = w.without_acceleration_term(),
             }
         }
     }

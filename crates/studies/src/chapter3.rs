@@ -5,10 +5,10 @@
 //! The thesis does not give the periods and durations of its tests; the
 //! choices here are documented on each case.
 
-use crate::rig::RigError;
-use crate::run::{nrmse, Run, RunOptions};
-use crate::signal::Signal;
-use crate::valve_rig::{Formulation, ValveRig};
+use hydrocyl_system::rig::RigError;
+use hydrocyl_system::run::{nrmse, Run, RunOptions};
+use hydrocyl_system::signal::Signal;
+use hydrocyl_system::valve_rig::{Formulation, ValveRig};
 
 /// One test case: a rig, a command, output times and the thesis's Simulink
 /// wall times (numerical X, analytical X, fundamental) \[s\], if it gives them.

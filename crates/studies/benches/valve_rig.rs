@@ -6,7 +6,7 @@
 //! (the goal for the fundamental model is ≥ 1000, i.e. ≥ 1 Melem/s).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use hydrocyl_system::chapter3;
+use hydrocyl_studies::chapter3;
 use hydrocyl_system::run::{RunOptions, Solver};
 use hydrocyl_system::valve_rig::Formulation;
 use std::hint::black_box;

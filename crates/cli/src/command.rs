@@ -238,26 +238,6 @@ pub fn parse_command(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use proptest::prelude::*;
-
-    proptest! {
-        #![proptest_config(ProptestConfig::with_cases(
-            std::env::var("HYDROCYL_FUZZ_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(2000)
-        ))]
-        /// Arbitrary bytes never panic the command reader, and what it
-        /// accepts is a strictly increasing, finite record.
-        #[test]
-        fn arbitrary_bytes_are_read_or_rejected(bytes in prop::collection::vec(any::<u8>(), 0..300),
-                                                 header in prop::sample::select(vec!["time,command\n", "time [ms];command\n", "command,time,x\n", ""])) {
-            let mut b = header.as_bytes().to_vec();
-            b.extend_from_slice(&bytes);
-            if let Ok((t, u)) = parse_command("fuzz.csv", &b, CommandUnit::Normalised) {
-                prop_assert!(t.len() >= 2 && t.len() == u.len());
-                prop_assert!(t.windows(2).all(|w| w[1] > w[0]));
-                prop_assert!(u.iter().all(|v| v.is_finite()));
-            }
-        }
-    }
 
     #[test]
     fn units_and_duplicates() {

@@ -9,6 +9,8 @@ mod components;
 mod diagnose;
 mod error;
 mod fmu;
+#[cfg(test)]
+mod fuzz;
 mod output;
 mod presets;
 mod rigfile;

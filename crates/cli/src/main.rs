@@ -13,6 +13,7 @@ mod fmu;
 mod fuzz;
 mod output;
 mod presets;
+mod progress;
 mod rigfile;
 mod simulate;
 mod xfactor;
@@ -75,6 +76,7 @@ fn definition() -> clap::Command {
 }
 
 fn main() {
+    progress::start();
     output::remove_temporaries_on_signal();
     let cli = match Cli::from_arg_matches(&definition().get_matches()) {
         Ok(c) => c,

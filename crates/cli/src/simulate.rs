@@ -25,7 +25,8 @@ use hydrocyl_energy::variant::{self, HybridVariant};
 use hydrocyl_identify::bench::{self, FrictionBench};
 use crate::command::{read_command, CommandUnit};
 use crate::output::Outputs;
-use hydrocyl_identify::plaincsv::{run_columns, write_columns_in_parts};
+use crate::progress::Progress;
+use hydrocyl_identify::plaincsv::{run_columns, write_columns_in_parts, write_rows_in_parts};
 use hydrocyl_system::hybrid::WangHybrid;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{self as runner, Run, RunOptions, Solver};
@@ -81,22 +82,37 @@ pub struct Args {
     /// Flush the output to the disk (fsync) before it is renamed into place.
     #[arg(long)]
     fsync: bool,
+    /// Show a progress bar even when stderr is not a terminal.
+    #[arg(long)]
+    progress: bool,
+    /// Print nothing but errors (no progress, no warnings, no summary).
+    #[arg(long)]
+    quiet: bool,
 }
 
-/// The run as CSV text in the measured-data format (shortest round-trip
-/// numbers, [`hydrocyl_identify::plaincsv::write_columns`]), in consecutive
-/// parts formatted in parallel on the machine's cores.
-pub fn to_csv(run: &Run, command: CommandUnit) -> Vec<Vec<u8>> {
+/// Output times per block of a streamed run: the memory a run needs grows
+/// with this, not with the record.
+const BLOCK: usize = 1 << 16;
+
+/// A block of a run as CSV text in the measured-data format (shortest
+/// round-trip numbers, [`hydrocyl_identify::plaincsv::write_columns`]), the
+/// header with the first block, in consecutive parts formatted in parallel
+/// on the machine's cores.
+pub fn to_csv(run: &Run, command: CommandUnit, first: bool) -> Vec<Vec<u8>> {
     let (_, columns) = run_columns(run);
-    let names = column_headers(run, command);
-    let names: Vec<&str> = names.iter().map(String::as_str).collect();
     // threads pay for themselves from a few thousand rows on
     let parts = if run.time.len() < 4096 {
         1
     } else {
         std::thread::available_parallelism().map_or(1, |n| n.get().min(8))
     };
-    write_columns_in_parts(&names, &columns, parts)
+    if first {
+        let names = column_headers(run, command);
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        write_columns_in_parts(&names, &columns, parts)
+    } else {
+        write_rows_in_parts(&columns, parts)
+    }
 }
 
 /// The CSV header of a run: `time [s]`, then each channel as `name [unit]`
@@ -127,17 +143,15 @@ fn load_variant(
     Ok((base, v))
 }
 
-/// Simulates a circuit variant of the hybrid drive on `command` \[V\]. A
+/// The circuit of a variant of the hybrid drive on `command` \[V\]. A
 /// variant that sets the needle opening per speed gets the entry for the
 /// command's peak speed, `K max(u_max / A1, −u_min / A2)` (K the pump's
 /// flow gain), the speed the chapter-8 scenarios command.
-fn simulate_variant(
+fn variant_circuit(
     base: &WangHybrid,
     v: &HybridVariant,
     command: Signal,
-    t: &[f64],
-    opts: &RunOptions,
-) -> Result<Run, CliError> {
+) -> Result<Circuit, CliError> {
     let mut r = base.clone();
     let (u_max, u_min) = match &command {
         Signal::Table { value, .. } => value
@@ -150,10 +164,7 @@ fn simulate_variant(
     let build = |e: hydrocyl_system::BuildError| CliError::Input(format!("rig {}: {e}", v.name));
     let mut comps = r.components(command).map_err(build)?;
     v.swap_components(&mut comps);
-    let mut c = Circuit::build(comps).map_err(build)?;
-    let x0 = c.initial_state();
-    c.reset(t.first().copied().unwrap_or(0.0), &x0);
-    runner::run(&mut c, &x0, t, opts).map_err(|e| CliError::Input(format!("rig {}: {e}", v.name)))
+    Circuit::build(comps).map_err(build)
 }
 
 /// `hydrocyl simulate` on a friction bench: the `--command` file carries the
@@ -359,10 +370,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let id = outputs.file("--out", &out)?;
     let unit = command_unit(&value);
     let (t, u) = read_command(&cmd_path, unit)?;
-    if unit == CommandUnit::Normalised {
+    if unit == CommandUnit::Normalised && !args.quiet {
         warn_clamped(&cmd_path, &t, &u);
     }
-    let signal = Signal::table(t.clone(), u)
+    let rows = t.len();
+    let (t0, t1) = (t[0], t[rows - 1]);
+    let signal = Signal::table(t, u)
         .map_err(|e| CliError::Input(format!("{}: {e}", cmd_path.display())))?;
     let opts = RunOptions {
         solver,
@@ -370,19 +383,51 @@ pub fn run(args: Args) -> Result<(), CliError> {
         rk4_step: args.rk4_step,
         ..RunOptions::default()
     };
-    let run = match variant {
-        None => rig::simulate(&value, signal, &t, &opts).map_err(solver_hint)?,
-        Some((base, v)) => simulate_variant(&base, &v, signal, &t, &opts)?,
+    let t = match &signal {
+        Signal::Table { time_s, .. } => time_s.clone(),
+        _ => Vec::new(),
     };
-    check_solution(&run, solver, args.rk4_step)?;
-    for p in to_csv(&run, unit) {
-        outputs.write(id, &p)?;
-    }
+    let mut c = match variant {
+        None => rig::circuit(&value, signal).map_err(|e| CliError::Input(e.to_string()))?,
+        Some((base, v)) => variant_circuit(&base, &v, signal)?,
+    };
+    let x0 = c.initial_state();
+    let mut bar = Progress::new("simulate", rows as u64, args.progress, args.quiet);
+    let mut failed: Option<CliError> = None;
+    let mut done = 0usize;
+    let mut min_p = f64::INFINITY;
+    let mut sink = |block: &Run| -> Result<(), String> {
+        let r = check_solution(block, solver, args.rk4_step).and_then(|()| {
+            for p in to_csv(block, unit, done == 0) {
+                outputs.write(id, &p)?;
+            }
+            Ok(())
+        });
+        done += block.time.len();
+        min_p = min_p.min(block.min_chamber_pressure());
+        bar.set("rows", done as u64, rows as u64);
+        r.map_err(|e| {
+            let m = e.to_string();
+            failed = Some(e);
+            m
+        })
+    };
+    let streamed = runner::run_streaming(&mut c, &x0, &t, &opts, BLOCK, &mut sink);
+    bar.finish();
+    let run = match (streamed, failed) {
+        (_, Some(e)) => return Err(e),
+        (Err(e), None) => return Err(solver_hint(rig::RigError::Sim(e.to_string()))),
+        (Ok(r), None) => r,
+    };
     outputs.commit(args.fsync)?;
+    if args.quiet {
+        return Ok(());
+    }
     let cav = run.cavitation_entries();
     eprintln!(
-        "hydrocyl: simulated {:.4} s in {:.3} s ({} {}: {} steps, {} rejected, {} rhs); {}",
-        t[t.len() - 1] - t[0],
+        "hydrocyl: simulated {:.4} s ({rows} rows) in {:.3} s, {:.3} s of it solving ({} {}: {} steps, {} rejected, {} rhs); {}",
+        t1 - t0,
+        crate::progress::wall(),
         run.wall.as_secs_f64(),
         solver.name(),
         run.stats.choice(),
@@ -392,7 +437,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         if cav > 0 {
             format!(
                 "CAVITATION: a chamber entered cavitation {cav} times between the output samples (lowest sampled chamber pressure {:.0} Pa)",
-                run.min_chamber_pressure()
+                min_p
             )
         } else {
             "no cavitation".to_string()

@@ -209,3 +209,47 @@ fn every_bad_input_of_the_table() {
         failures.join("\n")
     );
 }
+
+/// SIGTERM and SIGINT during a run: the temporary output is removed, no
+/// output appears, exit code 130.
+#[test]
+fn a_signal_during_the_run_leaves_no_file() {
+    for sig in ["-TERM", "-INT"] {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        // 2 s at an rk4 step of 1 µs: seconds of work, caught running
+        let rows: String = (0..20_000)
+            .map(|k| format!("{},{}\n", k as f64 * 1e-4, if k % 10_000 < 5_000 { 0.1 } else { -0.1 }))
+            .collect();
+        std::fs::write(d.join("cmd.csv"), format!("time,command\n{rows}")).unwrap();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_hydrocyl"))
+            .current_dir(d)
+            .args(["simulate", "--rig", "leaney-moog", "--command", "cmd.csv", "--out", "out.csv"])
+            .args(["--solver", "rk4", "--rk4-step", "1e-6"])
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // wait for the temporary file: the run has started
+        let start = std::time::Instant::now();
+        let tmp_exists = || {
+            std::fs::read_dir(d)
+                .unwrap()
+                .any(|e| e.unwrap().file_name().to_string_lossy().contains(".tmp"))
+        };
+        while !tmp_exists() && start.elapsed().as_secs() < 30 {
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        assert!(tmp_exists(), "no temporary file appeared");
+        Command::new("kill")
+            .args([sig, &child.id().to_string()])
+            .status()
+            .unwrap();
+        let st = child.wait().unwrap();
+        assert_eq!(st.code(), Some(130), "{sig}: {st:?}");
+        let left: Vec<_> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .collect();
+        assert_eq!(left, vec!["cmd.csv".to_string()], "{sig}");
+    }
+}

@@ -241,18 +241,30 @@ mod tests {
 
     #[test]
     fn units_and_duplicates() {
-        let r = parse_command("f", b"time [ms],command [%]\n0,50\n10,-20\n", CommandUnit::Normalised)
-            .unwrap();
+        let r = parse_command(
+            "f",
+            b"time [ms],command [%]\n0,50\n10,-20\n",
+            CommandUnit::Normalised,
+        )
+        .unwrap();
         assert_eq!(r, (vec![0.0, 0.01], vec![0.5, -0.2]));
-        let e = parse_command("f", b"time,command [mV]\n0,50\n1,2\n", CommandUnit::Normalised)
-            .unwrap_err()
-            .to_string();
+        let e = parse_command(
+            "f",
+            b"time,command [mV]\n0,50\n1,2\n",
+            CommandUnit::Normalised,
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("`mV`") && e.contains("[-]"), "{e}");
         let r = parse_command("f", b"time,command [mV]\n0,50\n1,2\n", CommandUnit::Volt).unwrap();
         assert_eq!(r.1, vec![0.05, 0.002]);
-        let e = parse_command("f", b"time,command,command\n0,1,2\n1,2,3\n", CommandUnit::Volt)
-            .unwrap_err()
-            .to_string();
+        let e = parse_command(
+            "f",
+            b"time,command,command\n0,1,2\n1,2,3\n",
+            CommandUnit::Volt,
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("two `command` columns (2 and 3)"), "{e}");
     }
 }

@@ -3,7 +3,6 @@
 //! report before and after (human table on stdout, JSON with `--report`,
 //! SVG plots with `--plots`). Nothing is written when anything fails.
 
-use std::io::IsTerminal as _;
 use std::path::{Path, PathBuf};
 
 use hydrocyl_identify::bench::{self, FrictionBench};
@@ -16,6 +15,7 @@ use hydrocyl_system::valve_rig::ValveRig;
 
 use crate::error::CliError;
 use crate::output::Outputs;
+use crate::progress::Progress;
 
 /// Arguments of this subcommand.
 #[derive(clap::Args)]
@@ -52,6 +52,9 @@ pub struct Args {
     /// Print nothing but errors.
     #[arg(long)]
     pub quiet: bool,
+    /// Show a progress bar even when stderr is not a terminal.
+    #[arg(long)]
+    pub progress: bool,
 }
 
 /// A rig `diagnose` can run.
@@ -131,7 +134,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     let rig = load_rig(&args.rig)?;
     // every output checked (and its temporary created) before any work
-    let mut inputs: Vec<(&str, &Path)> = args.data.iter().map(|p| ("--data", p.as_path())).collect();
+    let mut inputs: Vec<(&str, &Path)> =
+        args.data.iter().map(|p| ("--data", p.as_path())).collect();
     if Path::new(&args.rig).exists() {
         inputs.push(("--rig", Path::new(&args.rig)));
     }
@@ -170,23 +174,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         candidates,
         ..DiagnoseOptions::default()
     };
-    let show_bar = !args.quiet && std::io::stderr().is_terminal();
-    let bar = show_bar.then(|| {
-        let b = indicatif::ProgressBar::new(1);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} diagnose [{bar:30}] {pos}/{len} {msg} ({elapsed}, eta {eta})",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        b
-    });
+    let mut bar = Progress::new("diagnose", 1, args.progress, args.quiet);
     let mut progress = |stage: &str, done: usize, total: usize| {
-        if let Some(b) = &bar {
-            b.set_length(total as u64);
-            b.set_position(done as u64);
-            b.set_message(stage.to_string());
-        }
+        bar.set(stage, done as u64, total as u64);
     };
     let (report, traces) = match &rig {
         Rig::Bench(b) => {
@@ -206,16 +196,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
             (o.report, o.traces)
         }
     };
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
+    bar.finish();
     if let Some(wanted) = &args.effects {
         // an effect asked for that the loop neither added nor tried
         let seen = |id: &str| {
             report.effects_added.iter().any(|e| e.id == id)
                 || report.effects_rejected.iter().any(|e| e.id == id)
         };
-        let untried: Vec<&str> = wanted.iter().map(|w| w.trim()).filter(|w| !seen(w)).collect();
+        let untried: Vec<&str> = wanted
+            .iter()
+            .map(|w| w.trim())
+            .filter(|w| !seen(w))
+            .collect();
         if untried.len() == wanted.len() {
             return Err(CliError::Input(format!(
                 "--effects {}: cannot be tried on this rig ({} rig; the effects it can try are listed without --effects)",
@@ -263,12 +255,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if !args.quiet {
         print!("{}", report.human());
         if let Some(dir) = &args.plots {
-            println!(
-                "plots: {} SVG files in {}",
-                plots.len(),
-                dir.display()
-            );
+            println!("plots: {} SVG files in {}", plots.len(), dir.display());
         }
+        eprintln!(
+            "hydrocyl: diagnose took {:.2} s in all (reading, fitting, writing)",
+            crate::progress::wall()
+        );
     }
     Ok(())
 }
@@ -399,7 +391,11 @@ fn plot_series(
         ],
     )?;
     let resid = |sim: &[f64]| -> Vec<f64> {
-        tr.measured.iter().zip(sim).map(|(m, s)| (m - s) * f).collect()
+        tr.measured
+            .iter()
+            .zip(sim)
+            .map(|(m, s)| (m - s) * f)
+            .collect()
     };
     let (rb, ra) = (resid(&tr.before), resid(&tr.after));
     time_panel(

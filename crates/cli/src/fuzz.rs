@@ -21,10 +21,14 @@ const CSV_SEED: &str = "time [ms],command,comment\n0,0.1,x\n10,-0.2,y\n20,1e6,z\
 /// The rig files the mutations start from.
 fn rig_seeds() -> Vec<String> {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/");
-    ["rigs/leaney-moog.json", "measured/festo-hanging-load.rig.json", "rigs/wang-hybrid-needle.json"]
-        .iter()
-        .filter_map(|f| std::fs::read_to_string(format!("{root}{f}")).ok())
-        .collect()
+    [
+        "rigs/leaney-moog.json",
+        "measured/festo-hanging-load.rig.json",
+        "rigs/wang-hybrid-needle.json",
+    ]
+    .iter()
+    .filter_map(|f| std::fs::read_to_string(format!("{root}{f}")).ok())
+    .collect()
 }
 
 /// A mutation of `seed`: at byte `at` (mod length) replace, delete or
@@ -54,7 +58,11 @@ fn mutate(seed: &[u8], op: u8, at: usize, with: &[u8]) -> Vec<u8> {
 fn bytes_or_mutation(seed: Vec<u8>) -> impl Strategy<Value = Vec<u8>> {
     prop_oneof![
         prop::collection::vec(any::<u8>(), 0..400),
-        (any::<u8>(), any::<usize>(), prop::collection::vec(any::<u8>(), 1..8))
+        (
+            any::<u8>(),
+            any::<usize>(),
+            prop::collection::vec(any::<u8>(), 1..8)
+        )
             .prop_map(move |(op, at, with)| mutate(&seed, op, at, &with)),
     ]
 }

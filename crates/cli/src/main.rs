@@ -71,8 +71,7 @@ fn definition() -> clap::Command {
         );
         sub.mut_arg("rig", move |a| a.help(help))
     };
-    Cli::command()
-        .mut_subcommand("simulate", rig_help)
+    Cli::command().mut_subcommand("simulate", rig_help)
 }
 
 fn main() {

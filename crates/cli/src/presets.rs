@@ -23,7 +23,11 @@ fn one_line(text: &str) -> String {
 /// Every preset as `(name, kind, one-line description)`.
 pub fn all() -> Vec<(&'static str, String, String)> {
     let describe = |v: &serde_json::Value| {
-        let kind = v.get("kind").and_then(|k| k.as_str()).unwrap_or("?").to_string();
+        let kind = v
+            .get("kind")
+            .and_then(|k| k.as_str())
+            .unwrap_or("?")
+            .to_string();
         let what = v
             .get("description")
             .and_then(|d| d.as_str())

@@ -20,12 +20,12 @@
 //! (`--fsync` also flushes it to the disk first; without it the operating
 //! system writes it back when it likes, as for any ordinary file).
 
-use crate::error::CliError;
-use hydrocyl_energy::variant::{self, HybridVariant};
-use hydrocyl_identify::bench::{self, FrictionBench};
 use crate::command::{read_command, CommandUnit};
+use crate::error::CliError;
 use crate::output::Outputs;
 use crate::progress::Progress;
+use hydrocyl_energy::variant::{self, HybridVariant};
+use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_identify::plaincsv::{run_columns, write_columns_in_parts, write_rows_in_parts};
 use hydrocyl_system::hybrid::WangHybrid;
 use hydrocyl_system::rig;
@@ -74,7 +74,12 @@ pub struct Args {
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     rtol: f64,
     /// Fixed step of rk4 \[s\].
-    #[arg(long, default_value_t = 2e-5, allow_negative_numbers = true, help = "Fixed step of rk4 [s]")]
+    #[arg(
+        long,
+        default_value_t = 2e-5,
+        allow_negative_numbers = true,
+        help = "Fixed step of rk4 [s]"
+    )]
     rk4_step: f64,
     /// Print the rig (after --set) as JSON and exit.
     #[arg(long)]
@@ -232,7 +237,11 @@ fn command_unit(value: &serde_json::Value) -> CommandUnit {
 fn check_initial_pressures(value: &serde_json::Value) -> Result<(), CliError> {
     for p in rig::parameters(value) {
         let pressure = p.unit == Some("Pa")
-            || (p.unit.is_none() && p.path.rsplit('.').next().is_some_and(|l| l.starts_with('p')));
+            || (p.unit.is_none()
+                && p.path
+                    .rsplit('.')
+                    .next()
+                    .is_some_and(|l| l.starts_with('p')));
         let initial = p.path.starts_with("initial.") || p.path.contains(".initial.");
         match p.value {
             Some(v) if initial && pressure && v < rig::ABSOLUTE_VACUUM_GAUGE_PA => {
@@ -257,13 +266,18 @@ const ABSURD_PRESSURE_PA: f64 = 10.0 * rig::ABSOLUTE_VACUUM_GAUGE_PA;
 fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result<(), CliError> {
     let bad = run.channels.iter().find_map(|c| {
         c.values.iter().enumerate().find_map(|(k, &v)| {
-            let absurd = !v.is_finite() || (c.unit == "Pa" && matches!(c.name.as_str(), "p1" | "p2") && v < ABSURD_PRESSURE_PA);
+            let absurd = !v.is_finite()
+                || (c.unit == "Pa"
+                    && matches!(c.name.as_str(), "p1" | "p2")
+                    && v < ABSURD_PRESSURE_PA);
             absurd.then(|| format!("{} = {v:e} {} at t = {} s", c.name, c.unit, run.time[k]))
         })
     });
     let Some(what) = bad else { return Ok(()) };
     let fix = if solver == Solver::Rk4 {
-        format!("--rk4-step {rk4_step} is too large for this rig: use a smaller step or --solver auto")
+        format!(
+            "--rk4-step {rk4_step} is too large for this rig: use a smaller step or --solver auto"
+        )
     } else {
         "try --solver rosenbrock or a smaller --rtol".to_string()
     };
@@ -375,8 +389,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let rows = t.len();
     let (t0, t1) = (t[0], t[rows - 1]);
-    let signal = Signal::table(t, u)
-        .map_err(|e| CliError::Input(format!("{}: {e}", cmd_path.display())))?;
+    let signal =
+        Signal::table(t, u).map_err(|e| CliError::Input(format!("{}: {e}", cmd_path.display())))?;
     let opts = RunOptions {
         solver,
         rtol: args.rtol,

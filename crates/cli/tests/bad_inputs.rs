@@ -85,7 +85,12 @@ fn check(row: &Value) -> Result<(), String> {
             make_file(d, name, spec);
         }
     }
-    for before in row.get("before").and_then(Value::as_array).into_iter().flatten() {
+    for before in row
+        .get("before")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+    {
         let args: Vec<String> = before
             .as_array()
             .unwrap()
@@ -114,9 +119,18 @@ fn check(row: &Value) -> Result<(), String> {
         String::from_utf8_lossy(&o.stderr).to_string(),
     );
     let code = row["code"].as_i64().unwrap() as i32;
-    let ctx = || format!("\n  stderr: {err}\n  stdout: {}", out.chars().take(400).collect::<String>());
+    let ctx = || {
+        format!(
+            "\n  stderr: {err}\n  stdout: {}",
+            out.chars().take(400).collect::<String>()
+        )
+    };
     if o.status.code() != Some(code) {
-        return Err(format!("exit {:?}, expected {code}{}", o.status.code(), ctx()));
+        return Err(format!(
+            "exit {:?}, expected {code}{}",
+            o.status.code(),
+            ctx()
+        ));
     }
     if code == 2 && err.trim().lines().count() != 1 {
         return Err(format!("the error is not one line{}", ctx()));
@@ -170,7 +184,9 @@ fn check(row: &Value) -> Result<(), String> {
         let first = text.lines().next().unwrap_or("");
         let cols: Vec<&str> = first.split(',').collect();
         if cols.len() < header.len() || cols[..header.len()] != header[..] {
-            return Err(format!("out.csv header `{first}`, expected to start {header:?}"));
+            return Err(format!(
+                "out.csv header `{first}`, expected to start {header:?}"
+            ));
         }
     }
     // no temporary file left anywhere in the folder
@@ -219,12 +235,26 @@ fn a_signal_during_the_run_leaves_no_file() {
         let d = dir.path();
         // 2 s at an rk4 step of 1 µs: seconds of work, caught running
         let rows: String = (0..20_000)
-            .map(|k| format!("{},{}\n", k as f64 * 1e-4, if k % 10_000 < 5_000 { 0.1 } else { -0.1 }))
+            .map(|k| {
+                format!(
+                    "{},{}\n",
+                    k as f64 * 1e-4,
+                    if k % 10_000 < 5_000 { 0.1 } else { -0.1 }
+                )
+            })
             .collect();
         std::fs::write(d.join("cmd.csv"), format!("time,command\n{rows}")).unwrap();
         let mut child = Command::new(env!("CARGO_BIN_EXE_hydrocyl"))
             .current_dir(d)
-            .args(["simulate", "--rig", "leaney-moog", "--command", "cmd.csv", "--out", "out.csv"])
+            .args([
+                "simulate",
+                "--rig",
+                "leaney-moog",
+                "--command",
+                "cmd.csv",
+                "--out",
+                "out.csv",
+            ])
             .args(["--solver", "rk4", "--rk4-step", "1e-6"])
             .stderr(std::process::Stdio::piped())
             .spawn()

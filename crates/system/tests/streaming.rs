@@ -8,7 +8,10 @@ use hydrocyl_system::signal::Signal;
 
 fn setup() -> (hydrocyl_system::Circuit, Vec<f64>, Vec<f64>) {
     let t: Vec<f64> = (0..400).map(|k| k as f64 * 0.005).collect();
-    let u: Vec<f64> = t.iter().map(|&t| if t % 1.0 < 0.5 { 0.15 } else { -0.2 }).collect();
+    let u: Vec<f64> = t
+        .iter()
+        .map(|&t| if t % 1.0 < 0.5 { 0.15 } else { -0.2 })
+        .collect();
     let v = rig::preset("leaney-moog").unwrap();
     let c = rig::circuit(&v, Signal::table(t.clone(), u).unwrap()).unwrap();
     let x0 = c.initial_state();
@@ -18,14 +21,21 @@ fn setup() -> (hydrocyl_system::Circuit, Vec<f64>, Vec<f64>) {
 fn streamed(block: usize) -> (Vec<f64>, Vec<Vec<f64>>, Run) {
     let (mut c, x0, t) = setup();
     let (mut time, mut cols) = (Vec::new(), Vec::<Vec<f64>>::new());
-    let total = run_streaming(&mut c, &x0, &t, &RunOptions::default(), block, &mut |b: &Run| {
-        time.extend_from_slice(&b.time);
-        cols.resize(b.channels.len(), Vec::new());
-        for (c, ch) in cols.iter_mut().zip(&b.channels) {
-            c.extend_from_slice(&ch.values);
-        }
-        Ok(())
-    })
+    let total = run_streaming(
+        &mut c,
+        &x0,
+        &t,
+        &RunOptions::default(),
+        block,
+        &mut |b: &Run| {
+            time.extend_from_slice(&b.time);
+            cols.resize(b.channels.len(), Vec::new());
+            for (c, ch) in cols.iter_mut().zip(&b.channels) {
+                c.extend_from_slice(&ch.values);
+            }
+            Ok(())
+        },
+    )
     .unwrap();
     (time, cols, total)
 }

@@ -8,17 +8,23 @@
 //! ```
 //!
 //! The command file is CSV with a `time` column (`time`, `time [s]` or
-//! `time [ms]`) and a `command` column (the normalised spool demand of a
-//! valve rig, the drive voltage of a pump rig); other columns are ignored.
+//! `time [ms]`) and one `command` column in the unit of the rig's command
+//! (see [`crate::command`]); other columns are ignored.
 //! The output has one row per command sample: `time, command, position,
 //! velocity, p1, p2`, then the rig's other outputs (`ps`, `spool`, `p_le`,
-//! ...), all SI without unit suffixes. A `friction-bench` rig is driven by
-//! its motion instead: see [`crate::bench_sim`]. A `hybrid-variant` rig file
-//! (chapter 8's circuit improvements) runs on its base rig with the variant's
-//! components swapped in. It is written to a temporary file in
-//! the output's folder and renamed into place, so a failed run leaves no file
-//! (`--fsync` also flushes it to the disk first; without it the operating
-//! system writes it back when it likes, as for any ordinary file).
+//! ...), all SI, each header with its unit (`position [m]`; the readers take
+//! both forms; [`COLUMNS_HELP`] says what each is). A `friction-bench` rig is
+//! driven by its motion instead: see [`crate::bench_sim`]. A
+//! `hybrid-variant` rig file (chapter 8's circuit improvements) runs on its
+//! base rig with the variant's components swapped in.
+//!
+//! Every input is checked and the output's temporary file created before the
+//! run ([`crate::output`]); the run is streamed in blocks
+//! ([`hydrocyl_system::run::run_streaming`]), each written as it is
+//! computed, and the temporary is renamed into place at the end, so a failed
+//! or interrupted run leaves no file (`--fsync` also flushes it to the disk
+//! first; without it the operating system writes it back when it likes, as
+//! for any ordinary file).
 
 use crate::command::{read_command, CommandUnit};
 use crate::error::CliError;

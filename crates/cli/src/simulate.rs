@@ -61,11 +61,11 @@ pub struct Args {
     /// A preset name (`hydrocyl presets`) or a rig JSON file.
     #[arg(long)]
     rig: String,
-    /// [required] CSV with `time` and `command` columns; the output is
+    /// (required) CSV with `time` and `command` columns; the output is
     /// sampled at its times.
     #[arg(long, required_unless_present = "print_rig")]
     command: Option<PathBuf>,
-    /// [required] Output CSV (measured-data format, units in the header).
+    /// (required) Output CSV (measured-data format, units in the header).
     #[arg(long, required_unless_present = "print_rig")]
     out: Option<PathBuf>,
     /// Override a rig parameter by its JSON path, e.g. `--set load.mass_kg=50`

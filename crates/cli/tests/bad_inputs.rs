@@ -135,24 +135,17 @@ fn check(row: &Value) -> Result<(), String> {
     if code == 2 && err.trim().lines().count() != 1 {
         return Err(format!("the error is not one line{}", ctx()));
     }
-    for w in strs(row, "stderr") {
-        if !err.contains(&w) {
-            return Err(format!("stderr lacks `{w}`{}", ctx()));
-        }
-    }
-    for w in strs(row, "stderr_not") {
-        if err.contains(&w) {
-            return Err(format!("stderr has `{w}`{}", ctx()));
-        }
-    }
-    for w in strs(row, "stdout") {
-        if !out.contains(&w) {
-            return Err(format!("stdout lacks `{w}`{}", ctx()));
-        }
-    }
-    for w in strs(row, "stdout_not") {
-        if out.contains(&w) {
-            return Err(format!("stdout has `{w}`{}", ctx()));
+    for (key, text, present) in [
+        ("stderr", &err, true),
+        ("stderr_not", &err, false),
+        ("stdout", &out, true),
+        ("stdout_not", &out, false),
+    ] {
+        for w in strs(row, key) {
+            if text.contains(&w) != present {
+                let has = if present { "lacks" } else { "has" };
+                return Err(format!("{} {has} `{w}`{}", &key[..6], ctx()));
+            }
         }
     }
     for f in strs(row, "absent") {

@@ -3,18 +3,19 @@
 //! report before and after (human table on stdout, JSON with `--report`,
 //! SVG plots with `--plots`). Nothing is written when anything fails.
 
-use std::io::IsTerminal as _;
 use std::path::{Path, PathBuf};
 
 use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_identify::catalog::EffectId;
-use hydrocyl_identify::data::{write_atomic, ColumnMap, Record};
+use hydrocyl_identify::data::{ColumnMap, Record};
 use hydrocyl_identify::diagnose::{diagnose_bench, DiagnoseOptions, RecordTrace};
 use hydrocyl_identify::valve::diagnose_valve_traced;
 use hydrocyl_system::rig::valve_rig_from;
 use hydrocyl_system::valve_rig::ValveRig;
 
 use crate::error::CliError;
+use crate::output::Outputs;
+use crate::progress::Progress;
 
 /// Arguments of this subcommand.
 #[derive(clap::Args)]
@@ -31,7 +32,9 @@ pub struct Args {
     /// Where to write the JSON report.
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Folder for SVG plots (measured vs simulated, residual vs regressor).
+    /// Folder for SVG plots: per record and channel, measured vs simulated
+    /// with the residuals; for a friction bench with an effect added, also
+    /// the residual vs that effect's regressor.
     #[arg(long)]
     pub plots: Option<PathBuf>,
     /// Least share of the residual an effect must explain to be added.
@@ -49,6 +52,9 @@ pub struct Args {
     /// Print nothing but errors.
     #[arg(long)]
     pub quiet: bool,
+    /// Show a progress bar even when stderr is not a terminal.
+    #[arg(long)]
+    pub progress: bool,
 }
 
 /// A rig `diagnose` can run.
@@ -61,43 +67,42 @@ fn load_rig(spec: &str) -> Result<Rig, CliError> {
     if let Some(r) = bench::preset(spec) {
         return Ok(Rig::Bench(r));
     }
+    let unsupported = |e: &dyn std::fmt::Display| {
+        CliError::Input(format!(
+            "--rig {spec}: not supported for this rig kind (diagnose takes the valve-cylinder circuit or a friction bench): {e}"
+        ))
+    };
     if let Some(v) = hydrocyl_system::rig::preset(spec) {
         return valve_rig_from(&v)
             .map(|r| Rig::Valve(Box::new(r)))
-            .map_err(|e| CliError::Input(format!("--rig {spec}: {e}")));
+            .map_err(|e| unsupported(&e));
     }
-    let path = Path::new(spec);
-    if !path.exists() {
+    if !Path::new(spec).exists() {
         return Err(CliError::Input(format!(
-            "--rig '{spec}': neither a preset ({}, {}) nor an existing rig file",
-            bench::PRESETS.join(", "),
-            hydrocyl_system::rig::PRESETS
-                .iter()
-                .map(|p| p.name)
-                .collect::<Vec<_>>()
-                .join(", ")
+            "--rig '{spec}': neither a preset ({}; `hydrocyl presets`) nor an existing rig file",
+            crate::presets::names()
         )));
     }
-    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
-        path: spec.to_string(),
-        source: e,
-    })?;
-    let v: serde_json::Value = serde_json::from_str(&text)
-        .map_err(|e| CliError::Input(format!("{spec}: not valid JSON: {e}")))?;
+    // duplicate keys refused, errors with the JSON path and line
+    let v = hydrocyl_system::rig::load(spec).map_err(|e| CliError::Input(e.to_string()))?;
     match v.get("kind").and_then(|k| k.as_str()).unwrap_or("") {
-        k if k == bench::KIND => FrictionBench::from_json(&text)
+        k if k == bench::KIND => FrictionBench::from_json(&v.to_string())
             .map(Rig::Bench)
             .map_err(|e| CliError::Input(format!("{spec}: {e}"))),
         k if k == hydrocyl_system::valve_rig::KIND => valve_rig_from(&v)
             .map(|r| Rig::Valve(Box::new(r)))
-            .map_err(|e| CliError::Input(format!("{spec}: {e}"))),
-        k => Err(CliError::Input(format!(
-            "{spec}: rig kind '{k}' cannot be diagnosed (kinds: {}, {})",
+            .map_err(|e| crate::rigfile::locate(e, &v, spec)),
+        k => Err(unsupported(&format!(
+            "kind '{k}' (kinds: {}, {})",
             bench::KIND,
             hydrocyl_system::valve_rig::KIND
         ))),
     }
 }
+
+/// Fewer samples than this per record: the ± intervals of the report assume
+/// many independent samples, so they are not to be trusted.
+const SMALL_SAMPLE: usize = 100;
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<(), CliError> {
@@ -128,6 +133,21 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ),
     };
     let rig = load_rig(&args.rig)?;
+    // every output checked (and its temporary created) before any work
+    let mut inputs: Vec<(&str, &Path)> =
+        args.data.iter().map(|p| ("--data", p.as_path())).collect();
+    if Path::new(&args.rig).exists() {
+        inputs.push(("--rig", Path::new(&args.rig)));
+    }
+    let mut outputs = Outputs::new(&inputs);
+    let report_out = args
+        .report
+        .as_ref()
+        .map(|p| outputs.file("--report", p))
+        .transpose()?;
+    if let Some(dir) = &args.plots {
+        Outputs::check_dir("--plots", dir)?;
+    }
     let columns = match &rig {
         Rig::Bench(b) => b.columns.clone(),
         Rig::Valve(_) => ColumnMap::default(),
@@ -138,6 +158,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map(|p| Record::read_mapped(p, &columns))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| CliError::Input(e.to_string()))?;
+    for (p, r) in args.data.iter().zip(&records) {
+        if r.len() < SMALL_SAMPLE && !args.quiet {
+            eprintln!(
+                "hydrocyl: warning: {}: {} samples, fewer than {SMALL_SAMPLE}: the ± intervals assume many independent samples and are not to be trusted",
+                p.display(),
+                r.len()
+            );
+        }
+    }
     let opts = DiagnoseOptions {
         min_share: args.min_share,
         holdout: args.holdout,
@@ -145,23 +174,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         candidates,
         ..DiagnoseOptions::default()
     };
-    let show_bar = !args.quiet && std::io::stderr().is_terminal();
-    let bar = show_bar.then(|| {
-        let b = indicatif::ProgressBar::new(1);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} diagnose [{bar:30}] {pos}/{len} {msg} ({elapsed}, eta {eta})",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        b
-    });
+    let mut bar = Progress::new("diagnose", 1, args.progress, args.quiet);
     let mut progress = |stage: &str, done: usize, total: usize| {
-        if let Some(b) = &bar {
-            b.set_length(total as u64);
-            b.set_position(done as u64);
-            b.set_message(stage.to_string());
-        }
+        bar.set(stage, done as u64, total as u64);
     };
     let (report, traces) = match &rig {
         Rig::Bench(b) => {
@@ -181,61 +196,105 @@ pub fn run(args: Args) -> Result<(), CliError> {
             (o.report, o.traces)
         }
     };
-    if let Some(b) = &bar {
-        b.finish_and_clear();
+    bar.finish();
+    if let Some(wanted) = &args.effects {
+        // an effect asked for that the loop neither added nor tried
+        let seen = |id: &str| {
+            report.effects_added.iter().any(|e| e.id == id)
+                || report.effects_rejected.iter().any(|e| e.id == id)
+        };
+        let untried: Vec<&str> = wanted
+            .iter()
+            .map(|w| w.trim())
+            .filter(|w| !seen(w))
+            .collect();
+        if untried.len() == wanted.len() {
+            return Err(CliError::Input(format!(
+                "--effects {}: cannot be tried on this rig ({} rig; the effects it can try are listed without --effects)",
+                untried.join(","),
+                report.rig_kind
+            )));
+        }
     }
-    // Everything computed: now write, plots first, the report last.
-    if let Some(dir) = &args.plots {
-        write_plots(dir, &traces)?;
+    // Everything computed: now write every output together.
+    let plots = match &args.plots {
+        Some(dir) => render_plots(&traces)?
+            .into_iter()
+            .map(|(name, svg)| (dir.join(name), svg))
+            .collect(),
+        None => Vec::new(),
+    };
+    let made_dir = match &args.plots {
+        Some(dir) if !dir.exists() => {
+            std::fs::create_dir(dir).map_err(|e| CliError::Io {
+                path: dir.display().to_string(),
+                source: e,
+            })?;
+            Some(dir.clone())
+        }
+        _ => None,
+    };
+    let written = (|| {
+        for (path, svg) in &plots {
+            let id = outputs.file("--plots", path)?;
+            outputs.write(id, svg.as_bytes())?;
+        }
+        if let Some(id) = report_out {
+            let json = serde_json::to_string_pretty(&report)
+                .map_err(|e| CliError::Input(format!("report: {e}")))?;
+            outputs.write(id, json.as_bytes())?;
+        }
+        outputs.commit(false)
+    })();
+    if written.is_err() {
+        if let Some(dir) = made_dir {
+            let _ = std::fs::remove_dir_all(dir);
+        }
     }
-    if let Some(path) = &args.report {
-        let json = serde_json::to_string_pretty(&report)
-            .map_err(|e| CliError::Input(format!("report: {e}")))?;
-        write_atomic(path, json.as_bytes()).map_err(|e| CliError::Io {
-            path: path.display().to_string(),
-            source: e,
-        })?;
-    }
+    written?;
     if !args.quiet {
         print!("{}", report.human());
         if let Some(dir) = &args.plots {
-            println!(
-                "plots: {} SVG files in {}",
-                plot_count(&traces),
-                dir.display()
-            );
+            println!("plots: {} SVG files in {}", plots.len(), dir.display());
         }
+        eprintln!(
+            "hydrocyl: diagnose took {:.2} s in all (reading, fitting, writing)",
+            crate::progress::wall()
+        );
     }
     Ok(())
 }
 
-/// Number of SVG files [`write_plots`] writes for `traces`.
-fn plot_count(traces: &[RecordTrace]) -> usize {
-    traces.len() + traces.iter().filter(|t| t.regressor.is_some()).count()
-}
-
-/// Writes, per record and compared channel, `<stem>-<channel>.svg` (measured,
-/// before and after against time, and below it the residuals before and
-/// after) and, when an effect with a regressor was added (friction benches),
+/// The SVG files for `traces` as `(file name, text)`: per record and
+/// compared channel `<stem>-<channel>.svg` (measured, before and after
+/// against time, and below it the residuals before and after) and, when an
+/// effect with a regressor was added (friction benches),
 /// `<stem>-residual.svg` (residual before vs that effect's regressor).
-fn write_plots(dir: &Path, traces: &[RecordTrace]) -> Result<(), CliError> {
-    std::fs::create_dir_all(dir).map_err(|e| CliError::Io {
-        path: dir.display().to_string(),
-        source: e,
-    })?;
+fn render_plots(traces: &[RecordTrace]) -> Result<Vec<(String, String)>, CliError> {
+    let mut out = Vec::new();
     for (k, tr) in traces.iter().enumerate() {
-        let stem = Path::new(&tr.source)
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .map_or_else(|| format!("record{k}"), |s| s.to_string());
-        let f = dir.join(format!("{stem}-{}.svg", tr.channel));
-        plot_series(&f, tr).map_err(|e| CliError::Input(format!("{}: {e}", f.display())))?;
+        let stem = record_stem(tr, k);
+        let name = format!("{stem}-{}.svg", tr.channel);
+        let mut svg = String::new();
+        plot_series(&mut svg, &stem, tr).map_err(|e| CliError::Input(format!("{name}: {e}")))?;
+        out.push((name, svg));
         if tr.regressor.is_some() {
-            let f = dir.join(format!("{stem}-residual.svg"));
-            plot_residual(&f, tr).map_err(|e| CliError::Input(format!("{}: {e}", f.display())))?;
+            let name = format!("{stem}-residual.svg");
+            let mut svg = String::new();
+            plot_residual(&mut svg, &stem, tr)
+                .map_err(|e| CliError::Input(format!("{name}: {e}")))?;
+            out.push((name, svg));
         }
     }
-    Ok(())
+    Ok(out)
+}
+
+/// The record's file stem (`record<k>` if it has none).
+fn record_stem(tr: &RecordTrace, k: usize) -> String {
+    Path::new(&tr.source)
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .map_or_else(|| format!("record{k}"), |s| s.to_string())
 }
 
 fn bounds(series: &[&[f64]]) -> (f64, f64) {
@@ -253,14 +312,15 @@ fn bounds(series: &[&[f64]]) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-/// SI unit of a compared channel, for axis labels.
-fn unit(channel: &str) -> &'static str {
+/// Unit of a compared channel on the plots and the factor from SI to it
+/// (pressures in bar).
+fn unit(channel: &str) -> (&'static str, f64) {
     match channel {
-        "force" => "N",
-        "position" => "m",
-        "velocity" => "m/s",
-        "p1" | "p2" | "ps" => "Pa",
-        _ => "SI",
+        "force" => ("N", 1.0),
+        "position" => ("m", 1.0),
+        "velocity" => ("m/s", 1.0),
+        "p1" | "p2" | "ps" => ("bar", 1e-5),
+        _ => ("SI", 1.0),
     }
 }
 
@@ -280,6 +340,8 @@ fn time_panel(
     let t1 = *t.last().unwrap_or(&t0);
     let ys: Vec<&[f64]> = lines.iter().map(|l| l.1).collect();
     let (lo, hi) = bounds(&ys);
+    // head room above the data for the legend, so it hides none of it
+    let hi = hi + 0.25 * (hi - lo);
     let mut ch = ChartBuilder::on(area)
         .caption(caption, ("sans-serif", 15))
         .margin(10)
@@ -299,31 +361,42 @@ fn time_panel(
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], colour));
     }
     ch.configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
         .border_style(BLACK)
         .background_style(WHITE)
         .draw()?;
     Ok(())
 }
 
-fn plot_series(path: &Path, tr: &RecordTrace) -> Result<(), Box<dyn std::error::Error>> {
+fn plot_series(
+    svg: &mut String,
+    stem: &str,
+    tr: &RecordTrace,
+) -> Result<(), Box<dyn std::error::Error>> {
     use plotters::prelude::*;
-    let root = SVGBackend::new(path, (1000, 650)).into_drawing_area();
+    let root = SVGBackend::with_string(svg, (1000, 650)).into_drawing_area();
     root.fill(&WHITE)?;
     let (upper, lower) = root.split_vertically(420);
-    let u = unit(&tr.channel);
+    let (u, f) = unit(&tr.channel);
+    let scaled = |v: &[f64]| -> Vec<f64> { v.iter().map(|x| x * f).collect() };
     time_panel(
         &upper,
-        &format!("{}: {} measured vs simulated", tr.source, tr.channel),
+        &format!("{stem}: {} measured vs simulated", tr.channel),
         &format!("{} [{u}]", tr.channel),
         &tr.t,
         &[
-            ("measured", &tr.measured, BLACK),
-            ("before", &tr.before, RED),
-            ("after", &tr.after, BLUE),
+            ("measured", &scaled(&tr.measured), BLACK),
+            ("before", &scaled(&tr.before), RED),
+            ("after", &scaled(&tr.after), BLUE),
         ],
     )?;
-    let resid =
-        |sim: &[f64]| -> Vec<f64> { tr.measured.iter().zip(sim).map(|(m, s)| m - s).collect() };
+    let resid = |sim: &[f64]| -> Vec<f64> {
+        tr.measured
+            .iter()
+            .zip(sim)
+            .map(|(m, s)| (m - s) * f)
+            .collect()
+    };
     let (rb, ra) = (resid(&tr.before), resid(&tr.after));
     time_panel(
         &lower,
@@ -336,7 +409,11 @@ fn plot_series(path: &Path, tr: &RecordTrace) -> Result<(), Box<dyn std::error::
     Ok(())
 }
 
-fn plot_residual(path: &Path, tr: &RecordTrace) -> Result<(), Box<dyn std::error::Error>> {
+fn plot_residual(
+    svg: &mut String,
+    stem: &str,
+    tr: &RecordTrace,
+) -> Result<(), Box<dyn std::error::Error>> {
     use plotters::prelude::*;
     let Some((name, phi)) = &tr.regressor else {
         return Ok(());
@@ -347,13 +424,13 @@ fn plot_residual(path: &Path, tr: &RecordTrace) -> Result<(), Box<dyn std::error
         .zip(&tr.before)
         .map(|(m, b)| m - b)
         .collect();
-    let root = SVGBackend::new(path, (700, 500)).into_drawing_area();
+    let root = SVGBackend::with_string(svg, (700, 500)).into_drawing_area();
     root.fill(&WHITE)?;
     let (xlo, xhi) = bounds(&[phi]);
     let (ylo, yhi) = bounds(&[&resid]);
     let mut ch = ChartBuilder::on(&root)
         .caption(
-            format!("{}: residual before vs {name} regressor", tr.source),
+            format!("{stem}: residual before vs {name} regressor"),
             ("sans-serif", 15),
         )
         .margin(10)

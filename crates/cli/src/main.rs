@@ -4,14 +4,21 @@
 //! `main` turns an error into one line on stderr and exit code 2.
 
 mod bench_sim;
+mod command;
 mod components;
 mod diagnose;
 mod error;
 mod fmu;
+#[cfg(test)]
+mod fuzz;
+mod output;
+mod presets;
+mod progress;
+mod rigfile;
 mod simulate;
 mod xfactor;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
 use error::CliError;
 
 /// hydrocyl: simulate asymmetric hydraulic cylinder drives, compute X factors,
@@ -28,6 +35,10 @@ enum Command {
     /// Print Leaney's X factor for a cylinder area ratio and spool travels.
     Xfactor(xfactor::Args),
     /// Simulate a rig on a command signal and write the measured-data CSV format.
+    #[command(
+        override_usage = "hydrocyl simulate --rig <RIG> --command <COMMAND> --out <OUT> [OPTIONS]\n       hydrocyl simulate --rig <RIG> --print-rig [--set <PATH=VALUE>]...",
+        after_help = simulate::COLUMNS_HELP
+    )]
     Simulate(simulate::Args),
     /// Diagnose a rig against a measured record: residuals, missing effects, refits.
     Diagnose(diagnose::Args),
@@ -36,6 +47,8 @@ enum Command {
     Components(components::Args),
     /// Export a rig as an FMI 2.0 Co-Simulation FMU (linux64).
     Fmu(fmu::Args),
+    /// List the built-in rigs `--rig` takes by name, with what each is.
+    Presets(presets::Args),
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
@@ -45,11 +58,29 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Diagnose(a) => diagnose::run(a),
         Command::Components(a) => components::run(a),
         Command::Fmu(a) => fmu::run(a),
+        Command::Presets(a) => presets::run(a),
     }
 }
 
+/// The command line's definition, `--rig`'s help listing every preset.
+fn definition() -> clap::Command {
+    let names = presets::names();
+    let rig_help = |sub: clap::Command| {
+        let help = format!(
+            "A preset name ({names}; `hydrocyl presets` says what each is) or a rig JSON file"
+        );
+        sub.mut_arg("rig", move |a| a.help(help))
+    };
+    Cli::command().mut_subcommand("simulate", rig_help)
+}
+
 fn main() {
-    let cli = Cli::parse();
+    progress::start();
+    output::remove_temporaries_on_signal();
+    let cli = match Cli::from_arg_matches(&definition().get_matches()) {
+        Ok(c) => c,
+        Err(e) => e.exit(),
+    };
     if let Err(e) = run(cli) {
         eprintln!("hydrocyl: error: {e}");
         std::process::exit(2);

@@ -8,40 +8,64 @@
 //! ```
 //!
 //! The command file is CSV with a `time` column (`time`, `time [s]` or
-//! `time [ms]`) and a `command` column (the normalised spool demand of a
-//! valve rig, the drive voltage of a pump rig); other columns are ignored.
+//! `time [ms]`) and one `command` column in the unit of the rig's command
+//! (see [`crate::command`]); other columns are ignored.
 //! The output has one row per command sample: `time, command, position,
 //! velocity, p1, p2`, then the rig's other outputs (`ps`, `spool`, `p_le`,
-//! ...), all SI without unit suffixes. A `friction-bench` rig is driven by
-//! its motion instead: see [`crate::bench_sim`]. A `hybrid-variant` rig file
-//! (chapter 8's circuit improvements) runs on its base rig with the variant's
-//! components swapped in. It is written to a temporary file in
-//! the output's folder and renamed into place, so a failed run leaves no file
-//! (`--fsync` also flushes it to the disk first; without it the operating
-//! system writes it back when it likes, as for any ordinary file).
+//! ...), all SI, each header with its unit (`position [m]`; the readers take
+//! both forms; [`COLUMNS_HELP`] says what each is). A `friction-bench` rig is
+//! driven by its motion instead: see [`crate::bench_sim`]. A
+//! `hybrid-variant` rig file (chapter 8's circuit improvements) runs on its
+//! base rig with the variant's components swapped in.
+//!
+//! Every input is checked and the output's temporary file created before the
+//! run ([`crate::output`]); the run is streamed in blocks
+//! ([`hydrocyl_system::run::run_streaming`]), each written as it is
+//! computed, and the temporary is renamed into place at the end, so a failed
+//! or interrupted run leaves no file (`--fsync` also flushes it to the disk
+//! first; without it the operating system writes it back when it likes, as
+//! for any ordinary file).
 
+use crate::command::{read_command, CommandUnit};
 use crate::error::CliError;
+use crate::output::Outputs;
+use crate::progress::Progress;
 use hydrocyl_energy::variant::{self, HybridVariant};
 use hydrocyl_identify::bench::{self, FrictionBench};
-use hydrocyl_identify::plaincsv::{run_columns, write_columns_in_parts, PlainCsv};
+use hydrocyl_identify::plaincsv::{run_columns, write_columns_in_parts, write_rows_in_parts};
 use hydrocyl_system::hybrid::WangHybrid;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{self as runner, Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::Circuit;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
+
+/// The output columns, for `hydrocyl simulate --help`.
+pub const COLUMNS_HELP: &str = "\
+Output columns (one row per command sample; the header gives each unit, e.g. `position [m]`):
+  time [s]            the command file's times
+  command [-] or [V]  the command as read (normalised spool demand; pump drive voltage)
+  position [m]        rod position from the cap end      velocity [m/s]  rod velocity (+ extends)
+  p1, p2 [Pa]         cap-side and rod-side chamber pressures, gauge
+  spool [m]           valve spool position               ps [Pa]   supply pressure at the valve
+  p_le [Pa]           load pressure: the chambers' net force over the effective area (A1 + A2)/2 (eq 2.16)
+  friction_force [N]  friction on the rod
+  pump rigs:  pump_flow [m^3/s] pump flow; pp1, pp2 [Pa] pressures at the pump's ports (lines 1 and 2);
+              relief_*_flow, check_*_flow, return_flow_* [m^3/s] flows through those valves;
+              pilot_spool [m] the pilot-operated return valve's spool
+  netlists:   any other column is a component's probe, `<component>.<probe>` (see `hydrocyl components`)";
 
 /// Arguments of `hydrocyl simulate`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// A preset name (leaney-moog, ...) or a rig JSON file.
+    /// A preset name (`hydrocyl presets`) or a rig JSON file.
     #[arg(long)]
     rig: String,
-    /// CSV with `time` and `command` columns; the output is sampled at its times.
+    /// (required) CSV with `time` and `command` columns; the output is
+    /// sampled at its times.
     #[arg(long, required_unless_present = "print_rig")]
     command: Option<PathBuf>,
-    /// Output CSV (measured-data format).
+    /// (required) Output CSV (measured-data format, units in the header).
     #[arg(long, required_unless_present = "print_rig")]
     out: Option<PathBuf>,
     /// Override a rig parameter by its JSON path, e.g. `--set load.mass_kg=50`
@@ -53,10 +77,15 @@ pub struct Args {
     #[arg(long, default_value = "auto")]
     solver: String,
     /// Relative tolerance of the adaptive methods.
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     rtol: f64,
     /// Fixed step of rk4 \[s\].
-    #[arg(long, default_value_t = 2e-5)]
+    #[arg(
+        long,
+        default_value_t = 2e-5,
+        allow_negative_numbers = true,
+        help = "Fixed step of rk4 [s]"
+    )]
     rk4_step: f64,
     /// Print the rig (after --set) as JSON and exit.
     #[arg(long)]
@@ -64,163 +93,53 @@ pub struct Args {
     /// Flush the output to the disk (fsync) before it is renamed into place.
     #[arg(long)]
     fsync: bool,
+    /// Show a progress bar even when stderr is not a terminal.
+    #[arg(long)]
+    progress: bool,
+    /// Print nothing but errors (no progress, no warnings, no summary).
+    #[arg(long)]
+    quiet: bool,
 }
 
-/// The `time` column (index, factor to seconds) and the `command` column
-/// among `headers`.
-fn command_columns<'a>(
-    file: &str,
-    headers: impl Iterator<Item = &'a str>,
-) -> Result<(usize, f64, usize), CliError> {
-    let mut time_col = None;
-    let mut cmd_col = None;
-    for (i, h) in headers.enumerate() {
-        let (name, unit) = match h.find('[') {
-            Some(o) if h.ends_with(']') => (h[..o].trim(), Some(h[o + 1..h.len() - 1].trim())),
-            _ => (h.trim(), None),
-        };
-        match name {
-            "time" => {
-                let f = match unit {
-                    None | Some("s") => 1.0,
-                    Some("ms") => 1e-3,
-                    Some(u) => {
-                        return Err(CliError::Input(format!(
-                            "{file}: column `{h}`: unknown time unit `{u}` (use s or ms)"
-                        )))
-                    }
-                };
-                time_col = Some((i, f));
-            }
-            "command" => cmd_col = Some(i),
-            _ => {}
-        }
-    }
-    let (ti, tf) = time_col.ok_or_else(|| CliError::Input(format!("{file}: no `time` column")))?;
-    let ci = cmd_col.ok_or_else(|| CliError::Input(format!("{file}: no `command` column")))?;
-    Ok((ti, tf, ci))
-}
+/// Output times per block of a streamed run: the memory a run needs grows
+/// with this, not with the record.
+const BLOCK: usize = 1 << 16;
 
-/// The fast path of [`read_command`] for plain numeric CSV
-/// ([`hydrocyl_identify::plaincsv`]); `None` sends the text to the full
-/// reader, which also reports every error.
-fn read_command_plain(file: &str, text: &str) -> Option<(Vec<f64>, Vec<f64>)> {
-    let csv = PlainCsv::new(text)?;
-    let (ti, tf, ci) = command_columns(file, csv.headers()).ok()?;
-    let mut cols = csv.columns(&[ti, ci])?;
-    let u = cols.pop()?;
-    let mut t = cols.pop()?;
-    if tf != 1.0 {
-        t.iter_mut().for_each(|v| *v *= tf);
-    }
-    if t.len() < 2 || t.windows(2).any(|w| w[1] <= w[0]) {
-        return None;
-    }
-    Some((t, u))
-}
-
-/// Reads the command CSV: `(time [s], command)`; errors name file, row and column.
-pub fn read_command(path: &Path) -> Result<(Vec<f64>, Vec<f64>), CliError> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| CliError::Io {
-        path: file.clone(),
-        source,
-    })?;
-    if let Some(r) = read_command_plain(&file, &text) {
-        return Ok(r);
-    }
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
-    let headers = rdr
-        .headers()
-        .map_err(|e| CliError::Input(format!("{file}: row 1: {e}")))?
-        .clone();
-    let (ti, tf, ci) = command_columns(&file, headers.iter())?;
-    let (mut t, mut u) = (Vec::new(), Vec::new());
-    for (k, rec) in rdr.records().enumerate() {
-        let row = k + 2;
-        let rec = rec.map_err(|e| CliError::Input(format!("{file}: row {row}: {e}")))?;
-        let cell = |i: usize, col: &str| -> Result<f64, CliError> {
-            let s = rec.get(i).unwrap_or("");
-            let v: f64 = s.parse().map_err(|_| {
-                CliError::Input(format!(
-                    "{file}: row {row}, column `{col}`: `{s}` is not a number"
-                ))
-            })?;
-            if !v.is_finite() {
-                return Err(CliError::Input(format!(
-                    "{file}: row {row}, column `{col}`: {v} is not finite"
-                )));
-            }
-            Ok(v)
-        };
-        let tv = cell(ti, "time")? * tf;
-        if let Some(&prev) = t.last() {
-            if tv <= prev {
-                return Err(CliError::Input(format!(
-                    "{file}: row {row}, column `time`: {tv} s does not increase (previous {prev} s)"
-                )));
-            }
-        }
-        t.push(tv);
-        u.push(cell(ci, "command")?);
-    }
-    if t.len() < 2 {
-        return Err(CliError::Input(format!(
-            "{file}: needs at least two samples, found {}",
-            t.len()
-        )));
-    }
-    Ok((t, u))
-}
-
-/// The run as CSV text in the measured-data format (shortest round-trip
-/// numbers, [`hydrocyl_identify::plaincsv::write_columns`]), in consecutive
-/// parts formatted in parallel on the machine's cores.
-pub fn to_csv(run: &Run) -> Vec<Vec<u8>> {
-    let (names, columns) = run_columns(run);
+/// A block of a run as CSV text in the measured-data format (shortest
+/// round-trip numbers, [`hydrocyl_identify::plaincsv::write_columns`]), the
+/// header with the first block, in consecutive parts formatted in parallel
+/// on the machine's cores.
+pub fn to_csv(run: &Run, command: CommandUnit, first: bool) -> Vec<Vec<u8>> {
+    let (_, columns) = run_columns(run);
     // threads pay for themselves from a few thousand rows on
     let parts = if run.time.len() < 4096 {
         1
     } else {
         std::thread::available_parallelism().map_or(1, |n| n.get().min(8))
     };
-    write_columns_in_parts(&names, &columns, parts)
+    if first {
+        let names = column_headers(run, command);
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        write_columns_in_parts(&names, &columns, parts)
+    } else {
+        write_rows_in_parts(&columns, parts)
+    }
 }
 
-/// Writes `parts` (one after the other) to `path` through a temporary file in
-/// the same folder (renamed into place, so a failure leaves no half-written
-/// file); with `fsync` the data is flushed to the disk before the rename.
-fn write_atomic(path: &Path, parts: &[&[u8]], fsync: bool) -> Result<(), CliError> {
-    let io = |source| CliError::Io {
-        path: path.display().to_string(),
-        source,
-    };
-    let name = path
-        .file_name()
-        .ok_or_else(|| CliError::Input(format!("{}: not a file name", path.display())))?;
-    let tmp = path.with_file_name(format!(
-        ".{}.tmp{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = std::fs::File::create(&tmp)
-        .and_then(|mut f| {
-            for p in parts {
-                f.write_all(p)?;
+/// The CSV header of a run: `time [s]`, then each channel as `name [unit]`
+/// (the in-memory channel names stay bare; the readers take both forms).
+pub fn column_headers(run: &Run, command: CommandUnit) -> Vec<String> {
+    std::iter::once("time [s]".to_string())
+        .chain(run.channels.iter().map(|c| {
+            if c.name == "command" {
+                format!("command [{}]", command.symbol())
+            } else if c.unit.is_empty() {
+                c.name.clone()
+            } else {
+                format!("{} [{}]", c.name, c.unit)
             }
-            if fsync {
-                f.sync_all()?;
-            }
-            Ok(())
-        })
-        .and_then(|_| std::fs::rename(&tmp, path));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io(e));
-    }
-    Ok(())
+        }))
+        .collect()
 }
 
 /// A `hybrid-variant` rig (`hydrocyl-energy`): the variant (after `--set`)
@@ -235,17 +154,15 @@ fn load_variant(
     Ok((base, v))
 }
 
-/// Simulates a circuit variant of the hybrid drive on `command` \[V\]. A
+/// The circuit of a variant of the hybrid drive on `command` \[V\]. A
 /// variant that sets the needle opening per speed gets the entry for the
 /// command's peak speed, `K max(u_max / A1, −u_min / A2)` (K the pump's
 /// flow gain), the speed the chapter-8 scenarios command.
-fn simulate_variant(
+fn variant_circuit(
     base: &WangHybrid,
     v: &HybridVariant,
     command: Signal,
-    t: &[f64],
-    opts: &RunOptions,
-) -> Result<Run, CliError> {
+) -> Result<Circuit, CliError> {
     let mut r = base.clone();
     let (u_max, u_min) = match &command {
         Signal::Table { value, .. } => value
@@ -258,10 +175,7 @@ fn simulate_variant(
     let build = |e: hydrocyl_system::BuildError| CliError::Input(format!("rig {}: {e}", v.name));
     let mut comps = r.components(command).map_err(build)?;
     v.swap_components(&mut comps);
-    let mut c = Circuit::build(comps).map_err(build)?;
-    let x0 = c.initial_state();
-    c.reset(t.first().copied().unwrap_or(0.0), &x0);
-    runner::run(&mut c, &x0, t, opts).map_err(|e| CliError::Input(format!("rig {}: {e}", v.name)))
+    Circuit::build(comps).map_err(build)
 }
 
 /// `hydrocyl simulate` on a friction bench: the `--command` file carries the
@@ -278,14 +192,137 @@ fn run_bench(args: &Args, value: &serde_json::Value) -> Result<(), CliError> {
     let (Some(input), Some(out)) = (&args.command, &args.out) else {
         return Err(CliError::Input("--command and --out are required".into()));
     };
+    let mut outputs = Outputs::new(&[("--command", input.as_path())]);
+    let id = outputs.file("--out", out)?;
     let text = crate::bench_sim::simulate(&bench, input)?;
-    write_atomic(out, &[text.as_bytes()], args.fsync)?;
+    outputs.write(id, text.as_bytes())?;
+    outputs.commit(args.fsync)?;
     eprintln!(
         "hydrocyl: simulated the friction bench on {} samples of {}",
         text.lines().count() - 1,
         input.display()
     );
     Ok(())
+}
+
+/// The unit of a rig's command: [`CommandUnit::Volt`] when the port that
+/// reads it says so (a pump drive), else normalised.
+fn command_unit(value: &serde_json::Value) -> CommandUnit {
+    let kind = value.get("kind").and_then(|k| k.as_str());
+    if kind == Some(variant::KIND) || kind == Some(hydrocyl_system::hybrid::KIND) {
+        return CommandUnit::Volt;
+    }
+    if kind != Some(hydrocyl_system::netlist::KIND) {
+        return CommandUnit::Normalised;
+    }
+    let Ok(s) = hydrocyl_system::netlist::schematic(value) else {
+        return CommandUnit::Normalised;
+    };
+    let volt = s
+        .instances
+        .iter()
+        .filter(|i| i.ty.name == "command_input")
+        .filter_map(|i| i.nodes.get("out"))
+        .filter_map(|n| s.nodes.get(n))
+        .flat_map(|(_, ports)| ports.iter())
+        .filter_map(|p| p.split_once('.'))
+        .filter_map(|(c, port)| {
+            let inst = s.instance(c)?;
+            inst.ty.ports.iter().find(|q| q.name == port)
+        })
+        .any(|q| q.doc.ends_with("[V]"));
+    if volt {
+        CommandUnit::Volt
+    } else {
+        CommandUnit::Normalised
+    }
+}
+
+/// Rejects an initial chamber pressure below absolute vacuum (gauge
+/// pressures below −101 325 Pa do not exist).
+fn check_initial_pressures(value: &serde_json::Value) -> Result<(), CliError> {
+    for p in rig::parameters(value) {
+        let pressure = p.unit == Some("Pa")
+            || (p.unit.is_none()
+                && p.path
+                    .rsplit('.')
+                    .next()
+                    .is_some_and(|l| l.starts_with('p')));
+        let initial = p.path.starts_with("initial.") || p.path.contains(".initial.");
+        match p.value {
+            Some(v) if initial && pressure && v < rig::ABSOLUTE_VACUUM_GAUGE_PA => {
+                return Err(CliError::Input(format!(
+                    "rig parameter `{}` = {v} Pa: below absolute vacuum ({} Pa gauge)",
+                    p.path,
+                    rig::ABSOLUTE_VACUUM_GAUGE_PA
+                )));
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// Pressures far below absolute vacuum (ten times its depth) or a
+/// non-finite value: the solution is not physical, the integration blew up.
+const ABSURD_PRESSURE_PA: f64 = 10.0 * rig::ABSOLUTE_VACUUM_GAUGE_PA;
+
+/// Checks the solution for the signs of an unstable integration (a
+/// non-finite value, a chamber pressure far below vacuum) and names the fix.
+fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result<(), CliError> {
+    let bad = run.channels.iter().find_map(|c| {
+        c.values.iter().enumerate().find_map(|(k, &v)| {
+            let absurd = !v.is_finite()
+                || (c.unit == "Pa"
+                    && matches!(c.name.as_str(), "p1" | "p2")
+                    && v < ABSURD_PRESSURE_PA);
+            absurd.then(|| format!("{} = {v:e} {} at t = {} s", c.name, c.unit, run.time[k]))
+        })
+    });
+    let Some(what) = bad else { return Ok(()) };
+    let fix = if solver == Solver::Rk4 {
+        format!(
+            "--rk4-step {rk4_step} is too large for this rig: use a smaller step or --solver auto"
+        )
+    } else {
+        "try --solver rosenbrock or a smaller --rtol".to_string()
+    };
+    Err(CliError::Input(format!(
+        "the {} solution is unstable ({what}); {fix}",
+        solver.name()
+    )))
+}
+
+/// Warns when a normalised valve command leaves ±1: the spool stops at its
+/// stroke, so the valve acts on ±1.
+fn warn_clamped(file: &Path, t: &[f64], u: &[f64]) {
+    let Some((k, &v)) = u
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+    else {
+        return;
+    };
+    if v.abs() > 1.0 {
+        let n = u.iter().filter(|x| x.abs() > 1.0).count();
+        eprintln!(
+            "hydrocyl: warning: {}: {n} command samples outside ±1 (largest {v} at t = {} s); the valve clamps them to ±1 (the spool's stroke)",
+            file.display(),
+            t[k]
+        );
+    }
+}
+
+/// Adds the remedy to a step-limit failure of an explicit method.
+fn solver_hint(e: rig::RigError) -> CliError {
+    let m = e.to_string();
+    if m.contains("steps before t") {
+        CliError::Input(format!(
+            "{m}: the run is stiff for an explicit method; use --solver rosenbrock"
+        ))
+    } else {
+        CliError::Input(m)
+    }
 }
 
 /// Runs `hydrocyl simulate`.
@@ -306,9 +343,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let variant = if kind == Some(variant::KIND) {
         Some(load_variant(&args.rig, &value)?)
     } else {
-        rig::check(&value).map_err(|e| rig_err(rig::at_line(e, &args.rig)))?;
+        crate::rigfile::check(&value, &args.rig)?;
         None
     };
+    check_initial_pressures(&value)?;
     if args.print_rig {
         // a netlist is printed with every parameter written out (defaults
         // filled in), under the paths `--set` takes
@@ -330,39 +368,86 @@ pub fn run(args: Args) -> Result<(), CliError> {
     })?;
     if !(args.rtol > 0.0 && args.rtol < 1.0) {
         return Err(CliError::Input(format!(
-            "--rtol: {} is not in (0, 1)",
+            "--rtol {}: must be in (0, 1), e.g. 1e-6",
             args.rtol
         )));
     }
     if !(args.rk4_step > 0.0 && args.rk4_step.is_finite()) {
         return Err(CliError::Input(format!(
-            "--rk4-step: {} is not positive",
+            "--rk4-step {}: must be positive, e.g. 2e-5",
             args.rk4_step
         )));
     }
     let (Some(cmd_path), Some(out)) = (args.command, args.out) else {
         return Err(CliError::Input("--command and --out are required".into()));
     };
-    let (t, u) = read_command(&cmd_path)?;
-    let signal = Signal::table(t.clone(), u)
-        .map_err(|e| CliError::Input(format!("{}: {e}", cmd_path.display())))?;
+    let rig_path = Path::new(&args.rig);
+    let mut inputs = vec![("--command", cmd_path.as_path())];
+    if rig::preset(&args.rig).is_none() {
+        inputs.push(("--rig", rig_path));
+    }
+    let mut outputs = Outputs::new(&inputs);
+    let id = outputs.file("--out", &out)?;
+    let unit = command_unit(&value);
+    let (t, u) = read_command(&cmd_path, unit)?;
+    if unit == CommandUnit::Normalised && !args.quiet {
+        warn_clamped(&cmd_path, &t, &u);
+    }
+    let rows = t.len();
+    let (t0, t1) = (t[0], t[rows - 1]);
+    let signal =
+        Signal::table(t, u).map_err(|e| CliError::Input(format!("{}: {e}", cmd_path.display())))?;
     let opts = RunOptions {
         solver,
         rtol: args.rtol,
         rk4_step: args.rk4_step,
         ..RunOptions::default()
     };
-    let run = match variant {
-        None => rig::simulate(&value, signal, &t, &opts).map_err(rig_err)?,
-        Some((base, v)) => simulate_variant(&base, &v, signal, &t, &opts)?,
+    let t = match &signal {
+        Signal::Table { time_s, .. } => time_s.clone(),
+        _ => Vec::new(),
     };
-    let parts = to_csv(&run);
-    let parts: Vec<&[u8]> = parts.iter().map(Vec::as_slice).collect();
-    write_atomic(&out, &parts, args.fsync)?;
+    let mut c = match variant {
+        None => rig::circuit(&value, signal).map_err(|e| CliError::Input(e.to_string()))?,
+        Some((base, v)) => variant_circuit(&base, &v, signal)?,
+    };
+    let x0 = c.initial_state();
+    let mut bar = Progress::new("simulate", rows as u64, args.progress, args.quiet);
+    let mut failed: Option<CliError> = None;
+    let mut done = 0usize;
+    let mut min_p = f64::INFINITY;
+    let mut sink = |block: &Run| -> Result<(), String> {
+        let r = check_solution(block, solver, args.rk4_step).and_then(|()| {
+            for p in to_csv(block, unit, done == 0) {
+                outputs.write(id, &p)?;
+            }
+            Ok(())
+        });
+        done += block.time.len();
+        min_p = min_p.min(block.min_chamber_pressure());
+        bar.set("rows", done as u64, rows as u64);
+        r.map_err(|e| {
+            let m = e.to_string();
+            failed = Some(e);
+            m
+        })
+    };
+    let streamed = runner::run_streaming(&mut c, &x0, &t, &opts, BLOCK, &mut sink);
+    bar.finish();
+    let run = match (streamed, failed) {
+        (_, Some(e)) => return Err(e),
+        (Err(e), None) => return Err(solver_hint(rig::RigError::Sim(e.to_string()))),
+        (Ok(r), None) => r,
+    };
+    outputs.commit(args.fsync)?;
+    if args.quiet {
+        return Ok(());
+    }
     let cav = run.cavitation_entries();
     eprintln!(
-        "hydrocyl: simulated {:.4} s in {:.3} s ({} {}: {} steps, {} rejected, {} rhs); {}",
-        t[t.len() - 1] - t[0],
+        "hydrocyl: simulated {:.4} s ({rows} rows) in {:.3} s, {:.3} s of it solving ({} {}: {} steps, {} rejected, {} rhs); {}",
+        t1 - t0,
+        crate::progress::wall(),
         run.wall.as_secs_f64(),
         solver.name(),
         run.stats.choice(),
@@ -371,8 +456,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         run.stats.rhs_evals,
         if cav > 0 {
             format!(
-                "CAVITATION: {cav} entries below the cavitation pressure (min chamber pressure {:.0} Pa)",
-                run.min_chamber_pressure()
+                "CAVITATION: a chamber entered cavitation {cav} times between the output samples (lowest sampled chamber pressure {:.0} Pa)",
+                min_p
             )
         } else {
             "no cavitation".to_string()

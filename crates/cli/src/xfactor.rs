@@ -68,6 +68,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             hydrocyl_xfactor::x_factor_checked(gamma, t)
         }
         .map_err(|e| CliError::Input(format!("xfactor: {e}")))?;
+        if !x.is_finite() {
+            return Err(CliError::Input(format!(
+                "--gamma {} --travel {t}: X is not finite (gamma^2 overflows the arithmetic; area ratios of real cylinders are 1 to about 10)",
+                args.gamma.trim()
+            )));
+        }
         lines.push_str(&format!("{t:?} {x:?}\n"));
     }
     let mut out = std::io::stdout().lock();

@@ -34,7 +34,8 @@ fn read_csv(p: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
         .next()
         .unwrap()
         .split(',')
-        .map(str::to_string)
+        // the header carries units (`position [m]`): compare by name
+        .map(|h| h.split(" [").next().unwrap_or(h).to_string())
         .collect();
     let rows = lines
         .map(|l| l.split(',').map(|c| c.parse::<f64>().unwrap()).collect())
@@ -61,6 +62,12 @@ fn writes_the_measured_data_format_at_the_command_times() {
         st.status.success(),
         "{}",
         String::from_utf8_lossy(&st.stderr)
+    );
+    let header = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        header.starts_with("time [s],command [-],position [m],velocity [m/s],p1 [Pa],p2 [Pa],"),
+        "{}",
+        header.lines().next().unwrap_or("")
     );
     let (h, data) = read_csv(&out);
     assert_eq!(

@@ -172,10 +172,20 @@ pub fn write_columns(names: &[&str], columns: &[&[f64]]) -> Vec<u8> {
 /// rows (the header goes with the first): the parts, in order, are the text.
 /// Writing them one after the other spares the copy of a concatenation.
 pub fn write_columns_in_parts(names: &[&str], columns: &[&[f64]], parts: usize) -> Vec<Vec<u8>> {
-    let rows = columns.first().map_or(0, |c| c.len());
-    let parts = parts.clamp(1, rows.max(1));
     let mut head = names.join(",").into_bytes();
     head.push(b'\n');
+    rows_in_parts(head, columns, parts)
+}
+
+/// [`write_columns_in_parts`] without the header: the rows of a table's
+/// later block, for a writer that streams a table block by block.
+pub fn write_rows_in_parts(columns: &[&[f64]], parts: usize) -> Vec<Vec<u8>> {
+    rows_in_parts(Vec::new(), columns, parts)
+}
+
+fn rows_in_parts(head: Vec<u8>, columns: &[&[f64]], parts: usize) -> Vec<Vec<u8>> {
+    let rows = columns.first().map_or(0, |c| c.len());
+    let parts = parts.clamp(1, rows.max(1));
     let bounds: Vec<usize> = (0..=parts).map(|i| i * rows / parts).collect();
     let mut out: Vec<Vec<u8>> = vec![Vec::new(); parts];
     out[0] = head;

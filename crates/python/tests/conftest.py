@@ -64,7 +64,8 @@ def read_csv(path):
     with open(path) as f:
         header = f.readline().strip().split(",")
     data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    return {h: data[:, i] for i, h in enumerate(header)}
+    # the CLI's header carries units (`position [m]`): key by name
+    return {h.split(" [")[0]: data[:, i] for i, h in enumerate(header)}
 
 
 def path_of(rig, word):

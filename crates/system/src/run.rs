@@ -236,8 +236,19 @@ pub fn run(
             circuit.state_names()[i]
         )));
     }
+    circuit.reset(t_eval[0], &x);
+    solve_from(circuit, &x, t_eval, opts)
+}
+
+/// The solve of [`run`] from the full state `x` (quadratures included) at
+/// `t_eval[0]`, without resetting the circuit, and its output channels.
+fn solve_from(
+    circuit: &mut Circuit,
+    x: &[f64],
+    t_eval: &[f64],
+    opts: &RunOptions,
+) -> Result<Run, SimError> {
     let (t0, t_end) = (t_eval[0], t_eval[t_eval.len() - 1]);
-    circuit.reset(t0, &x);
     let sopts = Options {
         rtol: opts.rtol,
         atol: circuit.atol(opts.rtol),
@@ -251,7 +262,7 @@ pub fn run(
         ..Options::default()
     };
     let start = Instant::now();
-    let sol = solve(opts.solver.method(), circuit, t0, &x, t_end, &sopts).map_err(|source| {
+    let sol = solve(opts.solver.method(), circuit, t0, x, t_end, &sopts).map_err(|source| {
         SimError::Solve {
             method: opts.solver.name(),
             source,
@@ -291,6 +302,67 @@ pub fn run(
         diagnostics: circuit.diagnostics(),
         wall,
     })
+}
+
+/// [`run`] for long records: the output goes to `sink` in blocks of at most
+/// `block` output times as soon as each is computed, so the memory grows
+/// with the block, not the record. The integration restarts at each block's
+/// first time from the state there (the circuit is not reset; the step
+/// controller starts afresh, so a result differs from [`run`]'s within the
+/// tolerance); with one block it is [`run`]'s. Returns the totals: stats
+/// summed over the blocks, the diagnostics at the end, the wall time; its
+/// `time`, `channels` and `states` are empty.
+pub fn run_streaming(
+    circuit: &mut Circuit,
+    x0: &[f64],
+    t_eval: &[f64],
+    opts: &RunOptions,
+    block: usize,
+    sink: &mut dyn FnMut(&Run) -> Result<(), String>,
+) -> Result<Run, SimError> {
+    let block = block.max(2);
+    let mut total: Option<Run> = None;
+    let mut k0 = 0;
+    let mut x = Vec::new();
+    while k0 < t_eval.len() {
+        let k1 = (k0 + block).min(t_eval.len());
+        let mut r = if k0 == 0 {
+            run(circuit, x0, &t_eval[..k1], opts)?
+        } else {
+            // from the previous block's last time, which is not repeated
+            let mut r = solve_from(circuit, &x, &t_eval[k0 - 1..k1], opts)?;
+            r.time.remove(0);
+            r.channels.iter_mut().for_each(|c| {
+                c.values.remove(0);
+            });
+            r.states.drain(..r.dim);
+            r
+        };
+        x = r.state(r.time.len() - 1).to_vec();
+        sink(&r).map_err(SimError::Settings)?;
+        let t = total.get_or_insert_with(|| Run {
+            time: Vec::new(),
+            channels: Vec::new(),
+            states: Vec::new(),
+            dim: r.dim,
+            stats: Stats::default(),
+            diagnostics: Vec::new(),
+            wall: Duration::ZERO,
+        });
+        let (a, b) = (&mut t.stats, &r.stats);
+        a.steps += b.steps;
+        a.rejected += b.rejected;
+        a.rhs_evals += b.rhs_evals;
+        a.jac_evals += b.jac_evals;
+        a.lu_decomps += b.lu_decomps;
+        a.events += b.events;
+        a.stiff_steps += b.stiff_steps;
+        a.switches += b.switches;
+        t.wall += r.wall;
+        t.diagnostics = std::mem::take(&mut r.diagnostics);
+        k0 = k1;
+    }
+    total.ok_or_else(|| SimError::Settings("need at least two output times".into()))
 }
 
 /// Normalised RMS error `RMSE(a − b) / (max b − min b)` (the measured-data

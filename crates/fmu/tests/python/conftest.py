@@ -79,4 +79,7 @@ def nrmse(a, b):
 
 
 def read_csv(path):
-    return np.genfromtxt(path, delimiter=",", names=True)
+    # the CLI's header carries units (`position [m]`): name the fields by name
+    with open(path) as f:
+        names = [h.split(" [")[0] for h in f.readline().strip().split(",")]
+    return np.genfromtxt(path, delimiter=",", skip_header=1, names=names)

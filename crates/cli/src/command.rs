@@ -1,0 +1,270 @@
+//! The command file of `hydrocyl simulate`: CSV with a `time` column
+//! (`time`, `time [s]` or `time [ms]`) and one `command` column in the unit
+//! the rig's command takes ([`CommandUnit`]); other columns are ignored.
+//! Errors name the file, row and column.
+
+use crate::error::CliError;
+use hydrocyl_identify::plaincsv::PlainCsv;
+use std::path::Path;
+
+/// What a rig's command is, by the port that reads it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CommandUnit {
+    /// A normalised spool demand \[-\] (valve rigs): `command`,
+    /// `command [-]`, `command [1]` or `command [%]`.
+    Normalised,
+    /// A drive voltage \[V\] (pump rigs): `command`, `command [V]` or
+    /// `command [mV]`.
+    Volt,
+}
+
+impl CommandUnit {
+    /// The unit's symbol.
+    pub fn symbol(self) -> &'static str {
+        match self {
+            CommandUnit::Normalised => "-",
+            CommandUnit::Volt => "V",
+        }
+    }
+
+    /// The factor from `unit` to this unit, `None` if it does not fit.
+    fn factor(self, unit: Option<&str>) -> Option<f64> {
+        match (self, unit) {
+            (_, None) => Some(1.0),
+            (CommandUnit::Normalised, Some("-" | "1")) => Some(1.0),
+            (CommandUnit::Normalised, Some("%")) => Some(0.01),
+            (CommandUnit::Volt, Some("V")) => Some(1.0),
+            (CommandUnit::Volt, Some("mV")) => Some(1e-3),
+            _ => None,
+        }
+    }
+
+    fn accepted(self) -> &'static str {
+        match self {
+            CommandUnit::Normalised => "-, 1 or % (a normalised spool demand)",
+            CommandUnit::Volt => "V or mV (a drive voltage)",
+        }
+    }
+}
+
+/// Where the command file's columns are.
+#[derive(Debug)]
+struct Columns {
+    time: usize,
+    time_factor: f64,
+    command: usize,
+    command_factor: f64,
+}
+
+/// Splits `name [unit]`.
+fn name_unit(h: &str) -> (&str, Option<&str>) {
+    match h.find('[') {
+        Some(o) if h.ends_with(']') => (h[..o].trim(), Some(h[o + 1..h.len() - 1].trim())),
+        _ => (h.trim(), None),
+    }
+}
+
+/// Finds the `time` and `command` columns among `headers`.
+fn columns<'a>(
+    file: &str,
+    headers: impl Iterator<Item = &'a str>,
+    unit: CommandUnit,
+) -> Result<Columns, CliError> {
+    let headers: Vec<&str> = headers.collect();
+    if headers.len() == 1 && headers[0].contains(';') {
+        return Err(CliError::Input(format!(
+            "{file}: row 1: the file is semicolon-delimited (`;`); hydrocyl reads comma-separated CSV (`time,command`)"
+        )));
+    }
+    let mut time: Option<(usize, f64)> = None;
+    let mut command: Option<(usize, f64)> = None;
+    for (i, h) in headers.iter().enumerate() {
+        let (name, u) = name_unit(h);
+        let found = match name {
+            "time" => &mut time,
+            "command" => &mut command,
+            _ => continue,
+        };
+        if let Some((j, _)) = found {
+            return Err(CliError::Input(format!(
+                "{file}: row 1: two `{name}` columns ({} and {}); keep one",
+                *j + 1,
+                i + 1
+            )));
+        }
+        let f = if name == "time" {
+            match u {
+                None | Some("s") => 1.0,
+                Some("ms") => 1e-3,
+                Some(u) => {
+                    return Err(CliError::Input(format!(
+                        "{file}: row 1, column `{h}`: unknown time unit `{u}` (use s or ms)"
+                    )))
+                }
+            }
+        } else {
+            unit.factor(u).ok_or_else(|| {
+                CliError::Input(format!(
+                    "{file}: row 1, column `{h}`: unit `{}` does not fit this rig's command [{}] (use {})",
+                    u.unwrap_or_default(),
+                    unit.symbol(),
+                    unit.accepted()
+                ))
+            })?
+        };
+        *found = Some((i, f));
+    }
+    let (time, time_factor) =
+        time.ok_or_else(|| CliError::Input(format!("{file}: row 1: no `time` column")))?;
+    let (command, command_factor) =
+        command.ok_or_else(|| CliError::Input(format!("{file}: row 1: no `command` column")))?;
+    Ok(Columns {
+        time,
+        time_factor,
+        command,
+        command_factor,
+    })
+}
+
+/// The fast path of [`read_command`] for plain numeric CSV; `None` sends the
+/// text to the full reader, which also reports every error.
+fn read_plain(text: &str, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
+    let csv = PlainCsv::new(text)?;
+    let mut cols = csv.columns(&[c.time, c.command])?;
+    let mut u = cols.pop()?;
+    let mut t = cols.pop()?;
+    if c.time_factor != 1.0 {
+        t.iter_mut().for_each(|v| *v *= c.time_factor);
+    }
+    if c.command_factor != 1.0 {
+        u.iter_mut().for_each(|v| *v *= c.command_factor);
+    }
+    if t.len() < 2 || t.windows(2).any(|w| w[1] <= w[0]) {
+        return None;
+    }
+    Some((t, u))
+}
+
+/// Reads the command CSV: `(time [s], command [unit])`; errors name file,
+/// row and column.
+pub fn read_command(path: &Path, unit: CommandUnit) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| CliError::Io {
+        path: file.clone(),
+        source,
+    })?;
+    parse_command(&file, &bytes, unit)
+}
+
+/// [`read_command`] on the bytes of file `file`.
+pub fn parse_command(
+    file: &str,
+    bytes: &[u8],
+    unit: CommandUnit,
+) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        CliError::Input(format!(
+            "{file}: not UTF-8 text (byte {})",
+            e.valid_up_to() + 1
+        ))
+    })?;
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let headers = rdr
+        .headers()
+        .map_err(|e| CliError::Input(format!("{file}: row 1: {e}")))?
+        .clone();
+    let c = columns(file, headers.iter(), unit)?;
+    if let Some(r) = read_plain(text, &c) {
+        return Ok(r);
+    }
+    let (mut t, mut u) = (Vec::new(), Vec::new());
+    for (k, rec) in rdr.records().enumerate() {
+        let row = k + 2;
+        let rec = rec.map_err(|e| match e.kind() {
+            csv::ErrorKind::UnequalLengths {
+                expected_len, len, ..
+            } => CliError::Input(format!(
+                "{file}: row {row}: {len} cell{}, the header has {expected_len}{}",
+                if *len == 1 { "" } else { "s" },
+                if (*len as usize) <= c.command.max(c.time) {
+                    format!(
+                        " (no `{}` cell, column {})",
+                        headers.get(c.command.max(c.time)).unwrap_or(""),
+                        c.command.max(c.time) + 1
+                    )
+                } else {
+                    String::new()
+                }
+            )),
+            _ => CliError::Input(format!("{file}: row {row}: {e}")),
+        })?;
+        let cell = |i: usize| -> Result<f64, CliError> {
+            let col = headers.get(i).unwrap_or("");
+            let s = rec.get(i).unwrap_or("");
+            let v: f64 = s.parse().map_err(|_| {
+                CliError::Input(format!(
+                    "{file}: row {row}, column `{col}`: `{s}` is not a number"
+                ))
+            })?;
+            if !v.is_finite() {
+                return Err(CliError::Input(format!(
+                    "{file}: row {row}, column `{col}`: {v} is not finite"
+                )));
+            }
+            Ok(v)
+        };
+        let tv = cell(c.time)? * c.time_factor;
+        if let Some(&prev) = t.last() {
+            if tv <= prev {
+                return Err(CliError::Input(format!(
+                    "{file}: row {row}, column `time`: {tv} s does not increase (previous {prev} s)"
+                )));
+            }
+        }
+        t.push(tv);
+        u.push(cell(c.command)? * c.command_factor);
+    }
+    if t.len() < 2 {
+        return Err(CliError::Input(format!(
+            "{file}: needs at least two samples, found {}",
+            t.len()
+        )));
+    }
+    Ok((t, u))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn units_and_duplicates() {
+        let r = parse_command(
+            "f",
+            b"time [ms],command [%]\n0,50\n10,-20\n",
+            CommandUnit::Normalised,
+        )
+        .unwrap();
+        assert_eq!(r, (vec![0.0, 0.01], vec![0.5, -0.2]));
+        let e = parse_command(
+            "f",
+            b"time,command [mV]\n0,50\n1,2\n",
+            CommandUnit::Normalised,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("`mV`") && e.contains("[-]"), "{e}");
+        let r = parse_command("f", b"time,command [mV]\n0,50\n1,2\n", CommandUnit::Volt).unwrap();
+        assert_eq!(r.1, vec![0.05, 0.002]);
+        let e = parse_command(
+            "f",
+            b"time,command,command\n0,1,2\n1,2,3\n",
+            CommandUnit::Volt,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("two `command` columns (2 and 3)"), "{e}");
+    }
+}

@@ -1,0 +1,205 @@
+//! A command's output files: checked before any computation, written
+//! through temporary files in their folders, renamed into place together at
+//! the end (all of a command's outputs or none), and removed when the run
+//! fails, is dropped or is interrupted (SIGINT, SIGTERM).
+
+use crate::error::CliError;
+use std::fs::File;
+use std::io::{BufWriter, Write as _};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Temporary files not yet renamed into place, removed by the signal handler.
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Installs the SIGINT/SIGTERM handler that removes every pending temporary
+/// file and exits with code 130. Call once, at start-up.
+pub fn remove_temporaries_on_signal() {
+    let _ = ctrlc::set_handler(|| {
+        if let Ok(mut p) = PENDING.lock() {
+            for f in p.drain(..) {
+                let _ = std::fs::remove_file(f);
+            }
+        }
+        eprintln!("hydrocyl: interrupted; no output written");
+        std::process::exit(130);
+    });
+}
+
+fn register(tmp: &Path) {
+    if let Ok(mut p) = PENDING.lock() {
+        p.push(tmp.to_path_buf());
+    }
+}
+
+fn unregister(tmp: &Path) {
+    if let Ok(mut p) = PENDING.lock() {
+        p.retain(|f| f != tmp);
+    }
+}
+
+/// `path` made absolute and resolved through symbolic links as far as it
+/// exists (a file that does not exist yet: its folder's canonical path and
+/// its name).
+fn canonical(path: &Path) -> PathBuf {
+    if let Ok(c) = path.canonicalize() {
+        return c;
+    }
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    match (parent.canonicalize(), path.file_name()) {
+        (Ok(p), Some(n)) => p.join(n),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// One output file being written.
+struct Pending {
+    path: PathBuf,
+    tmp: PathBuf,
+    writer: Option<BufWriter<File>>,
+}
+
+/// The output files of one command (see the module doc).
+pub struct Outputs {
+    inputs: Vec<(String, PathBuf)>,
+    files: Vec<Pending>,
+}
+
+/// A handle to one of [`Outputs`]'s files.
+#[derive(Clone, Copy, Debug)]
+pub struct OutputId(usize);
+
+impl Outputs {
+    /// No outputs yet; `inputs` are `(option, path)` of the command's input
+    /// files, which no output may be.
+    pub fn new(inputs: &[(&str, &Path)]) -> Self {
+        Outputs {
+            inputs: inputs
+                .iter()
+                .map(|(o, p)| (o.to_string(), canonical(p)))
+                .collect(),
+            files: Vec::new(),
+        }
+    }
+
+    /// Checks that output `path` (given as `option`) is not an input or
+    /// another output, and that its folder exists and takes a file.
+    fn check(&self, option: &str, path: &Path) -> Result<PathBuf, CliError> {
+        let bad = |why: String| CliError::Input(format!("{option} {}: {why}", path.display()));
+        if path.file_name().is_none() {
+            return Err(bad("not a file name".into()));
+        }
+        if path.is_dir() {
+            return Err(bad("is a folder, not a file".into()));
+        }
+        let c = canonical(path);
+        if let Some((o, _)) = self.inputs.iter().find(|(_, p)| *p == c) {
+            return Err(bad(format!(
+                "is the {o} input file; writing it would destroy the input"
+            )));
+        }
+        if self.files.iter().any(|f| canonical(&f.path) == c) {
+            return Err(bad("is already another output of this command".into()));
+        }
+        Ok(c)
+    }
+
+    /// Opens output `path` (option `option`): checks it, then creates its
+    /// temporary file `.<name>.tmp<pid>` next to it, so that a missing or
+    /// read-only folder is reported before any computation.
+    pub fn file(&mut self, option: &str, path: &Path) -> Result<OutputId, CliError> {
+        self.check(option, path)?;
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
+        let f = File::create(&tmp).map_err(|source| CliError::Io {
+            path: format!("{option} {}", path.display()),
+            source,
+        })?;
+        register(&tmp);
+        self.files.push(Pending {
+            path: path.to_path_buf(),
+            tmp,
+            writer: Some(BufWriter::with_capacity(1 << 20, f)),
+        });
+        Ok(OutputId(self.files.len() - 1))
+    }
+
+    /// Checks that folder `dir` (option `option`) exists or can be created
+    /// (its parent exists), and is not a file; the files in it are opened
+    /// later with [`Outputs::file`].
+    pub fn check_dir(option: &str, dir: &Path) -> Result<(), CliError> {
+        let bad = |why: &str| CliError::Input(format!("{option} {}: {why}", dir.display()));
+        if dir.is_dir() {
+            return Ok(());
+        }
+        if dir.exists() {
+            return Err(bad("is a file, not a folder"));
+        }
+        match dir.parent() {
+            Some(p) if !p.as_os_str().is_empty() && !p.is_dir() => {
+                Err(bad("its parent folder does not exist"))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Appends `bytes` to output `id`.
+    pub fn write(&mut self, id: OutputId, bytes: &[u8]) -> Result<(), CliError> {
+        let f = &mut self.files[id.0];
+        let w = f.writer.as_mut().ok_or_else(|| CliError::Io {
+            path: f.path.display().to_string(),
+            source: std::io::Error::other("written after it was closed"),
+        })?;
+        w.write_all(bytes).map_err(|source| CliError::Io {
+            path: f.path.display().to_string(),
+            source,
+        })
+    }
+
+    /// Flushes every output (with `fsync`, to the disk), then renames them
+    /// all into place. On a failure nothing new is left: the temporaries go,
+    /// and files already renamed by this call are removed.
+    pub fn commit(mut self, fsync: bool) -> Result<(), CliError> {
+        for f in &mut self.files {
+            let Some(w) = f.writer.take() else { continue };
+            let io = |source| CliError::Io {
+                path: f.path.display().to_string(),
+                source,
+            };
+            let file = w.into_inner().map_err(|e| io(e.into_error()))?;
+            if fsync {
+                file.sync_all().map_err(io)?;
+            }
+        }
+        let mut done = Vec::new();
+        for f in &self.files {
+            if let Err(source) = std::fs::rename(&f.tmp, &f.path) {
+                for p in &done {
+                    let _ = std::fs::remove_file(p);
+                }
+                return Err(CliError::Io {
+                    path: f.path.display().to_string(),
+                    source,
+                });
+            }
+            unregister(&f.tmp);
+            done.push(f.path.clone());
+        }
+        self.files.clear();
+        Ok(())
+    }
+}
+
+impl Drop for Outputs {
+    /// Removes the temporaries of outputs never committed.
+    fn drop(&mut self) {
+        for f in self.files.drain(..) {
+            drop(f.writer);
+            let _ = std::fs::remove_file(&f.tmp);
+            unregister(&f.tmp);
+        }
+    }
+}

@@ -1,0 +1,72 @@
+//! `hydrocyl presets`: the built-in rigs `--rig` takes by name, one line
+//! each: name, kind and what it is.
+
+use crate::error::CliError;
+use hydrocyl_identify::bench;
+use hydrocyl_system::rig;
+
+/// Arguments of `hydrocyl presets` (none).
+#[derive(clap::Args)]
+pub struct Args {}
+
+/// The first sentence of `text`, at most ~100 characters.
+fn one_line(text: &str) -> String {
+    let first = text.trim_end_matches('.');
+    if first.chars().count() > 100 {
+        let cut: String = first.chars().take(97).collect();
+        format!("{cut}...")
+    } else {
+        first.to_string()
+    }
+}
+
+/// Every preset as `(name, kind, one-line description)`.
+pub fn all() -> Vec<(&'static str, String, String)> {
+    let describe = |v: &serde_json::Value| {
+        let kind = v
+            .get("kind")
+            .and_then(|k| k.as_str())
+            .unwrap_or("?")
+            .to_string();
+        let what = v
+            .get("description")
+            .and_then(|d| d.as_str())
+            .map(one_line)
+            .unwrap_or_default();
+        (kind, what)
+    };
+    let mut out: Vec<_> = rig::PRESETS
+        .iter()
+        .map(|p| {
+            let (k, d) = describe(&(p.json)());
+            (p.name, k, d)
+        })
+        .collect();
+    for name in bench::PRESETS {
+        let v = bench::preset(name)
+            .and_then(|b| serde_json::to_value(b).ok())
+            .unwrap_or_default();
+        let (k, mut d) = describe(&v);
+        if d.is_empty() {
+            d = "friction bench driven by its measured motion".into();
+        }
+        out.push((name, k, d));
+    }
+    out
+}
+
+/// The preset names, comma-separated (for `--rig`'s help).
+pub fn names() -> String {
+    all().iter().map(|p| p.0).collect::<Vec<_>>().join(", ")
+}
+
+/// Runs `hydrocyl presets`.
+pub fn run(_: Args) -> Result<(), CliError> {
+    let list = all();
+    let w = list.iter().map(|p| p.0.len()).max().unwrap_or(0);
+    let k = list.iter().map(|p| p.1.len()).max().unwrap_or(0);
+    for (name, kind, what) in list {
+        println!("{name:w$}  {kind:k$}  {what}");
+    }
+    Ok(())
+}

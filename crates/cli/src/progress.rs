@@ -1,0 +1,71 @@
+//! Progress of long runs: an indicatif bar on stderr, drawn only on a
+//! terminal or with `--progress`, never with `--quiet`, and only once the
+//! run has taken more than a second; and the command's true wall time (from
+//! the start of the process, reading and writing included).
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal as _;
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+static START: OnceLock<Instant> = OnceLock::new();
+
+/// Marks the start of the command (call first thing in `main`).
+pub fn start() {
+    let _ = START.set(Instant::now());
+}
+
+/// Wall time since [`start`] \[s\].
+pub fn wall() -> f64 {
+    START.get().map_or(0.0, |s| s.elapsed().as_secs_f64())
+}
+
+/// A progress bar that shows itself after a second (see the module doc).
+pub struct Progress {
+    bar: Option<ProgressBar>,
+    shown: bool,
+    since: Instant,
+}
+
+impl Progress {
+    /// A bar of `len` units of `what`; `force` = `--progress`, `quiet` = `--quiet`.
+    pub fn new(what: &str, len: u64, force: bool, quiet: bool) -> Self {
+        let on = !quiet && (force || std::io::stderr().is_terminal());
+        let bar = on.then(|| {
+            let b = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::hidden());
+            b.set_style(
+                ProgressStyle::with_template(&format!(
+                    "{{spinner}} {what} [{{bar:30}}] {{pos}}/{{len}} {{msg}} ({{elapsed}}, eta {{eta}})"
+                ))
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            );
+            b
+        });
+        Progress {
+            bar,
+            shown: false,
+            since: Instant::now(),
+        }
+    }
+
+    /// Sets the position (and total) with a stage message.
+    pub fn set(&mut self, stage: &str, done: u64, total: u64) {
+        let Some(b) = &self.bar else { return };
+        if !self.shown && self.since.elapsed() > Duration::from_secs(1) {
+            b.set_draw_target(ProgressDrawTarget::stderr());
+            self.shown = true;
+        }
+        b.set_length(total);
+        b.set_position(done);
+        if !stage.is_empty() {
+            b.set_message(stage.to_string());
+        }
+    }
+
+    /// Removes the bar.
+    pub fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}

@@ -10,6 +10,10 @@
 //! The command file is CSV with a `time` column (`time`, `time [s]` or
 //! `time [ms]`) and a `command` column (the normalised spool demand of a
 //! valve rig, the drive voltage of a pump rig); other columns are ignored.
+//! A closed-loop rig (one with a `position_controller`, e.g. the
+//! `leaney-moog-closed-loop` preset) is driven by a `reference` column
+//! instead (`reference` or `reference [m]` / `reference [mm]`: the position
+//! set-point), and its controller computes the command.
 //! The output has one row per command sample: `time, command, position,
 //! velocity, p1, p2`, then the rig's other outputs (`ps`, `spool`, `p_le`,
 //! ...), all SI without unit suffixes. A `friction-bench` rig is driven by
@@ -38,7 +42,8 @@ pub struct Args {
     /// A preset name (leaney-moog, ...) or a rig JSON file.
     #[arg(long)]
     rig: String,
-    /// CSV with `time` and `command` columns; the output is sampled at its times.
+    /// CSV with `time` and `command` columns (a closed-loop rig: `time` and
+    /// `reference` [m or mm], the position set-point); the output is sampled at its times.
     #[arg(long, required_unless_present = "print_rig")]
     command: Option<PathBuf>,
     /// Output CSV (measured-data format).
@@ -66,12 +71,14 @@ pub struct Args {
     fsync: bool,
 }
 
-/// The `time` column (index, factor to seconds) and the `command` column
+/// The `time` column (index, factor to seconds) and the input column `want`
+/// (`command`, or `reference` of a closed-loop rig: index, factor to SI)
 /// among `headers`.
 fn command_columns<'a>(
     file: &str,
     headers: impl Iterator<Item = &'a str>,
-) -> Result<(usize, f64, usize), CliError> {
+    want: &str,
+) -> Result<(usize, f64, usize, f64), CliError> {
     let mut time_col = None;
     let mut cmd_col = None;
     for (i, h) in headers.enumerate() {
@@ -92,23 +99,45 @@ fn command_columns<'a>(
                 };
                 time_col = Some((i, f));
             }
-            "command" => cmd_col = Some(i),
+            n if n == want => {
+                // the command's unit is not read (as before); the
+                // reference is a position
+                let f = match (want, unit) {
+                    ("reference", Some("mm")) => 1e-3,
+                    ("reference", Some(u)) if u != "m" => {
+                        return Err(CliError::Input(format!(
+                            "{file}: column `{h}`: unknown position unit `{u}` (use m or mm)"
+                        )))
+                    }
+                    _ => 1.0,
+                };
+                cmd_col = Some((i, f));
+            }
             _ => {}
         }
     }
     let (ti, tf) = time_col.ok_or_else(|| CliError::Input(format!("{file}: no `time` column")))?;
-    let ci = cmd_col.ok_or_else(|| CliError::Input(format!("{file}: no `command` column")))?;
-    Ok((ti, tf, ci))
+    let (ci, cf) = cmd_col.ok_or_else(|| {
+        CliError::Input(if want == "reference" {
+            format!("{file}: no `reference` column (a closed-loop rig is driven by its position reference)")
+        } else {
+            format!("{file}: no `command` column")
+        })
+    })?;
+    Ok((ti, tf, ci, cf))
 }
 
 /// The fast path of [`read_command`] for plain numeric CSV
 /// ([`hydrocyl_identify::plaincsv`]); `None` sends the text to the full
 /// reader, which also reports every error.
-fn read_command_plain(file: &str, text: &str) -> Option<(Vec<f64>, Vec<f64>)> {
+fn read_command_plain(file: &str, text: &str, want: &str) -> Option<(Vec<f64>, Vec<f64>)> {
     let csv = PlainCsv::new(text)?;
-    let (ti, tf, ci) = command_columns(file, csv.headers()).ok()?;
+    let (ti, tf, ci, cf) = command_columns(file, csv.headers(), want).ok()?;
     let mut cols = csv.columns(&[ti, ci])?;
-    let u = cols.pop()?;
+    let mut u = cols.pop()?;
+    if cf != 1.0 {
+        u.iter_mut().for_each(|v| *v *= cf);
+    }
     let mut t = cols.pop()?;
     if tf != 1.0 {
         t.iter_mut().for_each(|v| *v *= tf);
@@ -119,14 +148,30 @@ fn read_command_plain(file: &str, text: &str) -> Option<(Vec<f64>, Vec<f64>)> {
     Some((t, u))
 }
 
-/// Reads the command CSV: `(time [s], command)`; errors name file, row and column.
-pub fn read_command(path: &Path) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+/// Whether a rig (JSON) is closed loop: it has a `position_controller`
+/// (or, as a `valve-cylinder` file, a `controller`), and is driven by a
+/// position reference.
+pub fn closed_loop(rig: &serde_json::Value) -> bool {
+    rig.get("controller").is_some_and(|c| !c.is_null())
+        || rig
+            .get("components")
+            .and_then(serde_json::Value::as_object)
+            .is_some_and(|c| {
+                c.values().any(|i| {
+                    i.get("type").and_then(serde_json::Value::as_str) == Some("position_controller")
+                })
+            })
+}
+
+/// Reads `(time [s], column want [SI])` from an input CSV (`command`, or
+/// `reference` for a closed-loop rig); errors name file, row and column.
+pub fn read_input(path: &Path, want: &str) -> Result<(Vec<f64>, Vec<f64>), CliError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|source| CliError::Io {
         path: file.clone(),
         source,
     })?;
-    if let Some(r) = read_command_plain(&file, &text) {
+    if let Some(r) = read_command_plain(&file, &text, want) {
         return Ok(r);
     }
     let mut rdr = csv::ReaderBuilder::new()
@@ -136,7 +181,7 @@ pub fn read_command(path: &Path) -> Result<(Vec<f64>, Vec<f64>), CliError> {
         .headers()
         .map_err(|e| CliError::Input(format!("{file}: row 1: {e}")))?
         .clone();
-    let (ti, tf, ci) = command_columns(&file, headers.iter())?;
+    let (ti, tf, ci, cf) = command_columns(&file, headers.iter(), want)?;
     let (mut t, mut u) = (Vec::new(), Vec::new());
     for (k, rec) in rdr.records().enumerate() {
         let row = k + 2;
@@ -164,7 +209,7 @@ pub fn read_command(path: &Path) -> Result<(Vec<f64>, Vec<f64>), CliError> {
             }
         }
         t.push(tv);
-        u.push(cell(ci, "command")?);
+        u.push(cell(ci, want)? * cf);
     }
     if t.len() < 2 {
         return Err(CliError::Input(format!(
@@ -343,7 +388,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let (Some(cmd_path), Some(out)) = (args.command, args.out) else {
         return Err(CliError::Input("--command and --out are required".into()));
     };
-    let (t, u) = read_command(&cmd_path)?;
+    let (t, u) = read_input(
+        &cmd_path,
+        if closed_loop(&value) {
+            "reference"
+        } else {
+            "command"
+        },
+    )?;
     let signal = Signal::table(t.clone(), u)
         .map_err(|e| CliError::Input(format!("{}: {e}", cmd_path.display())))?;
     let opts = RunOptions {

@@ -479,7 +479,16 @@ struct Prepared {
     /// Relative tolerance of the simulations (looser while tracing).
     rtol: f64,
     t: Vec<f64>,
-    command: Vec<f64>,
+    /// The run's input: the measured command (open loop) or the position
+    /// reference (a closed-loop record, whose rig's controller computes the
+    /// command).
+    input: Vec<f64>,
+    /// Whether the record is closed loop (it has a `reference` column).
+    closed: bool,
+    /// The measured command at the first sample (the initial spool demand;
+    /// `None` in a closed-loop record without a `command` column: the
+    /// controller's output at the first sample is taken).
+    command0: Option<f64>,
     /// Measured channels present (velocity: measured, else smoothed derivative).
     meas: Vec<(Signal, Vec<f64>)>,
     ranges: Vec<f64>,
@@ -503,7 +512,13 @@ fn prepare(
     stroke: f64,
 ) -> Result<(Prepared, crate::smooth::SmootherInfo), DiagnoseError> {
     let t = rec.time.clone();
-    let command = rec.require(Signal::Command)?.to_vec();
+    let closed = rec.get(Signal::Reference).is_some();
+    let input = if closed {
+        rec.require(Signal::Reference)?.to_vec()
+    } else {
+        rec.require(Signal::Command)?.to_vec()
+    };
+    let command0 = rec.get(Signal::Command).map(|u| u[0]);
     let x = rec.require(Signal::Position)?;
     let s = match half {
         Some(h) => smooth_with(&t, x, h, 3),
@@ -511,7 +526,11 @@ fn prepare(
     };
     let position_ok = !excluded.contains(&Signal::Position);
     let mut meas = Vec::new();
-    for ch in CHANNELS {
+    // In closed loop the measured command is an output: compared like the others.
+    let compared = CHANNELS
+        .into_iter()
+        .chain(closed.then_some(Signal::Command));
+    for ch in compared {
         if excluded.contains(&ch) {
             continue;
         }
@@ -567,7 +586,9 @@ fn prepare(
             p20,
             restarts,
             t,
-            command,
+            input,
+            closed,
+            command0,
             meas,
             ranges,
             weights,
@@ -589,7 +610,13 @@ fn with_initial(rig: &ValveRig, p: &Prepared) -> ValveRig {
     if let Some(v0) = p.v0 {
         r.initial.velocity = v0;
     }
-    r.initial.spool = (p.command[0] * r.valve.stroke_m).clamp(-r.valve.stroke_m, r.valve.stroke_m);
+    let u0 = match (p.command0, &r.controller) {
+        (Some(u), _) => u,
+        (None, Some(c)) => (c.gain_per_m * (p.input[0] - r.initial.position) + c.bias)
+            .clamp(c.output_min, c.output_max),
+        (None, None) => 0.0,
+    };
+    r.initial.spool = (u0 * r.valve.stroke_m).clamp(-r.valve.stroke_m, r.valve.stroke_m);
     r.initial.p1 = p.p10;
     r.initial.p2 = p.p20;
     r
@@ -613,7 +640,7 @@ fn simulate(rig: &ValveRig, p: &Prepared) -> Result<Vec<Vec<f64>>, String> {
 fn simulate_prefix(rig: &ValveRig, p: &Prepared, n: usize) -> Result<Vec<Vec<f64>>, String> {
     let n = n.clamp(2.min(p.t.len()), p.t.len());
     let t = &p.t[..n];
-    let cmd = CmdSignal::table(p.t.clone(), p.command.clone()).map_err(|e| e.to_string())?;
+    let cmd = CmdSignal::table(p.t.clone(), p.input.clone()).map_err(|e| e.to_string())?;
     let opts = RunOptions {
         rtol: p.rtol,
         ..RunOptions::default()
@@ -939,16 +966,22 @@ fn trace_parallel<I: Sync, T: Send>(items: &[I], f: &(dyn Fn(&I) -> T + Sync)) -
 /// Out-of-catalog probe: the command reaching the rig late by τ (a
 /// transport delay), τ on a grid up to 60 ms, initial position refitted.
 fn delay_probe(rig: &ValveRig, p: &Prepared, holdout: f64) -> Option<Probe> {
+    if p.closed {
+        // the input is the reference, not the command the valve receives
+        return None;
+    }
     let rss0 = rss(rig, p, holdout, Part::All);
     let mut best = (0.0, rss0);
     for tau in [0.002, 0.005, 0.01, 0.015, 0.02, 0.03, 0.045, 0.06] {
         let mut q = Prepared {
             rtol: p.rtol,
-            command: p
+            input: p
                 .t
                 .iter()
-                .map(|&t| crate::data::interp_linear(&p.t, &p.command, t - tau))
+                .map(|&t| crate::data::interp_linear(&p.t, &p.input, t - tau))
                 .collect(),
+            closed: p.closed,
+            command0: p.command0,
             t: p.t.clone(),
             meas: p.meas.clone(),
             ranges: p.ranges.clone(),
@@ -959,7 +992,7 @@ fn delay_probe(rig: &ValveRig, p: &Prepared, holdout: f64) -> Option<Probe> {
             p20: p.p20,
             restarts: p.restarts.clone(),
         };
-        q.command[0] = p.command[0];
+        q.input[0] = p.input[0];
         let r = rss(rig, &q, holdout, Part::All);
         if r < best.1 {
             best = (tau, r);
@@ -1044,6 +1077,21 @@ pub fn diagnose_valve_traced(
 ) -> Result<ValveOutcome, DiagnoseError> {
     let start = Instant::now();
     let mut clock = crate::diagnose::StageClock::new();
+    match (rec.get(Signal::Reference).is_some(), declared.controller.is_some()) {
+        (true, false) => {
+            return Err(DiagnoseError::Rig(format!(
+                "{}: the record has a `reference` column (closed loop), but rig `{}` has no controller: use a closed-loop rig (e.g. the `leaney-moog-closed-loop` preset)",
+                rec.source, declared.name
+            )))
+        }
+        (false, true) => {
+            return Err(DiagnoseError::Rig(format!(
+                "{}: rig `{}` is closed loop (it has a controller), but the record has no `reference` column to drive it",
+                rec.source, declared.name
+            )))
+        }
+        _ => {}
+    }
     // Data problems first: each named channel is left out of the fit.
     let data_problems = check_record(rec, Some(&rig_facts(declared)));
     let mut excluded: Vec<Signal> = data_problems

@@ -16,7 +16,8 @@
 //! `viscous` (the coulomb-viscous law's b), `supply_droop`
 //! (supply.droop_resistance_pa_s_per_m3) and `sensor_lag`
 //! (sensors.pressure_lag_s: the simulated p1/p2 are then the lagged sensor
-//! readings the record is compared with). An effect is "off" at its neutral
+//! readings the record is compared with) and `valve_dead_band`
+//! (valve.dead_band_m). An effect is "off" at its neutral
 //! value (0, or kw = 1); `bulk_modulus` is always declared, so tracing it
 //! means refitting B away from the declared value.
 //!
@@ -55,7 +56,7 @@ mod stops;
 const MAX_REFITS_PER_ROUND: usize = 3;
 
 /// Effects the valve rig exposes as parameters.
-pub const VALVE_EFFECTS: [EffectId; 14] = [
+pub const VALVE_EFFECTS: [EffectId; 15] = [
     EffectId::CoulombAsymmetry,
     EffectId::Stribeck,
     EffectId::PressureViscous,
@@ -70,6 +71,7 @@ pub const VALVE_EFFECTS: [EffectId; 14] = [
     EffectId::Viscous,
     EffectId::SupplyDroop,
     EffectId::SensorLag,
+    EffectId::ValveDeadBand,
 ];
 
 /// Why effect `id` is not tried on this valve rig.
@@ -101,6 +103,7 @@ pub fn get(rig: &ValveRig, id: EffectId, name: &str) -> Option<f64> {
         (EffectId::ExternalForce, "F0") => rig.load.external_force_n,
         (EffectId::SupplyDroop, "Rs") => rig.supply.droop_resistance_pa_s_per_m3,
         (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s,
+        (EffectId::ValveDeadBand, "xd") => rig.valve.dead_band_m,
         (EffectId::PressureViscous, "K") => rig.friction_terms.k_pressure,
         (EffectId::AccelerationFriction, "H") => rig.friction_terms.h_acceleration,
         (EffectId::Viscous, "b") => match &rig.friction {
@@ -223,6 +226,7 @@ pub fn set(rig: &mut ValveRig, id: EffectId, name: &str, v: f64) {
         (EffectId::ExternalForce, "F0") => rig.load.external_force_n = v,
         (EffectId::SupplyDroop, "Rs") => rig.supply.droop_resistance_pa_s_per_m3 = v,
         (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s = v,
+        (EffectId::ValveDeadBand, "xd") => rig.valve.dead_band_m = v,
         (EffectId::PressureViscous, "K") => rig.friction_terms.k_pressure = v,
         (EffectId::AccelerationFriction, "H") => rig.friction_terms.h_acceleration = v,
         (EffectId::Viscous, "b") => match &mut rig.friction {
@@ -349,7 +353,7 @@ pub fn is_on(rig: &ValveRig, id: EffectId) -> bool {
 /// A typical magnitude of a parameter (scales the fit and its first step).
 fn typical(id: EffectId, name: &str, rig: &ValveRig) -> f64 {
     match (id, name) {
-        (EffectId::ValveNullBias, _) => 0.01 * rig.valve.stroke_m,
+        (EffectId::ValveNullBias | EffectId::ValveDeadBand, _) => 0.01 * rig.valve.stroke_m,
         (EffectId::FlowGainError, _) => 1.0,
         (EffectId::InternalLeakage | EffectId::ExternalLeakage, _) => 1e-12,
         (EffectId::BulkModulus, _) => rig.fluid.bulk_modulus_pa,
@@ -382,6 +386,7 @@ fn negligible(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> bool {
     let v = |n: &str| get(rig, id, n).unwrap_or(0.0);
     match id {
         EffectId::ValveNullBias => v("xb").abs() < 1e-3 * rig.valve.stroke_m,
+        EffectId::ValveDeadBand => v("xd") < 1e-3 * rig.valve.stroke_m,
         EffectId::FlowGainError => (v("kw") - 1.0).abs() < 5e-3,
         EffectId::InternalLeakage => v("Cl") < 1e-14,
         EffectId::ExternalLeakage => v("Ce1").max(v("Ce2")) < 1e-14,
@@ -423,6 +428,8 @@ fn negligible(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> bool {
 fn bounds(id: EffectId, name: &str, rig: &ValveRig) -> (f64, f64) {
     match id {
         EffectId::ValveNullBias => (-rig.valve.stroke_m, rig.valve.stroke_m),
+        // a dead zone up to half the spool stroke
+        EffectId::ValveDeadBand => (0.0, 0.5 * rig.valve.stroke_m),
         // both directions keep a positive Coulomb level
         EffectId::CoulombAsymmetry => {
             let fc = mean_coulomb(rig);

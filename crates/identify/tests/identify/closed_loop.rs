@@ -1,8 +1,8 @@
 //! Closed-loop records (a `reference` column): the rig's controller computes
 //! the command from the reference and the simulated position, and the
 //! measured command is a channel compared like the others. Generated
-//! `leaney-moog-closed-loop` records with nothing, an external force or a
-//! leak planted.
+//! `leaney-moog-closed-loop` records with nothing, an external force, a
+//! leak or a valve dead band planted.
 
 use hydrocyl_identify::catalog::EffectId;
 use hydrocyl_identify::data::{Record, Signal};
@@ -95,6 +95,16 @@ fn an_internal_leak_is_found_in_closed_loop() {
     let r = diagnose(&record(&[(id, n, v)], 83));
     eprintln!("{}", r.human());
     check_found(&r, id, n, v);
+}
+
+#[test]
+fn a_valve_dead_band_is_found_in_closed_loop() {
+    // 5 % of the spool stroke (18.75 µm): the piston stops short of the
+    // reference by the error whose command stays inside the dead zone
+    let xd = 0.05 * declared().valve.stroke_m;
+    let r = diagnose(&record(&[(EffectId::ValveDeadBand, "xd", xd)], 85));
+    eprintln!("{}", r.human());
+    check_found(&r, EffectId::ValveDeadBand, "xd", xd);
 }
 
 #[test]

@@ -145,24 +145,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         candidates,
         ..DiagnoseOptions::default()
     };
-    let show_bar = !args.quiet && std::io::stderr().is_terminal();
-    let bar = show_bar.then(|| {
-        let b = indicatif::ProgressBar::new(1);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} diagnose [{bar:30}] {pos}/{len} {msg} ({elapsed}, eta {eta})",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        b
-    });
-    let mut progress = |stage: &str, done: usize, total: usize| {
-        if let Some(b) = &bar {
-            b.set_length(total as u64);
-            b.set_position(done as u64);
-            b.set_message(stage.to_string());
-        }
-    };
+    let reporter = Progress::new(args.quiet);
+    let mut progress = |stage: &str, done: usize, total: usize| reporter.update(stage, done, total);
     let (report, traces) = match &rig {
         Rig::Bench(b) => {
             let o = diagnose_bench(b, &records, &opts, &mut progress)
@@ -181,9 +165,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             (o.report, o.traces)
         }
     };
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
+    drop(reporter);
     // Everything computed: now write, plots first, the report last.
     if let Some(dir) = &args.plots {
         write_plots(dir, &traces)?;
@@ -207,6 +189,46 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
     }
     Ok(())
+}
+
+/// The one place diagnose's progress goes: a bar with the stage, the
+/// candidate round, elapsed time and ETA on stderr when it is a terminal,
+/// nothing under `--quiet` (the bar is cleared when this is dropped).
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl Progress {
+    fn new(quiet: bool) -> Self {
+        let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+            let b = indicatif::ProgressBar::new(1);
+            b.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{spinner} diagnose [{bar:30}] {pos}/{len} {msg} ({elapsed}, eta {eta})",
+                )
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            b
+        });
+        Self { bar }
+    }
+
+    /// Stage `stage`, `done` of `total` steps.
+    fn update(&self, stage: &str, done: usize, total: usize) {
+        if let Some(b) = &self.bar {
+            b.set_length(total as u64);
+            b.set_position(done as u64);
+            b.set_message(stage.to_string());
+        }
+    }
+}
+
+impl Drop for Progress {
+    fn drop(&mut self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
 }
 
 /// Number of SVG files [`write_plots`] writes for `traces`.

@@ -127,7 +127,7 @@ fn command_columns<'a>(
     Ok((ti, tf, ci, cf))
 }
 
-/// The fast path of [`read_command`] for plain numeric CSV
+/// The fast path of [`read_input`] for plain numeric CSV
 /// ([`hydrocyl_identify::plaincsv`]); `None` sends the text to the full
 /// reader, which also reports every error.
 fn read_command_plain(file: &str, text: &str, want: &str) -> Option<(Vec<f64>, Vec<f64>)> {

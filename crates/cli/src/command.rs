@@ -1,7 +1,9 @@
 //! The command file of `hydrocyl simulate`: CSV with a `time` column
 //! (`time`, `time [s]` or `time [ms]`) and one `command` column in the unit
-//! the rig's command takes ([`CommandUnit`]); other columns are ignored.
-//! Errors name the file, row and column.
+//! the rig's command takes ([`CommandUnit`]) — or, for a closed-loop rig
+//! (one with a `position_controller`), one `reference` column, the position
+//! set-point in m or mm; other columns are ignored. Errors name the file, row
+//! and column.
 
 use crate::error::CliError;
 use hydrocyl_identify::plaincsv::PlainCsv;
@@ -16,6 +18,9 @@ pub enum CommandUnit {
     /// A drive voltage \[V\] (pump rigs): `command`, `command [V]` or
     /// `command [mV]`.
     Volt,
+    /// A position set-point \[m\] (closed-loop rigs, whose controller makes
+    /// the command): `reference`, `reference [m]` or `reference [mm]`.
+    Reference,
 }
 
 impl CommandUnit {
@@ -24,6 +29,15 @@ impl CommandUnit {
         match self {
             CommandUnit::Normalised => "-",
             CommandUnit::Volt => "V",
+            CommandUnit::Reference => "m",
+        }
+    }
+
+    /// The input column's name: `command`, or `reference` for a closed-loop rig.
+    pub fn column(self) -> &'static str {
+        match self {
+            CommandUnit::Reference => "reference",
+            _ => "command",
         }
     }
 
@@ -35,6 +49,8 @@ impl CommandUnit {
             (CommandUnit::Normalised, Some("%")) => Some(0.01),
             (CommandUnit::Volt, Some("V")) => Some(1.0),
             (CommandUnit::Volt, Some("mV")) => Some(1e-3),
+            (CommandUnit::Reference, Some("m")) => Some(1.0),
+            (CommandUnit::Reference, Some("mm")) => Some(1e-3),
             _ => None,
         }
     }
@@ -43,6 +59,7 @@ impl CommandUnit {
         match self {
             CommandUnit::Normalised => "-, 1 or % (a normalised spool demand)",
             CommandUnit::Volt => "V or mV (a drive voltage)",
+            CommandUnit::Reference => "m or mm (a position set-point)",
         }
     }
 }
@@ -82,7 +99,7 @@ fn columns<'a>(
         let (name, u) = name_unit(h);
         let found = match name {
             "time" => &mut time,
-            "command" => &mut command,
+            n if n == unit.column() => &mut command,
             _ => continue,
         };
         if let Some((j, _)) = found {
@@ -105,8 +122,9 @@ fn columns<'a>(
         } else {
             unit.factor(u).ok_or_else(|| {
                 CliError::Input(format!(
-                    "{file}: row 1, column `{h}`: unit `{}` does not fit this rig's command [{}] (use {})",
+                    "{file}: row 1, column `{h}`: unit `{}` does not fit this rig's {} [{}] (use {})",
                     u.unwrap_or_default(),
+                    unit.column(),
                     unit.symbol(),
                     unit.accepted()
                 ))
@@ -116,8 +134,14 @@ fn columns<'a>(
     }
     let (time, time_factor) =
         time.ok_or_else(|| CliError::Input(format!("{file}: row 1: no `time` column")))?;
-    let (command, command_factor) =
-        command.ok_or_else(|| CliError::Input(format!("{file}: row 1: no `command` column")))?;
+    let (command, command_factor) = command.ok_or_else(|| {
+        CliError::Input(match unit {
+            CommandUnit::Reference => format!(
+                "{file}: row 1: no `reference` column (a closed-loop rig is driven by its position set-point)"
+            ),
+            _ => format!("{file}: row 1: no `command` column"),
+        })
+    })?;
     Ok(Columns {
         time,
         time_factor,

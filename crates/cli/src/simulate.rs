@@ -9,7 +9,11 @@
 //!
 //! The command file is CSV with a `time` column (`time`, `time [s]` or
 //! `time [ms]`) and one `command` column in the unit of the rig's command
-//! (see [`crate::command`]); other columns are ignored.
+//! (see [`crate::command`]); other columns are ignored. A closed-loop rig
+//! (one with a `position_controller`, e.g. the `leaney-moog-closed-loop`
+//! preset) is driven by a `reference` column instead (`reference [m]` /
+//! `reference [mm]`: the position set-point), and its controller computes the
+//! command.
 //! The output has one row per command sample: `time, command, position,
 //! velocity, p1, p2`, then the rig's other outputs (`ps`, `spool`, `p_le`,
 //! ...), all SI, each header with its unit (`position [m]`; the readers take
@@ -61,8 +65,9 @@ pub struct Args {
     /// A preset name (`hydrocyl presets`) or a rig JSON file.
     #[arg(long)]
     rig: String,
-    /// (required) CSV with `time` and `command` columns; the output is
-    /// sampled at its times.
+    /// (required) CSV with `time` and `command` columns (a closed-loop rig:
+    /// `time` and `reference` [m or mm], the position set-point); the output
+    /// is sampled at its times.
     #[arg(long, required_unless_present = "print_rig")]
     command: Option<PathBuf>,
     /// (required) Output CSV (measured-data format, units in the header).
@@ -132,7 +137,13 @@ pub fn column_headers(run: &Run, command: CommandUnit) -> Vec<String> {
     std::iter::once("time [s]".to_string())
         .chain(run.channels.iter().map(|c| {
             if c.name == "command" {
-                format!("command [{}]", command.symbol())
+                // a closed-loop rig's command is its controller's output,
+                // a normalised spool demand
+                let unit = match command {
+                    CommandUnit::Reference => CommandUnit::Normalised,
+                    u => u,
+                };
+                format!("command [{}]", unit.symbol())
             } else if c.unit.is_empty() {
                 c.name.clone()
             } else {
@@ -205,9 +216,28 @@ fn run_bench(args: &Args, value: &serde_json::Value) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The unit of a rig's command: [`CommandUnit::Volt`] when the port that
-/// reads it says so (a pump drive), else normalised.
+/// Whether a rig (JSON) is closed loop: it has a `position_controller`
+/// (or, as a `valve-cylinder` file, a `controller`), and is driven by a
+/// position reference.
+pub fn closed_loop(rig: &serde_json::Value) -> bool {
+    rig.get("controller").is_some_and(|c| !c.is_null())
+        || rig
+            .get("components")
+            .and_then(serde_json::Value::as_object)
+            .is_some_and(|c| {
+                c.values().any(|i| {
+                    i.get("type").and_then(serde_json::Value::as_str) == Some("position_controller")
+                })
+            })
+}
+
+/// The unit of a rig's input: the position set-point of a closed-loop rig,
+/// [`CommandUnit::Volt`] when the port that reads the command says so (a
+/// pump drive), else normalised.
 fn command_unit(value: &serde_json::Value) -> CommandUnit {
+    if closed_loop(value) {
+        return CommandUnit::Reference;
+    }
     let kind = value.get("kind").and_then(|k| k.as_str());
     if kind == Some(variant::KIND) || kind == Some(hydrocyl_system::hybrid::KIND) {
         return CommandUnit::Volt;

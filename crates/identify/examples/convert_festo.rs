@@ -8,7 +8,9 @@
 //! * `command` = controller output u / 10 V (a ±10 V proportional-valve input
 //!   read as the normalised spool demand);
 //! * `position [mm]` = (position_V − 5 V) × 20 mm/V (a 0–10 V transducer over
-//!   a 200 mm stroke, 0 at mid-stroke).
+//!   a 200 mm stroke, 0 at mid-stroke);
+//! * `reference [mm]` = (reference_V − 5 V) × 20 mm/V, the same scale: the
+//!   record is closed loop, and its reference drives the rig's controller.
 //!
 //! ```sh
 //! cargo run -p hydrocyl-identify --example convert_festo -- \
@@ -39,7 +41,7 @@ fn run() -> Result<(), String> {
         return Err("usage: convert_festo <hanging_load.csv> <output csv>".into());
     };
     let text = std::fs::read_to_string(src).map_err(|e| format!("cannot read {src}: {e}"))?;
-    let mut out = String::from("time [s],command,position [mm]\n");
+    let mut out = String::from("time [s],command,position [mm],reference [mm]\n");
     for (i, line) in text.lines().enumerate().skip(1) {
         let cols: Vec<f64> = line
             .split(',')
@@ -51,12 +53,13 @@ fn run() -> Result<(), String> {
                 i + 1
             ));
         }
-        let (t, y, u) = (cols[0], cols[2], cols[3]);
+        let (t, r, y, u) = (cols[0], cols[1], cols[2], cols[3]);
         let _ = writeln!(
             out,
-            "{t:.2},{:.6},{:.4}",
+            "{t:.2},{:.6},{:.4},{:.4}",
             u / COMMAND_FULL_SCALE_V,
-            (y - POSITION_MID_V) * POSITION_MM_PER_V
+            (y - POSITION_MID_V) * POSITION_MM_PER_V,
+            (r - POSITION_MID_V) * POSITION_MM_PER_V
         );
     }
     let tmp = format!("{dst}.tmp");

@@ -68,6 +68,8 @@ pub enum EffectId {
     SupplyDroop,
     /// First-order lag on the pressure sensors (`tau`).
     SensorLag,
+    /// A dead zone on the spool: the metering sees `sign(xs) max(0, |xs| − xd)` (`xd`).
+    ValveDeadBand,
 }
 
 const fn p(name: &'static str, unit: &'static str, lower: f64, upper: f64) -> ParamSpec {
@@ -81,7 +83,7 @@ const fn p(name: &'static str, unit: &'static str, lower: f64, upper: f64) -> Pa
 
 impl EffectId {
     /// Every effect, in catalog order.
-    pub const ALL: [EffectId; 14] = [
+    pub const ALL: [EffectId; 15] = [
         EffectId::CoulombAsymmetry,
         EffectId::Stribeck,
         EffectId::Viscous,
@@ -96,6 +98,7 @@ impl EffectId {
         EffectId::BulkModulus,
         EffectId::SupplyDroop,
         EffectId::SensorLag,
+        EffectId::ValveDeadBand,
     ];
 
     /// The stable id of the catalog.
@@ -115,6 +118,7 @@ impl EffectId {
             EffectId::BulkModulus => "bulk_modulus",
             EffectId::SupplyDroop => "supply_droop",
             EffectId::SensorLag => "sensor_lag",
+            EffectId::ValveDeadBand => "valve_dead_band",
         }
     }
 
@@ -136,9 +140,10 @@ impl EffectId {
             EffectId::InternalLeakage | EffectId::BulkModulus | EffectId::ExternalLeakage => {
                 Balance::Flow12
             }
-            EffectId::ValveNullBias | EffectId::FlowGainError | EffectId::SupplyDroop => {
-                Balance::Valve
-            }
+            EffectId::ValveNullBias
+            | EffectId::FlowGainError
+            | EffectId::SupplyDroop
+            | EffectId::ValveDeadBand => Balance::Valve,
             EffectId::SensorLag => Balance::Measurement,
         }
     }
@@ -160,6 +165,7 @@ impl EffectId {
             EffectId::BulkModulus => "effective bulk modulus B",
             EffectId::SupplyDroop => "Ps = Ps0 - Rs Qs",
             EffectId::SensorLag => "first-order lag tau on the pressure sensors",
+            EffectId::ValveDeadBand => "sign(xs) max(0, |xs| - xd): a dead zone on the spool",
         }
     }
 
@@ -233,6 +239,10 @@ impl EffectId {
                 const P: &[ParamSpec] = &[p("tau", "s", 0.0, 1.0)];
                 P
             }
+            EffectId::ValveDeadBand => {
+                const P: &[ParamSpec] = &[p("xd", "m", 0.0, 1e-3)];
+                P
+            }
         }
     }
 }
@@ -265,6 +275,7 @@ mod tests {
             ("bulk_modulus", "B"),
             ("supply_droop", "Rs"),
             ("sensor_lag", "tau"),
+            ("valve_dead_band", "xd"),
         ];
         assert_eq!(spec.len(), EffectId::ALL.len());
         for (e, (id, params)) in EffectId::ALL.iter().zip(spec) {

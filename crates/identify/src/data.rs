@@ -37,11 +37,13 @@ pub enum Signal {
     Flow,
     /// External force on the rod \[N\].
     Force,
+    /// Position set-point of a closed-loop record \[m\].
+    Reference,
 }
 
 impl Signal {
     /// Every signal, in column order of the format.
-    pub const ALL: [Signal; 9] = [
+    pub const ALL: [Signal; 10] = [
         Signal::Time,
         Signal::Command,
         Signal::Position,
@@ -51,6 +53,7 @@ impl Signal {
         Signal::Ps,
         Signal::Flow,
         Signal::Force,
+        Signal::Reference,
     ];
 
     /// The column name of the format (`time`, `p1`, ...).
@@ -65,6 +68,7 @@ impl Signal {
             Signal::Ps => "ps",
             Signal::Flow => "flow",
             Signal::Force => "force",
+            Signal::Reference => "reference",
         }
     }
 
@@ -80,8 +84,8 @@ impl Signal {
             (Signal::Time, "s") => 1.0,
             (Signal::Time, "ms") => 1e-3,
             (Signal::Command, "-" | "V" | "1") => 1.0,
-            (Signal::Position, "m") => 1.0,
-            (Signal::Position, "mm") => 1e-3,
+            (Signal::Position | Signal::Reference, "m") => 1.0,
+            (Signal::Position | Signal::Reference, "mm") => 1e-3,
             (Signal::Velocity, "m/s") => 1.0,
             (Signal::Velocity, "mm/s") => 1e-3,
             (Signal::Velocity, "cm/s") => 1e-2,
@@ -107,7 +111,7 @@ impl Signal {
         match self {
             Signal::Time => "s, ms",
             Signal::Command => "-, V",
-            Signal::Position => "m, mm",
+            Signal::Position | Signal::Reference => "m, mm",
             Signal::Velocity => "m/s, mm/s, cm/s",
             Signal::P1 | Signal::P2 | Signal::Ps => "Pa, bar, kPa, MPa, psi",
             Signal::Flow => "m^3/s, l/min",

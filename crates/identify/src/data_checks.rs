@@ -111,7 +111,7 @@ fn resolution(y: &[f64]) -> Option<(f64, usize)> {
 /// SI unit of a channel for messages.
 fn unit(s: Signal) -> &'static str {
     match s {
-        Signal::Position => "m",
+        Signal::Position | Signal::Reference => "m",
         Signal::Velocity => "m/s",
         Signal::P1 | Signal::P2 | Signal::Ps => "Pa",
         Signal::Flow => "m^3/s",

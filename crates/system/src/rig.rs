@@ -103,6 +103,10 @@ pub const PRESETS: &[Preset] = &[
         json: || netlist_preset(crate::valve_netlist::GENERALISED),
     },
     Preset {
+        name: "leaney-moog-closed-loop",
+        json: || netlist_preset(crate::valve_netlist::CLOSED_LOOP),
+    },
+    Preset {
         name: "wang-valve-c10",
         json: || netlist_preset(include_str!("../../../fixtures/rigs/wang-valve-c10.json")),
     },

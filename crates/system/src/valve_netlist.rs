@@ -8,8 +8,8 @@
 use crate::netlist::{self, registry::Instance, Schematic};
 use crate::rig::RigError;
 use crate::valve_rig::{
-    CylinderSpec, FluidSpec, Formulation, InitialSpec, LoadSpec, SensorSpec, SupplySpec, ValveRig,
-    ValveSpec, KIND,
+    ControllerSpec, CylinderSpec, FluidSpec, Formulation, InitialSpec, LoadSpec, SensorSpec,
+    SupplySpec, ValveRig, ValveSpec, KIND,
 };
 use hydrocyl_friction::FrictionLaw;
 use hydrocyl_valves::servovalve::SpoolDynamics;
@@ -19,6 +19,71 @@ use serde_json::{json, Value};
 pub const FUNDAMENTAL: &str = include_str!("../../../fixtures/rigs/leaney-moog.json");
 /// The generalised-form circuit (the `leaney-moog-generalised` preset).
 pub const GENERALISED: &str = include_str!("../../../fixtures/rigs/leaney-moog-generalised.json");
+/// The fundamental-form circuit in closed loop (the `leaney-moog-closed-loop`
+/// preset): a `position_controller` between the reference input and the spool.
+pub const CLOSED_LOOP: &str = include_str!("../../../fixtures/rigs/leaney-moog-closed-loop.json");
+
+/// Closes the loop of a valve-cylinder netlist: the input `command` becomes
+/// the position reference `reference`, and a `controller` reads it and the
+/// rod and drives the spool (the wiring of [`CLOSED_LOOP`]).
+fn close_loop(v: &mut Value, c: &ControllerSpec) {
+    let comps = v["components"]
+        .as_object_mut()
+        .expect("a template has components");
+    let mut out = serde_json::Map::new();
+    for (k, x) in std::mem::take(comps) {
+        if k == "command" {
+            out.insert("reference".into(), json!({ "type": "command_input" }));
+            out.insert(
+                "controller".into(),
+                json!({
+                    "type": "position_controller",
+                    "gain": c.gain_per_m,
+                    "integral_time": c.integral_time_s,
+                    "bias": c.bias,
+                    "output_min": c.output_min,
+                    "output_max": c.output_max
+                }),
+            );
+        } else {
+            out.insert(k, x);
+        }
+    }
+    *comps = out;
+    let conns = v["connections"]
+        .as_array_mut()
+        .expect("a template has connections");
+    let mut next = Vec::new();
+    for c in conns.drain(..) {
+        let ends: Vec<&str> = c
+            .as_array()
+            .map(|a| a.iter().filter_map(Value::as_str).collect())
+            .unwrap_or_default();
+        if ends == ["command.out", "spool.command"] {
+            next.push(json!(["reference.out", "controller.reference"]));
+            next.push(json!(["controller.command", "spool.command"]));
+        } else if ends.contains(&"cylinder.rod") {
+            let mut e = c.as_array().cloned().unwrap_or_default();
+            e.push(Value::from("controller.rod"));
+            next.push(Value::Array(e));
+        } else {
+            next.push(c);
+        }
+    }
+    *conns = next;
+    let outs = v["outputs"]
+        .as_object_mut()
+        .expect("a template has outputs");
+    let mut o = serde_json::Map::new();
+    o.insert("reference".into(), Value::from("reference.command"));
+    o.insert("command".into(), Value::from("controller.command"));
+    for (k, x) in std::mem::take(outs) {
+        if k != "command" {
+            o.insert(k, x);
+        }
+    }
+    *outs = o;
+}
 
 fn template(text: &str) -> Value {
     serde_json::from_str(text).expect("the embedded netlist is valid JSON (tested)")
@@ -107,6 +172,7 @@ impl ValveRig {
                 "valve.supply_resistance".into(),
                 s.droop_resistance_pa_s_per_m3,
             ));
+            sets.push(("valve.dead_band".into(), va.dead_band_m));
             sets.push(("cylinder.initial.p1".into(), p1));
             sets.push(("cylinder.initial.p2".into(), p2));
         } else {
@@ -114,6 +180,12 @@ impl ValveRig {
                 return Err(RigError::Invalid {
                     path: "supply.droop_resistance_pa_s_per_m3".into(),
                     why: "supply droop needs the `fundamental` formulation".into(),
+                });
+            }
+            if va.dead_band_m > 0.0 {
+                return Err(RigError::Invalid {
+                    path: "valve.dead_band_m".into(),
+                    why: "a valve dead band needs the `fundamental` formulation".into(),
                 });
             }
             let tol = match c.formulation {
@@ -178,13 +250,18 @@ impl ValveRig {
                 v["outputs"][format!("{k}_chamber")] = Value::from(format!("cylinder.{k}"));
             }
         }
+        if let Some(c) = &self.controller {
+            close_loop(&mut v, c);
+        }
         Ok(v)
     }
 
     /// The rig a netlist of the valve-cylinder circuit describes: the
     /// components `supply`, `tank`, `command`, `spool`, `valve` (fundamental
     /// form), `cylinder`, `load`, `friction` (and optional chamber pressure
-    /// sensors `sensor_A`, `sensor_B`), wired as in the `leaney-moog` preset.
+    /// sensors `sensor_A`, `sensor_B`), wired as in the `leaney-moog` preset;
+    /// or in closed loop, `reference` and `controller` in place of `command`
+    /// (wired as in `leaney-moog-closed-loop`).
     /// Another circuit is refused, naming what differs.
     pub fn from_netlist(v: &Value) -> Result<ValveRig, RigError> {
         let s = netlist::read(v)?;
@@ -219,8 +296,18 @@ impl ValveRig {
         let cyl = get("cylinder", &["cylinder", "generalised_cylinder"])?;
         let fundamental = cyl.ty.name == "cylinder";
         let known = [
-            "supply", "tank", "command", "spool", "valve", "cylinder", "load", "friction",
-            "sensor_A", "sensor_B",
+            "supply",
+            "tank",
+            "command",
+            "spool",
+            "valve",
+            "cylinder",
+            "load",
+            "friction",
+            "sensor_A",
+            "sensor_B",
+            "reference",
+            "controller",
         ];
         if let Some(extra) = s
             .instances
@@ -234,7 +321,21 @@ impl ValveRig {
         }
         let supply = get("supply", &["pressure_source"])?;
         let tank = get("tank", &["pressure_source"])?;
-        get("command", &["command_input"])?;
+        let closed = s.instance("controller").is_some();
+        let controller = if closed {
+            get("reference", &["command_input"])?;
+            let c = get("controller", &["position_controller"])?;
+            Some(ControllerSpec {
+                gain_per_m: c.get("gain"),
+                integral_time_s: c.get("integral_time"),
+                bias: c.get("bias"),
+                output_min: c.get("output_min"),
+                output_max: c.get("output_max"),
+            })
+        } else {
+            get("command", &["command_input"])?;
+            None
+        };
         let spool = get("spool", &["servo_spool_*"])?;
         let load = get("load", &["mass"])?;
         let friction = get("friction", &["friction_*"])?;
@@ -243,7 +344,7 @@ impl ValveRig {
         } else {
             cyl
         };
-        wired_as_the_preset(&s, fundamental)?;
+        wired_as_the_preset(&s, fundamental, closed)?;
         let law = crate::netlist::catalog_friction_law(friction)
             .expect("a friction_* type")
             .map_err(|why| bad(&format!("components.{}", friction.name), why))?;
@@ -301,6 +402,7 @@ impl ValveRig {
                 regularisation_pa: metering.get("orifice.dp_transition"),
                 null_bias_m: metering.get("null_bias"),
                 flow_gain: metering.get("flow_gain"),
+                dead_band_m: metering.opt("dead_band").unwrap_or(0.0),
                 dynamics,
             },
             cylinder: CylinderSpec {
@@ -332,6 +434,7 @@ impl ValveRig {
             sensors: SensorSpec {
                 pressure_lag_s: lag,
             },
+            controller,
         };
         r.validate()?;
         Ok(r)
@@ -339,10 +442,18 @@ impl ValveRig {
 }
 
 /// Checks that the netlist joins the ports as the preset's circuit does.
-fn wired_as_the_preset(s: &Schematic, fundamental: bool) -> Result<(), RigError> {
+fn wired_as_the_preset(s: &Schematic, fundamental: bool, closed: bool) -> Result<(), RigError> {
     let meter = if fundamental { "valve" } else { "cylinder" };
-    let mut same: Vec<[(&str, &str); 2]> = vec![
-        [("command", "out"), ("spool", "command")],
+    let mut same: Vec<[(&str, &str); 2]> = if closed {
+        vec![
+            [("reference", "out"), ("controller", "reference")],
+            [("controller", "command"), ("spool", "command")],
+            [("controller", "rod"), ("load", "rod")],
+        ]
+    } else {
+        vec![[("command", "out"), ("spool", "command")]]
+    };
+    same.extend([
         [("spool", "spool"), (meter, "spool")],
         [("supply", "port"), (meter, "P")],
         [("tank", "port"), (meter, "T")],
@@ -350,7 +461,7 @@ fn wired_as_the_preset(s: &Schematic, fundamental: bool) -> Result<(), RigError>
         [("cylinder", "B"), ("friction", "B")],
         [("cylinder", "rod"), ("load", "rod")],
         [("cylinder", "rod"), ("friction", "rod")],
-    ];
+    ]);
     if fundamental {
         same.push([("valve", "A"), ("cylinder", "A")]);
         same.push([("valve", "B"), ("cylinder", "B")]);

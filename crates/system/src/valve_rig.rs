@@ -78,6 +78,10 @@ pub struct ValveSpec {
     pub null_bias_m: f64,
     /// Scale on the area gradient \[-\] (catalog `flow_gain_error`, 1 = nominal).
     pub flow_gain: f64,
+    /// Spool dead band x_d \[m\]: the metering sees `sign(x_s) max(0, |x_s| − x_d)`
+    /// (catalog `valve_dead_band`; absent = 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub dead_band_m: f64,
     /// Spool dynamics: `{"order": "first", "time_constant_s": τ}` or
     /// `{"order": "second", "natural_frequency_rad_per_s": ω, "damping_ratio": ζ}`.
     pub dynamics: SpoolDynamics,
@@ -201,6 +205,46 @@ pub struct ValveRig {
     /// Sensors (absent = ideal).
     #[serde(default)]
     pub sensors: SensorSpec,
+    /// A position controller closing the loop (absent = open loop: the
+    /// run's input is the valve command; present: it is the position
+    /// reference \[m\] and the controller computes the command).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub controller: Option<ControllerSpec>,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+/// The position controller of a closed-loop rig (netlist component
+/// `position_controller`): `u = clip(Kp (e + ∫e dt / Ti) + u0, lo, hi)`,
+/// `e = reference − position`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControllerSpec {
+    /// Proportional gain Kp \[1/m\].
+    pub gain_per_m: f64,
+    /// Integral time Ti \[s\]; 0 = a P controller.
+    #[serde(default)]
+    pub integral_time_s: f64,
+    /// Output offset u0 added before the limits \[-\].
+    #[serde(default)]
+    pub bias: f64,
+    /// Lower output limit \[-\].
+    pub output_min: f64,
+    /// Upper output limit \[-\].
+    pub output_max: f64,
+}
+
+impl ControllerSpec {
+    /// The `leaney-moog-closed-loop` preset's: P, Kp = 10 /m, limits ±1.
+    pub const P10: ControllerSpec = ControllerSpec {
+        gain_per_m: 10.0,
+        integral_time_s: 0.0,
+        bias: 0.0,
+        output_min: -1.0,
+        output_max: 1.0,
+    };
 }
 
 fn check(path: &str, value: f64, ok: bool, why: &str) -> Result<(), RigError> {
@@ -239,6 +283,7 @@ impl ValveRig {
                 regularisation_pa: hydrocyl_valves::orifice::DEFAULT_DP_TRANSITION.si(),
                 null_bias_m: 0.0,
                 flow_gain: 1.0,
+                dead_band_m: 0.0,
                 dynamics: SpoolDynamics::First { time_constant_s: 0.004 },
             },
             cylinder: CylinderSpec {
@@ -268,6 +313,7 @@ impl ValveRig {
                 p2: None,
             },
             sensors: SensorSpec::default(),
+            controller: None,
         }
     }
 
@@ -334,6 +380,20 @@ impl ValveRig {
         pos("valve.regularisation_pa", v.regularisation_pa)?;
         fin("valve.null_bias_m", v.null_bias_m)?;
         pos("valve.flow_gain", v.flow_gain)?;
+        nonneg("valve.dead_band_m", v.dead_band_m)?;
+        if let Some(c) = &self.controller {
+            fin("controller.gain_per_m", c.gain_per_m)?;
+            nonneg("controller.integral_time_s", c.integral_time_s)?;
+            fin("controller.bias", c.bias)?;
+            fin("controller.output_min", c.output_min)?;
+            fin("controller.output_max", c.output_max)?;
+            if c.output_min >= c.output_max {
+                return Err(RigError::Invalid {
+                    path: "controller.output_min".into(),
+                    why: "must be below controller.output_max".into(),
+                });
+            }
+        }
         match v.dynamics {
             SpoolDynamics::First { time_constant_s } => {
                 pos("valve.dynamics.time_constant_s", time_constant_s)?
@@ -475,9 +535,11 @@ impl ValveRig {
         }
     }
 
-    /// Normalised travel `(x_s + x_b)/u0` of spool position `xs` \[-\].
+    /// Normalised travel `(x_s + x_b)/u0` of spool position `xs` \[-\]
+    /// (after the dead band).
     fn travel(&self, xs: f64) -> f64 {
         let u0 = self.valve.underlap_m;
+        let xs = xs.signum() * (xs.abs() - self.valve.dead_band_m).max(0.0);
         let x = xs + self.valve.null_bias_m;
         if u0 > 0.0 {
             x / u0

@@ -3,5 +3,6 @@
 //! and on the valve rig.
 
 mod checks;
+mod closed_loop;
 mod planted;
 mod valve;

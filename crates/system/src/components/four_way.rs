@@ -20,6 +20,9 @@ pub struct FourWayValve {
     pub supply_resistance: f64,
     /// Output name of the supply pressure the valve sees (with droop on).
     pub supply_probe: Option<String>,
+    /// Spool dead band x_d \[m\]: the metering sees
+    /// `sign(x_s) max(0, |x_s| − x_d)` (catalog `valve_dead_band`; 0 = none).
+    pub dead_band: f64,
     spool: Wire<Position>,
     p: HydraulicNode,
     t: HydraulicNode,
@@ -47,6 +50,7 @@ impl FourWayValve {
             supply_resistance: 0.0,
             supply_probe: None,
             spool: Wire::UNBOUND,
+            dead_band: 0.0,
             p: HydraulicNode::UNBOUND,
             t: HydraulicNode::UNBOUND,
             a: HydraulicNode::UNBOUND,
@@ -59,8 +63,14 @@ impl FourWayValve {
     /// `supply_resistance > 0`).
     fn flows(&self, w: &Wires) -> (hydrocyl_valves::servovalve::MeteringFlows, Pressure) {
         let g = |n: &HydraulicNode| w.get(n.pressure);
+        let xs = w.get(self.spool);
+        let xs = if self.dead_band > 0.0 {
+            Position::new(xs.si().signum() * (xs.si().abs() - self.dead_band).max(0.0))
+        } else {
+            xs
+        };
         self.metering.flows_drooped(
-            w.get(self.spool),
+            xs,
             g(&self.p),
             self.supply_resistance,
             g(&self.t),

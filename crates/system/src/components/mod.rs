@@ -13,7 +13,9 @@
 //! | [`GeneralisedCylinder`] | A, B pressures (algebraic) | P_LE | spool, P, T, rod | flows at P, T; force |
 //! | [`Mass`] | rod x, v | x, v | forces on rod | – |
 //! | [`Friction`] | – | model's (z) | rod v; A, B pressures | −F, added mass |
+//! | [`PositionController`] | command signal (algebraic) | (∫e) | reference, rod x | – |
 
+mod controller;
 mod cylinder;
 mod four_way;
 mod friction;
@@ -24,6 +26,7 @@ mod sources;
 mod spool;
 mod volume;
 
+pub use controller::{PositionController, PositionLaw};
 pub use cylinder::TwoChamberCylinder;
 pub use four_way::FourWayValve;
 pub use friction::Friction;

@@ -67,15 +67,24 @@ pub(crate) fn metering(i: &Instance) -> Result<Metering, String> {
     Ok(m)
 }
 
-const FOUR_WAY: [ParamSpec; 8] = join(
+const FOUR_WAY: [ParamSpec; 9] = join(
     METERING,
-    [param(
-        "supply_resistance",
-        "Pa s/m^3",
-        Value(0.0),
-        Range::NON_NEGATIVE,
-        "supply droop Rs: the valve sees Ps = P − Rs Q_P (catalog `supply_droop`)",
-    )],
+    [
+        param(
+            "supply_resistance",
+            "Pa s/m^3",
+            Value(0.0),
+            Range::NON_NEGATIVE,
+            "supply droop Rs: the valve sees Ps = P − Rs Q_P (catalog `supply_droop`)",
+        ),
+        param(
+            "dead_band",
+            "m",
+            Value(0.0),
+            Range::NON_NEGATIVE,
+            "spool dead band x_d: the metering sees sign(x_s) max(0, abs(x_s) − x_d) (catalog `valve_dead_band`)",
+        ),
+    ],
 );
 
 const SPOOL_PORTS: &[super::PortSpec] = &[
@@ -242,6 +251,7 @@ pub const TYPES: &[ComponentType] = &[
                 metering(i)?,
             );
             v.supply_resistance = i.get("supply_resistance");
+            v.dead_band = i.get("dead_band");
             v.supply_probe = Some("ps".into());
             built(v)
         },

@@ -1,0 +1,619 @@
+//! The loop on the friction bench: output-error traces of the catalog's
+//! friction effects on imposed motion, LM refits and the out-of-catalog
+//! probes (delay, spring).
+
+use super::*;
+
+/// Which samples a residual uses.
+#[derive(Clone, Copy, PartialEq)]
+pub(super) enum Part {
+    All,
+    Train,
+    Held,
+}
+
+pub(super) struct Bench<'a> {
+    sigs: &'a [BenchSignals],
+    holdout: f64,
+}
+
+impl Bench<'_> {
+    fn range(&self, s: &BenchSignals, part: Part) -> std::ops::Range<usize> {
+        let n = s.t.len();
+        let cut = ((1.0 - self.holdout) * n as f64) as usize;
+        match part {
+            Part::All => 0..n,
+            Part::Train => 0..cut,
+            Part::Held => cut..n,
+        }
+    }
+
+    fn residual(&self, rig: &FrictionBench, part: Part, out: &mut Vec<f64>) {
+        out.clear();
+        for s in self.sigs {
+            let sim = rig.simulate(s);
+            for i in self.range(s, part) {
+                out.push(s.force[i] - sim[i]);
+            }
+        }
+    }
+
+    fn rss(&self, rig: &FrictionBench, part: Part) -> f64 {
+        let mut r = Vec::new();
+        self.residual(rig, part, &mut r);
+        r.iter().map(|v| v * v).sum()
+    }
+
+    /// Fits `params` of `rig` in place on `part`; returns the LM result.
+    fn fit(
+        &self,
+        rig: &mut FrictionBench,
+        params: &[ParamRef],
+        part: Part,
+    ) -> Result<lm::LmResult, lm::LmError> {
+        let x0: Vec<f64> = params.iter().map(|p| rig.get(p)).collect();
+        let (lo, hi): (Vec<f64>, Vec<f64>) = params.iter().map(|p| p.bounds()).unzip();
+        let x0: Vec<f64> = x0
+            .iter()
+            .zip(lo.iter().zip(&hi))
+            .map(|(x, (l, h))| x.clamp(*l, *h))
+            .collect();
+        let typ: Vec<f64> = params
+            .iter()
+            .zip(&x0)
+            .map(|(p, x)| x.abs().max(fallback_scale(p)))
+            .collect();
+        let mut work = rig.clone();
+        let res = lm::fit(
+            |x, r| {
+                for (p, v) in params.iter().zip(x) {
+                    work.set(p, *v);
+                }
+                self.residual(&work, part, r);
+                Ok(())
+            },
+            &x0,
+            &lo,
+            &hi,
+            &typ,
+            &LmOptions::default(),
+        )?;
+        for (p, v) in params.iter().zip(&res.x) {
+            rig.set(p, *v);
+        }
+        Ok(res)
+    }
+}
+
+/// A scale for a parameter whose start value is zero.
+pub(super) fn fallback_scale(p: &ParamRef) -> f64 {
+    match p {
+        ParamRef::Coulomb | ParamRef::Mass => 1.0,
+        ParamRef::Effect(_, name) => match name.as_str() {
+            "K" => 1e-12,
+            "H" => 1e6,
+            "vs" => 1e-3,
+            "sigma0" => 1e4,
+            "tau" => 1e-3,
+            _ => 1.0,
+        },
+    }
+}
+
+pub(super) fn n_eff(r: &[f64]) -> f64 {
+    let rho = lm::lag1_autocorrelation(r).clamp(0.0, 0.999);
+    (r.len() as f64 * (1.0 - rho) / (1.0 + rho)).max(2.0)
+}
+
+/// Starting values of a candidate effect's parameters: linear terms by least
+/// squares on the current residual, nonlinear ones from the data's scales.
+pub(super) fn initial_guess(
+    id: EffectId,
+    rig: &FrictionBench,
+    b: &Bench<'_>,
+) -> BTreeMap<String, f64> {
+    let mut g = BTreeMap::new();
+    let sg = rig.force_sign;
+    let vt = rig.friction.smoothing_velocity;
+    let k = rig.get(&ParamRef::Effect(EffectId::PressureViscous, "K".into()));
+    let regressor = |s: &BenchSignals, i: usize| -> f64 {
+        sg * match id {
+            EffectId::CoulombAsymmetry => 0.5 * (s.v[i] / vt).tanh().abs(),
+            EffectId::Viscous => s.v[i],
+            EffectId::PressureViscous => (s.p1[i] - s.p2[i]).powi(2) * s.v[i],
+            EffectId::AccelerationFriction => k * s.a[i],
+            EffectId::ExternalForce => 1.0,
+            _ => 0.0,
+        }
+    };
+    let mut r = Vec::new();
+    b.residual(rig, Part::Train, &mut r);
+    let (mut num, mut den) = (0.0, 0.0);
+    let mut j = 0;
+    for s in b.sigs {
+        for i in b.range(s, Part::Train) {
+            let phi = regressor(s, i);
+            num += phi * r[j];
+            den += phi * phi;
+            j += 1;
+        }
+    }
+    let ls = if den > 0.0 { num / den } else { 0.0 };
+    let fc = rig.friction.coulomb.max(1e-3);
+    let mut speeds: Vec<f64> = b
+        .sigs
+        .iter()
+        .flat_map(|s| s.v.iter().map(|v| v.abs()))
+        .filter(|v| *v > 10.0 * vt)
+        .collect();
+    let vmed = if speeds.is_empty() {
+        1e-2
+    } else {
+        let m = speeds.len() / 2;
+        *speeds.select_nth_unstable_by(m, f64::total_cmp).1
+    };
+    match id {
+        EffectId::CoulombAsymmetry => {
+            g.insert("dFc".into(), ls);
+        }
+        EffectId::Viscous => {
+            g.insert("b".into(), ls);
+        }
+        EffectId::PressureViscous => {
+            g.insert("K".into(), ls);
+        }
+        EffectId::AccelerationFriction => {
+            g.insert("H".into(), ls);
+        }
+        EffectId::ExternalForce => {
+            g.insert("F0".into(), ls);
+        }
+        EffectId::Stribeck => {
+            g.insert("Fs".into(), 1.5 * fc);
+            g.insert("vs".into(), (0.3 * vmed).clamp(2e-5, 0.5));
+            g.insert("alpha".into(), 1.0);
+        }
+        EffectId::LugreDynamics => {
+            // Presliding range Fc/σ0 of about 50 µm; little micro-damping.
+            let s0 = (fc / 5e-5).clamp(1e3, 1e9);
+            g.insert("sigma0".into(), s0);
+            g.insert("sigma1".into(), 0.01 * (s0 * rig.mass.max(1e-2)).sqrt());
+        }
+        _ => {}
+    }
+    g
+}
+
+/// Out-of-catalog probes on the current model: a time shift of the measured
+/// force (transport delay, up to ±40 samples) and a force proportional to
+/// the position (a spring the catalog lacks).
+pub(super) fn probes(rig: &FrictionBench, sigs: &[BenchSignals]) -> Vec<Probe> {
+    let sims: Vec<Vec<f64>> = sigs.iter().map(|s| rig.simulate(s)).collect();
+    let rss0: f64 = sigs
+        .iter()
+        .zip(&sims)
+        .flat_map(|(s, f)| s.force.iter().zip(f).map(|(a, b)| (a - b).powi(2)))
+        .sum::<f64>()
+        .max(1e-300);
+    let mut out = Vec::new();
+    // Delay: the measurement lags the model by τ.
+    let dt = crate::smooth::median_step(&sigs[0].t);
+    let mut best = (0.0, rss0);
+    for k in (-40i32..=40).filter(|k| *k != 0) {
+        let tau = k as f64 * dt;
+        let rss: f64 = sigs
+            .iter()
+            .zip(&sims)
+            .map(|(s, f)| {
+                s.t.iter()
+                    .zip(&s.force)
+                    .map(|(&t, &m)| (m - crate::data::interp_linear(&s.t, f, t - tau)).powi(2))
+                    .sum::<f64>()
+            })
+            .sum();
+        if rss < best.1 {
+            best = (tau, rss);
+        }
+    }
+    out.push(Probe {
+        kind: "delay".into(),
+        what: "time shift of the measured force (transport delay)".into(),
+        value: best.0,
+        explained_share: 1.0 - best.1 / rss0,
+    });
+    // Spring: residual ∝ position.
+    let (mut num, mut den) = (0.0, 0.0);
+    for (s, f) in sigs.iter().zip(&sims) {
+        for ((x, m), f) in s.x.iter().zip(&s.force).zip(f) {
+            let phi = rig.force_sign * x;
+            num += phi * (m - f);
+            den += phi * phi;
+        }
+    }
+    let k = if den > 0.0 { num / den } else { 0.0 };
+    out.push(Probe {
+        kind: "spring".into(),
+        what: "force proportional to position (spring)".into(),
+        value: k,
+        explained_share: num * k / rss0,
+    });
+    out
+}
+
+/// Runs the loop on a friction bench.
+pub fn diagnose_bench(
+    rig: &FrictionBench,
+    records: &[Record],
+    opts: &DiagnoseOptions,
+    progress: &mut dyn FnMut(&str, usize, usize),
+) -> Result<Outcome, DiagnoseError> {
+    let start = Instant::now();
+    rig.validate()
+        .map_err(|e| DiagnoseError::Rig(e.to_string()))?;
+    if records.is_empty() {
+        return Err(DiagnoseError::NoData);
+    }
+    // Data problems that need no rig facts; the bench's output is the force,
+    // so a constant force leaves nothing to fit.
+    let mut data_problems = Vec::new();
+    for r in records {
+        let problems = crate::data_checks::check_record(r, None);
+        if let Some(p) = problems
+            .iter()
+            .find(|p| p.channel == "force" && p.kind == crate::data_checks::ProblemKind::Constant)
+        {
+            return Err(DiagnoseError::Unusable {
+                file: r.source.clone(),
+                why: p.message.clone(),
+            });
+        }
+        data_problems.extend(problems);
+    }
+    let mut sigs = Vec::new();
+    let mut windows = Vec::new();
+    let mut smoother = None;
+    for r in records {
+        let (s, info) = bench_signals(r, opts.half_window, rig.steady_state)?;
+        windows.push(info.half_window);
+        smoother.get_or_insert(info);
+        sigs.push(s);
+    }
+    let b = Bench {
+        sigs: &sigs,
+        holdout: opts.holdout,
+    };
+    let measured: Vec<f64> = sigs.iter().flat_map(|s| s.force.iter().copied()).collect();
+    let sim_all =
+        |rig: &FrictionBench| -> Vec<f64> { sigs.iter().flat_map(|s| rig.simulate(s)).collect() };
+    let channel = |rig: &FrictionBench| -> BTreeMap<String, f64> {
+        let mut m = BTreeMap::new();
+        m.insert("force".to_string(), nrmse(&measured, &sim_all(rig)));
+        m
+    };
+    let nrmse_declared = channel(rig);
+    // Declared refit.
+    let mut model = rig.clone();
+    let refit: Vec<ParamRef> = rig
+        .refit
+        .iter()
+        .filter_map(|s| ParamRef::parse(s))
+        .collect();
+    let total_steps = 2 + opts.max_effects;
+    progress("declared refit", 0, total_steps);
+    if !refit.is_empty() {
+        b.fit(&mut model, &refit, Part::All)
+            .map_err(|e| DiagnoseError::Fit {
+                what: "declared parameters".into(),
+                reason: e.to_string(),
+            })?;
+    }
+    let before = model.clone();
+    let nrmse_before = channel(&model);
+    let rss_before = b.rss(&model, Part::All);
+    let candidates: Vec<EffectId> = opts
+        .candidates
+        .clone()
+        .unwrap_or_else(|| EffectId::ALL.to_vec())
+        .into_iter()
+        .filter(|e| BENCH_EFFECTS.contains(e))
+        // Steady-state tables have no time: no bristle dynamics, no acceleration.
+        .filter(|e| {
+            !(rig.steady_state
+                && matches!(e, EffectId::LugreDynamics | EffectId::AccelerationFriction))
+        })
+        .collect();
+    let mut added: Vec<EffectReport> = Vec::new();
+    let mut last_scores: BTreeMap<EffectId, EffectReport> = BTreeMap::new();
+    let mut free: Vec<ParamRef> = refit.clone();
+    let mut first_added: Option<EffectId> = None;
+    let mut resembles: Option<Probe> = None;
+    for round in 0..opts.max_effects {
+        progress("tracing", round + 1, total_steps);
+        let mut r0 = Vec::new();
+        b.residual(&model, Part::All, &mut r0);
+        let rss0: f64 = r0.iter().map(|v| v * v).sum();
+        let rss0_held = b.rss(&model, Part::Held);
+        let neff = n_eff(&r0);
+        let mut best: Option<(EffectId, FrictionBench, EffectReport)> = None;
+        for &id in &candidates {
+            if model.has(id) {
+                continue;
+            }
+            if id == EffectId::AccelerationFriction
+                && model.get(&ParamRef::Effect(EffectId::PressureViscous, "K".into())) == 0.0
+            {
+                last_scores.insert(
+                    id,
+                    EffectReport {
+                        id: id.id().into(),
+                        params: BTreeMap::new(),
+                        ci95: BTreeMap::new(),
+                        explained_share: 0.0,
+                        heldout_share: 0.0,
+                        delta_bic: 0.0,
+                        reason: Some("needs pressure_viscous's K (term is K H a, eq 5.12)".into()),
+                    },
+                );
+                continue;
+            }
+            let mut trial = model.clone();
+            let guess = initial_guess(id, &model, &b);
+            let params: Vec<ParamRef> = id
+                .params()
+                .iter()
+                .map(|p| ParamRef::Effect(id, p.name.to_string()))
+                .collect();
+            for p in &params {
+                let v = guess.get(param_name(p)).copied().unwrap_or(0.0);
+                let (lo, hi) = p.bounds();
+                trial.set(p, v.clamp(lo, hi));
+            }
+            let fit = b.fit(&mut trial, &params, Part::Train);
+            let rss1 = b.rss(&trial, Part::All);
+            let rss1_held = b.rss(&trial, Part::Held);
+            let share = 1.0 - rss1 / rss0.max(1e-300);
+            let held = 1.0 - rss1_held / rss0_held.max(1e-300);
+            let k = params.len() as f64;
+            let dbic = neff * (rss1 / rss0.max(1e-300)).ln() + k * neff.ln();
+            let mut rep = EffectReport {
+                id: id.id().into(),
+                params: params
+                    .iter()
+                    .map(|p| (param_name(p).to_string(), trial.get(p)))
+                    .collect(),
+                ci95: BTreeMap::new(),
+                explained_share: share,
+                heldout_share: held,
+                delta_bic: dbic,
+                reason: None,
+            };
+            if let Err(e) = &fit {
+                rep.reason = Some(format!("fit failed: {e}"));
+            } else if share < opts.min_share {
+                rep.reason = Some(format!(
+                    "explains {:.1} % < {:.1} %",
+                    100.0 * share,
+                    100.0 * opts.min_share
+                ));
+            } else if held < 0.5 * opts.min_share {
+                rep.reason = Some(format!(
+                    "held-out share {:.1} %: does not generalise",
+                    100.0 * held
+                ));
+            } else if dbic >= 0.0 {
+                rep.reason = Some(format!("BIC does not fall (ΔBIC = {dbic:.1})"));
+            }
+            if rep.reason.is_none()
+                && best
+                    .as_ref()
+                    .is_none_or(|(_, _, r)| share > r.explained_share)
+            {
+                best = Some((id, trial, rep.clone()));
+            }
+            last_scores.insert(id, rep);
+        }
+        let probe = if rig.steady_state {
+            Vec::new()
+        } else {
+            probes(&model, &sigs)
+        }
+        .into_iter()
+        .max_by(|a, b| a.explained_share.total_cmp(&b.explained_share));
+        if let Some(p) = &probe {
+            if p.explained_share >= opts.min_share
+                && best
+                    .as_ref()
+                    .is_none_or(|(_, _, r)| p.explained_share > r.explained_share + opts.min_share)
+            {
+                if let Some((id, _, _)) = &best {
+                    if let Some(r) = last_scores.get_mut(id) {
+                        r.reason = Some(format!(
+                            "the residual is better explained by a {} ({:.1} %), which is not in the catalog",
+                            p.what,
+                            100.0 * p.explained_share
+                        ));
+                    }
+                }
+                resembles = Some(p.clone());
+                break;
+            }
+        }
+        let Some((id, trial, mut rep)) = best else {
+            break;
+        };
+        // Refit every free parameter against the output error.
+        model = trial;
+        for p in id.params() {
+            free.push(ParamRef::Effect(id, p.name.to_string()));
+        }
+        progress("refit", round + 1, total_steps);
+        let res = b
+            .fit(&mut model, &free, Part::All)
+            .map_err(|e| DiagnoseError::Fit {
+                what: id.id().into(),
+                reason: e.to_string(),
+            })?;
+        // Report the effect's refitted values and intervals.
+        for (p, (x, ci)) in free.iter().zip(res.x.iter().zip(&res.ci95)) {
+            if let ParamRef::Effect(e, name) = p {
+                for a in added.iter_mut().chain(std::iter::once(&mut rep)) {
+                    if a.id == e.id() {
+                        a.params.insert(name.clone(), *x);
+                        a.ci95.insert(name.clone(), ci.is_finite().then_some(*ci));
+                    }
+                }
+            }
+        }
+        last_scores.remove(&id);
+        first_added.get_or_insert(id);
+        added.push(rep);
+    }
+    // Final intervals of the declared refits.
+    let mut declared_refit = Vec::new();
+    if !free.is_empty() {
+        let mut m2 = model.clone();
+        let res = b
+            .fit(&mut m2, &free, Part::All)
+            .map_err(|e| DiagnoseError::Fit {
+                what: "final refit".into(),
+                reason: e.to_string(),
+            })?;
+        model = m2;
+        for (p, (x, ci)) in free.iter().zip(res.x.iter().zip(&res.ci95)) {
+            match p {
+                ParamRef::Effect(e, name) if !rig.has(*e) => {
+                    for a in added.iter_mut() {
+                        if a.id == e.id() {
+                            a.params.insert(name.clone(), *x);
+                            a.ci95.insert(name.clone(), ci.is_finite().then_some(*ci));
+                        }
+                    }
+                }
+                _ => declared_refit.push(ParamReport {
+                    name: p.label(),
+                    declared: rig.get(p),
+                    fitted: *x,
+                    ci95: ci.is_finite().then_some(*ci),
+                }),
+            }
+        }
+    }
+    progress("report", total_steps, total_steps);
+    let nrmse_after = channel(&model);
+    let rss_after = b.rss(&model, Part::All);
+    // The floor: load-cell noise plus the pressure sensors' noise carried
+    // into the prediction by the areas (the balance is linear in both).
+    let noise_ss: f64 = sigs
+        .iter()
+        .map(|s| {
+            let var = noise_sigma(&s.force).powi(2)
+                + (rig.area1 * noise_sigma(&s.p1)).powi(2)
+                + (rig.area2 * noise_sigma(&s.p2)).powi(2);
+            var * s.force.len() as f64
+        })
+        .sum();
+    let range = {
+        let lo = measured.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = measured.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        (hi - lo).max(1e-300)
+    };
+    // A steady-state table is not a time series: no noise estimate from it.
+    let noise_ss = if rig.steady_state { f64::NAN } else { noise_ss };
+    let mut noise_floor = BTreeMap::new();
+    noise_floor.insert(
+        "force".to_string(),
+        (noise_ss / measured.len() as f64).sqrt() / range,
+    );
+    let traces = sigs
+        .iter()
+        .map(|s| {
+            // Show friction (the force minus the pressure force), not the
+            // pressure-dominated load-cell force.
+            let pf: Vec<f64> = (0..s.t.len())
+                .map(|i| rig.force_sign * (rig.area2 * s.p2[i] - rig.area1 * s.p1[i]))
+                .collect();
+            let minus =
+                |y: Vec<f64>| -> Vec<f64> { y.iter().zip(&pf).map(|(a, b)| a - b).collect() };
+            RecordTrace {
+                source: s.source.clone(),
+                t: s.t.clone(),
+                velocity: s.v.clone(),
+                channel: "friction".into(),
+                measured: minus(s.force.clone()),
+                before: minus(before.simulate(s)),
+                after: minus(model.simulate(s)),
+                regressor: first_added.map(|id| {
+                    let vt = model.friction.smoothing_velocity;
+                    let k = model.get(&ParamRef::Effect(EffectId::PressureViscous, "K".into()));
+                    let phi: Vec<f64> = (0..s.t.len())
+                        .map(|i| match id {
+                            EffectId::CoulombAsymmetry => 0.5 * (s.v[i] / vt).tanh().abs(),
+                            EffectId::Viscous | EffectId::Stribeck | EffectId::LugreDynamics => {
+                                s.v[i]
+                            }
+                            EffectId::PressureViscous => (s.p1[i] - s.p2[i]).powi(2) * s.v[i],
+                            EffectId::AccelerationFriction => k * s.a[i],
+                            _ => 1.0,
+                        })
+                        .collect();
+                    (id.id().to_string(), phi)
+                }),
+            }
+        })
+        .collect();
+    let rejected: Vec<EffectReport> = last_scores.into_values().collect();
+    let report = Report {
+        rig: rig.name.clone(),
+        rig_kind: "friction-bench".into(),
+        records: records.iter().map(|r| r.source.clone()).collect(),
+        samples: measured.len(),
+        data_problems,
+        smoother: smoother.expect("at least one record"),
+        smoother_windows: windows,
+        initial_state: if rig.has(EffectId::LugreDynamics) || added.iter().any(|a| a.id == "lugre_dynamics") {
+            "motion imposed by the drive (measured); bristle state z0 from the mean friction of the first 5 samples, limited to |z0| <= g(v0)/sigma0".into()
+        } else {
+            "motion imposed by the drive (measured); static friction law has no state".into()
+        },
+        nrmse_declared,
+        nrmse_before,
+        nrmse_after,
+        noise_floor,
+        declared_refit,
+        effects_added: added,
+        effects_rejected: rejected,
+        effects_not_applicable: EffectId::ALL
+            .iter()
+            .filter(|e| !BENCH_EFFECTS.contains(e))
+            .map(|e| NotApplicable {
+                id: e.id().to_string(),
+                why: format!(
+                    "the friction bench has only the force balance; {} belongs to the {:?} balance",
+                    e.id(),
+                    e.balance()
+                ),
+            })
+            .collect(),
+        unexplained_share: rss_after / rss_before.max(1e-300),
+        unexplained_resembles: resembles,
+        warnings: Vec::new(),
+        noise_share: if noise_ss.is_nan() {
+            f64::NAN
+        } else {
+            (noise_ss / rss_after.max(1e-300)).min(1.0)
+        },
+        selection: format!(
+            "add the effect explaining the largest share of the force-balance residual if share >= {:.0} %, held-out share >= {:.1} % (last {:.0} % of each record) and BIC falls (n_eff from lag-1 autocorrelation); refit all free parameters on the output error",
+            100.0 * opts.min_share,
+            50.0 * opts.min_share,
+            100.0 * opts.holdout
+        ),
+        wall_times_s: BTreeMap::from([("total".to_string(), start.elapsed().as_secs_f64())]),
+        elapsed_s: start.elapsed().as_secs_f64(),
+    };
+    Ok(Outcome {
+        report,
+        traces,
+        rig: model,
+    })
+}

@@ -1,0 +1,318 @@
+//! Simulating the valve rig against a record: the prepared record (input,
+//! compared channels, weights, initial state, stop restarts), the simulated
+//! channels, the weighted output error and the NRMSE per channel.
+
+use super::*;
+/// The channels compared, in report order.
+pub(super) const CHANNELS: [Signal; 4] =
+    [Signal::Position, Signal::Velocity, Signal::P1, Signal::P2];
+
+#[derive(Clone)]
+pub(super) struct Prepared {
+    /// Relative tolerance of the simulations (looser while tracing).
+    pub(super) rtol: f64,
+    pub(super) t: Vec<f64>,
+    /// The run's input: the measured command (open loop) or the position
+    /// reference (a closed-loop record, whose rig's controller computes the
+    /// command).
+    pub(super) input: Vec<f64>,
+    /// Whether the record is closed loop (it has a `reference` column).
+    pub(super) closed: bool,
+    /// The measured command at the first sample (the initial spool demand;
+    /// `None` in a closed-loop record without a `command` column: the
+    /// controller's output at the first sample is taken).
+    pub(super) command0: Option<f64>,
+    /// Measured channels present (velocity: measured, else smoothed derivative).
+    pub(super) meas: Vec<(Signal, Vec<f64>)>,
+    pub(super) ranges: Vec<f64>,
+    /// Weight of each channel in the output error: 1/σ (its noise, floored at
+    /// 1e-4 of its range); 0 for a velocity derived from position (it would
+    /// count the position twice).
+    pub(super) weights: Vec<f64>,
+    /// Initial state estimates: smoothed position, velocity, p1, p2 at t0.
+    pub(super) x0: Option<f64>,
+    pub(super) v0: Option<f64>,
+    pub(super) p10: Option<f64>,
+    pub(super) p20: Option<f64>,
+    /// Restarts of the simulation where the measured piston leaves a stop.
+    pub(super) restarts: Vec<stops::Restart>,
+}
+
+pub(super) fn prepare(
+    rec: &Record,
+    half: Option<usize>,
+    excluded: &[Signal],
+    stroke: f64,
+) -> Result<(Prepared, crate::smooth::SmootherInfo), DiagnoseError> {
+    let t = rec.time.clone();
+    let closed = rec.get(Signal::Reference).is_some();
+    let input = if closed {
+        rec.require(Signal::Reference)?.to_vec()
+    } else {
+        rec.require(Signal::Command)?.to_vec()
+    };
+    let command0 = rec.get(Signal::Command).map(|u| u[0]);
+    let x = rec.require(Signal::Position)?;
+    let s = match half {
+        Some(h) => smooth_with(&t, x, h, 3),
+        None => smooth_gcv(&t, x, 3, 400),
+    };
+    let position_ok = !excluded.contains(&Signal::Position);
+    let mut meas = Vec::new();
+    // In closed loop the measured command is an output: compared like the others.
+    let compared = CHANNELS
+        .into_iter()
+        .chain(closed.then_some(Signal::Command));
+    for ch in compared {
+        if excluded.contains(&ch) {
+            continue;
+        }
+        match (ch, rec.get(ch)) {
+            (_, Some(v)) => meas.push((ch, v.to_vec())),
+            (Signal::Velocity, None) if position_ok => meas.push((ch, s.d1.clone())),
+            _ => {}
+        }
+    }
+    let ranges = meas
+        .iter()
+        .map(|(_, v)| {
+            let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            (hi - lo).max(1e-300)
+        })
+        .collect();
+    let weights = meas
+        .iter()
+        .zip(&ranges)
+        .map(|((ch, y), r)| {
+            if *ch == Signal::Velocity && rec.get(Signal::Velocity).is_none() {
+                0.0
+            } else {
+                1.0 / noise_sigma(y).max(1e-4 * r)
+            }
+        })
+        .collect();
+    // A position left out of the fit (a data problem) gives no initial
+    // state: the rig's declared one is kept.
+    let v0 = match rec.get(Signal::Velocity) {
+        Some(v) if !excluded.contains(&Signal::Velocity) => Some(v[0]),
+        _ => position_ok.then(|| s.d1[0]),
+    };
+    // The first sample's noise would start the simulation off the record:
+    // take the smoothed values at t0 (local cubic fit over the GCV window).
+    let p0 = |sig: Signal| {
+        (!excluded.contains(&sig))
+            .then(|| rec.get(sig).map(|y| smooth_gcv(&t, y, 3, 100).value[0]))
+            .flatten()
+    };
+    let (p10, p20) = (p0(Signal::P1), p0(Signal::P2));
+    let restarts = if position_ok {
+        stops::restarts(x, stroke, (5.0 * noise_sigma(x)).max(1e-4 * stroke))
+    } else {
+        Vec::new()
+    };
+    Ok((
+        Prepared {
+            rtol: 1e-8,
+            x0: position_ok.then(|| s.value[0]),
+            p10,
+            p20,
+            restarts,
+            t,
+            input,
+            closed,
+            command0,
+            meas,
+            ranges,
+            weights,
+            v0,
+        },
+        s.info,
+    ))
+}
+
+/// Sets the rig's initial state from the record: measured position, velocity
+/// and chamber pressures at the first sample (the steady pressures of the
+/// rig when p1/p2 are not measured), spool at the first command.
+pub(super) fn with_initial(rig: &ValveRig, p: &Prepared) -> ValveRig {
+    let mut r = rig.clone();
+    if let Some(x0) = p.x0 {
+        let half = 0.5 * r.cylinder.stroke_m;
+        r.initial.position = x0.clamp(-half, half);
+    }
+    if let Some(v0) = p.v0 {
+        r.initial.velocity = v0;
+    }
+    let u0 = match (p.command0, &r.controller) {
+        (Some(u), _) => u,
+        (None, Some(c)) => (c.gain_per_m * (p.input[0] - r.initial.position) + c.bias)
+            .clamp(c.output_min, c.output_max),
+        (None, None) => 0.0,
+    };
+    r.initial.spool = (u0 * r.valve.stroke_m).clamp(-r.valve.stroke_m, r.valve.stroke_m);
+    r.initial.p1 = p.p10;
+    r.initial.p2 = p.p20;
+    r
+}
+
+/// Simulates and returns, per measured channel, the simulated series.
+///
+/// `sensor_lag` is applied here as a measurement model on the simulated
+/// samples ([`lag_samples`]) rather than by the rig's sensor states: the rig
+/// is run with ideal sensors. A lag state with τ far below the integrator's
+/// step makes the system stiff (the fit's first finite-difference steps
+/// start from τ = 0), and the sampled filter is smooth in τ down to 0. On
+/// 1 kHz records of this rig the two agree to well under the sensor noise
+/// (the planted `sensor_lag` test generates its record with the states).
+pub(super) fn simulate(rig: &ValveRig, p: &Prepared) -> Result<Vec<Vec<f64>>, String> {
+    simulate_prefix(rig, p, p.t.len())
+}
+
+/// [`simulate`] over the first `n` samples only (the training part needs no
+/// more; at least two samples are simulated).
+pub(super) fn simulate_prefix(
+    rig: &ValveRig,
+    p: &Prepared,
+    n: usize,
+) -> Result<Vec<Vec<f64>>, String> {
+    let n = n.clamp(2.min(p.t.len()), p.t.len());
+    let t = &p.t[..n];
+    let cmd = CmdSignal::table(p.t.clone(), p.input.clone()).map_err(|e| e.to_string())?;
+    let opts = RunOptions {
+        rtol: p.rtol,
+        ..RunOptions::default()
+    };
+    let tau = rig.sensors.pressure_lag_s;
+    if !(tau.is_finite() && tau >= 0.0) {
+        return Err(format!(
+            "sensors.pressure_lag_s must be finite and non-negative, got {tau}"
+        ));
+    }
+    let mut seg = rig.clone();
+    seg.sensors.pressure_lag_s = 0.0;
+    let mut out: Vec<Vec<f64>> = vec![Vec::with_capacity(n); p.meas.len()];
+    // One segment per stretch between restarts at stop exits (`stops`).
+    let mut cuts = p
+        .restarts
+        .iter()
+        .filter(|r| r.index > 0 && r.index + 1 < n)
+        .peekable();
+    let mut a = 0;
+    loop {
+        let next = cuts.next();
+        let b = next.map_or(n - 1, |r| r.index);
+        let run = seg
+            .simulate(cmd.clone(), &t[a..=b], &opts)
+            .map_err(|e| e.to_string())?;
+        // the restart sample belongs to the next segment
+        let keep = if next.is_some() { b - a } else { b - a + 1 };
+        for (o, (ch, _)) in out.iter_mut().zip(&p.meas) {
+            let v = run
+                .channel(ch.name())
+                .ok_or_else(|| format!("simulation has no channel '{}'", ch.name()))?;
+            o.extend_from_slice(&v[..keep]);
+        }
+        let Some(r) = next else { break };
+        let last = |name: &str| run.channel(name).and_then(|v| v.last().copied());
+        let xm = seg.valve.stroke_m;
+        seg.initial.position = r.position;
+        seg.initial.velocity = 0.0;
+        seg.initial.spool = last("spool").unwrap_or(0.0).clamp(-xm, xm);
+        seg.initial.p1 = last("p1");
+        seg.initial.p2 = last("p2");
+        a = b;
+    }
+    if tau > 0.0 {
+        for (o, (ch, _)) in out.iter_mut().zip(&p.meas) {
+            if matches!(ch, Signal::P1 | Signal::P2) {
+                *o = lag_samples(t, o, tau);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// A first-order lag `τ dy/dt = u − y` applied to samples `u` at times `t`,
+/// exact when `u` is linear between samples (first-order hold): over a step
+/// `h` with `a = exp(−h/τ)` and slope `s = Δu/h`,
+/// `y ← a y + (1 − a) u_k + s (h − τ (1 − a))`. It starts at rest
+/// (`y_0 = u_0`), as the rig's sensor states do; `τ = 0` returns `u`.
+pub fn lag_samples(t: &[f64], u: &[f64], tau: f64) -> Vec<f64> {
+    let mut y = Vec::with_capacity(u.len());
+    let Some(&u0) = u.first() else {
+        return y;
+    };
+    y.push(u0);
+    for k in 1..u.len().min(t.len()) {
+        let h = t[k] - t[k - 1];
+        let (a, tau_1a) = if tau > 0.0 {
+            let a = (-h / tau).exp();
+            (a, tau * (1.0 - a))
+        } else {
+            (0.0, 0.0)
+        };
+        let s = (u[k] - u[k - 1]) / h;
+        let prev = y[k - 1];
+        y.push(a * prev + (1.0 - a) * u[k - 1] + s * (h - tau_1a));
+    }
+    y
+}
+
+#[derive(Clone, Copy, PartialEq)]
+pub(super) enum Part {
+    All,
+    Train,
+    Held,
+}
+
+pub(super) fn residual(
+    rig: &ValveRig,
+    p: &Prepared,
+    holdout: f64,
+    part: Part,
+    out: &mut Vec<f64>,
+) -> Result<(), String> {
+    let n = p.t.len();
+    let cut = ((1.0 - holdout) * n as f64) as usize;
+    let sims = if part == Part::Train {
+        simulate_prefix(rig, p, cut)?
+    } else {
+        simulate(rig, p)?
+    };
+    let range = match part {
+        Part::All => 0..n,
+        Part::Train => 0..cut,
+        Part::Held => cut..n,
+    };
+    out.clear();
+    for ((_, m), (s, w)) in p.meas.iter().zip(sims.iter().zip(&p.weights)) {
+        if *w == 0.0 {
+            continue;
+        }
+        for i in range.clone() {
+            out.push((s[i] - m[i]) * w);
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn rss(rig: &ValveRig, p: &Prepared, holdout: f64, part: Part) -> f64 {
+    let mut r = Vec::new();
+    match residual(rig, p, holdout, part, &mut r) {
+        Ok(()) => r.iter().map(|v| v * v).sum(),
+        Err(_) => f64::INFINITY,
+    }
+}
+
+pub(super) fn channel_nrmse(rig: &ValveRig, p: &Prepared) -> BTreeMap<String, f64> {
+    simulate(rig, p).map_or_else(|_| BTreeMap::new(), |sims| nrmse_of(p, &sims))
+}
+
+/// NRMSE per measured channel of the simulated series `sims`.
+pub(super) fn nrmse_of(p: &Prepared, sims: &[Vec<f64>]) -> BTreeMap<String, f64> {
+    p.meas
+        .iter()
+        .zip(sims)
+        .map(|((ch, meas), s)| (ch.name().to_string(), nrmse(meas, s)))
+        .collect()
+}

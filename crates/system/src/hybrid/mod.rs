@@ -25,7 +25,10 @@
 //!   pass reverse flow);
 //! * the DDDC four-way valve opens the chamber that is not fed to its T port
 //!   (`B → T` when `Pp1 > Pp2`), the NCCC needle valve (with its reverse-flow
-//!   check) throttles it to the tank ([`ReturnPath`]);
+//!   check) throttles it to the tank ([`PilotValve`], [`NeedleComponent`]);
+//!   the T port between them is an algebraic node
+//!   ([`AlgebraicNode`](crate::series::AlgebraicNode)) whose pressure the
+//!   assembler solves;
 //! * the C10 cylinder (Table 4-6), a moving mass, the new friction model of
 //!   chapter 5 (eq 5.14, Tables 5-8 to 5-10).
 //!
@@ -36,7 +39,9 @@ pub mod chapter7;
 pub mod components;
 mod netlist;
 
-pub use components::{CheckComponent, PumpComponent, ReliefComponent, ReturnNodes, ReturnPath};
+pub use components::{
+    CheckComponent, NeedleComponent, PilotNodes, PilotValve, PumpComponent, ReliefComponent,
+};
 
 use crate::circuit::{BuildError, Circuit, Component};
 use crate::components::{CommandInput, Friction, Mass, PressureSource, TwoChamberCylinder, Volume};
@@ -68,6 +73,8 @@ pub mod nodes {
     pub const CHAMBER_2: &str = "chamber_2";
     /// The tank.
     pub const TANK: &str = "tank";
+    /// The four-way valve's T port, joined to the needle valve (algebraic).
+    pub const RETURN_PORT: &str = "return_port";
     /// The piston rod and load.
     pub const ROD: &str = "rod";
     /// The pump command signal \[V\].
@@ -348,17 +355,27 @@ impl WangHybrid {
             )),
             Box::new(CheckComponent::new("check_1", self.check, TANK, LINE_1)),
             Box::new(CheckComponent::new("check_2", self.check, TANK, LINE_2)),
-            Box::new(ReturnPath::with_nodes(
-                "return",
+            Box::new(PilotValve::new(
+                "pilot_valve",
                 self.four_way,
-                self.needle,
-                ReturnNodes {
+                PilotNodes {
                     pilot_1: LINE_1,
                     pilot_2: LINE_2,
                     a: CHAMBER_1,
                     b: CHAMBER_2,
-                    tank: TANK,
+                    t: RETURN_PORT,
                 },
+            )),
+            Box::new(NeedleComponent::new(
+                "needle_valve",
+                self.needle,
+                RETURN_PORT,
+                TANK,
+            )),
+            Box::new(crate::series::AlgebraicNode::new(
+                "return_port",
+                RETURN_PORT,
+                None,
             )),
         ])
     }

@@ -10,7 +10,7 @@ use hydrocyl_ports::{Area, Position, Pressure};
 use serde_json::Value;
 
 /// The components of the hybrid circuit, in state order.
-const PARTS: [(&str, &str); 15] = [
+const PARTS: [(&str, &str); 17] = [
     ("command", "command_input"),
     ("pump", "pump_identified"),
     ("line_1", "volume"),
@@ -25,11 +25,13 @@ const PARTS: [(&str, &str); 15] = [
     ("relief_3_line_2", "relief_valve"),
     ("check_1", "check_valve"),
     ("check_2", "check_valve"),
-    ("return", "pilot_return_path"),
+    ("pilot_valve", "pilot_valve"),
+    ("needle_valve", "needle_valve"),
+    ("return_port", "algebraic_node"),
 ];
 
 /// Ports the circuit joins: each group shares one node.
-const NODES: [&[(&str, &str)]; 7] = [
+const NODES: [&[(&str, &str)]; 8] = [
     &[("command", "out"), ("pump", "command")],
     &[
         ("pump", "a"),
@@ -37,7 +39,7 @@ const NODES: [&[(&str, &str)]; 7] = [
         ("relief_1", "inlet"),
         ("relief_3_line_1", "inlet"),
         ("check_1", "outlet"),
-        ("return", "pilot_1"),
+        ("pilot_valve", "pilot_1"),
     ],
     &[
         ("pump", "b"),
@@ -45,19 +47,19 @@ const NODES: [&[(&str, &str)]; 7] = [
         ("relief_2", "inlet"),
         ("relief_3_line_2", "inlet"),
         ("check_2", "outlet"),
-        ("return", "pilot_2"),
+        ("pilot_valve", "pilot_2"),
     ],
     &[
         ("cylinder", "A"),
         ("friction", "A"),
         ("relief_1", "outlet"),
-        ("return", "A"),
+        ("pilot_valve", "A"),
     ],
     &[
         ("cylinder", "B"),
         ("friction", "B"),
         ("relief_2", "outlet"),
-        ("return", "B"),
+        ("pilot_valve", "B"),
     ],
     &[
         ("tank", "port"),
@@ -65,7 +67,12 @@ const NODES: [&[(&str, &str)]; 7] = [
         ("relief_3_line_2", "outlet"),
         ("check_1", "inlet"),
         ("check_2", "inlet"),
-        ("return", "T"),
+        ("needle_valve", "outlet"),
+    ],
+    &[
+        ("return_port", "node"),
+        ("pilot_valve", "T"),
+        ("needle_valve", "inlet"),
     ],
     &[("cylinder", "rod"), ("load", "rod"), ("friction", "rod")],
 ];
@@ -162,8 +169,8 @@ impl WangHybrid {
             relief_pilot: typed(get("relief_1")?, "")?,
             relief_safety: typed(get("relief_3_line_1")?, "")?,
             check: typed(get("check_1")?, "")?,
-            four_way: typed(get("return")?, "four_way")?,
-            needle: typed(get("return")?, "needle")?,
+            four_way: typed(get("pilot_valve")?, "")?,
+            needle: typed(get("needle_valve")?, "")?,
             cylinder: Cylinder {
                 area_1: Area::new(cyl.get("area_1")),
                 area_2: Area::new(cyl.get("area_2")),

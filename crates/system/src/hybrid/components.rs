@@ -761,4 +761,32 @@ mod tests {
         .unwrap_err();
         assert!(e.to_string().contains("at least two"), "{e}");
     }
+
+    /// On the rig the warm-started Newton solve of the T port costs a few
+    /// member evaluations and never falls back to Brent.
+    #[test]
+    fn the_return_port_solve_is_cheap_on_the_rig() {
+        use crate::hybrid::chapter7::{Chapter7Test, Load, Shape};
+        use crate::run::{run, RunOptions, Solver};
+        let test = Chapter7Test::new(Shape::Square, Load::None);
+        let rig = test.rig();
+        let mut c = rig.build(test.command(&rig)).unwrap();
+        let x0 = c.initial_state();
+        c.reset(0.0, &x0);
+        let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-2).collect();
+        let opts = RunOptions {
+            solver: Solver::Rosenbrock,
+            ..RunOptions::default()
+        };
+        run(&mut c, &x0, &t, &opts).unwrap();
+        let d = c.diagnostics();
+        let get = |k: &str| d.iter().find(|(n, _)| n == k).unwrap().1;
+        let (solves, evals) = (
+            get("return_port.solves"),
+            get("return_port.solve_evaluations"),
+        );
+        assert!(solves > 1000.0);
+        assert!(evals / solves < 3.0, "{}", evals / solves);
+        assert_eq!(get("return_port.solve_fallbacks"), 0.0);
+    }
 }

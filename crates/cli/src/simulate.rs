@@ -28,7 +28,6 @@ use hydrocyl_system::hybrid::WangHybrid;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{self as runner, Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
-use hydrocyl_system::Circuit;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -255,10 +254,9 @@ fn simulate_variant(
     };
     let speed = r.pump.gain * (u_max / r.cylinder.area_1.si()).max(-u_min / r.cylinder.area_2.si());
     v.apply_to_rig(&mut r, Some(1e3 * speed));
-    let build = |e: hydrocyl_system::BuildError| CliError::Input(format!("rig {}: {e}", v.name));
-    let mut comps = r.components(command).map_err(build)?;
-    v.swap_components(&mut comps);
-    let mut c = Circuit::build(comps).map_err(build)?;
+    let mut c = r
+        .build_with(command, |comps| v.swap_components(comps))
+        .map_err(|e| CliError::Input(format!("rig {}: {e}", v.name)))?;
     let x0 = c.initial_state();
     c.reset(t.first().copied().unwrap_or(0.0), &x0);
     runner::run(&mut c, &x0, t, opts).map_err(|e| CliError::Input(format!("rig {}: {e}", v.name)))

@@ -24,7 +24,6 @@ use hydrocyl_system::rig::RigError;
 use hydrocyl_system::run::{run, RunOptions, SimError, Solver};
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::valve_rig::ValveRig;
-use hydrocyl_system::Circuit;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -370,13 +369,13 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
             let amplitude = v * (a1 + a2) / (2.0 * k);
             let bias = v * (a1 - a2) / (2.0 * k);
             let cmd = wave_signal(sc.wave, amplitude, period, bias);
-            let mut comps = r
-                .components(cmd)
-                .map_err(|e| rig_err(&label)(RigError::Build(e)))?;
-            if let Some(var) = variant {
-                var.swap_components(&mut comps);
-            }
-            let c = Circuit::build(comps).map_err(|e| rig_err(&label)(RigError::Build(e)))?;
+            let c = r
+                .build_with(cmd, |comps| {
+                    if let Some(var) = variant {
+                        var.swap_components(comps);
+                    }
+                })
+                .map_err(rig_err(&label))?;
             (c, Solver::Rosenbrock)
         }
     };

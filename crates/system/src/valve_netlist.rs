@@ -25,7 +25,7 @@ fn template(text: &str) -> Value {
 }
 
 /// A friction law as a netlist component object (`friction_<model>`).
-fn friction_component(law: &FrictionLaw) -> Value {
+pub(crate) fn friction_component(law: &FrictionLaw) -> Value {
     let mut v = serde_json::to_value(law).expect("a friction law serialises");
     let obj = v.as_object_mut().expect("a tagged object");
     obj.remove("model");

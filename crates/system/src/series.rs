@@ -36,7 +36,7 @@ use std::cell::Cell;
 
 /// Relative tolerance of the series solve on the node pressure (of the
 /// bracket's largest magnitude, floored at 1 bar).
-pub const SERIES_RTOL: f64 = 1e-12;
+pub const SERIES_RTOL: f64 = 1e-14;
 
 /// Newton iterations (each safeguarded by bisection) before the solve falls
 /// back to Brent's method; on the hybrid rig a solve takes ~2 evaluations.
@@ -183,6 +183,7 @@ fn newton(
     tol: f64,
 ) -> Option<f64> {
     let mut p = p0;
+    let mut last_step = f64::INFINITY;
     for _ in 0..NEWTON_ITERATIONS {
         let r = f(p, w);
         if r == 0.0 {
@@ -196,9 +197,11 @@ fn newton(
         }
         let s = slope(w)?;
         let step = if s < 0.0 { -r / s } else { f64::NAN };
-        if step.abs() <= tol {
+        // converged, or at the rounding floor (a step that stopped shrinking)
+        if step.abs() <= tol || (step.abs() <= 1e3 * tol && step.abs() >= 0.5 * last_step) {
             return Some(p);
         }
+        last_step = step.abs();
         let next = p + step;
         p = if next > a && next < b {
             next

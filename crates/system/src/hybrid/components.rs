@@ -405,6 +405,10 @@ pub struct PilotValve {
     flow_a: Wire<VolumeFlow>,
     flow_b: Wire<VolumeFlow>,
     counts: [usize; 3],
+    /// The last `(Pp1, Pp2, y)`: the opening (two circle segments) is
+    /// computed once per pilot pressures, not once per trial of the T
+    /// port's Newton solve.
+    last_opening: std::cell::Cell<[f64; 3]>,
 }
 
 impl PilotValve {
@@ -429,15 +433,26 @@ impl PilotValve {
             flow_a: Wire::UNBOUND,
             flow_b: Wire::UNBOUND,
             counts: [0; 3],
+            last_opening: std::cell::Cell::new([f64::NAN; 3]),
         }
+    }
+
+    /// The signed opening `y` at the pilot pressures on `w` (memoised).
+    fn opening(&self, w: &Wires) -> f64 {
+        let (pp1, pp2) = (w.get(self.pp1.pressure), w.get(self.pp2.pressure));
+        let [a, b, y] = self.last_opening.get();
+        if a == pp1.si() && b == pp2.si() {
+            return y;
+        }
+        let y = self.four_way.opening(pp1, pp2);
+        self.last_opening.set([pp1.si(), pp2.si(), y]);
+        y
     }
 
     /// The opening `y`, the flow from the open chamber to the T port and the
     /// open chamber's pressure.
     fn state(&self, w: &Wires) -> (f64, VolumeFlow, Pressure) {
-        let y = self
-            .four_way
-            .opening(w.get(self.pp1.pressure), w.get(self.pp2.pressure));
+        let y = self.opening(w);
         let px = if y > 0.0 {
             w.get(self.b.pressure)
         } else {
@@ -492,9 +507,7 @@ impl Component for PilotValve {
         w.set(self.flow_b, if y > 0.0 { q } else { none });
     }
     fn inflow_slope(&self, _t: f64, _x: &[f64], w: &Wires, node: Wire<Pressure>) -> Option<f64> {
-        let y = self
-            .four_way
-            .opening(w.get(self.pp1.pressure), w.get(self.pp2.pressure));
+        let y = self.opening(w);
         let open = if y > 0.0 { self.b } else { self.a };
         if node == self.pp1.pressure || node == self.pp2.pressure {
             return None; // the opening moves with the pilot pressures

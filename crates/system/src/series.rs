@@ -353,7 +353,13 @@ fn kahn<I: Iterator<Item = usize>>(
             .find(|&i| !order.contains(&i) && deps(i).all(|d| order.contains(&d)));
         match next {
             Some(i) => order.push(i),
-            None => return Err(items.iter().copied().filter(|i| !order.contains(i)).collect()),
+            None => {
+                return Err(items
+                    .iter()
+                    .copied()
+                    .filter(|i| !order.contains(i))
+                    .collect())
+            }
         }
     }
     Ok(order)

@@ -627,7 +627,12 @@ fn algebraic_node_errors_name_the_json_path() {
                     .unwrap()
                     .remove("return_port");
             },
-            &["connections[6]", "needle_valve.inlet", "no owner", "algebraic_node"],
+            &[
+                "connections[6]",
+                "needle_valve.inlet",
+                "no owner",
+                "algebraic_node",
+            ],
         ),
         (
             "two owners",
@@ -641,7 +646,12 @@ fn algebraic_node_errors_name_the_json_path() {
                     {"type": "volume", "volume": 1e-6, "bulk_modulus": 1e9}
                 );
             },
-            &["connections[6]", "owned by both", "return_port.node", "hose.port"],
+            &[
+                "connections[6]",
+                "owned by both",
+                "return_port.node",
+                "hose.port",
+            ],
         ),
         (
             "one neighbour",

@@ -98,8 +98,7 @@ fn a_signal_used_as_two_quantities_is_a_build_error() {
         "u",
         crate::signal::Signal::Constant { value: 0.0 },
     );
-    let e =
-        Circuit::build(vec![Box::new(cmd), Box::new(spool), gain("g", "x", "y")]).unwrap_err();
+    let e = Circuit::build(vec![Box::new(cmd), Box::new(spool), gain("g", "x", "y")]).unwrap_err();
     assert!(matches!(e, BuildError::UnitMismatch { .. }), "{e}");
     let msg = e.to_string();
     assert!(

@@ -66,13 +66,7 @@ const PILOT: [ParamSpec; 7] = [
         Range::POSITIVE,
         "pilot spool centring spring rate k_s",
     ),
-    param(
-        "overlap",
-        "m",
-        Required,
-        Range::NON_NEGATIVE,
-        "overlap x_o",
-    ),
+    param("overlap", "m", Required, Range::NON_NEGATIVE, "overlap x_o"),
     param(
         "stroke",
         "m",

@@ -183,10 +183,8 @@ fn variant_circuit(
     };
     let speed = r.pump.gain * (u_max / r.cylinder.area_1.si()).max(-u_min / r.cylinder.area_2.si());
     v.apply_to_rig(&mut r, Some(1e3 * speed));
-    let build = |e: hydrocyl_system::BuildError| CliError::Input(format!("rig {}: {e}", v.name));
-    let mut comps = r.components(command).map_err(build)?;
-    v.swap_components(&mut comps);
-    Circuit::build(comps).map_err(build)
+    r.build_with(command, |comps| v.swap_components(comps))
+        .map_err(|e| CliError::Input(format!("rig {}: {e}", v.name)))
 }
 
 /// `hydrocyl simulate` on a friction bench: the `--command` file carries the

@@ -27,8 +27,7 @@ use serde::Serialize;
 /// One named energy \[J\] over the window.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Term {
-    /// Name: the component's, with a `.part` suffix where one component's
-    /// term is split (`return.needle_valve`).
+    /// Name: the component's (`needle_valve`, `pilot_valve`, ...).
     pub name: String,
     /// Energy over the window \[J\].
     pub energy_j: f64,
@@ -88,25 +87,6 @@ impl Ledger {
             .filter(|t| t.name == name)
             .map(|t| t.energy_j)
             .sum()
-    }
-
-    /// Replaces loss `name` by the parts given (names `name.part`), keeping
-    /// the total: the last part takes whatever the others leave, so the
-    /// balance is unchanged.
-    pub fn split_loss(&mut self, name: &str, parts: &[(&str, f64)]) {
-        let Some(i) = self.losses.iter().position(|t| t.name == name) else {
-            return;
-        };
-        let total = self.losses.remove(i).energy_j;
-        let mut rest = total;
-        for (k, (part, e)) in parts.iter().enumerate() {
-            let e = if k + 1 == parts.len() { rest } else { *e };
-            rest -= e;
-            self.losses.push(Term {
-                name: format!("{name}.{part}"),
-                energy_j: e,
-            });
-        }
     }
 
     /// Every term by name, for reports: `in.<source>`, `load`, `loss.<c>`,

@@ -115,29 +115,6 @@ mod closed_forms {
             }
         }
     }
-
-    #[test]
-    fn split_loss_keeps_the_total() {
-        let mut l = hydrocyl_energy::Ledger {
-            window_s: (0.0, 1.0),
-            energy_in_j: 10.0,
-            sources: vec![],
-            load_out_j: 0.0,
-            cylinder_out_j: 0.0,
-            losses: vec![hydrocyl_energy::Term {
-                name: "return".into(),
-                energy_j: 4.0,
-            }],
-            storage: vec![],
-            stored_change_from_states_j: 0.0,
-            error: 0.6,
-            storage_error: 0.0,
-        };
-        l.split_loss("return", &[("needle_valve", 3.0), ("pilot_valve", 0.0)]);
-        assert_eq!(l.loss("return.needle_valve"), 3.0);
-        assert_eq!(l.loss("return.pilot_valve"), 1.0);
-        assert_eq!(l.total_loss_j(), 4.0);
-    }
 }
 
 mod bad_input {

@@ -16,16 +16,14 @@
 //!   load cases (Table 8-1: "20 kg, include tray and piston rod").
 
 use hydrocyl_energy::error::EnergyError;
-use hydrocyl_energy::ledger::{ledger, trapezoid, Ledger, RodSide};
+use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
 use hydrocyl_energy::variant::HybridVariant;
 use hydrocyl_friction::FrictionLaw;
-use hydrocyl_ports::Pressure;
-use hydrocyl_system::hybrid::{nodes, ReturnPath, WangHybrid};
+use hydrocyl_system::hybrid::WangHybrid;
 use hydrocyl_system::rig::RigError;
 use hydrocyl_system::run::{run, RunOptions, SimError, Solver};
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::valve_rig::ValveRig;
-use hydrocyl_system::Circuit;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -356,7 +354,7 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
     let v = sc.speed();
     let period = sc.period();
     let force = sc.load_kg * G;
-    let (mut circuit, solver, hybrid) = match drive {
+    let (mut circuit, solver) = match drive {
         Drive::Valve(rig) => {
             let mut r = (**rig).clone();
             r.load.external_force_n = force;
@@ -364,7 +362,7 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
             r.initial.position = sc.start_position();
             let (bias, amplitude) = r.open_loop_square(v).map_err(rig_err(&label))?;
             let cmd = wave_signal(sc.wave, amplitude, period, bias);
-            (r.circuit(cmd).map_err(rig_err(&label))?, Solver::Dp45, None)
+            (r.circuit(cmd).map_err(rig_err(&label))?, Solver::Dp45)
         }
         Drive::Hybrid(rig, variant) => {
             let mut r = (**rig).clone();
@@ -379,14 +377,14 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
             let amplitude = v * (a1 + a2) / (2.0 * k);
             let bias = v * (a1 - a2) / (2.0 * k);
             let cmd = wave_signal(sc.wave, amplitude, period, bias);
-            let mut comps = r
-                .components(cmd)
-                .map_err(|e| rig_err(&label)(RigError::Build(e)))?;
-            if let Some(var) = variant {
-                var.swap_components(&mut comps);
-            }
-            let c = Circuit::build(comps).map_err(|e| rig_err(&label)(RigError::Build(e)))?;
-            (c, Solver::Rosenbrock, Some(r))
+            let c = r
+                .build_with(cmd, |comps| {
+                    if let Some(var) = variant {
+                        var.swap_components(comps);
+                    }
+                })
+                .map_err(rig_err(&label))?;
+            (c, Solver::Rosenbrock)
         }
     };
     let n_per = (period / plan.sample_s).round().max(1.0) as usize;
@@ -410,11 +408,7 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
     let wall_s = start.elapsed().as_secs_f64();
     let (k0, k1) = (n_per * plan.warmup_periods, n);
     let rod = RodSide::default();
-    let mut led = ledger(&circuit, &out, k0, k1, &rod)?;
-    if let Some(r) = &hybrid {
-        let needle = needle_energy(r, &out, k0, k1)?;
-        led.split_loss("return", &[("needle_valve", needle), ("pilot_valve", 0.0)]);
-    }
+    let led = ledger(&circuit, &out, k0, k1, &rod)?;
     // power traces: the ledger's integrands at each sample
     let names: Vec<String> = circuit.components().map(|c| c.name().to_string()).collect();
     let mut trace = Trace::default();
@@ -469,50 +463,4 @@ fn wave_signal(wave: Wave, amplitude: f64, period_s: f64, bias: f64) -> Signal {
             phase_rad: 0.0,
         },
     }
-}
-
-/// The needle valve's share of the return path's loss over samples
-/// `k0..=k1` \[J\]: the pressure between the four-way's T port and the needle
-/// from the series law, `∫ Q (p_mid − p_tank) dt` by the trapezoidal rule.
-fn needle_energy(
-    r: &WangHybrid,
-    out: &hydrocyl_system::run::Run,
-    k0: usize,
-    k1: usize,
-) -> Result<f64, EnergyError> {
-    let ch = |n: &str| {
-        out.channel(n)
-            .ok_or_else(|| EnergyError::Ledger(format!("hybrid run has no `{n}` channel")))
-    };
-    let (pp1, pp2, p1, p2) = (ch("pp1")?, ch("pp2")?, ch("p1")?, ch("p2")?);
-    let (qa, qb) = (ch("return_flow_1")?, ch("return_flow_2")?);
-    let path = ReturnPath::new(
-        "split",
-        r.four_way,
-        r.needle,
-        nodes::LINE_1,
-        nodes::LINE_2,
-        nodes::CHAMBER_1,
-        nodes::CHAMBER_2,
-        nodes::TANK,
-    );
-    let pt = r.tank_pressure;
-    let power: Vec<f64> = (0..out.time.len())
-        .map(|k| {
-            if k < k0 || k > k1 {
-                return 0.0;
-            }
-            let y = r
-                .four_way
-                .opening(Pressure::new(pp1[k]), Pressure::new(pp2[k]));
-            let (px, q) = if y > 0.0 {
-                (p2[k], qb[k])
-            } else {
-                (p1[k], qa[k])
-            };
-            let (_, pm) = path.series_flow(r.four_way.return_coefficient(y), px, pt);
-            q * (pm - pt)
-        })
-        .collect();
-    Ok(trapezoid(&out.time, &power, k0, k1))
 }

@@ -24,8 +24,8 @@ fn common_invariants(r: &Chapter7Run) {
     // the valve-state events are located by the integrator: each reversal shifts the
     // pilot valve, cracks the relief valve of the fed line and opens the suction check
     for name in [
-        "return.pilot_shifted_extend",
-        "return.pilot_shifted_retract",
+        "pilot_valve.shifted_extend",
+        "pilot_valve.shifted_retract",
         "relief_1.cracked",
         "relief_2.cracked",
         "check_1.opened",
@@ -159,4 +159,31 @@ fn bias_makes_the_command_implied_velocity_symmetric() {
     let k = rig.pump.gain;
     assert!((k * (bias + amplitude) / 8.042e-4 - 0.05).abs() < 1e-12);
     assert!((k * (bias - amplitude) / 5.50e-4 + 0.05).abs() < 1e-12);
+}
+
+/// On the rig the warm-started Newton solve of the T port costs a few
+/// member evaluations and never falls back to Brent.
+#[test]
+fn the_return_port_solve_is_cheap_on_the_rig() {
+    use hydrocyl_system::run::{run, RunOptions, Solver};
+    let test = Chapter7Test::new(Shape::Square, Load::None);
+    let rig = test.rig();
+    let mut c = rig.build(test.command(&rig)).unwrap();
+    let x0 = c.initial_state();
+    c.reset(0.0, &x0);
+    let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-2).collect();
+    let opts = RunOptions {
+        solver: Solver::Rosenbrock,
+        ..RunOptions::default()
+    };
+    run(&mut c, &x0, &t, &opts).unwrap();
+    let d = c.diagnostics();
+    let get = |k: &str| d.iter().find(|(n, _)| n == k).unwrap().1;
+    let (solves, evals) = (
+        get("return_port.solves"),
+        get("return_port.solve_evaluations"),
+    );
+    assert!(solves > 1000.0);
+    assert!(evals / solves < 3.0, "{}", evals / solves);
+    assert_eq!(get("return_port.solve_fallbacks"), 0.0);
 }

@@ -38,6 +38,8 @@ pub struct Netlist {
     pub(crate) accumulators: Vec<usize>,
     pub(crate) reads: Vec<(usize, usize, &'static str, String)>,
     pub(crate) mismatch: Option<BuildError>,
+    /// Algebraic nodes: (declaring component, node, name).
+    pub(crate) solved: Vec<(usize, HydraulicNode, String)>,
     pub(crate) current: usize,
     pub(crate) component_names: Vec<String>,
 }
@@ -123,6 +125,16 @@ impl Netlist {
     pub fn own_hydraulic(&mut self, node: &str, c: Causality) -> Result<HydraulicNode, BuildError> {
         let h = self.hyd(node);
         self.own(h.pressure.0, "hydraulic node", node, c)?;
+        Ok(h)
+    }
+
+    /// Declares hydraulic node `node` algebraic: its pressure is solved by
+    /// the assembler so that the flows into it sum to zero
+    /// ([`crate::series`]); it counts as the node's owner.
+    pub fn solve_hydraulic(&mut self, node: &str) -> Result<HydraulicNode, BuildError> {
+        let h = self.hyd(node);
+        self.own(h.pressure.0, "hydraulic node", node, Causality::Algebraic)?;
+        self.solved.push((self.current, h, node.to_string()));
         Ok(h)
     }
 

@@ -8,6 +8,8 @@ use hydrocyl_ports::Quantity;
 use std::cell::RefCell;
 use thiserror::Error;
 
+use crate::series::{SeriesGroup, Step};
+
 pub use crate::binding::{Causality, Netlist};
 pub use crate::wires::{Acc, AnyWire, HydraulicNode, MechanicalNode, ReadWire, Wire, Wires};
 
@@ -29,7 +31,7 @@ pub enum BuildError {
         second: String,
     },
     /// A node is used but nothing sets its effort.
-    #[error("{kind} `{node}` is used by `{user}` but no component sets it (add a volume, chamber, pressure source, mass or signal source)")]
+    #[error("{kind} `{node}` is used by `{user}` but no component sets it (add a volume, chamber, pressure source, mass or signal source; or an algebraic node between resistive components)")]
     NoOwner {
         /// "hydraulic node", "mechanical node" or "signal".
         kind: &'static str,
@@ -154,6 +156,20 @@ pub trait Component {
     /// to the node accumulators; writes [`Causality::Algebraic`] wires.
     fn evaluate(&self, _t: f64, _x: &[f64], _w: &mut Wires) {}
 
+    /// `∂Q/∂p` of the flow this component adds into hydraulic node `node`
+    /// with respect to that node's pressure \[m³·s⁻¹·Pa⁻¹\] (negative for a
+    /// resistive component), or `None` if it cannot say. The assembler's
+    /// Newton solve of an algebraic node ([`crate::series`]) uses it.
+    fn inflow_slope(
+        &self,
+        _t: f64,
+        _x: &[f64],
+        _w: &Wires,
+        _node: Wire<hydrocyl_ports::Pressure>,
+    ) -> Option<f64> {
+        None
+    }
+
     /// Time derivatives of its states (all accumulators are complete here).
     fn derivatives(&self, _t: f64, _x: &[f64], _w: &Wires, _dx: &mut [f64]) {}
 
@@ -219,7 +235,9 @@ pub struct Circuit {
     comps: Vec<Box<dyn Component>>,
     offsets: Vec<usize>,
     ev_offsets: Vec<usize>,
-    order: Vec<usize>,
+    order: Vec<Step>,
+    groups: Vec<SeriesGroup>,
+    scratch: RefCell<Vec<f64>>,
     accumulators: Vec<usize>,
     wires: RefCell<Wires>,
     n_states: usize,
@@ -275,47 +293,8 @@ impl Circuit {
         if let Some(e) = net.mismatch.take() {
             return Err(e);
         }
-        // every read wire has an owner; dependencies on algebraic owners
+        let (order, groups) = crate::series::evaluation_order(&net)?;
         let n = comps.len();
-        let mut deps: Vec<Vec<usize>> = vec![Vec::new(); n];
-        for (reader, w, kind, node) in &net.reads {
-            match net.owners.get(w) {
-                None => {
-                    return Err(BuildError::NoOwner {
-                        kind,
-                        node: node.clone(),
-                        user: net.component_names[*reader].clone(),
-                    })
-                }
-                Some(o) => {
-                    if o.causality == Causality::Algebraic
-                        && o.owner != *reader
-                        && !deps[*reader].contains(&o.owner)
-                    {
-                        deps[*reader].push(o.owner);
-                    }
-                }
-            }
-        }
-        // Kahn's order, stable in the given component order
-        let mut order = Vec::with_capacity(n);
-        let mut done = vec![false; n];
-        while order.len() < n {
-            let next = (0..n).find(|&i| !done[i] && deps[i].iter().all(|&d| done[d]));
-            match next {
-                Some(i) => {
-                    done[i] = true;
-                    order.push(i);
-                }
-                None => {
-                    let left: Vec<String> = (0..n)
-                        .filter(|&i| !done[i])
-                        .map(|i| net.component_names[i].clone())
-                        .collect();
-                    return Err(BuildError::AlgebraicLoop(left.join(", ")));
-                }
-            }
-        }
         let mut offsets = Vec::with_capacity(n + 1);
         let mut ev_offsets = Vec::with_capacity(n + 1);
         let mut q_offsets = Vec::with_capacity(n + 1);
@@ -336,6 +315,8 @@ impl Circuit {
             offsets,
             ev_offsets,
             order,
+            groups,
+            scratch: RefCell::new(Vec::new()),
             accumulators: net.accumulators,
             wires: RefCell::new(Wires {
                 v: vec![0.0; net.names.len()],
@@ -476,9 +457,13 @@ impl Circuit {
         self.probe_names = Some(names);
     }
 
-    /// Diagnostics of every component, names prefixed by the component's.
+    /// Diagnostics of every component, names prefixed by the component's;
+    /// an algebraic node's report its solves, the member evaluations they
+    /// took and how many fell back to Brent (`<node>.solves`,
+    /// `<node>.solve_evaluations`, `<node>.solve_fallbacks`).
     pub fn diagnostics(&self) -> Vec<(String, f64)> {
-        self.comps
+        let mut d: Vec<(String, f64)> = self
+            .comps
             .iter()
             .flat_map(|c| {
                 let n = c.name().to_string();
@@ -486,7 +471,14 @@ impl Circuit {
                     .into_iter()
                     .map(move |(k, v)| (format!("{n}.{k}"), v))
             })
-            .collect()
+            .collect();
+        for g in &self.groups {
+            let n = self.comps[g.owner].name();
+            d.push((format!("{n}.solves"), g.solves.get() as f64));
+            d.push((format!("{n}.solve_evaluations"), g.evaluations.get() as f64));
+            d.push((format!("{n}.solve_fallbacks"), g.fallbacks.get() as f64));
+        }
+        d
     }
 
     /// Evaluates every wire at `(t, x)` and returns a copy of the table.
@@ -534,7 +526,17 @@ impl Circuit {
 
     /// Calls [`Component::reset`] on every component at `(t, x)`.
     pub fn reset(&mut self, t: f64, x: &[f64]) {
+        // a run from a given state solves its algebraic nodes the same way
+        // whatever ran before
+        for g in &self.groups {
+            g.guess.set(f64::NAN);
+        }
         self.fill(t, x);
+        for g in &self.groups {
+            g.solves.set(0);
+            g.evaluations.set(0);
+            g.fallbacks.set(0);
+        }
         let w = self.wires.borrow().clone();
         for (i, c) in self.comps.iter_mut().enumerate() {
             c.reset(t, &x[self.offsets[i]..self.offsets[i + 1]], &w);
@@ -550,8 +552,25 @@ impl Circuit {
         for (i, c) in self.comps.iter().enumerate() {
             c.publish(t, &x[self.offsets[i]..self.offsets[i + 1]], &mut w);
         }
-        for &i in &self.order {
-            self.comps[i].evaluate(t, &x[self.offsets[i]..self.offsets[i + 1]], &mut w);
+        let xs = |i: usize| &x[self.offsets[i]..self.offsets[i + 1]];
+        for step in &self.order {
+            match *step {
+                Step::Evaluate(i) => self.comps[i].evaluate(t, xs(i), &mut w),
+                Step::Solve(g) => {
+                    let g = &self.groups[g];
+                    let eval = |w: &mut Wires| {
+                        for &i in &g.members {
+                            self.comps[i].evaluate(t, xs(i), w);
+                        }
+                    };
+                    let slope = |w: &Wires| {
+                        g.members.iter().try_fold(0.0, |s, &i| {
+                            Some(s + self.comps[i].inflow_slope(t, xs(i), w, g.node.pressure)?)
+                        })
+                    };
+                    g.solve(&mut w, &mut self.scratch.borrow_mut(), eval, slope);
+                }
+            }
         }
     }
 }
@@ -646,170 +665,4 @@ impl OdeSystem for Circuit {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::components::{FixedOrifice, PressureSource, Volume};
-    use hydrocyl_integrators::{solve, Method, Options};
-    use hydrocyl_ports::{Area, Density, Pressure};
-    use hydrocyl_valves::orifice::Orifice;
-
-    /// A test component that writes signal `out` algebraically from signal `inp`.
-    struct Gain {
-        name: String,
-        inp: String,
-        out: String,
-        w: (Wire<f64>, Wire<f64>),
-    }
-
-    impl Component for Gain {
-        fn name(&self) -> &str {
-            &self.name
-        }
-        fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
-            self.w = (
-                net.signal(&self.inp),
-                net.own_signal(&self.out, Causality::Algebraic)?,
-            );
-            Ok(())
-        }
-        fn evaluate(&self, _t: f64, _x: &[f64], w: &mut Wires) {
-            w.set(self.w.1, 2.0 * w.get(self.w.0));
-        }
-    }
-
-    fn gain(name: &str, inp: &str, out: &str) -> Box<dyn Component> {
-        Box::new(Gain {
-            name: name.into(),
-            inp: inp.into(),
-            out: out.into(),
-            w: (Wire::UNBOUND, Wire::UNBOUND),
-        })
-    }
-
-    fn orifice() -> Orifice {
-        Orifice::new(0.65, Density::new(870.0))
-    }
-
-    #[test]
-    fn causality_errors_name_components_and_nodes() {
-        let two = Circuit::build(vec![
-            Box::new(PressureSource::new(
-                "supply",
-                "P",
-                Pressure::from_bar(70.0),
-                None,
-            )),
-            Box::new(Volume::new("line", "P", 1e-4, 7e8, 0.0, None)),
-        ])
-        .unwrap_err();
-        assert!(matches!(two, BuildError::TwoOwners { .. }));
-        assert!(
-            two.to_string().contains("`P`")
-                && two.to_string().contains("supply")
-                && two.to_string().contains("line")
-        );
-
-        let none = Circuit::build(vec![
-            Box::new(PressureSource::new(
-                "supply",
-                "P",
-                Pressure::from_bar(70.0),
-                None,
-            )),
-            Box::new(FixedOrifice::new("o", "P", "A", Area::new(1e-6), orifice())),
-        ])
-        .unwrap_err();
-        assert!(
-            none.to_string().contains("`A`") && none.to_string().contains("`o`"),
-            "{none}"
-        );
-
-        let looped = Circuit::build(vec![gain("g1", "a", "b"), gain("g2", "b", "a")]).unwrap_err();
-        assert!(matches!(looped, BuildError::AlgebraicLoop(_)), "{looped}");
-
-        let dup = Circuit::build(vec![gain("g", "a", "b"), gain("g", "b", "c")]).unwrap_err();
-        assert!(dup.to_string().contains("two components"), "{dup}");
-    }
-
-    #[test]
-    fn a_signal_used_as_two_quantities_is_a_build_error() {
-        // the spool writes `x` as a position; the gain reads it as a bare f64
-        let spool = crate::components::ServoSpool::new(
-            "spool",
-            "u",
-            "x",
-            hydrocyl_valves::servovalve::Spool::leaney_moog(),
-            0.0,
-        );
-        let cmd = crate::components::CommandInput::new(
-            "cmd",
-            "u",
-            crate::signal::Signal::Constant { value: 0.0 },
-        );
-        let e =
-            Circuit::build(vec![Box::new(cmd), Box::new(spool), gain("g", "x", "y")]).unwrap_err();
-        assert!(matches!(e, BuildError::UnitMismatch { .. }), "{e}");
-        let msg = e.to_string();
-        assert!(
-            msg.contains("sig:x") && msg.contains("`g`") && msg.contains("m"),
-            "{msg}"
-        );
-    }
-
-    #[test]
-    fn algebraic_components_are_ordered_by_dependency() {
-        // given in reverse order: g2 reads what g1 writes; g1 reads a stored signal
-        let mut c = Circuit::build(vec![
-            gain("g2", "b", "c"),
-            gain("g1", "a", "b"),
-            Box::new(crate::components::CommandInput::new(
-                "cmd",
-                "a",
-                crate::signal::Signal::Constant { value: 1.5 },
-            )),
-        ])
-        .unwrap();
-        let w = c.wires_at(0.0, &[]);
-        let cw = c.find_wire("sig:c").unwrap();
-        assert_eq!(w.get(cw), 6.0);
-        c.reset(0.0, &[]);
-    }
-
-    #[test]
-    fn volume_filled_through_an_orifice_conserves_mass_and_reaches_supply() {
-        // supply → orifice → volume: V/B (p(T) − p(0)) = ∫Q dt, p → Ps
-        let (v, b) = (1e-4, 7e8);
-        let mut c = Circuit::build(vec![
-            Box::new(PressureSource::new(
-                "supply",
-                "P",
-                Pressure::from_bar(70.0),
-                Some("ps"),
-            )),
-            Box::new(FixedOrifice::new("o", "P", "A", Area::new(1e-7), orifice())),
-            Box::new(Volume::new("vol", "A", v, b, 0.0, Some("pa"))),
-        ])
-        .unwrap();
-        c.set_ledger(true);
-        let x0 = c.initial_state();
-        let opts = Options {
-            rtol: 1e-9,
-            atol: c.atol(1e-9),
-            ..Options::default()
-        };
-        let sol = solve(Method::DormandPrince45, &mut c, 0.0, &x0, 2.0, &opts).unwrap();
-        let last = sol.last().unwrap();
-        assert!((last[0] - 7e6).abs() < 1e3, "p = {}", last[0]);
-        // energy: source = dissipated + storage (volume), each integrated
-        let o = c.ledger_offset();
-        let src = last[o];
-        let diss = last[o + 4 + 1];
-        let stored = last[o + 8 + 2];
-        assert!(
-            (src - diss - stored).abs() < 1e-6 * src,
-            "{src} {diss} {stored}"
-        );
-        // stored = V p²/(2B) for a constant volume
-        assert!((stored - v * last[0] * last[0] / (2.0 * b)).abs() < 1e-6 * stored);
-    }
-}
+mod tests;

@@ -133,6 +133,7 @@ pub mod netlist;
 pub mod rig;
 pub mod run;
 pub mod sensor;
+pub mod series;
 pub mod signal;
 pub mod simulation;
 pub mod valve_netlist;

@@ -144,7 +144,7 @@ pub const RIG_KINDS: &[RigKind] = &[
     RigKind {
         kind: crate::hybrid::KIND,
         check: |v| crate::hybrid::WangHybrid::from_value(v).map(|_| ()),
-        circuit: |v, cmd| Ok(crate::hybrid::WangHybrid::from_value(v)?.build(cmd)?),
+        circuit: |v, cmd| crate::hybrid::WangHybrid::from_value(v)?.build(cmd),
     },
     RigKind {
         kind: crate::netlist::KIND,

@@ -92,7 +92,7 @@ fn template(text: &str) -> Value {
 /// A friction law as a netlist component object (`friction_<model>`), and
 /// the bound of its seal term (Wang's `seal_dp_max`, which the netlist
 /// names `seal.dp_max`; 0 = unbounded).
-fn friction_component(law: &FrictionLaw) -> (Value, f64) {
+pub(crate) fn friction_component(law: &FrictionLaw) -> (Value, f64) {
     let mut v = serde_json::to_value(law).expect("a friction law serialises");
     let obj = v.as_object_mut().expect("a tagged object");
     obj.remove("model");

@@ -473,6 +473,11 @@ fn bad_netlists_are_refused_by_path() {
             &["outputs.p3", "no output `p3`"],
         ),
     ];
+    assert_refused(&base, cases);
+}
+
+/// Each case's edit of `base` is refused with a one-line error holding its words.
+fn assert_refused(base: &serde_json::Value, cases: &[Case]) {
     for (what, edit, words) in cases {
         let mut v = base.clone();
         edit(&mut v);
@@ -598,4 +603,78 @@ fn every_netlist_ledger_closes() {
             f.display()
         );
     }
+}
+
+/// An algebraic node (two resistive components in series, no volume) is
+/// legal; the wiring mistakes around one are refused naming the JSON path:
+/// a node between resistive components with no algebraic node (no owner),
+/// an algebraic node on a node a volume owns (two owners), and one with a
+/// single neighbour (nothing to balance).
+#[test]
+fn algebraic_node_errors_name_the_json_path() {
+    let base = load("fixtures/rigs/wang-hybrid.json");
+    let group = |v: &serde_json::Value| {
+        v["connections"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .position(|c| c[0] == "return_port")
+            .unwrap()
+    };
+    let cases: &[Case] = &[
+        (
+            "no owner",
+            &|v| {
+                let g = group(v);
+                v["connections"][g].as_array_mut().unwrap().remove(1);
+                v["components"]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove("return_port");
+            },
+            &[
+                "connections[6]",
+                "needle_valve.inlet",
+                "no owner",
+                "algebraic_node",
+            ],
+        ),
+        (
+            "two owners",
+            &|v| {
+                let g = group(v);
+                v["connections"][g]
+                    .as_array_mut()
+                    .unwrap()
+                    .push("hose.port".into());
+                v["components"]["hose"] = serde_json::json!(
+                    {"type": "volume", "volume": 1e-6, "bulk_modulus": 1e9}
+                );
+            },
+            &[
+                "connections[6]",
+                "owned by both",
+                "return_port.node",
+                "hose.port",
+            ],
+        ),
+        (
+            "one neighbour",
+            &|v| {
+                let g = group(v);
+                let c = v["connections"][g].as_array_mut().unwrap();
+                c.retain(|e| e != "needle_valve.inlet");
+                let t = v["connections"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .position(|c| c[0] == "tank")
+                    .unwrap();
+                let c = v["connections"][t].as_array_mut().unwrap();
+                c.push("needle_valve.inlet".into());
+            },
+            &["components.return_port", "at least two"],
+        ),
+    ];
+    assert_refused(&base, cases);
 }

@@ -227,8 +227,8 @@ fn report_run(s: &mut Section, rig: &WangHybrid, r: &Chapter7Run, wall: f64) {
         &format!("{l}: valve events (pilot ext/ret, relief 1/2/3, check 1/2)"),
         format!(
             "{}/{}, {}/{}/{}, {}/{}",
-            ev("return.pilot_shifted_extend"),
-            ev("return.pilot_shifted_retract"),
+            ev("pilot_valve.shifted_extend"),
+            ev("pilot_valve.shifted_retract"),
             ev("relief_1.cracked"),
             ev("relief_2.cracked"),
             ev("relief_3_line_1.cracked") + ev("relief_3_line_2.cracked"),
@@ -236,7 +236,7 @@ fn report_run(s: &mut Section, rig: &WangHybrid, r: &Chapter7Run, wall: f64) {
             ev("check_2.opened")
         ),
         "located at each reversal".into(),
-        ev("return.pilot_shifted_extend") >= 2 && ev("return.pilot_shifted_retract") >= 2,
+        ev("pilot_valve.shifted_extend") >= 2 && ev("pilot_valve.shifted_retract") >= 2,
     );
     if p.locked {
         s.note(&format!(

@@ -122,7 +122,7 @@ pub struct Chapter7Run {
     /// Volume the pump moved, `∫|Q_p| dt` \[m³\].
     pub volume_pumped: f64,
     /// Event and diagnostic counters of every component (`pump.reversals`,
-    /// `relief_1.cracked`, `return.pilot_shifted_extend`, `check_1.opened`,
+    /// `relief_1.cracked`, `pilot_valve.shifted_extend`, `check_1.opened`,
     /// `cylinder.cavitation_entries_1`, ...).
     pub diagnostics: Vec<(String, f64)>,
     /// Lowest pressure in each volume (chambers, pump lines) \[Pa\].
@@ -298,11 +298,11 @@ fn balances(
     let (v1b, v2b) = vols(x_b);
     let (p1a, p2a) = (state("cylinder", 0, first), state("cylinder", 1, first));
     let (p1b, p2b) = (state("cylinder", 0, last), state("cylinder", 1, last));
-    let in_c1 = quad("relief_1", 0) - quad("return", 0);
+    let in_c1 = quad("relief_1", 0) - quad("pilot_valve", 0);
     let acc_c1 =
         cyl.area_1.si() * (x_b - x_a) + (v1b.si() * p1b - v1a.si() * p1a) / b - quad("cylinder", 2);
     push("chamber_1", in_c1, acc_c1);
-    let in_c2 = quad("relief_2", 0) - quad("return", 1);
+    let in_c2 = quad("relief_2", 0) - quad("pilot_valve", 1);
     let acc_c2 =
         (v2b.si() * p2b - v2a.si() * p2a) / b + quad("cylinder", 3) - cyl.area_2.si() * (x_b - x_a);
     push("chamber_2", in_c2, acc_c2);

@@ -71,6 +71,9 @@ pub enum RunError {
     /// The rig could not be assembled.
     #[error("building the wang-hybrid rig: {0}")]
     Build(#[from] BuildError),
+    /// The rig's netlist could not be assembled.
+    #[error("building the wang-hybrid rig: {0}")]
+    Rig(#[from] hydrocyl_system::rig::RigError),
     /// The solver failed.
     #[error("solving the {test}: {source}")]
     Solve {

@@ -1,7 +1,7 @@
 //! A fixed sharp-edged orifice between two nodes.
 
-use crate::circuit::{BuildError, Component, HydraulicNode, Netlist, PowerTerms, Wires};
-use hydrocyl_ports::VolumeFlow;
+use crate::circuit::{BuildError, Component, HydraulicNode, Netlist, PowerTerms, Wire, Wires};
+use hydrocyl_ports::{Pressure, VolumeFlow};
 use hydrocyl_valves::orifice::Orifice;
 
 /// A fixed sharp-edged orifice between two nodes (flow from `a` to `b`).
@@ -50,6 +50,17 @@ impl Component for FixedOrifice {
         let q = self.flow(w);
         w.add(self.a.inflow, -q);
         w.add(self.b.inflow, q);
+    }
+    fn inflow_slope(&self, _t: f64, _x: &[f64], w: &Wires, node: Wire<Pressure>) -> Option<f64> {
+        // Q leaves a and enters b; ∂Q/∂p_a = −∂Q/∂p_b = g
+        let g = self
+            .orifice
+            .conductance(self.area, w.get(self.a.pressure), w.get(self.b.pressure));
+        Some(if node == self.a.pressure || node == self.b.pressure {
+            -g
+        } else {
+            0.0
+        })
     }
     fn power(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         p.dissipated = ((w.get(self.a.pressure) - w.get(self.b.pressure)) * self.flow(w)).si();

@@ -1,8 +1,10 @@
 //! The hybrid drive's components as assembler [`Component`]s: the pump (its
-//! identified command → flow model), relief valves, check valves, and the
-//! pilot four-way valve's return path with the needle valve. Each wraps a pure constitutive law of `hydrocyl-valves` or
-//! `hydrocyl-pump-motor`, binds to named nodes, and forwards the law's
-//! switching functions as events (counted per run in its diagnostics).
+//! identified command → flow model), relief valves, check valves, the
+//! pilot-operated four-way valve and the needle valve (joined in series by an
+//! algebraic node, [`crate::series`]). Each wraps a pure constitutive law of
+//! `hydrocyl-valves` or `hydrocyl-pump-motor`, binds to named nodes, and
+//! forwards the law's switching functions as events (counted per run in its
+//! diagnostics); the valves give the slopes the node's Newton solve uses.
 
 use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, Netlist, PowerTerms, Probe, Wire, Wires,
@@ -12,8 +14,8 @@ use hydrocyl_ports::{Position, Pressure, Voltage, VolumeFlow};
 use hydrocyl_pump_motor::IdentifiedPump;
 use hydrocyl_valves::check::CheckValve;
 use hydrocyl_valves::needle::NeedleValve;
-use hydrocyl_valves::orifice::signed_sqrt_regularised;
-use hydrocyl_valves::pilot_valve::{series_coefficient, PilotFourWay};
+use hydrocyl_valves::orifice::{signed_sqrt_regularised, signed_sqrt_regularised_derivative};
+use hydrocyl_valves::pilot_valve::PilotFourWay;
 use hydrocyl_valves::relief::ReliefValve;
 
 const UNBOUND_NODE: HydraulicNode = HydraulicNode::UNBOUND;
@@ -364,9 +366,9 @@ impl Component for CheckComponent {
     }
 }
 
-/// The nodes a [`ReturnPath`] joins.
+/// The nodes a [`PilotValve`] joins.
 #[derive(Clone, Copy, Debug)]
-pub struct ReturnNodes<'a> {
+pub struct PilotNodes<'a> {
     /// Pump line 1: pilot port 1 of the four-way valve.
     pub pilot_1: &'a str,
     /// Pump line 2: pilot port 6.
@@ -375,29 +377,25 @@ pub struct ReturnNodes<'a> {
     pub a: &'a str,
     /// Work port B: cylinder chamber 2.
     pub b: &'a str,
-    /// The tank, behind the needle valve.
-    pub tank: &'a str,
+    /// The T port (joined to the needle valve by a short pipe).
+    pub t: &'a str,
 }
 
-/// The return path: the DDDC four-way valve, piloted by the pump lines,
-/// opens the chamber that is not fed (B when `Pp1 > Pp2`, A otherwise) to its
-/// T port, which a short pipe joins to the needle valve and on to the tank
-/// (section 6.2.2.3, Fig 7-3). The four-way's T port and the needle are two
-/// orifices in series (exact series coefficient while the needle's reverse
-/// check is shut; the T-port pressure is solved by bisection when it opens).
-/// The four-way's P port is not connected: the fed chamber is supplied
-/// through its relief valve directly, as in `pcyl4_1.m`.
+/// The DDDC four-way valve, piloted by the pump lines: it opens the chamber
+/// that is not fed (B when `Pp1 > Pp2`, A otherwise) to its T port
+/// (section 6.2.2.3, Fig 7-3), `Q = k_T(y) √(p_x − p_T)` (regularised). The
+/// P port is not connected: the fed chamber is supplied through its relief
+/// valve directly, as in `pcyl4_1.m`. On the rig the T port feeds the
+/// [`NeedleComponent`] through an algebraic node
+/// ([`AlgebraicNode`](crate::series::AlgebraicNode)).
 ///
-/// Events: the pilot valve shifting into either state and reaching full
-/// shift, and the needle's reverse check cracking.
+/// Events: the valve shifting into either state and reaching full shift.
 #[derive(Clone, Debug)]
-pub struct ReturnPath {
+pub struct PilotValve {
     name: String,
     nodes: [String; 5],
     /// The pilot four-way valve.
     pub four_way: PilotFourWay,
-    /// The needle valve with its reverse-flow check.
-    pub needle: NeedleValve,
     pp1: HydraulicNode,
     pp2: HydraulicNode,
     a: HydraulicNode,
@@ -406,44 +404,16 @@ pub struct ReturnPath {
     spool: Wire<Position>,
     flow_a: Wire<VolumeFlow>,
     flow_b: Wire<VolumeFlow>,
-    counts: [usize; 4],
+    counts: [usize; 3],
+    /// The last `(Pp1, Pp2, y)`: the opening (two circle segments) is
+    /// computed once per pilot pressures, not once per trial of the T
+    /// port's Newton solve.
+    last_opening: std::cell::Cell<[f64; 3]>,
 }
 
-impl ReturnPath {
-    /// The return path `name`, piloted by `pilot_1`, `pilot_2`, opening
-    /// chambers `a`, `b` to `tank` (the same as [`ReturnPath::with_nodes`]).
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        name: &str,
-        four_way: PilotFourWay,
-        needle: NeedleValve,
-        pilot_1: &str,
-        pilot_2: &str,
-        a: &str,
-        b: &str,
-        tank: &str,
-    ) -> Self {
-        Self::with_nodes(
-            name,
-            four_way,
-            needle,
-            ReturnNodes {
-                pilot_1,
-                pilot_2,
-                a,
-                b,
-                tank,
-            },
-        )
-    }
-
-    /// The return path `name` joined to `nodes`.
-    pub fn with_nodes(
-        name: &str,
-        four_way: PilotFourWay,
-        needle: NeedleValve,
-        nodes: ReturnNodes<'_>,
-    ) -> Self {
+impl PilotValve {
+    /// The valve `name` joined to `nodes`.
+    pub fn new(name: &str, four_way: PilotFourWay, nodes: PilotNodes<'_>) -> Self {
         Self {
             name: name.into(),
             nodes: [
@@ -451,10 +421,9 @@ impl ReturnPath {
                 nodes.pilot_2.into(),
                 nodes.a.into(),
                 nodes.b.into(),
-                nodes.tank.into(),
+                nodes.t.into(),
             ],
             four_way,
-            needle,
             pp1: UNBOUND_NODE,
             pp2: UNBOUND_NODE,
             a: UNBOUND_NODE,
@@ -463,85 +432,53 @@ impl ReturnPath {
             spool: Wire::UNBOUND,
             flow_a: Wire::UNBOUND,
             flow_b: Wire::UNBOUND,
-            counts: [0; 4],
+            counts: [0; 3],
+            last_opening: std::cell::Cell::new([f64::NAN; 3]),
         }
     }
 
-    /// Flow from a chamber at `p_x` to the tank at `p_t` through the four-way
-    /// return port of coefficient `k_fw` and the needle valve, and the
-    /// pressure between them.
-    pub fn series_flow(&self, k_fw: f64, p_x: f64, p_t: f64) -> (f64, f64) {
-        if k_fw <= 0.0 {
-            return (0.0, p_t);
+    /// The signed opening `y` at the pilot pressures on `w` (memoised).
+    fn opening(&self, w: &Wires) -> f64 {
+        let (pp1, pp2) = (w.get(self.pp1.pressure), w.get(self.pp2.pressure));
+        let [a, b, y] = self.last_opening.get();
+        if a == pp1.si() && b == pp2.si() {
+            return y;
+        }
+        let y = self.four_way.opening(pp1, pp2);
+        self.last_opening.set([pp1.si(), pp2.si(), y]);
+        y
+    }
+
+    /// The opening `y`, the flow from the open chamber to the T port and the
+    /// open chamber's pressure.
+    fn state(&self, w: &Wires) -> (f64, VolumeFlow, Pressure) {
+        let y = self.opening(w);
+        let px = if y > 0.0 {
+            w.get(self.b.pressure)
+        } else {
+            w.get(self.a.pressure)
+        };
+        let k = self.four_way.return_coefficient(y);
+        if k <= 0.0 {
+            return (y, VolumeFlow::ZERO, px);
         }
         let xt = self.four_way.dp_transition.si();
-        let crack = self.needle.reverse_check.cracking.si();
-        if p_t - p_x <= crack {
-            // the reverse check stays shut for any T pressure between p_x and p_t:
-            // two square-root orifices in series
-            let k = series_coefficient(k_fw, self.needle.coefficient());
-            let q = k * signed_sqrt_regularised(p_x - p_t, xt);
-            let k_n = self.needle.coefficient();
-            let p_mid = if k_n > 0.0 {
-                p_t + (p_x - p_t) * (k * k) / (k_n * k_n)
-            } else {
-                p_x
-            };
-            return (q, p_mid);
-        }
-        // reverse flow with the check open: solve Q_fw(p_x − p_T) = Q_needle(p_T → p_t)
-        // for p_T in [p_x, p_t]; the residual falls monotonically in p_T.
-        let resid = |pm: f64| {
-            k_fw * signed_sqrt_regularised(p_x - pm, xt)
-                - self.needle.flow(Pressure::new(pm), Pressure::new(p_t)).si()
-        };
-        let (mut lo, mut hi) = (p_x, p_t);
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if resid(mid) > 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        let pm = 0.5 * (lo + hi);
-        (k_fw * signed_sqrt_regularised(p_x - pm, xt), pm)
-    }
-
-    fn state(&self, w: &Wires) -> (f64, f64, f64, f64) {
-        let y = self
-            .four_way
-            .opening(w.get(self.pp1.pressure), w.get(self.pp2.pressure));
-        let (px, pt) = (
-            if y > 0.0 {
-                w.get(self.b.pressure).si()
-            } else {
-                w.get(self.a.pressure).si()
-            },
-            w.get(self.t.pressure).si(),
-        );
-        let (q, pm) = self.series_flow(self.four_way.return_coefficient(y), px, pt);
-        (y, q, pm, pt)
+        let dp = (px - w.get(self.t.pressure)).si();
+        (y, VolumeFlow::new(k * signed_sqrt_regularised(dp, xt)), px)
     }
 }
 
-impl Component for ReturnPath {
+impl Component for PilotValve {
     fn name(&self) -> &str {
         &self.name
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
-        let err = |e: hydrocyl_valves::check::ParameterError| BuildError::Component {
-            component: self.name.clone(),
-            message: e.to_string(),
-        };
-        self.four_way.validate().map_err(err)?;
-        NeedleValve::new(
-            self.needle.area,
-            self.needle.effective_factor,
-            self.needle.orifice,
-            self.needle.reverse_check,
-        )
-        .map_err(err)?;
+        self.four_way
+            .validate()
+            .map_err(|e| BuildError::Component {
+                component: self.name.clone(),
+                message: e.to_string(),
+            })?;
         self.pp1 = net.hydraulic(&self.nodes[0]);
         self.pp2 = net.hydraulic(&self.nodes[1]);
         self.a = net.hydraulic(&self.nodes[2]);
@@ -553,13 +490,12 @@ impl Component for ReturnPath {
         Ok(())
     }
     fn evaluate(&self, _t: f64, _x: &[f64], w: &mut Wires) {
-        let (y, q, _, _) = self.state(w);
+        let (y, q, _) = self.state(w);
         let from = if y > 0.0 {
             self.b.inflow
         } else {
             self.a.inflow
         };
-        let q = VolumeFlow::new(q);
         w.add(from, -q);
         w.add(self.t.inflow, q);
         let s = self
@@ -570,16 +506,29 @@ impl Component for ReturnPath {
         w.set(self.flow_a, if y > 0.0 { none } else { q });
         w.set(self.flow_b, if y > 0.0 { q } else { none });
     }
+    fn inflow_slope(&self, _t: f64, _x: &[f64], w: &Wires, node: Wire<Pressure>) -> Option<f64> {
+        let y = self.opening(w);
+        let open = if y > 0.0 { self.b } else { self.a };
+        if node == self.pp1.pressure || node == self.pp2.pressure {
+            return None; // the opening moves with the pilot pressures
+        }
+        if node != self.t.pressure && node != open.pressure {
+            return Some(0.0);
+        }
+        // Q = k √(p_x − p_T) leaves the open chamber and enters T
+        let k = self.four_way.return_coefficient(y);
+        let dp = (w.get(open.pressure) - w.get(self.t.pressure)).si();
+        let xt = self.four_way.dp_transition.si();
+        Some(-k * signed_sqrt_regularised_derivative(dp, xt))
+    }
     fn n_events(&self) -> usize {
-        4
+        3
     }
     fn events(&self, _t: f64, _x: &[f64], w: &Wires, g: &mut [f64]) {
         let (pp1, pp2) = (w.get(self.pp1.pressure), w.get(self.pp2.pressure));
         g[0] = self.four_way.extend_shift_margin(pp1, pp2);
         g[1] = self.four_way.retract_shift_margin(pp1, pp2);
         g[2] = self.four_way.full_shift_margin(pp1, pp2);
-        let (_, _, pm, pt) = self.state(w);
-        g[3] = pt - pm - self.needle.reverse_check.cracking.si();
     }
     fn on_event(
         &mut self,
@@ -595,13 +544,8 @@ impl Component for ReturnPath {
         EventAction::Continue
     }
     fn power(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
-        let (y, q, _, pt) = self.state(w);
-        let px = if y > 0.0 {
-            w.get(self.b.pressure).si()
-        } else {
-            w.get(self.a.pressure).si()
-        };
-        p.dissipated = q * (px - pt);
+        let (_, q, px) = self.state(w);
+        p.dissipated = ((px - w.get(self.t.pressure)) * q).si();
     }
     fn n_quadratures(&self) -> usize {
         2
@@ -625,60 +569,209 @@ impl Component for ReturnPath {
     }
     fn diagnostics(&self) -> Vec<(String, f64)> {
         vec![
-            ("pilot_shifted_extend".into(), self.counts[0] as f64),
-            ("pilot_shifted_retract".into(), self.counts[1] as f64),
-            ("pilot_fully_shifted".into(), self.counts[2] as f64),
-            ("needle_check_opened".into(), self.counts[3] as f64),
+            ("shifted_extend".into(), self.counts[0] as f64),
+            ("shifted_retract".into(), self.counts[1] as f64),
+            ("fully_shifted".into(), self.counts[2] as f64),
         ]
     }
     fn reset(&mut self, _t: f64, _x: &[f64], _w: &Wires) {
-        self.counts = [0; 4];
+        self.counts = [0; 3];
+    }
+}
+
+/// The needle valve with its reverse-flow check from node `inlet` to node
+/// `outlet` (metered forward flow, the check opening for reverse flow).
+/// Event: the reverse check cracking (openings counted).
+#[derive(Clone, Debug)]
+pub struct NeedleComponent {
+    name: String,
+    inlet: String,
+    outlet: String,
+    /// The valve.
+    pub needle: NeedleValve,
+    i: HydraulicNode,
+    o: HydraulicNode,
+    openings: usize,
+}
+
+impl NeedleComponent {
+    /// A needle valve `name` from `inlet` to `outlet`.
+    pub fn new(name: &str, needle: NeedleValve, inlet: &str, outlet: &str) -> Self {
+        Self {
+            name: name.into(),
+            inlet: inlet.into(),
+            outlet: outlet.into(),
+            needle,
+            i: UNBOUND_NODE,
+            o: UNBOUND_NODE,
+            openings: 0,
+        }
+    }
+}
+
+impl Component for NeedleComponent {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
+        NeedleValve::new(
+            self.needle.area,
+            self.needle.effective_factor,
+            self.needle.orifice,
+            self.needle.reverse_check,
+        )
+        .map_err(|e| BuildError::Component {
+            component: self.name.clone(),
+            message: e.to_string(),
+        })?;
+        self.i = net.hydraulic(&self.inlet);
+        self.o = net.hydraulic(&self.outlet);
+        Ok(())
+    }
+    fn evaluate(&self, _t: f64, _x: &[f64], w: &mut Wires) {
+        let q = self
+            .needle
+            .flow(w.get(self.i.pressure), w.get(self.o.pressure));
+        w.add(self.i.inflow, -q);
+        w.add(self.o.inflow, q);
+    }
+    fn inflow_slope(&self, _t: f64, _x: &[f64], w: &Wires, node: Wire<Pressure>) -> Option<f64> {
+        // Q leaves the inlet and enters the outlet; ∂Q/∂p_in = −∂Q/∂p_out = g
+        let g = self
+            .needle
+            .conductance(w.get(self.i.pressure), w.get(self.o.pressure));
+        Some(if node == self.i.pressure || node == self.o.pressure {
+            -g
+        } else {
+            0.0
+        })
+    }
+    fn n_events(&self) -> usize {
+        1
+    }
+    fn events(&self, _t: f64, _x: &[f64], w: &Wires, g: &mut [f64]) {
+        g[0] = self
+            .needle
+            .reverse_check_margin(w.get(self.i.pressure), w.get(self.o.pressure));
+    }
+    fn on_event(
+        &mut self,
+        _t: f64,
+        _x: &mut [f64],
+        _w: &Wires,
+        _which: usize,
+        dir: Crossing,
+    ) -> EventAction {
+        if dir == Crossing::Rising {
+            self.openings += 1;
+        }
+        EventAction::Continue
+    }
+    fn power(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
+        p.dissipated = self
+            .needle
+            .power_dissipated(w.get(self.i.pressure), w.get(self.o.pressure))
+            .si();
+    }
+    fn diagnostics(&self) -> Vec<(String, f64)> {
+        vec![("check_opened".into(), self.openings as f64)]
+    }
+    fn reset(&mut self, _t: f64, _x: &[f64], _w: &Wires) {
+        self.openings = 0;
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::components::PressureSource;
+    use crate::series::AlgebraicNode;
+    use crate::Circuit;
+    use hydrocyl_valves::pilot_valve::series_coefficient;
 
-    fn path() -> ReturnPath {
-        ReturnPath::with_nodes(
-            "return",
-            PilotFourWay::dddc(),
-            NeedleValve::nccc(),
-            ReturnNodes {
-                pilot_1: "l1",
-                pilot_2: "l2",
-                a: "a",
-                b: "b",
-                tank: "t",
-            },
-        )
+    /// chamber ══[ pilot valve ]══ T (solved) ══[ needle ]══ tank, pilot fully shifted
+    fn series(p_chamber: f64) -> Circuit {
+        let src = |n: &str, node: &str, p: f64| -> Box<dyn Component> {
+            Box::new(PressureSource::new(n, node, Pressure::new(p), None))
+        };
+        Circuit::build(vec![
+            src("l1", "l1", 30.0e5),
+            src("l2", "l2", 0.0),
+            src("a", "a", 0.0),
+            src("b", "b", p_chamber),
+            src("tank", "tank", 0.0),
+            Box::new(PilotValve::new(
+                "pilot",
+                PilotFourWay::dddc(),
+                PilotNodes {
+                    pilot_1: "l1",
+                    pilot_2: "l2",
+                    a: "a",
+                    b: "b",
+                    t: "t",
+                },
+            )),
+            Box::new(NeedleComponent::new(
+                "needle",
+                NeedleValve::nccc(),
+                "t",
+                "tank",
+            )),
+            Box::new(AlgebraicNode::new("t_port", "t", Some("p_t"))),
+        ])
+        .unwrap()
     }
 
     #[test]
-    fn forward_series_flow_splits_the_drop() {
-        let r = path();
-        let k_fw = r.four_way.k_t * 0.3;
-        let (q, pm) = r.series_flow(k_fw, 5.0e5, 0.0);
-        // the same flow through both orifices
-        assert!((k_fw * (5.0e5 - pm).sqrt() - q).abs() < 1e-12 * q);
-        assert!((r.needle.flow(Pressure::new(pm), Pressure::ZERO).si() - q).abs() < 1e-12 * q);
-        assert_eq!(r.series_flow(0.0, 5.0e5, 0.0), (0.0, 0.0));
-    }
-
-    #[test]
-    fn reverse_flow_through_the_open_check_is_continuous_in_the_node_pressure() {
-        let r = path();
-        let k_fw = r.four_way.k_t;
-        let (q, pm) = r.series_flow(k_fw, -0.9e5, 0.0);
-        assert!(q < 0.0 && pm > -0.9e5 && pm < 0.0);
-        let q_needle = r.needle.flow(Pressure::new(pm), Pressure::ZERO).si();
-        assert!((q - q_needle).abs() < 1e-9 * q.abs(), "{q} {q_needle}");
-        // the reverse check opened: more backflow than the needle alone would pass
-        let metered = r
-            .needle
-            .metered_flow(Pressure::new(pm), Pressure::ZERO)
+    fn forward_series_flow_matches_the_series_coefficient() {
+        let c = series(5.0e5);
+        let w = c.wires_at(0.0, &[]);
+        let pt = w.get(c.find_wire("hyd:t:p").unwrap());
+        let fw = PilotFourWay::dddc();
+        let y = fw.opening(Pressure::new(30.0e5), Pressure::ZERO);
+        let (k_fw, k_n) = (fw.return_coefficient(y), NeedleValve::nccc().coefficient());
+        // two square-root orifices in series: Q = k √Δp with 1/k² = 1/k1² + 1/k2²
+        let q = series_coefficient(k_fw, k_n) * 5.0e5_f64.sqrt();
+        let q_needle = NeedleValve::nccc()
+            .flow(Pressure::new(pt), Pressure::ZERO)
             .si();
-        assert!(q < metered);
+        assert!((q_needle - q).abs() < 1e-10 * q, "{q_needle} {q}");
+        // the flows into the T node balance: what reaches the tank left chamber B
+        let q_tank = w.get(c.find_wire("hyd:tank:q").unwrap());
+        let q_b = -w.get(c.find_wire("hyd:b:q").unwrap());
+        assert!((q_tank - q_b).abs() < 1e-12 * q, "{q_tank} {q_b}");
+        let d = c.diagnostics();
+        let solves = d.iter().find(|(k, _)| k == "t_port.solves").unwrap().1;
+        assert!(solves >= 1.0);
+    }
+
+    #[test]
+    fn reverse_flow_through_the_open_check_balances_at_the_node() {
+        let c = series(-0.9e5);
+        let w = c.wires_at(0.0, &[]);
+        let pt = w.get(c.find_wire("hyd:t:p").unwrap());
+        assert!(pt > -0.9e5 && pt < 0.0, "{pt}");
+        let n = NeedleValve::nccc();
+        let q = n.flow(Pressure::new(pt), Pressure::ZERO).si();
+        // the reverse check opened: more backflow than the needle alone would pass
+        assert!(q < n.metered_flow(Pressure::new(pt), Pressure::ZERO).si());
+        let q_b = w.get(c.find_wire("hyd:b:q").unwrap());
+        assert!((q_b + q).abs() < 1e-9 * q.abs(), "{q_b} {q}");
+    }
+
+    #[test]
+    fn an_algebraic_node_needs_two_resistive_neighbours() {
+        let e = Circuit::build(vec![
+            Box::new(PressureSource::new("tank", "tank", Pressure::ZERO, None)),
+            Box::new(NeedleComponent::new(
+                "needle",
+                NeedleValve::nccc(),
+                "t",
+                "tank",
+            )),
+            Box::new(AlgebraicNode::new("t_port", "t", None)),
+        ])
+        .unwrap_err();
+        assert!(e.to_string().contains("at least two"), "{e}");
     }
 }

@@ -1,6 +1,8 @@
 //! The `wang-hybrid` rig: the hybrid pump-controlled asymmetric cylinder of
-//! thesis chapters 4, 6 and 7, assembled from components through the
-//! [`Circuit`] — no hand-written whole-circuit equations.
+//! thesis chapters 4, 6 and 7, assembled from its netlist
+//! (`fixtures/rigs/wang-hybrid.json`, filled with the rig's values by
+//! [`WangHybrid::to_netlist`]) through the [`Circuit`] — no hand-written
+//! topology, no whole-circuit equations.
 //!
 //! ```text
 //!                      ┌── check 1 ◀── tank          tank ──▶ check 2 ──┐
@@ -25,7 +27,10 @@
 //!   pass reverse flow);
 //! * the DDDC four-way valve opens the chamber that is not fed to its T port
 //!   (`B → T` when `Pp1 > Pp2`), the NCCC needle valve (with its reverse-flow
-//!   check) throttles it to the tank ([`ReturnPath`]);
+//!   check) throttles it to the tank ([`PilotValve`], [`NeedleComponent`]);
+//!   the T port between them is an algebraic node
+//!   ([`AlgebraicNode`](crate::series::AlgebraicNode)) whose pressure the
+//!   assembler solves;
 //! * the C10 cylinder (Table 4-6), a moving mass, the new friction model of
 //!   chapter 5 (eq 5.14, Tables 5-8 to 5-10).
 //!
@@ -35,10 +40,11 @@
 pub mod components;
 mod netlist;
 
-pub use components::{CheckComponent, PumpComponent, ReliefComponent, ReturnNodes, ReturnPath};
+pub use components::{
+    CheckComponent, NeedleComponent, PilotNodes, PilotValve, PumpComponent, ReliefComponent,
+};
 
 use crate::circuit::{BuildError, Circuit, Component};
-use crate::components::{CommandInput, Friction, Mass, PressureSource, TwoChamberCylinder, Volume};
 use crate::rig::RigError;
 use crate::run::{Run, RunOptions};
 use crate::signal::Signal;
@@ -67,6 +73,8 @@ pub mod nodes {
     pub const CHAMBER_2: &str = "chamber_2";
     /// The tank.
     pub const TANK: &str = "tank";
+    /// The four-way valve's T port, joined to the needle valve (algebraic).
+    pub const RETURN_PORT: &str = "return_port";
     /// The piston rod and load.
     pub const ROD: &str = "rod";
     /// The pump command signal \[V\].
@@ -268,106 +276,24 @@ impl WangHybrid {
         })
     }
 
-    /// The components of the rig driven by `command` \[V\], in state order.
-    pub fn components(&self, command: Signal) -> Result<Vec<Box<dyn Component>>, BuildError> {
-        use nodes::*;
-        self.validate()?;
-        command.validate().map_err(|e| BuildError::Component {
-            component: "command".into(),
-            message: e.to_string(),
-        })?;
-        let mut cyl = TwoChamberCylinder::new(
-            "cylinder",
-            CHAMBER_1,
-            CHAMBER_2,
-            ROD,
-            self.cylinder,
-            (self.tank_pressure, self.tank_pressure),
-        );
-        cyl.cavitation_pressure = self.vapour_pressure;
-        let stops = Some(self.cylinder.stroke_ends());
-        let tank = Pressure::new(self.tank_pressure);
-        Ok(vec![
-            Box::new(CommandInput::new("command", COMMAND, command)),
-            Box::new(PumpComponent::new(
-                "pump", self.pump, COMMAND, LINE_1, LINE_2,
-            )),
-            Box::new(Volume::new(
-                "line_1",
-                LINE_1,
-                self.pump_line_volume,
-                self.bulk_modulus,
-                self.tank_pressure,
-                Some("pp1"),
-            )),
-            Box::new(Volume::new(
-                "line_2",
-                LINE_2,
-                self.pump_line_volume,
-                self.bulk_modulus,
-                self.tank_pressure,
-                Some("pp2"),
-            )),
-            Box::new(cyl),
-            Box::new(Mass::new(
-                "load",
-                ROD,
-                self.mass,
-                self.external_force,
-                stops,
-                (self.initial_position, 0.0),
-            )),
-            Box::new(Friction::new(
-                "friction",
-                ROD,
-                Some((CHAMBER_1, CHAMBER_2)),
-                Box::new(self.friction),
-            )),
-            Box::new(PressureSource::new("tank", TANK, tank, None)),
-            Box::new(ReliefComponent::new(
-                "relief_1",
-                self.relief_pilot,
-                LINE_1,
-                CHAMBER_1,
-            )),
-            Box::new(ReliefComponent::new(
-                "relief_2",
-                self.relief_pilot,
-                LINE_2,
-                CHAMBER_2,
-            )),
-            Box::new(ReliefComponent::new(
-                "relief_3_line_1",
-                self.relief_safety,
-                LINE_1,
-                TANK,
-            )),
-            Box::new(ReliefComponent::new(
-                "relief_3_line_2",
-                self.relief_safety,
-                LINE_2,
-                TANK,
-            )),
-            Box::new(CheckComponent::new("check_1", self.check, TANK, LINE_1)),
-            Box::new(CheckComponent::new("check_2", self.check, TANK, LINE_2)),
-            Box::new(ReturnPath::with_nodes(
-                "return",
-                self.four_way,
-                self.needle,
-                ReturnNodes {
-                    pilot_1: LINE_1,
-                    pilot_2: LINE_2,
-                    a: CHAMBER_1,
-                    b: CHAMBER_2,
-                    tank: TANK,
-                },
-            )),
-        ])
+    /// The assembled circuit driven by `command` \[V\]: the netlist of
+    /// [`WangHybrid::to_netlist`].
+    pub fn build(&self, command: Signal) -> Result<Circuit, RigError> {
+        self.build_with(command, |_| ())
     }
 
-    /// The assembled circuit driven by `command` \[V\].
-    pub fn build(&self, command: Signal) -> Result<Circuit, BuildError> {
-        Circuit::build(self.components(command)?)
+    /// [`WangHybrid::build`], with `edit` given the components before they
+    /// are joined (the chapter-8 variants swap valves).
+    pub fn build_with(
+        &self,
+        command: Signal,
+        edit: impl FnOnce(&mut Vec<Box<dyn Component>>),
+    ) -> Result<Circuit, RigError> {
+        crate::netlist::assemble_with(
+            &crate::netlist::schematic(&self.to_netlist()?)?,
+            command,
+            edit,
+        )
     }
 }
 
@@ -394,6 +320,12 @@ mod tests {
         assert_eq!(r.cylinder.area_2.si(), 5.50e-4);
         assert_eq!(r.mass, 20.0);
         assert!(r.validate().is_ok());
+    }
+
+    #[test]
+    fn the_preset_as_a_netlist_is_the_fixture_file() {
+        let file: serde_json::Value = serde_json::from_str(netlist::CIRCUIT).unwrap();
+        assert_eq!(WangHybrid::preset().to_netlist().unwrap(), file);
     }
 
     #[test]
@@ -462,6 +394,6 @@ mod tests {
         let mut r = WangHybrid::preset();
         r.needle.orifice.cd = 1.5;
         let e = r.build(Signal::Constant { value: 0.0 }).unwrap_err();
-        assert!(e.to_string().contains("`cd`"), "{e}");
+        assert!(e.to_string().contains("needle_valve.orifice.cd"), "{e}");
     }
 }

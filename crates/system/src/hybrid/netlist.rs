@@ -1,16 +1,30 @@
-//! The `hybrid-pump` rig read from a netlist of its circuit (the
-//! `wang-hybrid` preset file): the typed view the chapter-7 and chapter-8
-//! studies work on.
+//! The `hybrid-pump` rig as a netlist and back: its topology lives in the
+//! netlist file `fixtures/rigs/wang-hybrid.json`, not in code.
+//! [`WangHybrid::to_netlist`] fills it with the rig's values;
+//! [`WangHybrid::from_netlist`] reads them back from a netlist of that
+//! circuit (the typed view the chapter-7 and chapter-8 studies work on).
 
 use super::{WangHybrid, KIND};
 use crate::netlist::{self, registry::Instance};
 use crate::rig::RigError;
 use hydrocyl_actuator::Cylinder;
 use hydrocyl_ports::{Area, Position, Pressure};
-use serde_json::Value;
+use serde_json::{json, Value};
+
+/// The hybrid circuit (the `wang-hybrid` preset).
+pub const CIRCUIT: &str = include_str!("../../../../fixtures/rigs/wang-hybrid.json");
+
+/// A law as a netlist component object of type `ty`.
+fn component<T: serde::Serialize>(ty: &str, law: &T) -> Value {
+    let mut v = serde_json::to_value(law).expect("a law serialises");
+    v.as_object_mut()
+        .expect("a law is an object")
+        .insert("type".into(), Value::from(ty));
+    v
+}
 
 /// The components of the hybrid circuit, in state order.
-const PARTS: [(&str, &str); 15] = [
+const PARTS: [(&str, &str); 17] = [
     ("command", "command_input"),
     ("pump", "pump_identified"),
     ("line_1", "volume"),
@@ -25,11 +39,13 @@ const PARTS: [(&str, &str); 15] = [
     ("relief_3_line_2", "relief_valve"),
     ("check_1", "check_valve"),
     ("check_2", "check_valve"),
-    ("return", "pilot_return_path"),
+    ("pilot_valve", "pilot_valve"),
+    ("needle_valve", "needle_valve"),
+    ("return_port", "algebraic_node"),
 ];
 
 /// Ports the circuit joins: each group shares one node.
-const NODES: [&[(&str, &str)]; 7] = [
+const NODES: [&[(&str, &str)]; 8] = [
     &[("command", "out"), ("pump", "command")],
     &[
         ("pump", "a"),
@@ -37,7 +53,7 @@ const NODES: [&[(&str, &str)]; 7] = [
         ("relief_1", "inlet"),
         ("relief_3_line_1", "inlet"),
         ("check_1", "outlet"),
-        ("return", "pilot_1"),
+        ("pilot_valve", "pilot_1"),
     ],
     &[
         ("pump", "b"),
@@ -45,19 +61,19 @@ const NODES: [&[(&str, &str)]; 7] = [
         ("relief_2", "inlet"),
         ("relief_3_line_2", "inlet"),
         ("check_2", "outlet"),
-        ("return", "pilot_2"),
+        ("pilot_valve", "pilot_2"),
     ],
     &[
         ("cylinder", "A"),
         ("friction", "A"),
         ("relief_1", "outlet"),
-        ("return", "A"),
+        ("pilot_valve", "A"),
     ],
     &[
         ("cylinder", "B"),
         ("friction", "B"),
         ("relief_2", "outlet"),
-        ("return", "B"),
+        ("pilot_valve", "B"),
     ],
     &[
         ("tank", "port"),
@@ -65,7 +81,12 @@ const NODES: [&[(&str, &str)]; 7] = [
         ("relief_3_line_2", "outlet"),
         ("check_1", "inlet"),
         ("check_2", "inlet"),
-        ("return", "T"),
+        ("needle_valve", "outlet"),
+    ],
+    &[
+        ("return_port", "node"),
+        ("pilot_valve", "T"),
+        ("needle_valve", "inlet"),
     ],
     &[("cylinder", "rod"), ("load", "rod"), ("friction", "rod")],
 ];
@@ -84,6 +105,64 @@ fn bad(path: impl Into<String>, why: impl Into<String>) -> RigError {
 }
 
 impl WangHybrid {
+    /// This rig as a netlist: the hybrid circuit with this rig's values
+    /// (every volume starting at the tank pressure).
+    pub fn to_netlist(&self) -> Result<Value, RigError> {
+        self.validate()?;
+        let mut v: Value =
+            serde_json::from_str(CIRCUIT).expect("the embedded netlist is valid JSON (tested)");
+        let c = &mut v["components"];
+        let tank = self.tank_pressure;
+        c["pump"] = component("pump_identified", &self.pump);
+        for line in ["line_1", "line_2"] {
+            c[line] = json!({
+                "type": "volume",
+                "volume": self.pump_line_volume,
+                "bulk_modulus": self.bulk_modulus,
+                "initial": { "pressure": tank }
+            });
+        }
+        let cyl = &self.cylinder;
+        c["cylinder"] = json!({
+            "type": "cylinder",
+            "area_1": cyl.area_1.si(),
+            "area_2": cyl.area_2.si(),
+            "stroke": cyl.stroke.si(),
+            "chamber_length_1": cyl.chamber_length_1.si(),
+            "chamber_length_2": cyl.chamber_length_2.si(),
+            "bulk_modulus": cyl.bulk_modulus.si(),
+            "internal_leakage": cyl.internal_leakage,
+            "external_leakage_1": cyl.external_leakage_1,
+            "external_leakage_2": cyl.external_leakage_2,
+            "cavitation_pressure": self.vapour_pressure,
+            "initial": { "position": self.initial_position, "velocity": 0.0, "p1": tank, "p2": tank }
+        });
+        c["load"] = json!({
+            "type": "mass",
+            "mass": self.mass,
+            "external_force": self.external_force
+        });
+        let (friction, dp_max) = crate::valve_netlist::friction_component(&self.friction);
+        c["friction"] = friction;
+        if dp_max > 0.0 {
+            // the bound of Wang's own seal term (0 = the thesis's unbounded form)
+            c["friction"]["seal"] = json!({ "dp_max": dp_max });
+        }
+        c["tank"] = json!({ "type": "pressure_source", "pressure": tank });
+        for r in ["relief_1", "relief_2"] {
+            c[r] = component("relief_valve", &self.relief_pilot);
+        }
+        for r in ["relief_3_line_1", "relief_3_line_2"] {
+            c[r] = component("relief_valve", &self.relief_safety);
+        }
+        for k in ["check_1", "check_2"] {
+            c[k] = component("check_valve", &self.check);
+        }
+        c["pilot_valve"] = component("pilot_valve", &self.four_way);
+        c["needle_valve"] = component("needle_valve", &self.needle);
+        Ok(v)
+    }
+
     /// The rig a netlist of the hybrid circuit describes (the components and
     /// wiring of the `wang-hybrid` preset; relief valves 1/2, 3 and the
     /// check valves each pairwise equal). Another circuit is refused, naming
@@ -162,8 +241,8 @@ impl WangHybrid {
             relief_pilot: typed(get("relief_1")?, "")?,
             relief_safety: typed(get("relief_3_line_1")?, "")?,
             check: typed(get("check_1")?, "")?,
-            four_way: typed(get("return")?, "four_way")?,
-            needle: typed(get("return")?, "needle")?,
+            four_way: typed(get("pilot_valve")?, "")?,
+            needle: typed(get("needle_valve")?, "")?,
             cylinder: Cylinder {
                 area_1: Area::new(cyl.get("area_1")),
                 area_2: Area::new(cyl.get("area_2")),

@@ -78,6 +78,17 @@ fn probe_path(component: &str, declared: &[(&str, &str)], probe: &str) -> String
 /// Assembles the circuit of a checked netlist, the first `command_input`
 /// driven by `command`.
 pub fn assemble(s: &Schematic, command: Signal) -> Result<Circuit, RigError> {
+    assemble_with(s, command, |_| ())
+}
+
+/// [`assemble`], with `edit` given the built components before they are
+/// joined (a study swapping one component for another; the probes of a
+/// component the netlist does not declare keep their own names).
+pub fn assemble_with(
+    s: &Schematic,
+    command: Signal,
+    edit: impl FnOnce(&mut Vec<Box<dyn crate::Component>>),
+) -> Result<Circuit, RigError> {
     command.validate().map_err(|e| RigError::Invalid {
         path: "command".into(),
         why: e.to_string(),
@@ -106,6 +117,7 @@ pub fn assemble(s: &Schematic, command: Signal) -> Result<Circuit, RigError> {
         })?;
         comps.push(c);
     }
+    edit(&mut comps);
     let mut c = Circuit::build(comps).map_err(|e| match e {
         BuildError::Component { component, message } => RigError::Invalid {
             path: format!("components.{component}"),
@@ -126,11 +138,9 @@ pub fn assemble(s: &Schematic, command: Signal) -> Result<Circuit, RigError> {
         .map(|i| (i.name.clone(), i.ty.probes))
         .collect();
     c.name_probes(|comp, probe| {
-        let types = declared
-            .iter()
-            .find(|(n, _)| n == comp)
-            .map(|(_, p)| *p)
-            .unwrap_or(&[]);
+        let Some(types) = declared.iter().find(|(n, _)| n == comp).map(|(_, p)| *p) else {
+            return Some(probe.to_string());
+        };
         let path = probe_path(comp, types, probe);
         if outputs.is_empty() {
             Some(path)

@@ -454,7 +454,7 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                         ports.join(", "),
                         match domain {
                             Domain::Hydraulic =>
-                                "connect a volume, a cylinder chamber or a pressure source to it",
+                                "connect a volume, a cylinder chamber or a pressure source to it (or an `algebraic_node` between two resistive components)",
                             Domain::Mechanical => "connect a mass to it",
                             Domain::Signal =>
                                 "connect a signal source (command input, spool) to it",

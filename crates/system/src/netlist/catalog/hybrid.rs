@@ -1,13 +1,14 @@
 //! The hybrid pump-controlled drive's components (chapter 6): the identified
 //! servomotor–pump (section 6.2.1), relief valves (eqs 6.6–6.10), check
-//! valves (eqs 6.11–6.13) and the pilot-operated return path (DDDC four-way
-//! and NCCC needle valve, eqs 6.2–6.5, 6.14–6.19).
+//! valves (eqs 6.11–6.13), the pilot-operated DDDC four-way valve (eqs
+//! 6.2–6.5) and the NCCC needle valve with its reverse check (eqs
+//! 6.14–6.19), joined in series by an `algebraic_node`.
 
 use super::super::registry::{param, ComponentType, Default::*, Instance, ParamSpec, Range, Role};
 use super::hydraulic::orifice_params;
 use super::{built, port, HYD, SIG};
 use crate::hybrid::components::{
-    CheckComponent, PumpComponent, ReliefComponent, ReturnNodes, ReturnPath,
+    CheckComponent, NeedleComponent, PilotNodes, PilotValve, PumpComponent, ReliefComponent,
 };
 use hydrocyl_pump_motor::IdentifiedPump;
 use hydrocyl_valves::check::CheckValve;
@@ -57,68 +58,65 @@ macro_rules! check_params {
 
 const CHECK: [ParamSpec; 3] = check_params!("");
 
-const RETURN: [ParamSpec; 15] = {
-    let o = orifice_params!("needle.orifice.");
-    let c = check_params!("needle.reverse_check.");
+const PILOT: [ParamSpec; 7] = [
+    param(
+        "spring_rate",
+        "Pa/m",
+        Required,
+        Range::POSITIVE,
+        "pilot spool centring spring rate k_s",
+    ),
+    param("overlap", "m", Required, Range::NON_NEGATIVE, "overlap x_o"),
+    param(
+        "stroke",
+        "m",
+        Required,
+        Range::POSITIVE,
+        "opening travel beyond the overlap",
+    ),
+    param(
+        "hole_radius",
+        "m",
+        Required,
+        Range::POSITIVE,
+        "radius of each port hole",
+    ),
+    param(
+        "k_p",
+        "m^3/(s Pa^0.5)",
+        Required,
+        Range::POSITIVE,
+        "full-shift coefficient P→A, P→B (eq 6.4)",
+    ),
+    param(
+        "k_t",
+        "m^3/(s Pa^0.5)",
+        Required,
+        Range::POSITIVE,
+        "full-shift coefficient A→T, B→T (eq 6.5)",
+    ),
+    param(
+        "dp_transition",
+        "Pa",
+        Value(1000.0),
+        Range::POSITIVE,
+        "transition pressure of the regularised root",
+    ),
+];
+
+const NEEDLE: [ParamSpec; 8] = {
+    let o = orifice_params!("orifice.");
+    let c = check_params!("reverse_check.");
     [
         param(
-            "four_way.spring_rate",
-            "Pa/m",
-            Required,
-            Range::POSITIVE,
-            "pilot spool centring spring rate k_s",
-        ),
-        param(
-            "four_way.overlap",
-            "m",
-            Required,
-            Range::NON_NEGATIVE,
-            "overlap x_o",
-        ),
-        param(
-            "four_way.stroke",
-            "m",
-            Required,
-            Range::POSITIVE,
-            "opening travel beyond the overlap",
-        ),
-        param(
-            "four_way.hole_radius",
-            "m",
-            Required,
-            Range::POSITIVE,
-            "radius of each port hole",
-        ),
-        param(
-            "four_way.k_p",
-            "m^3/(s Pa^0.5)",
-            Required,
-            Range::POSITIVE,
-            "full-shift coefficient P→A, P→B (eq 6.4)",
-        ),
-        param(
-            "four_way.k_t",
-            "m^3/(s Pa^0.5)",
-            Required,
-            Range::POSITIVE,
-            "full-shift coefficient A→T, B→T (eq 6.5)",
-        ),
-        param(
-            "four_way.dp_transition",
-            "Pa",
-            Value(1000.0),
-            Range::POSITIVE,
-            "transition pressure of the regularised root",
-        ),
-        param(
-            "needle.area",
+            "area",
             "m^2",
             Required,
             Range::NON_NEGATIVE,
             "needle opening area Avn",
         ),
         param(
-            "needle.effective_factor",
+            "effective_factor",
             "-",
             Required,
             Range::UNIT,
@@ -197,36 +195,50 @@ pub const TYPES: &[ComponentType] = &[
         probes: &[("flow", "m^3/s")],
     },
     ComponentType {
-        name: "pilot_return_path",
-        summary: "pilot-shifted DDDC four-way valve opening the unfed chamber to T, in series with the NCCC needle valve to tank (eqs 6.2–6.5, 6.14–6.19)",
+        name: "pilot_valve",
+        summary: "pilot-shifted DDDC four-way valve opening the unfed chamber to its T port, Q = k_T(y) √(p_x − p_T) (eqs 6.2–6.5)",
         ports: &[
             port("pilot_1", HYD, Role::Reads, false, "pilot port 1 (pump line 1)"),
             port("pilot_2", HYD, Role::Reads, false, "pilot port 6 (pump line 2)"),
             port("A", HYD, Role::Reads, false, "work port A (chamber 1)"),
             port("B", HYD, Role::Reads, false, "work port B (chamber 2)"),
-            port("T", HYD, Role::Reads, false, "the tank, behind the needle valve"),
+            port("T", HYD, Role::Reads, false, "the T port (to the needle valve: an algebraic node)"),
         ],
-        params: &RETURN,
+        params: &PILOT,
         states: &[],
         build: |i| {
-            let fw: PilotFourWay = law(i, "four_way", PilotFourWay::validate)?;
-            let needle: NeedleValve = law(i, "needle", |n: &NeedleValve| {
-                NeedleValve::new(n.area, n.effective_factor, n.orifice, n.reverse_check).map(|_| ())
-            })?;
-            built(ReturnPath::with_nodes(
+            let fw: PilotFourWay = law(i, "", PilotFourWay::validate)?;
+            built(PilotValve::new(
                 &i.name,
                 fw,
-                needle,
-                ReturnNodes {
+                PilotNodes {
                     pilot_1: i.node("pilot_1"),
                     pilot_2: i.node("pilot_2"),
                     a: i.node("A"),
                     b: i.node("B"),
-                    tank: i.node("T"),
+                    t: i.node("T"),
                 },
             ))
         },
         hints: None,
         probes: &[("pilot_spool", "m"), ("return_flow_1", "m^3/s"), ("return_flow_2", "m^3/s")],
+    },
+    ComponentType {
+        name: "needle_valve",
+        summary: "NCCC needle valve with its reverse-flow check, inlet → outlet (eqs 6.14–6.19)",
+        ports: &[
+            port("inlet", HYD, Role::Reads, false, "inlet (metered flow inlet → outlet)"),
+            port("outlet", HYD, Role::Reads, false, "outlet (the reverse check opens outlet → inlet)"),
+        ],
+        params: &NEEDLE,
+        states: &[],
+        build: |i| {
+            let needle: NeedleValve = law(i, "", |n: &NeedleValve| {
+                NeedleValve::new(n.area, n.effective_factor, n.orifice, n.reverse_check).map(|_| ())
+            })?;
+            built(NeedleComponent::new(&i.name, needle, i.node("inlet"), i.node("outlet")))
+        },
+        hints: None,
+        probes: &[],
     },
 ];

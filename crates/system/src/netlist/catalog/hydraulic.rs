@@ -114,6 +114,28 @@ pub const TYPES: &[ComponentType] = &[
         probes: &[("p", "Pa")],
     },
     ComponentType {
+        name: "algebraic_node",
+        summary: "a node between resistive components with no volume: the assembler solves its pressure so the flows into it sum to zero (Newton on the components' slopes)",
+        ports: &[port(
+            "node",
+            HYD,
+            Role::Owns,
+            false,
+            "the node whose pressure is solved",
+        )],
+        params: &[],
+        states: &[],
+        build: |i| {
+            built(crate::series::AlgebraicNode::new(
+                &i.name,
+                i.node("node"),
+                Some("p"),
+            ))
+        },
+        hints: None,
+        probes: &[("p", "Pa")],
+    },
+    ComponentType {
         name: "orifice",
         summary: "a fixed sharp-edged orifice, Q = Cd A √(2Δp/ρ) regularised (eqs 2.4–2.7)",
         ports: &[

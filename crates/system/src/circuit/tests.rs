@@ -1,0 +1,165 @@
+//! Tests of the assembler core.
+use super::*;
+use crate::components::{FixedOrifice, PressureSource, Volume};
+use hydrocyl_integrators::{solve, Method, Options};
+use hydrocyl_ports::{Area, Density, Pressure};
+use hydrocyl_valves::orifice::Orifice;
+
+/// A test component that writes signal `out` algebraically from signal `inp`.
+struct Gain {
+    name: String,
+    inp: String,
+    out: String,
+    w: (Wire<f64>, Wire<f64>),
+}
+
+impl Component for Gain {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
+        self.w = (
+            net.signal(&self.inp),
+            net.own_signal(&self.out, Causality::Algebraic)?,
+        );
+        Ok(())
+    }
+    fn evaluate(&self, _t: f64, _x: &[f64], w: &mut Wires) {
+        w.set(self.w.1, 2.0 * w.get(self.w.0));
+    }
+}
+
+fn gain(name: &str, inp: &str, out: &str) -> Box<dyn Component> {
+    Box::new(Gain {
+        name: name.into(),
+        inp: inp.into(),
+        out: out.into(),
+        w: (Wire::UNBOUND, Wire::UNBOUND),
+    })
+}
+
+fn orifice() -> Orifice {
+    Orifice::new(0.65, Density::new(870.0))
+}
+
+#[test]
+fn causality_errors_name_components_and_nodes() {
+    let two = Circuit::build(vec![
+        Box::new(PressureSource::new(
+            "supply",
+            "P",
+            Pressure::from_bar(70.0),
+            None,
+        )),
+        Box::new(Volume::new("line", "P", 1e-4, 7e8, 0.0, None)),
+    ])
+    .unwrap_err();
+    assert!(matches!(two, BuildError::TwoOwners { .. }));
+    assert!(
+        two.to_string().contains("`P`")
+            && two.to_string().contains("supply")
+            && two.to_string().contains("line")
+    );
+
+    let none = Circuit::build(vec![
+        Box::new(PressureSource::new(
+            "supply",
+            "P",
+            Pressure::from_bar(70.0),
+            None,
+        )),
+        Box::new(FixedOrifice::new("o", "P", "A", Area::new(1e-6), orifice())),
+    ])
+    .unwrap_err();
+    assert!(
+        none.to_string().contains("`A`") && none.to_string().contains("`o`"),
+        "{none}"
+    );
+
+    let looped = Circuit::build(vec![gain("g1", "a", "b"), gain("g2", "b", "a")]).unwrap_err();
+    assert!(matches!(looped, BuildError::AlgebraicLoop(_)), "{looped}");
+
+    let dup = Circuit::build(vec![gain("g", "a", "b"), gain("g", "b", "c")]).unwrap_err();
+    assert!(dup.to_string().contains("two components"), "{dup}");
+}
+
+#[test]
+fn a_signal_used_as_two_quantities_is_a_build_error() {
+    // the spool writes `x` as a position; the gain reads it as a bare f64
+    let spool = crate::components::ServoSpool::new(
+        "spool",
+        "u",
+        "x",
+        hydrocyl_valves::servovalve::Spool::leaney_moog(),
+        0.0,
+    );
+    let cmd = crate::components::CommandInput::new(
+        "cmd",
+        "u",
+        crate::signal::Signal::Constant { value: 0.0 },
+    );
+    let e = Circuit::build(vec![Box::new(cmd), Box::new(spool), gain("g", "x", "y")]).unwrap_err();
+    assert!(matches!(e, BuildError::UnitMismatch { .. }), "{e}");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("sig:x") && msg.contains("`g`") && msg.contains("m"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn algebraic_components_are_ordered_by_dependency() {
+    // given in reverse order: g2 reads what g1 writes; g1 reads a stored signal
+    let mut c = Circuit::build(vec![
+        gain("g2", "b", "c"),
+        gain("g1", "a", "b"),
+        Box::new(crate::components::CommandInput::new(
+            "cmd",
+            "a",
+            crate::signal::Signal::Constant { value: 1.5 },
+        )),
+    ])
+    .unwrap();
+    let w = c.wires_at(0.0, &[]);
+    let cw = c.find_wire("sig:c").unwrap();
+    assert_eq!(w.get(cw), 6.0);
+    c.reset(0.0, &[]);
+}
+
+#[test]
+fn volume_filled_through_an_orifice_conserves_mass_and_reaches_supply() {
+    // supply → orifice → volume: V/B (p(T) − p(0)) = ∫Q dt, p → Ps
+    let (v, b) = (1e-4, 7e8);
+    let mut c = Circuit::build(vec![
+        Box::new(PressureSource::new(
+            "supply",
+            "P",
+            Pressure::from_bar(70.0),
+            Some("ps"),
+        )),
+        Box::new(FixedOrifice::new("o", "P", "A", Area::new(1e-7), orifice())),
+        Box::new(Volume::new("vol", "A", v, b, 0.0, Some("pa"))),
+    ])
+    .unwrap();
+    c.set_ledger(true);
+    let x0 = c.initial_state();
+    let opts = Options {
+        rtol: 1e-9,
+        atol: c.atol(1e-9),
+        ..Options::default()
+    };
+    let sol = solve(Method::DormandPrince45, &mut c, 0.0, &x0, 2.0, &opts).unwrap();
+    let last = sol.last().unwrap();
+    assert!((last[0] - 7e6).abs() < 1e3, "p = {}", last[0]);
+    // energy: source = dissipated + storage (volume), each integrated
+    let o = c.ledger_offset();
+    let src = last[o];
+    let diss = last[o + 4 + 1];
+    let stored = last[o + 8 + 2];
+    assert!(
+        (src - diss - stored).abs() < 1e-6 * src,
+        "{src} {diss} {stored}"
+    );
+    // stored = V p²/(2B) for a constant volume
+    assert!((stored - v * last[0] * last[0] / (2.0 * b)).abs() < 1e-6 * stored);
+}

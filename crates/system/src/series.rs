@@ -1,0 +1,537 @@
+//! Algebraic hydraulic nodes: two or more resistive components in series,
+//! and the evaluation order of a circuit around them.
+//!
+//! A hydraulic node normally has an owner that sets its pressure from a
+//! state (a volume, a chamber) or holds it fixed (a source). Between two
+//! resistive components (a valve's return port and a needle valve, two
+//! orifices in series) there is no volume worth a state: the node's pressure
+//! is the one at which the flows into it sum to zero,
+//!
+//! ```text
+//!   ΣQ_in(p) = 0,      p ∈ [min p_neighbour, max p_neighbour]
+//!   chamber ══[ pilot valve ]══ T port (p solved) ══[ needle ]══ tank
+//! ```
+//!
+//! Such a node is declared explicitly with an [`AlgebraicNode`] component (a
+//! node without an owner stays a build error). The assembler gathers the
+//! components that connect to the node (its *members*) and evaluates them as
+//! one unit in the dependency order. Each evaluation solves `ΣQ_in(p) = 0`
+//! by Newton's method on the members' analytic slopes
+//! ([`Component::inflow_slope`]), started from the previous solution and
+//! kept inside the bracket given by the lowest and highest pressure the
+//! members read elsewhere (each resistive flow into the node falls
+//! monotonically with `p`, so the root is bracketed and unique): a step that
+//! leaves the bracket, or a member without a slope, falls back to bisection
+//! and Brent's method. Converged when the Newton step is below
+//! [`SERIES_RTOL`] of the pressure scale; only a converged evaluation is
+//! kept (every trial starts from the wire table as it was before the members
+//! ran). The result depends on the starting point only within that
+//! tolerance; [`Circuit::reset`](crate::Circuit::reset) forgets it.
+
+use crate::circuit::{BuildError, Component, Probe};
+use crate::wires::{HydraulicNode, Wires};
+use crate::Netlist;
+use hydrocyl_ports::Pressure;
+use std::cell::Cell;
+
+/// Relative tolerance of the series solve on the node pressure (of the
+/// bracket's largest magnitude, floored at 1 bar).
+pub const SERIES_RTOL: f64 = 1e-14;
+
+/// Newton iterations (each safeguarded by bisection) before the solve falls
+/// back to Brent's method; on the hybrid rig a solve takes ~2 evaluations.
+const NEWTON_ITERATIONS: usize = 100;
+
+/// Declares hydraulic node `node` algebraic: no component owns it, the
+/// assembler solves its pressure so that the flows into it sum to zero.
+/// Every component connected to it must be resistive (flows only, falling
+/// with the node pressure).
+#[derive(Debug)]
+pub struct AlgebraicNode {
+    name: String,
+    node_name: String,
+    probe: Option<String>,
+    node: HydraulicNode,
+}
+
+impl AlgebraicNode {
+    /// Node `node` solved by the assembler; `probe` names its pressure as
+    /// an output column.
+    pub fn new(name: &str, node: &str, probe: Option<&str>) -> Self {
+        Self {
+            name: name.into(),
+            node_name: node.into(),
+            probe: probe.map(str::to_string),
+            node: HydraulicNode::UNBOUND,
+        }
+    }
+}
+
+impl Component for AlgebraicNode {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
+        self.node = net.solve_hydraulic(&self.node_name)?;
+        Ok(())
+    }
+    fn probes(&self) -> Vec<Probe> {
+        self.probe
+            .iter()
+            .map(|n| Probe::of(n.clone(), self.node.pressure))
+            .collect()
+    }
+}
+
+/// One step of an evaluation, in dependency order.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Step {
+    /// [`Component::evaluate`] of one component.
+    Evaluate(usize),
+    /// Solve an algebraic node with its members.
+    Solve(usize),
+}
+
+/// One algebraic node and the components the assembler evaluates with it.
+#[derive(Debug)]
+pub(crate) struct SeriesGroup {
+    /// The [`AlgebraicNode`] component.
+    pub(crate) owner: usize,
+    pub(crate) node: HydraulicNode,
+    /// Members in evaluation order.
+    pub(crate) members: Vec<usize>,
+    /// Pressure wires (table indices) the members read elsewhere: the bracket.
+    bracket: Vec<usize>,
+    pub(crate) solves: Cell<u64>,
+    pub(crate) evaluations: Cell<u64>,
+    pub(crate) fallbacks: Cell<u64>,
+    /// The last solution: the next solve starts from it.
+    pub(crate) guess: Cell<f64>,
+}
+
+impl SeriesGroup {
+    /// Solves the node: `eval(w)` runs the members on `w`, `slope(w)` sums
+    /// their [`Component::inflow_slope`] (None if one has none); `snap` is
+    /// scratch.
+    pub(crate) fn solve(
+        &self,
+        w: &mut Wires,
+        snap: &mut Vec<f64>,
+        mut eval: impl FnMut(&mut Wires),
+        slope: impl Fn(&Wires) -> Option<f64>,
+    ) {
+        snap.clear();
+        snap.extend_from_slice(&w.v);
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for &i in &self.bracket {
+            lo = lo.min(w.v[i]);
+            hi = hi.max(w.v[i]);
+        }
+        let (last, n) = (Cell::new(f64::NAN), Cell::new(0u64));
+        let mut f = |p: f64, w: &mut Wires| {
+            w.v.copy_from_slice(snap);
+            w.set(self.node.pressure, Pressure::new(p));
+            eval(w);
+            last.set(p);
+            n.set(n.get() + 1);
+            w.get(self.node.inflow).si()
+        };
+        let scale = lo.abs().max(hi.abs()).max(1.0e5);
+        let tol = SERIES_RTOL * scale;
+        let p = if lo >= hi {
+            lo
+        } else {
+            let guess = self.guess.get();
+            let p0 = if guess > lo && guess < hi {
+                guess
+            } else {
+                0.5 * (lo + hi)
+            };
+            match newton(&mut f, &slope, w, p0, (lo, hi), tol) {
+                Some(p) => p,
+                None => {
+                    self.fallbacks.set(self.fallbacks.get() + 1);
+                    let (flo, fhi) = (f(lo, w), f(hi, w));
+                    if flo <= 0.0 {
+                        lo
+                    } else if fhi >= 0.0 {
+                        hi
+                    } else {
+                        brent(|p| f(p, w), lo, hi, flo, fhi, tol)
+                    }
+                }
+            }
+        };
+        self.guess.set(p);
+        if last.get() != p {
+            f(p, w);
+        }
+        self.solves.set(self.solves.get() + 1);
+        self.evaluations.set(self.evaluations.get() + n.get());
+    }
+}
+
+/// Newton's method for the root of the falling `f` in `(lo, hi)` from `p0`,
+/// safeguarded by bisection of the bracket it narrows; `None` if a member has
+/// no slope or it does not converge (the caller falls back to Brent).
+fn newton(
+    f: &mut impl FnMut(f64, &mut Wires) -> f64,
+    slope: &impl Fn(&Wires) -> Option<f64>,
+    w: &mut Wires,
+    p0: f64,
+    (mut a, mut b): (f64, f64),
+    tol: f64,
+) -> Option<f64> {
+    let mut p = p0;
+    let mut last_step = f64::INFINITY;
+    for _ in 0..NEWTON_ITERATIONS {
+        let r = f(p, w);
+        if r == 0.0 {
+            return Some(p);
+        }
+        // the inflow falls with p: a positive residual puts the root above p
+        if r > 0.0 {
+            a = p;
+        } else {
+            b = p;
+        }
+        let s = slope(w)?;
+        let step = if s < 0.0 { -r / s } else { f64::NAN };
+        // converged, or at the rounding floor (a step that stopped shrinking)
+        if step.abs() <= tol || (step.abs() <= 1e3 * tol && step.abs() >= 0.5 * last_step) {
+            return Some(p);
+        }
+        last_step = step.abs();
+        let next = p + step;
+        p = if next > a && next < b {
+            next
+        } else {
+            0.5 * (a + b)
+        };
+        if b - a <= tol {
+            return Some(p);
+        }
+    }
+    None
+}
+
+/// Brent's method (inverse quadratic interpolation safeguarded by
+/// bisection) for a root of `f` in `[a, b]` with `f(a) > 0 > f(b)` or the
+/// reverse, to `tol` absolute in the argument.
+fn brent(mut f: impl FnMut(f64) -> f64, a: f64, b: f64, fa: f64, fb: f64, tol: f64) -> f64 {
+    let (mut a, mut b, mut fa, mut fb) = (a, b, fa, fb);
+    let (mut c, mut fc) = (a, fa);
+    let (mut d, mut e) = (b - a, b - a);
+    for _ in 0..200 {
+        if (fb > 0.0) == (fc > 0.0) {
+            (c, fc, d) = (a, fa, b - a);
+            e = d;
+        }
+        if fc.abs() < fb.abs() {
+            (a, b, c) = (b, c, b);
+            (fa, fb, fc) = (fb, fc, fb);
+        }
+        let tol1 = 2.0 * f64::EPSILON * b.abs() + 0.5 * tol;
+        let xm = 0.5 * (c - b);
+        if xm.abs() <= tol1 || fb == 0.0 {
+            return b;
+        }
+        if e.abs() >= tol1 && fa.abs() > fb.abs() {
+            let s = fb / fa;
+            let (mut p, mut q) = if a == c {
+                (2.0 * xm * s, 1.0 - s)
+            } else {
+                let (qa, r) = (fa / fc, fb / fc);
+                (
+                    s * (2.0 * xm * qa * (qa - r) - (b - a) * (r - 1.0)),
+                    (qa - 1.0) * (r - 1.0) * (s - 1.0),
+                )
+            };
+            if p > 0.0 {
+                q = -q;
+            }
+            p = p.abs();
+            if 2.0 * p < (3.0 * xm * q - (tol1 * q).abs()).min((e * q).abs()) {
+                e = d;
+                d = p / q;
+            } else {
+                d = xm;
+                e = d;
+            }
+        } else {
+            d = xm;
+            e = d;
+        }
+        a = b;
+        fa = fb;
+        b += if d.abs() > tol1 { d } else { tol1.copysign(xm) };
+        fb = f(b);
+    }
+    b
+}
+
+/// Groups the components around each algebraic node (see the module docs);
+/// `deps[i]` are the algebraic writers component `i` reads. Returns the
+/// groups and, per component, the group it belongs to.
+fn groups(
+    net: &Netlist,
+    deps: &[Vec<usize>],
+) -> Result<(Vec<SeriesGroup>, Vec<Option<usize>>), BuildError> {
+    let n = net.component_names.len();
+    let mut of: Vec<Option<usize>> = vec![None; n];
+    let mut out = Vec::new();
+    for (g, (owner, node, name)) in net.solved.iter().enumerate() {
+        let p = node.pressure.raw();
+        let mut members: Vec<usize> = Vec::new();
+        for (reader, w, _, _) in &net.reads {
+            if *w == p.0 && *reader != *owner && !members.contains(reader) {
+                members.push(*reader);
+            }
+        }
+        let err = |m: String| BuildError::Component {
+            component: net.component_names[*owner].clone(),
+            message: m,
+        };
+        if members.len() < 2 {
+            return Err(err(format!(
+                "algebraic node `{name}` needs at least two components connected to it"
+            )));
+        }
+        for &m in &members {
+            if let Some(h) = of[m] {
+                return Err(err(format!(
+                    "`{}` joins two algebraic nodes (`{}` and `{name}`): give one of them a volume",
+                    net.component_names[m], net.solved[h].2
+                )));
+            }
+            of[m] = Some(g);
+        }
+        of[*owner] = Some(g);
+        // members in their dependency order
+        let order = kahn(&members, |m| {
+            deps[m].iter().filter(|d| members.contains(d)).copied()
+        })
+        .map_err(|left| loop_error(net, &left))?;
+        let mut bracket: Vec<usize> = net
+            .reads
+            .iter()
+            .filter(|(r, w, kind, _)| members.contains(r) && *kind == "hydraulic node" && *w != p.0)
+            .map(|(_, w, _, _)| *w)
+            .collect();
+        bracket.sort_unstable();
+        bracket.dedup();
+        if bracket.is_empty() {
+            return Err(err(format!(
+                "algebraic node `{name}` is connected to no other hydraulic node"
+            )));
+        }
+        out.push(SeriesGroup {
+            owner: *owner,
+            node: *node,
+            members: order,
+            bracket,
+            solves: Cell::new(0),
+            evaluations: Cell::new(0),
+            fallbacks: Cell::new(0),
+            guess: Cell::new(f64::NAN),
+        });
+    }
+    Ok((out, of))
+}
+
+/// Kahn's order of `items`, stable in the order given; `Err` holds the
+/// items left in a cycle.
+fn kahn<I: Iterator<Item = usize>>(
+    items: &[usize],
+    deps: impl Fn(usize) -> I,
+) -> Result<Vec<usize>, Vec<usize>> {
+    let mut order = Vec::with_capacity(items.len());
+    while order.len() < items.len() {
+        let next = items
+            .iter()
+            .copied()
+            .find(|&i| !order.contains(&i) && deps(i).all(|d| order.contains(&d)));
+        match next {
+            Some(i) => order.push(i),
+            None => {
+                return Err(items
+                    .iter()
+                    .copied()
+                    .filter(|i| !order.contains(i))
+                    .collect())
+            }
+        }
+    }
+    Ok(order)
+}
+
+fn loop_error(net: &Netlist, left: &[usize]) -> BuildError {
+    let names: Vec<String> = left
+        .iter()
+        .map(|&i| net.component_names[i].clone())
+        .collect();
+    BuildError::AlgebraicLoop(names.join(", "))
+}
+
+/// The evaluation order of a bound netlist: every read wire has an owner,
+/// the components around each algebraic node form one unit, and the units
+/// are ordered so that each runs after the algebraic writers it reads.
+pub(crate) fn evaluation_order(net: &Netlist) -> Result<(Vec<Step>, Vec<SeriesGroup>), BuildError> {
+    let n = net.component_names.len();
+    let mut deps: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (reader, w, kind, node) in &net.reads {
+        match net.owners.get(w) {
+            None => {
+                return Err(BuildError::NoOwner {
+                    kind,
+                    node: node.clone(),
+                    user: net.component_names[*reader].clone(),
+                })
+            }
+            Some(o) => {
+                let solved = net.solved.iter().any(|(_, h, _)| h.pressure.0 == *w);
+                if o.causality == crate::Causality::Algebraic
+                    && !solved
+                    && o.owner != *reader
+                    && !deps[*reader].contains(&o.owner)
+                {
+                    deps[*reader].push(o.owner);
+                }
+            }
+        }
+    }
+    let (groups, group_of) = groups(net, &deps)?;
+    let unit = |i: usize| group_of[i].map_or(i, |g| groups[g].owner);
+    let mut unit_deps: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (i, d) in deps.iter().enumerate() {
+        for &o in d {
+            let (u, v) = (unit(i), unit(o));
+            if u != v && !unit_deps[u].contains(&v) {
+                unit_deps[u].push(v);
+            }
+        }
+    }
+    let units: Vec<usize> = (0..n).filter(|&i| unit(i) == i).collect();
+    let order = kahn(&units, |u| unit_deps[u].iter().copied()).map_err(|l| loop_error(net, &l))?;
+    let steps = order
+        .into_iter()
+        .map(|i| match group_of[i] {
+            Some(g) => Step::Solve(g),
+            None => Step::Evaluate(i),
+        })
+        .collect();
+    Ok((steps, groups))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::components::{FixedOrifice, PressureSource, Volume};
+    use crate::Circuit;
+    use hydrocyl_integrators::{solve, Method, Options};
+    use hydrocyl_ports::{Area, Density};
+    use hydrocyl_valves::orifice::Orifice;
+
+    fn orifice() -> Orifice {
+        Orifice::new(0.65, Density::new(870.0))
+    }
+
+    /// supply ──[A1]── m (algebraic) ──[A2]── `to`
+    fn two_in_series(to: Box<dyn Component>) -> Vec<Box<dyn Component>> {
+        vec![
+            Box::new(PressureSource::new(
+                "supply",
+                "P",
+                Pressure::from_bar(70.0),
+                None,
+            )),
+            Box::new(FixedOrifice::new(
+                "o1",
+                "P",
+                "M",
+                Area::from_mm2(0.2),
+                orifice(),
+            )),
+            Box::new(FixedOrifice::new(
+                "o2",
+                "M",
+                "L",
+                Area::from_mm2(0.1),
+                orifice(),
+            )),
+            Box::new(AlgebraicNode::new("m", "M", Some("pm"))),
+            to,
+        ]
+    }
+
+    fn diag(c: &Circuit, k: &str) -> f64 {
+        c.diagnostics().iter().find(|(n, _)| n == k).unwrap().1
+    }
+
+    #[test]
+    fn two_orifices_in_series_pass_the_series_area_flow() {
+        let c = Circuit::build(two_in_series(Box::new(PressureSource::new(
+            "tank",
+            "L",
+            Pressure::ZERO,
+            None,
+        ))))
+        .unwrap();
+        let w = c.wires_at(0.0, &[]);
+        // 1/A² = 1/A1² + 1/A2²: Q = Cd A √(2 Ps/ρ), p_m = Ps A²/A2²
+        let (a1, a2) = (0.2e-6_f64, 0.1e-6_f64);
+        let a = 1.0 / (1.0 / (a1 * a1) + 1.0 / (a2 * a2)).sqrt();
+        let q = 0.65 * a * (2.0 * 7.0e6 / 870.0_f64).sqrt();
+        let q_tank = w.get(c.find_wire("hyd:L:q").unwrap());
+        assert!((q_tank - q).abs() < 1e-10 * q, "{q_tank} {q}");
+        let pm = w.get(c.find_wire("hyd:M:p").unwrap());
+        let pm_exact = 7.0e6 * (a * a) / (a2 * a2);
+        assert!((pm - pm_exact).abs() < 1e-9 * pm_exact, "{pm} {pm_exact}");
+        assert_eq!(c.probes().iter().filter(|p| p.name == "pm").count(), 1);
+        // Newton on the orifices' slopes, no fallback
+        assert_eq!(diag(&c, "m.solve_fallbacks"), 0.0);
+    }
+
+    #[test]
+    fn a_volume_fills_through_two_orifices_in_series() {
+        // the algebraic node inside an ODE: the volume reaches supply pressure
+        let mut c = Circuit::build(two_in_series(Box::new(Volume::new(
+            "vol", "L", 1e-5, 7e8, 0.0, None,
+        ))))
+        .unwrap();
+        let x0 = c.initial_state();
+        c.reset(0.0, &x0);
+        let opts = Options {
+            atol: c.atol(1e-8),
+            rtol: 1e-8,
+            ..Options::default()
+        };
+        let sol = solve(Method::DormandPrince45, &mut c, 0.0, &x0, 1.0, &opts).unwrap();
+        let p = sol.last().unwrap()[0];
+        assert!((p - 7.0e6).abs() < 1e3, "{p}");
+        // warm-started Newton: a few member evaluations per solve
+        let per = diag(&c, "m.solve_evaluations") / diag(&c, "m.solves");
+        assert!(diag(&c, "m.solves") > 0.0 && per < 4.0, "{per}");
+        assert_eq!(diag(&c, "m.solve_fallbacks"), 0.0);
+    }
+
+    #[test]
+    fn a_node_without_an_owner_is_still_an_error() {
+        let mut parts = two_in_series(Box::new(PressureSource::new(
+            "tank",
+            "L",
+            Pressure::ZERO,
+            None,
+        )));
+        parts.remove(3); // the AlgebraicNode
+        let e = Circuit::build(parts).unwrap_err();
+        assert!(matches!(e, BuildError::NoOwner { .. }), "{e}");
+        assert!(e.to_string().contains("`M`"), "{e}");
+    }
+
+    #[test]
+    fn brent_finds_the_root_of_a_falling_function() {
+        let r = brent(|p| 2.0 - p * p, 0.0, 2.0, 2.0, -2.0, 1e-14);
+        assert!((r - 2.0_f64.sqrt()).abs() < 1e-13, "{r}");
+    }
+}

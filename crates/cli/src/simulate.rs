@@ -12,8 +12,12 @@
 //! valve rig, the drive voltage of a pump rig); other columns are ignored.
 //! The output has one row per command sample: `time, command, position,
 //! velocity, p1, p2`, then the rig's other outputs (`ps`, `spool`, `p_le`,
-//! ...), all SI without unit suffixes. A `friction-bench` rig is driven by
-//! its motion instead: see [`crate::bench_sim`]. A `hybrid-variant` rig file
+//! ...), all SI without unit suffixes. The friction-bench presets
+//! (`tudelft-seal-25`, `tudelft-seal-257`, `emps`) are netlists whose drive
+//! imposes the rod's velocity: their `command` column is that velocity
+//! \[m·s⁻¹\] and their output has the load-cell `force`. A `friction-bench`
+//! rig *file* (the identification format of `diagnose`) is driven by a
+//! measured record's motion instead: see [`crate::bench_sim`]. A `hybrid-variant` rig file
 //! (chapter 8's circuit improvements) runs on its base rig with the variant's
 //! components swapped in. It is written to a temporary file in
 //! the output's folder and renamed into place, so a failed run leaves no file
@@ -291,11 +295,7 @@ fn run_bench(args: &Args, value: &serde_json::Value) -> Result<(), CliError> {
 /// Runs `hydrocyl simulate`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let rig_err = |e: rig::RigError| CliError::Input(e.to_string());
-    let mut value = match bench::preset(&args.rig) {
-        Some(b) => serde_json::to_value(b)
-            .map_err(|e| CliError::Input(format!("--rig {}: {e}", args.rig)))?,
-        None => rig::load(&args.rig).map_err(rig_err)?,
-    };
+    let mut value = rig::load(&args.rig).map_err(rig_err)?;
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(rig_err)?;
     }

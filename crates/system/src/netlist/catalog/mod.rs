@@ -4,6 +4,7 @@ use super::registry::{ComponentType, Domain, ParamSpec, PortSpec, Role};
 use crate::circuit::Component;
 use std::sync::LazyLock;
 
+mod bench;
 mod friction;
 mod hybrid;
 mod hydraulic;
@@ -68,6 +69,7 @@ static ALL: LazyLock<Vec<ComponentType>> = LazyLock::new(|| {
         mechanical::TYPES,
         friction::TYPES,
         hybrid::TYPES,
+        bench::TYPES,
     ]
     .concat()
 });

@@ -293,15 +293,12 @@ impl Signal {
                 }
             }
             Signal::Table { time_s, value } => {
-                let n = time_s.len();
                 if t <= time_s[0] {
                     return value[0];
                 }
-                if t >= time_s[n - 1] {
-                    return value[n - 1];
-                }
-                let i = table_interval(time_s, t, hint.get().min(n - 2));
-                hint.set(i);
+                let Some(i) = interval_hinted(time_s, t, hint) else {
+                    return value[value.len() - 1];
+                };
                 let (t0, t1) = (time_s[i], time_s[i + 1]);
                 value[i] + (value[i + 1] - value[i]) * (t - t0) / (t1 - t0)
             }
@@ -344,17 +341,26 @@ impl Signal {
                     (to - from) / (t1_s - t0_s)
                 }
             }
-            Signal::Table { time_s, value } => {
-                let n = time_s.len();
-                if n < 2 || t < time_s[0] || t >= time_s[n - 1] {
-                    return 0.0;
-                }
-                let i = table_interval(time_s, t, hint.get().min(n - 2));
-                hint.set(i);
-                (value[i + 1] - value[i]) / (time_s[i + 1] - time_s[i])
-            }
+            Signal::Table { time_s, value } => match interval_hinted(time_s, t, hint) {
+                Some(i) => (value[i + 1] - value[i]) / (time_s[i + 1] - time_s[i]),
+                None => 0.0,
+            },
         }
     }
+}
+
+/// The interval `i` of a table with `time_s[i] <= t < time_s[i + 1]`
+/// (`None` outside `[time_s[0], time_s[n − 1])`), searched from the interval
+/// in `hint`, which it updates.
+#[inline]
+fn interval_hinted(time_s: &[f64], t: f64, hint: &Cell<usize>) -> Option<usize> {
+    let n = time_s.len();
+    if n < 2 || t < time_s[0] || t >= time_s[n - 1] {
+        return None;
+    }
+    let i = table_interval(time_s, t, hint.get().min(n - 2));
+    hint.set(i);
+    Some(i)
 }
 
 /// The interval `i` of a table with `time_s[i] <= t < time_s[i + 1]`, for

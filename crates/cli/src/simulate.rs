@@ -17,8 +17,12 @@
 //! The output has one row per command sample: `time, command, position,
 //! velocity, p1, p2`, then the rig's other outputs (`ps`, `spool`, `p_le`,
 //! ...), all SI, each header with its unit (`position [m]`; the readers take
-//! both forms; [`COLUMNS_HELP`] says what each is). A `friction-bench` rig is
-//! driven by its motion instead: see [`crate::bench_sim`]. A
+//! both forms; [`COLUMNS_HELP`] says what each is). The friction-bench presets
+//! (`tudelft-seal-25`, `tudelft-seal-257`, `emps`) are netlists whose drive
+//! imposes the rod's velocity: their `command` column is that velocity
+//! \[m·s⁻¹\] and their output has the load-cell `force`. A `friction-bench`
+//! rig *file* (the identification format of `diagnose`) is driven by a
+//! measured record's motion instead: see [`crate::bench_sim`]. A
 //! `hybrid-variant` rig file (chapter 8's circuit improvements) runs on its
 //! base rig with the variant's components swapped in.
 //!
@@ -356,11 +360,7 @@ fn solver_hint(e: rig::RigError) -> CliError {
 /// Runs `hydrocyl simulate`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let rig_err = |e: rig::RigError| CliError::Input(e.to_string());
-    let mut value = match bench::preset(&args.rig) {
-        Some(b) => serde_json::to_value(b)
-            .map_err(|e| CliError::Input(format!("--rig {}: {e}", args.rig)))?,
-        None => rig::load(&args.rig).map_err(rig_err)?,
-    };
+    let mut value = rig::load(&args.rig).map_err(rig_err)?;
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(rig_err)?;
     }

@@ -14,7 +14,7 @@
 #![allow(unsafe_code, non_snake_case, clippy::missing_safety_doc)]
 
 use crate::model_description::guid;
-use crate::slave::Slave;
+use crate::slave::{Slave, Snapshot};
 use std::ffi::{c_char, c_int, c_uint, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
@@ -537,54 +537,119 @@ pub unsafe extern "C" fn fmi2CancelStep(c: *mut c_void) -> Status {
     unsafe { unsupported(c, "fmi2CancelStep") }
 }
 
-/// `fmi2GetFMUstate` (not supported: `canGetAndSetFMUstate` false).
+/// `fmi2GetFMUstate`: saves the instance's state into `*s` (a new state when
+/// `*s` is null, else the one given, overwritten).
 #[no_mangle]
-pub unsafe extern "C" fn fmi2GetFMUstate(c: *mut c_void, _s: *mut *mut c_void) -> Status {
-    unsafe { unsupported(c, "fmi2GetFMUstate") }
+pub unsafe extern "C" fn fmi2GetFMUstate(c: *mut c_void, s: *mut *mut c_void) -> Status {
+    unsafe {
+        with(c, "fmi2GetFMUstate", |i| {
+            if s.is_null() {
+                return Err("fmi2GetFMUstate: null state pointer".into());
+            }
+            let snap = i.slave.get_state()?;
+            if (*s).is_null() {
+                *s = Box::into_raw(Box::new(snap)).cast();
+            } else {
+                *(*s).cast::<Snapshot>() = snap;
+            }
+            Ok(OK)
+        })
+    }
 }
 
-/// `fmi2SetFMUstate` (not supported).
+/// `fmi2SetFMUstate`: restores a saved state.
 #[no_mangle]
-pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, _s: *mut c_void) -> Status {
-    unsafe { unsupported(c, "fmi2SetFMUstate") }
+pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, s: *mut c_void) -> Status {
+    unsafe {
+        with(c, "fmi2SetFMUstate", |i| {
+            if s.is_null() {
+                return Err("fmi2SetFMUstate: null state".into());
+            }
+            i.slave.set_state(&*s.cast::<Snapshot>()).map(|_| OK)
+        })
+    }
 }
 
-/// `fmi2FreeFMUstate` (not supported).
+/// `fmi2FreeFMUstate`: frees a saved state and nulls `*s`.
 #[no_mangle]
-pub unsafe extern "C" fn fmi2FreeFMUstate(c: *mut c_void, _s: *mut *mut c_void) -> Status {
-    unsafe { unsupported(c, "fmi2FreeFMUstate") }
+pub unsafe extern "C" fn fmi2FreeFMUstate(c: *mut c_void, s: *mut *mut c_void) -> Status {
+    unsafe {
+        with(c, "fmi2FreeFMUstate", |_| {
+            if !s.is_null() && !(*s).is_null() {
+                drop(Box::from_raw((*s).cast::<Snapshot>()));
+                *s = std::ptr::null_mut();
+            }
+            Ok(OK)
+        })
+    }
 }
 
-/// `fmi2SerializedFMUstateSize` (not supported).
+/// `fmi2SerializedFMUstateSize`: the length of a state's bytes.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     c: *mut c_void,
-    _s: *mut c_void,
-    _size: *mut usize,
+    s: *mut c_void,
+    size: *mut usize,
 ) -> Status {
-    unsafe { unsupported(c, "fmi2SerializedFMUstateSize") }
+    unsafe {
+        with(c, "fmi2SerializedFMUstateSize", |_| {
+            if s.is_null() || size.is_null() {
+                return Err("null state or size pointer".into());
+            }
+            *size = (*s.cast::<Snapshot>()).serialize().len();
+            Ok(OK)
+        })
+    }
 }
 
-/// `fmi2SerializeFMUstate` (not supported).
+/// `fmi2SerializeFMUstate`: a state's bytes into the host's buffer.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SerializeFMUstate(
     c: *mut c_void,
-    _s: *mut c_void,
-    _bytes: *mut c_char,
-    _size: usize,
+    s: *mut c_void,
+    bytes: *mut c_char,
+    size: usize,
 ) -> Status {
-    unsafe { unsupported(c, "fmi2SerializeFMUstate") }
+    unsafe {
+        with(c, "fmi2SerializeFMUstate", |_| {
+            if s.is_null() || bytes.is_null() {
+                return Err("null state or buffer".into());
+            }
+            let data = (*s.cast::<Snapshot>()).serialize();
+            if data.len() > size {
+                return Err(format!(
+                    "buffer of {size} bytes, the state needs {}",
+                    data.len()
+                ));
+            }
+            std::ptr::copy_nonoverlapping(data.as_ptr(), bytes.cast::<u8>(), data.len());
+            Ok(OK)
+        })
+    }
 }
 
-/// `fmi2DeSerializeFMUstate` (not supported).
+/// `fmi2DeSerializeFMUstate`: a new state from serialized bytes.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     c: *mut c_void,
-    _bytes: *const c_char,
-    _size: usize,
-    _s: *mut *mut c_void,
+    bytes: *const c_char,
+    size: usize,
+    s: *mut *mut c_void,
 ) -> Status {
-    unsafe { unsupported(c, "fmi2DeSerializeFMUstate") }
+    unsafe {
+        with(c, "fmi2DeSerializeFMUstate", |_| {
+            if bytes.is_null() || s.is_null() {
+                return Err("null buffer or state pointer".into());
+            }
+            let data = std::slice::from_raw_parts(bytes.cast::<u8>(), size);
+            let snap = Snapshot::deserialize(data)?;
+            if !(*s).is_null() {
+                drop(Box::from_raw((*s).cast::<Snapshot>()));
+            }
+            *s = Box::into_raw(Box::new(snap)).cast();
+            Ok(OK)
+        })
+    }
 }
 
 /// `fmi2GetDirectionalDerivative` (not supported).

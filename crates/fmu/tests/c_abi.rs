@@ -158,9 +158,15 @@ fn errors_are_statuses_not_crashes() {
         assert_eq!(fmi2DoStep(c, 0.0, -1.0, 1), ERROR);
         // fixed parameters cannot change after initialisation
         assert_eq!(set(c, f.vr("load.mass"), 50.0), ERROR);
-        // unsupported optional functions say so
+        // a state saved here and freed; a null state pointer is an error
         let mut s = null_mut();
-        assert_eq!(fmi2GetFMUstate(c, &mut s), ERROR);
+        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
+        assert!(!s.is_null());
+        assert_eq!(fmi2SetFMUstate(c, null_mut()), ERROR);
+        assert_eq!(fmi2FreeFMUstate(c, &mut s), OK);
+        assert!(s.is_null());
+        // an unsupported optional function says so
+        assert_eq!(fmi2CancelStep(c), ERROR);
         // null component
         assert_eq!(fmi2DoStep(null_mut(), 0.0, 1e-3, 1), ERROR);
         // steps of 1 µs and of 1 s both work

@@ -425,10 +425,55 @@ impl FrictionBench {
     }
 }
 
-/// Names of the built-in friction-bench presets.
+/// Names of the built-in friction-bench presets: netlist files in
+/// `fixtures/rigs/` listed in `hydrocyl_system::rig::PRESETS`.
 pub const PRESETS: [&str; 3] = ["tudelft-seal-25", "tudelft-seal-257", "emps"];
 
-/// A built-in friction-bench preset, or `None`.
+/// What identification needs of a bench preset beyond its circuit: where
+/// the signals are in the measured files, which parameters to refit, and the
+/// smoothing velocity of the static law where the netlist's law has none.
+struct Identification {
+    name: &'static str,
+    columns: &'static [(Signal, &'static str)],
+    refit: &'static [&'static str],
+    smoothing_velocity: f64,
+}
+
+const TUDELFT_COLUMNS: &[(Signal, &str)] = &[
+    (Signal::Time, "time_ms [ms]"),
+    (Signal::Position, "position_mm [mm]"),
+    (Signal::P2, "pressure_bar_gauge [bar]"),
+    (Signal::Force, "force_N [N]"),
+];
+const TUDELFT_REFIT: &[&str] = &["Fc", "lugre_dynamics.sigma0", "viscous.b"];
+
+const IDENTIFICATION: [Identification; 3] = [
+    Identification {
+        name: "tudelft-seal-25",
+        columns: TUDELFT_COLUMNS,
+        refit: TUDELFT_REFIT,
+        smoothing_velocity: 1e-4,
+    },
+    Identification {
+        name: "tudelft-seal-257",
+        columns: TUDELFT_COLUMNS,
+        refit: TUDELFT_REFIT,
+        smoothing_velocity: 1e-4,
+    },
+    Identification {
+        name: "emps",
+        columns: &[
+            (Signal::Time, "t_s"),
+            (Signal::Position, "qm_motor_position_m"),
+            (Signal::Force, "force_N(=gtau*vir)"),
+        ],
+        refit: &["Fc", "m", "viscous.b"],
+        smoothing_velocity: 1e-3,
+    },
+];
+
+/// A built-in friction-bench preset, or `None`: the identification view
+/// ([`FrictionBench::from_netlist`]) of the netlist preset of that name.
 ///
 /// * `tudelft-seal-25` / `tudelft-seal-257`: the TU Delft pneumatic seal
 ///   rig (Zillen 2021), bore 25 mm / 25.7 mm, one chamber at constant gauge
@@ -441,75 +486,140 @@ pub const PRESETS: [&str; 3] = ["tudelft-seal-25", "tudelft-seal-257", "emps"];
 ///   force `gtau · vir` pushes +x, no pressures; declared Coulomb + viscous
 ///   with Fc, b and the moving mass m refitted.
 pub fn preset(name: &str) -> Option<FrictionBench> {
-    let tudelft = |bore: f64, label: &str| {
-        let mut columns = ColumnMap::default();
-        columns.0.insert(Signal::Time, "time_ms [ms]".into());
-        columns
-            .0
-            .insert(Signal::Position, "position_mm [mm]".into());
-        columns
-            .0
-            .insert(Signal::P2, "pressure_bar_gauge [bar]".into());
-        columns.0.insert(Signal::Force, "force_N [N]".into());
+    let id = IDENTIFICATION.iter().find(|i| i.name == name)?;
+    let v = hydrocyl_system::rig::preset(name)?;
+    let mut rig = FrictionBench::from_netlist(&v, id.smoothing_velocity).ok()?;
+    rig.name = name.into();
+    for (sig, col) in id.columns {
+        rig.columns.0.insert(*sig, (*col).into());
+    }
+    rig.refit = id.refit.iter().map(|r| r.to_string()).collect();
+    Some(rig)
+}
+
+impl FrictionBench {
+    /// The identification view of a friction-bench netlist: one
+    /// `imposed_motion` drive (mass, load-cell sign), at most one `piston`
+    /// (areas) and one friction law on the rod, `friction_coulomb_viscous`
+    /// or `friction_lugre` with equal extending and retracting sets (a
+    /// stiction level above the Coulomb level is the `stribeck` effect).
+    /// `smoothing_velocity` is the static law's tanh velocity where the
+    /// netlist's law has none (LuGre). Another circuit is refused by path.
+    pub fn from_netlist(v: &serde_json::Value, smoothing_velocity: f64) -> Result<Self, String> {
+        let s = hydrocyl_system::netlist::read(v)
+            .map_err(|e| hydrocyl_system::rig::RigError::from(e).to_string())?;
+        let of = |ty: &str| -> Vec<&hydrocyl_system::netlist::registry::Instance> {
+            s.instances
+                .iter()
+                .filter(|i| i.ty.name.starts_with(ty))
+                .collect()
+        };
+        let one = |ty: &str| match of(ty).as_slice() {
+            [i] => Ok(*i),
+            l => Err(format!(
+                "components: a friction bench has one `{ty}` component, found {}",
+                l.len()
+            )),
+        };
+        let drive = one("imposed_motion")?;
+        let law = one("friction_")?;
+        let (area1, area2) = match of("piston").as_slice() {
+            [] => (0.0, 0.0),
+            [p] => (p.get("area_1"), p.get("area_2")),
+            _ => return Err("components: a friction bench has at most one `piston`".into()),
+        };
+        if let Some(extra) = s.instances.iter().find(|i| {
+            !["imposed_motion", "piston", "pressure_source"].contains(&i.ty.name)
+                && !std::ptr::eq(*i, law)
+        }) {
+            return Err(format!(
+                "components.{}: a `{}` is not part of a friction bench (imposed_motion, piston, pressure_source, one friction law)",
+                extra.name, extra.ty.name
+            ));
+        }
+        let here = |p: &str| format!("components.{}.{p}", law.name);
         let mut effects = BTreeMap::new();
-        effects.insert(
-            EffectId::LugreDynamics,
-            BTreeMap::from([("sigma0".to_string(), 1e5), ("sigma1".to_string(), 0.0)]),
-        );
-        effects.insert(EffectId::Viscous, BTreeMap::from([("b".to_string(), 0.0)]));
-        FrictionBench {
+        let mut on = |id: EffectId, params: &[(&str, f64)]| {
+            effects.insert(
+                id,
+                params.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+            );
+        };
+        let (coulomb, vt) = match law.ty.name {
+            "friction_coulomb_viscous" => {
+                on(EffectId::Viscous, &[("b", law.get("viscous"))]);
+                (law.get("coulomb"), law.get("smoothing_velocity"))
+            }
+            "friction_lugre" => {
+                for p in [
+                    "curve.coulomb",
+                    "curve.stiction",
+                    "curve.stribeck_velocity",
+                    "curve.stribeck_exponent",
+                    "sigma2",
+                ] {
+                    let (e, r) = (format!("extending.{p}"), format!("retracting.{p}"));
+                    if law.get(&e) != law.get(&r) {
+                        return Err(format!(
+                            "{}: the bench's law has one set for both directions ({} ≠ {})",
+                            here(&e),
+                            law.get(&e),
+                            law.get(&r)
+                        ));
+                    }
+                }
+                let fc = law.get("extending.curve.coulomb");
+                let fs = law.get("extending.curve.stiction");
+                if fs != fc {
+                    on(
+                        EffectId::Stribeck,
+                        &[
+                            ("Fs", fs),
+                            ("vs", law.get("extending.curve.stribeck_velocity")),
+                            ("alpha", law.get("extending.curve.stribeck_exponent")),
+                        ],
+                    );
+                }
+                on(
+                    EffectId::LugreDynamics,
+                    &[("sigma0", law.get("sigma0")), ("sigma1", law.get("sigma1"))],
+                );
+                on(EffectId::Viscous, &[("b", law.get("extending.sigma2"))]);
+                (fc, smoothing_velocity)
+            }
+            other => {
+                return Err(format!(
+                    "components.{}.type: `{other}` has no friction-bench view (friction_coulomb_viscous or friction_lugre)",
+                    law.name
+                ))
+            }
+        };
+        let k = law.opt("seal.k_pressure").unwrap_or(0.0);
+        let h = law.opt("seal.h_acceleration").unwrap_or(0.0);
+        if k > 0.0 {
+            on(EffectId::PressureViscous, &[("K", k)]);
+        }
+        if h != 0.0 {
+            on(EffectId::AccelerationFriction, &[("H", h)]);
+        }
+        let rig = FrictionBench {
             kind: KIND.into(),
-            name: label.into(),
-            area1: 0.0,
-            area2: std::f64::consts::PI * (0.5 * bore).powi(2),
-            mass: 0.1,
-            force_sign: 1.0,
+            name: s.name.clone(),
+            area1,
+            area2,
+            mass: drive.get("mass"),
+            force_sign: drive.get("force_sign"),
             friction: BenchFriction {
-                coulomb: 5.0,
-                smoothing_velocity: 1e-4,
+                coulomb,
+                smoothing_velocity: vt,
                 effects,
             },
-            refit: vec![
-                "Fc".into(),
-                "lugre_dynamics.sigma0".into(),
-                "viscous.b".into(),
-            ],
-            columns,
             steady_state: false,
-        }
-    };
-    match name {
-        "tudelft-seal-25" => Some(tudelft(0.025, name)),
-        "tudelft-seal-257" => Some(tudelft(0.0257, name)),
-        "emps" => {
-            let mut columns = ColumnMap::default();
-            columns.0.insert(Signal::Time, "t_s".into());
-            columns
-                .0
-                .insert(Signal::Position, "qm_motor_position_m".into());
-            columns.0.insert(Signal::Force, "force_N(=gtau*vir)".into());
-            let effects = BTreeMap::from([(
-                EffectId::Viscous,
-                BTreeMap::from([("b".to_string(), 100.0)]),
-            )]);
-            Some(FrictionBench {
-                kind: KIND.into(),
-                name: name.into(),
-                area1: 0.0,
-                area2: 0.0,
-                mass: 50.0,
-                force_sign: 1.0,
-                friction: BenchFriction {
-                    coulomb: 10.0,
-                    smoothing_velocity: 1e-3,
-                    effects,
-                },
-                refit: vec!["Fc".into(), "m".into(), "viscous.b".into()],
-                columns,
-                steady_state: false,
-            })
-        }
-        _ => None,
+            refit: Vec::new(),
+            columns: ColumnMap::default(),
+        };
+        rig.validate().map_err(|e| e.to_string())?;
+        Ok(rig)
     }
 }
 
@@ -713,6 +823,102 @@ mod tests {
         }
         // Small travel: spring of stiffness σ0.
         assert!((f[10] / (v0 * dt * 10.0) / 1e6 - 1.0).abs() < 0.05);
+    }
+
+    /// The presets' identification view is the declaration the bench had
+    /// before its circuit became a netlist, field for field (so `diagnose`
+    /// and `cargo xtask validate` fit the same model from the same start).
+    #[test]
+    fn presets_are_the_netlists_seen_as_benches() {
+        let effects = |e: &[(EffectId, &[(&str, f64)])]| -> BTreeMap<_, _> {
+            e.iter()
+                .map(|(id, p)| (*id, p.iter().map(|(k, v)| (k.to_string(), *v)).collect()))
+                .collect()
+        };
+        for (name, bore) in [("tudelft-seal-25", 0.025f64), ("tudelft-seal-257", 0.0257)] {
+            let r = preset(name).unwrap();
+            assert_eq!(r.area1, 0.0);
+            assert_eq!(r.area2, std::f64::consts::PI * (0.5 * bore).powi(2));
+            assert_eq!((r.mass, r.force_sign), (0.1, 1.0));
+            assert_eq!(r.friction.coulomb, 5.0);
+            assert_eq!(r.friction.smoothing_velocity, 1e-4);
+            assert_eq!(
+                r.friction.effects,
+                effects(&[
+                    (EffectId::LugreDynamics, &[("sigma0", 1e5), ("sigma1", 0.0)]),
+                    (EffectId::Viscous, &[("b", 0.0)]),
+                ])
+            );
+            assert_eq!(r.refit, ["Fc", "lugre_dynamics.sigma0", "viscous.b"]);
+            assert_eq!(r.columns.0[&Signal::Time], "time_ms [ms]");
+        }
+        let r = preset("emps").unwrap();
+        assert_eq!(
+            (r.area1, r.area2, r.mass, r.force_sign),
+            (0.0, 0.0, 50.0, 1.0)
+        );
+        assert_eq!(
+            (r.friction.coulomb, r.friction.smoothing_velocity),
+            (10.0, 1e-3)
+        );
+        assert_eq!(
+            r.friction.effects,
+            effects(&[(EffectId::Viscous, &[("b", 100.0)])])
+        );
+        assert_eq!(r.refit, ["Fc", "m", "viscous.b"]);
+        assert!(preset("leaney-moog").is_none());
+    }
+
+    /// The netlist run of a bench preset (`rig::simulate`, imposed velocity)
+    /// and the bench's inverse model on the same motion give the same
+    /// load-cell force: LuGre's bristle from rest on a velocity that ramps
+    /// up, holds, reverses (the model integrates it exactly per sample, the
+    /// netlist with DP45 at rtol 1e-9).
+    #[test]
+    fn netlist_run_equals_the_inverse_model() {
+        use hydrocyl_system::{rig, run::RunOptions, signal::Signal as Cmd};
+        for name in PRESETS {
+            let bench = preset(name).unwrap();
+            let dt = 1e-3;
+            let t: Vec<f64> = (0..3000).map(|i| i as f64 * dt).collect();
+            let v: Vec<f64> = t
+                .iter()
+                .map(|&t| 0.02 * (t / 0.5).min(1.0) * (std::f64::consts::PI * t / 1.5).cos())
+                .collect();
+            let mut opts = RunOptions::dp45();
+            opts.rtol = 1e-9;
+            let mut value = rig::preset(name).unwrap();
+            // the record's chamber pressure is the preset's constant
+            let p = if bench.area2 > 0.0 { 3e5 } else { 0.0 };
+            if p > 0.0 {
+                rig::apply_set(&mut value, "chamber.pressure=3e5").unwrap();
+            }
+            let run = rig::simulate(&value, Cmd::table(t.clone(), v.clone()).unwrap(), &t, &opts)
+                .unwrap();
+            let f = run.channel("force").unwrap();
+            // the model's signals: acceleration as the netlist sees it (the
+            // slope of the interval that starts at the sample)
+            let mut a: Vec<f64> = v.windows(2).map(|w| (w[1] - w[0]) / dt).collect();
+            a.push(0.0);
+            let s = BenchSignals {
+                source: "x".into(),
+                x: vec![0.0; t.len()],
+                p1: vec![0.0; t.len()],
+                p2: vec![p; t.len()],
+                force: vec![0.0; t.len()],
+                v,
+                a,
+                t,
+            };
+            let model = bench.simulate_from_rest(&s);
+            let scale = model.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+            let worst = f
+                .iter()
+                .zip(&model)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max);
+            assert!(worst < 1e-6 * scale, "{name}: worst {worst} N of {scale} N");
+        }
     }
 
     #[test]

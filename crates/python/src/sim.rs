@@ -106,7 +106,8 @@ fn failure_time(e: &SolveError) -> Option<f64> {
 
 /// Turns a failed run into a [`Failure::Solver`]: the rig's run is repeated
 /// on its circuit to get the solver's time, then integrated up to that time
-/// for the state there. The message is the CLI's, with the state appended.
+/// for the state there (or up to the last point before it a run reaches,
+/// when the failing step ends at that time). The message is the CLI's, with the state appended.
 fn locate_failure(
     value: &Value,
     command: &Signal,
@@ -123,13 +124,28 @@ fn locate_failure(
             Err(SimError::Solve { source, .. }) => failure_time(&source)?,
             _ => return None,
         };
-        let state: Vec<f64> = if time > t[0] {
+        // the state at the failure time, or — where the solver failed on a
+        // step that ends there (a non-finite fixed step) — at the last point
+        // before it that a run reaches: one fixed step back, else the last
+        // output sample before it
+        let mut candidates = vec![time];
+        if opts.solver == runner::Solver::Rk4 {
+            candidates.push(time - opts.rk4_step);
+        }
+        candidates.extend(t.iter().rev().find(|&&s| s < time));
+        let mut reached = None;
+        for at in candidates.into_iter().filter(|&at| at >= t[0]) {
+            if at == t[0] {
+                reached = Some((at, x0[..n].to_vec()));
+                break;
+            }
             let mut c = rig::circuit(value, command.clone()).ok()?;
-            let r = runner::run(&mut c, &x0, &[t[0], time], opts).ok()?;
-            r.state(1)[..n].to_vec()
-        } else {
-            x0[..n].to_vec()
-        };
+            if let Ok(r) = runner::run(&mut c, &x0, &[t[0], at], opts) {
+                reached = Some((at, r.state(1)[..n].to_vec()));
+                break;
+            }
+        }
+        let (time, state) = reached?;
         Some((
             time,
             names.into_iter().take(n).zip(state).collect::<Vec<_>>(),

@@ -138,6 +138,34 @@ def test_solver_failure_is_a_simulation_error_with_time_and_state(cli, tmp_path,
     assert not isinstance(err, ValueError)
 
 
+def test_a_solver_failure_in_mid_run_carries_the_state_before_it(cli, tmp_path):
+    """A bristle stiffness of 1e9 N/m on the seal bench with RK4 at 0.1 ms:
+    stable at rest, the step blows up once the imposed velocity makes the
+    bristle fast (σ0 |v| h / Fc > 2.8, v > 0.14 mm/s): the solver stops in
+    mid-run, and the error carries the last finite state the run reached
+    before the failing step."""
+    rig = hydrocyl.Rig.load("tudelft-seal-25")
+    rig.set("friction.sigma0", 1e9)
+    t = np.linspace(0.0, 0.2, 201)
+    u = 0.01 * t / 0.2
+    with pytest.raises(hydrocyl.SimulationError) as e:
+        rig.simulate(t, u, solver="rk4", rk4_step=1e-4)
+    err = e.value
+    assert t[0] < err.time < t[-1]
+    assert err.state and all(np.isfinite(v) for v in err.state.values())
+    # the drive's position is the integral of the imposed velocity up to there
+    x = next(v for k, v in err.state.items() if k.startswith("drive."))
+    assert abs(x - 0.01 * err.time**2 / 0.4) < 1e-9
+    assert f"state at t = {err.time} s" in str(err)
+    # the CLI's line comes first
+    cmd = tmp_path / "cmd.csv"
+    write_command(cmd, t, u)
+    code, _, line = run_cli(cli, "simulate", "--rig", "tudelft-seal-25", "--set", "friction.sigma0=1e9",
+                            "--command", cmd, "--solver", "rk4", "--rk4-step", "1e-4",
+                            "--out", tmp_path / "o.csv", expect_ok=False)
+    assert code == 2 and line.startswith("simulation: solver rk4") and str(err).startswith(line)
+
+
 def test_a_panic_becomes_a_runtime_error():
     with pytest.raises(RuntimeError, match="internal error .*deliberate test panic"):
         hydrocyl._panic_for_test()

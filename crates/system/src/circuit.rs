@@ -173,6 +173,14 @@ pub trait Component {
     /// Time derivatives of its states (all accumulators are complete here).
     fn derivatives(&self, _t: f64, _x: &[f64], _w: &Wires, _dx: &mut [f64]) {}
 
+    /// Whether [`evaluate`](Component::evaluate) must run after every other
+    /// component's, to read complete accumulators (an imposed-motion source
+    /// reporting the force it takes to impose its motion). Nothing may read
+    /// its algebraic wires but probes.
+    fn evaluates_last(&self) -> bool {
+        false
+    }
+
     /// Number of switching functions.
     fn n_events(&self) -> usize {
         0
@@ -295,6 +303,11 @@ impl Circuit {
         }
         let (order, groups) = crate::series::evaluation_order(&net)?;
         let n = comps.len();
+        // components that read complete accumulators go last, in order
+        let (mut order, last): (Vec<Step>, Vec<Step>) = order
+            .into_iter()
+            .partition(|s| !matches!(s, Step::Evaluate(i) if comps[*i].evaluates_last()));
+        order.extend(last);
         let mut offsets = Vec::with_capacity(n + 1);
         let mut ev_offsets = Vec::with_capacity(n + 1);
         let mut q_offsets = Vec::with_capacity(n + 1);

@@ -114,6 +114,18 @@ pub const PRESETS: &[Preset] = &[
         name: "wang-hybrid",
         json: || netlist_preset(include_str!("../../../fixtures/rigs/wang-hybrid.json")),
     },
+    Preset {
+        name: "tudelft-seal-25",
+        json: || netlist_preset(include_str!("../../../fixtures/rigs/tudelft-seal-25.json")),
+    },
+    Preset {
+        name: "tudelft-seal-257",
+        json: || netlist_preset(include_str!("../../../fixtures/rigs/tudelft-seal-257.json")),
+    },
+    Preset {
+        name: "emps",
+        json: || netlist_preset(include_str!("../../../fixtures/rigs/emps.json")),
+    },
 ];
 
 /// An embedded preset file's value (`Null` if it did not parse, which the

@@ -293,20 +293,74 @@ impl Signal {
                 }
             }
             Signal::Table { time_s, value } => {
-                let n = time_s.len();
                 if t <= time_s[0] {
                     return value[0];
                 }
-                if t >= time_s[n - 1] {
-                    return value[n - 1];
-                }
-                let i = table_interval(time_s, t, hint.get().min(n - 2));
-                hint.set(i);
+                let Some(i) = interval_hinted(time_s, t, hint) else {
+                    return value[value.len() - 1];
+                };
                 let (t0, t1) = (time_s[i], time_s[i + 1]);
                 value[i] + (value[i + 1] - value[i]) * (t - t0) / (t1 - t0)
             }
         }
     }
+}
+
+impl Signal {
+    /// The time derivative at `t` (right-hand: the slope of the interval
+    /// that starts at `t` for a table or ramp; 0 across a step's or a
+    /// square's jump, which have no finite derivative) \[1/s\]. What an
+    /// imposed-motion source takes as the acceleration of an imposed velocity.
+    pub fn slope_hinted(&self, t: f64, hint: &Cell<usize>) -> f64 {
+        match self {
+            Signal::Constant { .. } | Signal::Step { .. } | Signal::Square { .. } => 0.0,
+            Signal::External(input) => input.get().2,
+            Signal::Sine {
+                amplitude,
+                period_s,
+                phase_rad,
+                ..
+            } => {
+                let w = std::f64::consts::TAU / period_s;
+                amplitude * w * (w * t + phase_rad).cos()
+            }
+            Signal::Sawtooth {
+                amplitude,
+                period_s,
+                ..
+            } => 2.0 * amplitude / period_s,
+            Signal::Ramp {
+                from,
+                to,
+                t0_s,
+                t1_s,
+            } => {
+                if t < *t0_s || t >= *t1_s {
+                    0.0
+                } else {
+                    (to - from) / (t1_s - t0_s)
+                }
+            }
+            Signal::Table { time_s, value } => match interval_hinted(time_s, t, hint) {
+                Some(i) => (value[i + 1] - value[i]) / (time_s[i + 1] - time_s[i]),
+                None => 0.0,
+            },
+        }
+    }
+}
+
+/// The interval `i` of a table with `time_s[i] <= t < time_s[i + 1]`
+/// (`None` outside `[time_s[0], time_s[n − 1])`), searched from the interval
+/// in `hint`, which it updates.
+#[inline]
+fn interval_hinted(time_s: &[f64], t: f64, hint: &Cell<usize>) -> Option<usize> {
+    let n = time_s.len();
+    if n < 2 || t < time_s[0] || t >= time_s[n - 1] {
+        return None;
+    }
+    let i = table_interval(time_s, t, hint.get().min(n - 2));
+    hint.set(i);
+    Some(i)
 }
 
 /// The interval `i` of a table with `time_s[i] <= t < time_s[i + 1]`, for

@@ -75,8 +75,12 @@ fn probe_path(component: &str, declared: &[(&str, &str)], probe: &str) -> String
     format!("{component}.{local}")
 }
 
-/// Assembles the circuit of a checked netlist, the first `command_input`
-/// driven by `command`.
+/// The component types driven by the run's command: a signal source, or an
+/// imposed-motion source (a friction bench's drive).
+pub const INPUT_TYPES: [&str; 2] = ["command_input", "imposed_motion"];
+
+/// Assembles the circuit of a checked netlist, its command input (one of
+/// [`INPUT_TYPES`]) driven by `command`.
 pub fn assemble(s: &Schematic, command: Signal) -> Result<Circuit, RigError> {
     assemble_with(s, command, |_| ())
 }
@@ -96,19 +100,22 @@ pub fn assemble_with(
     let inputs: Vec<&str> = s
         .instances
         .iter()
-        .filter(|i| i.ty.name == "command_input")
+        .filter(|i| INPUT_TYPES.contains(&i.ty.name))
         .map(|i| i.name.as_str())
         .collect();
     if inputs.len() > 1 {
         return Err(RigError::Invalid {
             path: format!("components.{}", inputs[1]),
-            why: "a netlist has at most one command_input so far".into(),
+            why: format!(
+                "a netlist has at most one command input ({}) so far",
+                INPUT_TYPES.join(", ")
+            ),
         });
     }
     let mut comps = Vec::with_capacity(s.instances.len());
     for inst in &s.instances {
         let mut inst = inst.clone();
-        if inst.ty.name == "command_input" {
+        if INPUT_TYPES.contains(&inst.ty.name) {
             inst.input = Some(command.clone());
         }
         let c = (inst.ty.build)(&inst).map_err(|why| RigError::Invalid {

@@ -4,6 +4,7 @@ use super::registry::{ComponentType, Domain, ParamSpec, PortSpec, Role};
 use crate::circuit::Component;
 use std::sync::LazyLock;
 
+mod bench;
 mod control;
 mod friction;
 mod hybrid;
@@ -70,6 +71,7 @@ static ALL: LazyLock<Vec<ComponentType>> = LazyLock::new(|| {
         friction::TYPES,
         hybrid::TYPES,
         control::TYPES,
+        bench::TYPES,
     ]
     .concat()
 });

@@ -21,8 +21,9 @@ use hydrocyl_energy::variant::HybridVariant;
 use hydrocyl_friction::FrictionLaw;
 use hydrocyl_system::hybrid::WangHybrid;
 use hydrocyl_system::rig::RigError;
-use hydrocyl_system::run::{run, RunOptions, SimError, Solver};
+use hydrocyl_system::run::{RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
+use hydrocyl_system::simulation::Simulation;
 use hydrocyl_system::valve_rig::ValveRig;
 use serde::Serialize;
 use std::time::Instant;
@@ -354,7 +355,7 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
     let v = sc.speed();
     let period = sc.period();
     let force = sc.load_kg * G;
-    let (mut circuit, solver) = match drive {
+    let (circuit, solver) = match drive {
         Drive::Valve(rig) => {
             let mut r = (**rig).clone();
             r.load.external_force_n = force;
@@ -397,18 +398,14 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
         ledger: true,
         ..RunOptions::default()
     };
-    let x0 = circuit.initial_state();
+    let mut sim = Simulation::of_circuit(circuit).options(opts);
     let start = Instant::now();
-    let out = run(&mut circuit, &x0, &t, &opts).map_err(|e| {
-        rig_err(&label)(match e {
-            SimError::Build(b) => RigError::Build(b),
-            other => RigError::Sim(other.to_string()),
-        })
-    })?;
+    let out = sim.run(&t).map_err(rig_err(&label))?;
     let wall_s = start.elapsed().as_secs_f64();
+    let circuit = sim.circuit();
     let (k0, k1) = (n_per * plan.warmup_periods, n);
     let rod = RodSide::default();
-    let led = ledger(&circuit, &out, k0, k1, &rod)?;
+    let led = ledger(circuit, &out, k0, k1, &rod)?;
     // power traces: the ledger's integrands at each sample
     let names: Vec<String> = circuit.components().map(|c| c.name().to_string()).collect();
     let mut trace = Trace::default();

@@ -241,7 +241,7 @@ mod chapter8 {
             };
             let (base, var) = (find("hybrid").unwrap(), find("hybrid-needle").unwrap());
             assert!(
-                var.ledger.loss("return.needle_valve") < base.ledger.loss("return.needle_valve"),
+                var.ledger.loss("needle_valve") < base.ledger.loss("needle_valve"),
                 "{}",
                 sc.label()
             );

@@ -51,10 +51,11 @@ def step():
     return t, np.where(t < 0.01, 0.0, 0.4)
 
 
-def write_command(path, t, u):
-    """The command CSV `hydrocyl simulate --command` reads."""
+def write_command(path, t, u, column="command"):
+    """The command CSV `hydrocyl simulate --command` reads (`column`:
+    `reference` for a closed-loop rig, whose input is the set-point)."""
     with open(path, "w") as f:
-        f.write("time,command\n")
+        f.write(f"time,{column}\n")
         for a, b in zip(t, u):
             f.write(f"{float(a)!r},{float(b)!r}\n")
 

@@ -13,15 +13,19 @@ from conftest import read_csv, run_cli, write_command
 
 
 def command_for(rig):
-    """A short command each rig kind reads: the pump's drive voltage [V], a
-    bench drive's velocity [m/s] (ramped), a valve's normalised demand."""
+    """A short input each rig kind reads, and its CSV column: the pump's
+    drive voltage [V], a bench drive's velocity [m/s] (ramped), a
+    closed-loop rig's position set-point [m] (`reference`), a valve's
+    normalised demand."""
     spec = json.loads(rig.to_json())
     types = {c.get("type") for c in spec.get("components", {}).values()}
     t = np.linspace(0.0, 0.1, 201)
     if "imposed_motion" in types:
-        return t, 0.01 * np.minimum(t / 0.05, 1.0)
+        return t, 0.01 * np.minimum(t / 0.05, 1.0), "command"
+    if "position_controller" in types:
+        return t, np.where(t < 0.01, 0.0, 0.01), "reference"
     level = 2.0 if "pump" in spec.get("components", {}) else 0.3
-    return t, np.where(t < 0.01, 0.0, level)
+    return t, np.where(t < 0.01, 0.0, level), "command"
 
 
 def netlist_files(repo):
@@ -34,11 +38,11 @@ def netlist_files(repo):
 def test_every_preset_runs_and_equals_the_cli(cli, tmp_path, name):
     rig = hydrocyl.Rig.load(name)
     assert rig.parameters(), name
-    t, u = command_for(rig)
+    t, u, column = command_for(rig)
     run = rig.simulate(t, u, solver="rosenbrock")
     assert run.names and all(np.isfinite(run[c]).all() for c in run.names), name
     cmd, out = tmp_path / "cmd.csv", tmp_path / "out.csv"
-    write_command(cmd, t, u)
+    write_command(cmd, t, u, column)
     run_cli(cli, "simulate", "--rig", name, "--command", cmd, "--out", out, "--solver", "rosenbrock")
     csv = read_csv(out)
     assert ["time", *run.names] == list(csv)
@@ -52,7 +56,7 @@ def test_every_netlist_file_loads_and_runs(repo):
     assert len(files) >= len(hydrocyl.PRESETS)
     for f in files:
         rig = hydrocyl.Rig.load(str(f))
-        t, u = command_for(rig)
+        t, u, _ = command_for(rig)
         run = rig.simulate(t, u, solver="rosenbrock")
         assert all(np.isfinite(run[c]).all() for c in run.names), f.name
 

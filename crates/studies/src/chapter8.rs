@@ -226,6 +226,9 @@ pub enum FrictionCase {
     /// The rig's own law without the acceleration term `K H a` (H = 0, eq
     /// 5.4; the seal term stays, bounded as the rig bounds it).
     WithoutAccelerationTerm,
+    /// The rig's own law with Table 5-8's acceleration term `K H a` (eq
+    /// 5.12/5.14; the `wang-hybrid` preset ships without it).
+    WithTable58AccelerationTerm,
 }
 
 impl FrictionCase {
@@ -235,6 +238,7 @@ impl FrictionCase {
             FrictionCase::AsRig => "as-rig",
             FrictionCase::WithoutSealTerm => "without-seal-term",
             FrictionCase::WithoutAccelerationTerm => "without-acceleration-term",
+            FrictionCase::WithTable58AccelerationTerm => "with-table-5-8-acceleration-term",
         }
     }
 
@@ -247,6 +251,11 @@ impl FrictionCase {
                     w.retracting.k_pressure = 0.0;
                 }
                 FrictionCase::WithoutAccelerationTerm => *w = w.without_acceleration_term(),
+                FrictionCase::WithTable58AccelerationTerm => {
+                    let t = hydrocyl_friction::Wang::table_5_8();
+                    w.extending.h_acceleration = t.extending.h_acceleration;
+                    w.retracting.h_acceleration = t.retracting.h_acceleration;
+                }
             }
         }
     }

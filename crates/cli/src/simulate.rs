@@ -38,14 +38,12 @@ use crate::command::{read_command, CommandUnit};
 use crate::error::CliError;
 use crate::output::Outputs;
 use crate::progress::Progress;
-use hydrocyl_energy::variant::{self, HybridVariant};
 use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_identify::plaincsv::{run_columns, write_columns_in_parts, write_rows_in_parts};
-use hydrocyl_system::hybrid::WangHybrid;
+use hydrocyl_system::hybrid::variant;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{self as runner, Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
-use hydrocyl_system::Circuit;
 use std::path::{Path, PathBuf};
 
 /// The output columns, for `hydrocyl simulate --help`.
@@ -155,40 +153,6 @@ pub fn column_headers(run: &Run, command: CommandUnit) -> Vec<String> {
             }
         }))
         .collect()
-}
-
-/// A `hybrid-variant` rig (`hydrocyl-energy`): the variant (after `--set`)
-/// and its base rig, resolved relative to the variant file.
-fn load_variant(
-    spec: &str,
-    value: &serde_json::Value,
-) -> Result<(WangHybrid, HybridVariant), CliError> {
-    let input = |e: hydrocyl_energy::EnergyError| CliError::Input(e.to_string());
-    let v = HybridVariant::from_json(&value.to_string(), spec).map_err(input)?;
-    let base = v.base_rig(Path::new(spec).parent()).map_err(input)?;
-    Ok((base, v))
-}
-
-/// The circuit of a variant of the hybrid drive on `command` \[V\]. A
-/// variant that sets the needle opening per speed gets the entry for the
-/// command's peak speed, `K max(u_max / A1, −u_min / A2)` (K the pump's
-/// flow gain), the speed the chapter-8 scenarios command.
-fn variant_circuit(
-    base: &WangHybrid,
-    v: &HybridVariant,
-    command: Signal,
-) -> Result<Circuit, CliError> {
-    let mut r = base.clone();
-    let (u_max, u_min) = match &command {
-        Signal::Table { value, .. } => value
-            .iter()
-            .fold((0.0f64, 0.0f64), |(hi, lo), &u| (hi.max(u), lo.min(u))),
-        _ => (0.0, 0.0),
-    };
-    let speed = r.pump.gain * (u_max / r.cylinder.area_1.si()).max(-u_min / r.cylinder.area_2.si());
-    v.apply_to_rig(&mut r, Some(1e3 * speed));
-    r.build_with(command, |comps| v.swap_components(comps))
-        .map_err(|e| CliError::Input(format!("rig {}: {e}", v.name)))
 }
 
 /// `hydrocyl simulate` on a friction bench: the `--command` file carries the
@@ -368,12 +332,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if kind == Some(bench::KIND) {
         return run_bench(&args, &value);
     }
-    let variant = if kind == Some(variant::KIND) {
-        Some(load_variant(&args.rig, &value)?)
-    } else {
-        crate::rigfile::check(&value, &args.rig)?;
-        None
-    };
+    crate::rigfile::check(&value, &args.rig)?;
     check_initial_pressures(&value)?;
     if args.print_rig {
         // a netlist is printed with every parameter written out (defaults
@@ -435,10 +394,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Signal::Table { time_s, .. } => time_s.clone(),
         _ => Vec::new(),
     };
-    let mut c = match variant {
-        None => rig::circuit(&value, signal).map_err(|e| CliError::Input(e.to_string()))?,
-        Some((base, v)) => variant_circuit(&base, &v, signal)?,
-    };
+    let mut c = rig::circuit(&value, signal).map_err(|e| CliError::Input(e.to_string()))?;
     let x0 = c.initial_state();
     let mut bar = Progress::new("simulate", rows as u64, args.progress, args.quiet);
     let mut failed: Option<CliError> = None;

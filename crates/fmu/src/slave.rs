@@ -286,7 +286,7 @@ impl Slave {
         }
         let (mut circuit, input) =
             circuit_with_input(&self.rig).map_err(|e| format!("assembling the rig: {e}"))?;
-        let probes = output_channels(&circuit);
+        let probes = output_channels(&circuit, &crate::variables::input_name(&self.rig));
         let mut wires = Vec::with_capacity(self.vars.outputs.len());
         for (name, _) in &self.vars.outputs {
             let p = probes.iter().find(|p| &p.name == name).ok_or_else(|| {

@@ -12,9 +12,34 @@ use hydrocyl_system::signal::Signal;
 use hydrocyl_system::{Circuit, Probe};
 use serde_json::Value;
 
-/// The name of the input variable (and of the circuit's command signal,
-/// whose own output channel the input replaces).
+/// The name of the input variable of a rig without a named input (and of
+/// the circuit's command signal, whose own output channel the input
+/// replaces).
 pub const INPUT: &str = "command";
+
+/// The name of `rig`'s input variable: the output channel of its
+/// `command_input` component — `command` on an open-loop rig, `reference` on
+/// a closed-loop one whose input is the controller's set-point (the
+/// controller's output is then the `command` output) — or [`INPUT`].
+pub fn input_name(rig: &Value) -> String {
+    let Some(comps) = rig.get("components").and_then(Value::as_object) else {
+        return INPUT.into();
+    };
+    let Some((inst, _)) = comps
+        .iter()
+        .find(|(_, c)| c.get("type").and_then(Value::as_str) == Some("command_input"))
+    else {
+        return INPUT.into();
+    };
+    let probe = format!("{inst}.command");
+    match rig.get("outputs").and_then(Value::as_object) {
+        Some(outs) => outs
+            .iter()
+            .find(|(_, p)| p.as_str() == Some(probe.as_str()))
+            .map_or_else(|| INPUT.into(), |(col, _)| col.clone()),
+        None => probe,
+    }
+}
 
 /// The solver methods by their `solver.method` number.
 pub const METHODS: [Solver; 3] = [Solver::Dp45, Solver::Rosenbrock, Solver::Rk4];
@@ -77,15 +102,17 @@ pub struct Variables {
 }
 
 /// The circuit's output channels in the order of a run's channels
-/// (position, velocity, p1, p2, then the others in component order, as
+/// (command, position, velocity, p1, p2, then the others in component order, as
 /// `hydrocyl_system::run::run` orders them), without the command (it is the
-/// FMU's input).
-pub fn output_channels(circuit: &Circuit) -> Vec<Probe> {
-    const ORDER: [&str; 4] = ["position", "velocity", "p1", "p2"];
+/// FMU's input, named `input`).
+pub fn output_channels(circuit: &Circuit, input: &str) -> Vec<Probe> {
+    // a closed-loop rig's `command` (its controller's output) comes first,
+    // as in a run
+    const ORDER: [&str; 5] = ["command", "position", "velocity", "p1", "p2"];
     let mut out: Vec<Probe> = circuit
         .probes()
         .into_iter()
-        .filter(|p| p.name != INPUT)
+        .filter(|p| p.name != input)
         .collect();
     out.sort_by_key(|p| {
         ORDER
@@ -108,7 +135,8 @@ impl Variables {
     pub fn of(rig: &Value) -> Result<Self, RigError> {
         rig::check(rig)?;
         let (circuit, input) = circuit_with_input(rig)?;
-        let probes = output_channels(&circuit);
+        let input_name = input_name(rig);
+        let probes = output_channels(&circuit, &input_name);
         // direct feedthrough: does the output change with the input at a fixed state?
         let x0 = circuit.initial_state();
         let wires: Vec<_> = probes.iter().map(|p| p.wire).collect();
@@ -120,12 +148,16 @@ impl Variables {
         };
         let (lo, hi) = (read(-0.5), read(0.5));
         let mut list = vec![Variable {
-            name: INPUT.into(),
+            name: input_name.clone(),
             role: Role::Input,
             integer: false,
             start: 0.0,
             unit: None,
-            description: "the rig's command (normalised spool demand of a valve rig, drive voltage of a pump rig); linear inside a step with fmi2SetRealInputDerivatives".into(),
+            description: if input_name == INPUT {
+                "the rig's command (normalised spool demand of a valve rig, drive voltage of a pump rig); linear inside a step with fmi2SetRealInputDerivatives".into()
+            } else {
+                format!("the rig's input `{input_name}` (a closed-loop rig's position set-point [m]); linear inside a step with fmi2SetRealInputDerivatives")
+            },
             feedthrough: false,
         }];
         for (i, p) in probes.iter().enumerate() {
@@ -236,7 +268,7 @@ mod tests {
                 .channels
                 .iter()
                 .map(|c| c.name.as_str())
-                .filter(|n| *n != INPUT)
+                .filter(|n| *n != input_name(&rig))
                 .collect();
             let ours: Vec<&str> = v.outputs.iter().map(|(n, _)| n.as_str()).collect();
             assert_eq!(ours, names, "{}", preset.name);

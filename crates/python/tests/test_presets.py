@@ -24,14 +24,18 @@ def command_for(rig):
         return t, 0.01 * np.minimum(t / 0.05, 1.0), "command"
     if "position_controller" in types:
         return t, np.where(t < 0.01, 0.0, 0.01), "reference"
-    level = 2.0 if "pump" in spec.get("components", {}) else 0.3
+    pump = "pump" in spec.get("components", {}) or spec.get("kind") == "hybrid-variant"
+    level = 2.0 if pump else 0.3
     return t, np.where(t < 0.01, 0.0, level), "command"
 
 
 def netlist_files(repo):
+    """Every rig file of fixtures/rigs/ a user runs: the netlists and the
+    hybrid drive's variant files."""
     files = sorted((repo / "fixtures/rigs").glob("*.json"))
     files += sorted((repo / "fixtures/rigs/examples").glob("*.json"))
-    return [f for f in files if json.loads(f.read_text()).get("kind") == "netlist"]
+    kinds = ("netlist", "hybrid-variant")
+    return [f for f in files if json.loads(f.read_text()).get("kind") in kinds]
 
 
 @pytest.mark.parametrize("name", hydrocyl.PRESETS)
@@ -59,6 +63,24 @@ def test_every_netlist_file_loads_and_runs(repo):
         t, u, _ = command_for(rig)
         run = rig.simulate(t, u, solver="rosenbrock")
         assert all(np.isfinite(run[c]).all() for c in run.names), f.name
+
+
+def test_variant_files_run_and_equal_the_cli(cli, repo, tmp_path):
+    """The hybrid drive's variant files (chapter 8's circuit improvements)
+    load from any folder, run, and equal `hydrocyl simulate` on them."""
+    files = [f for f in netlist_files(repo) if json.loads(f.read_text())["kind"] == "hybrid-variant"]
+    assert files
+    for f in files:
+        rig = hydrocyl.Rig.load(str(f))
+        t, u, column = command_for(rig)
+        run = rig.simulate(t, u, solver="rosenbrock")
+        cmd, out = tmp_path / "cmd.csv", tmp_path / f"{f.stem}.csv"
+        write_command(cmd, t, u, column)
+        run_cli(cli, "simulate", "--rig", f, "--command", cmd, "--out", out, "--solver", "rosenbrock")
+        csv = read_csv(out)
+        for c in run.names:
+            scale = max(1.0, float(np.abs(csv[c]).max()))
+            assert float(np.abs(run[c] - csv[c]).max()) <= 1e-12 * scale, (f.name, c)
 
 
 def test_a_bench_preset_gives_the_load_cell_force():

@@ -159,6 +159,11 @@ pub const RIG_KINDS: &[RigKind] = &[
         circuit: |v, cmd| crate::hybrid::WangHybrid::from_value(v)?.build(cmd),
     },
     RigKind {
+        kind: crate::hybrid::variant::KIND,
+        check: |v| crate::hybrid::variant::HybridVariant::from_value(v).map(|_| ()),
+        circuit: |v, cmd| crate::hybrid::variant::HybridVariant::from_value(v)?.circuit(cmd),
+    },
+    RigKind {
         kind: crate::netlist::KIND,
         check: |v| crate::netlist::read(v).map(|_| ()).map_err(RigError::from),
         circuit: crate::netlist::circuit,
@@ -211,6 +216,8 @@ pub fn load(name_or_path: &str) -> Result<Value, RigError> {
             why: format!("duplicate key at line {line} (a key may appear once in an object)"),
         });
     }
+    let mut v = v;
+    crate::hybrid::variant::resolve_base(&mut v, std::path::Path::new(name_or_path).parent());
     Ok(v)
 }
 

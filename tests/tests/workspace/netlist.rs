@@ -702,3 +702,46 @@ fn algebraic_node_errors_name_the_json_path() {
     ];
     assert_refused(&base, cases);
 }
+
+/// The hybrid drive's variant files load through `rig::load` (any working
+/// directory), check, and run through the one run path; the solenoid variant
+/// has no relief valves 1 and 2 but its two solenoid valves.
+#[test]
+fn variant_files_run_through_the_rig_facade() {
+    let dir = root().join("fixtures/rigs");
+    let t = times(0.5, 0.01);
+    let cmd = || {
+        Signal::table(
+            t.clone(),
+            t.iter()
+                .map(|&x| if x < 0.25 { 2.0 } else { -2.0 })
+                .collect(),
+        )
+        .unwrap()
+    };
+    let mut found = 0;
+    for f in files(&dir, ".json") {
+        let v = rig::load(f.to_str().unwrap()).unwrap();
+        if v["kind"] != "hybrid-variant" {
+            continue;
+        }
+        found += 1;
+        rig::check(&v).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        let c = rig::circuit(&v, cmd()).unwrap();
+        let names: Vec<&str> = c.components().map(|c| c.name()).collect();
+        if v.get("solenoid_valves").is_some() {
+            assert!(
+                names.contains(&"solenoid_1") && !names.contains(&"relief_1"),
+                "{names:?}"
+            );
+        }
+        let run = rig::simulate(&v, cmd(), &t, &RunOptions::default())
+            .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        assert!(run
+            .channel("position")
+            .unwrap()
+            .iter()
+            .all(|x| x.is_finite()));
+    }
+    assert_eq!(found, 3);
+}

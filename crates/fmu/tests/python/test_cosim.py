@@ -57,6 +57,34 @@ def test_p_controller_closes_the_position_loop(export):
     assert y[100] > 0.0                          # it moved from the start
 
 
+def test_a_closed_loop_rig_takes_its_reference_as_input(export):
+    """The closed-loop preset's FMU: the input is the set-point `reference`,
+    the controller's output is the `command` output (direct feedthrough:
+    u = Kp (r - x) at a fixed state), and the drive settles at the P
+    controller's steady state, within a few mm of the set-point."""
+    path = export("leaney-moog-closed-loop")
+    md = read_model_description(str(path))
+    by_name = {v.name: v for v in md.modelVariables}
+    assert by_name["reference"].causality == "input"
+    assert by_name["command"].causality == "output"
+    assert "command" not in [v.name for v in md.modelVariables if v.causality == "input"]
+    s, vr, d = open_fmu(path)
+    start(s)
+    ref, h = 0.03, 1e-3
+    t = 0.0
+    for _ in range(1500):
+        s.setReal([vr["reference"]], [ref])
+        s.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+        t += h
+    x, u = s.getReal([vr["position"], vr["command"]])
+    s.terminate()
+    s.freeInstance()
+    shutil.rmtree(d, ignore_errors=True)
+    kp = 10.0  # the preset's gain [1/m]
+    assert abs(u - np.clip(kp * (ref - x), -1, 1)) < 1e-3, (u, x)  # the controller's law
+    assert abs(x - ref) < 5e-3, x                                   # settled near the set-point
+
+
 def run_alone(path, mass, n=300, h=1e-3):
     s, vr, d = open_fmu(path)
     s.setReal([vr["load.mass"]], [mass])

@@ -24,6 +24,7 @@ mod mass;
 mod orifice;
 mod sources;
 mod spool;
+mod switched_orifice;
 mod volume;
 
 pub use controller::{PositionController, PositionLaw};
@@ -35,4 +36,5 @@ pub use mass::Mass;
 pub use orifice::FixedOrifice;
 pub use sources::{CommandInput, PressureSource};
 pub use spool::ServoSpool;
+pub use switched_orifice::SwitchedOrifice;
 pub use volume::Volume;

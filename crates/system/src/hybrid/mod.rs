@@ -39,6 +39,7 @@
 
 pub mod components;
 mod netlist;
+pub mod variant;
 
 pub use components::{
     CheckComponent, NeedleComponent, PilotNodes, PilotValve, PumpComponent, ReliefComponent,

@@ -157,7 +157,9 @@ impl SeriesGroup {
                     } else if fhi >= 0.0 {
                         hi
                     } else {
-                        brent(|p| f(p, w), lo, hi, flo, fhi, tol)
+                        // f(lo) > 0 > f(hi): a bracket, so Brent converges
+                        hydrocyl_xfactor::brent(|p| f(p, w), lo, hi, tol)
+                            .map_or(0.5 * (lo + hi), |s| s.x)
                     }
                 }
             }
@@ -213,61 +215,6 @@ fn newton(
         }
     }
     None
-}
-
-/// Brent's method (inverse quadratic interpolation safeguarded by
-/// bisection) for a root of `f` in `[a, b]` with `f(a) > 0 > f(b)` or the
-/// reverse, to `tol` absolute in the argument.
-fn brent(mut f: impl FnMut(f64) -> f64, a: f64, b: f64, fa: f64, fb: f64, tol: f64) -> f64 {
-    let (mut a, mut b, mut fa, mut fb) = (a, b, fa, fb);
-    let (mut c, mut fc) = (a, fa);
-    let (mut d, mut e) = (b - a, b - a);
-    for _ in 0..200 {
-        if (fb > 0.0) == (fc > 0.0) {
-            (c, fc, d) = (a, fa, b - a);
-            e = d;
-        }
-        if fc.abs() < fb.abs() {
-            (a, b, c) = (b, c, b);
-            (fa, fb, fc) = (fb, fc, fb);
-        }
-        let tol1 = 2.0 * f64::EPSILON * b.abs() + 0.5 * tol;
-        let xm = 0.5 * (c - b);
-        if xm.abs() <= tol1 || fb == 0.0 {
-            return b;
-        }
-        if e.abs() >= tol1 && fa.abs() > fb.abs() {
-            let s = fb / fa;
-            let (mut p, mut q) = if a == c {
-                (2.0 * xm * s, 1.0 - s)
-            } else {
-                let (qa, r) = (fa / fc, fb / fc);
-                (
-                    s * (2.0 * xm * qa * (qa - r) - (b - a) * (r - 1.0)),
-                    (qa - 1.0) * (r - 1.0) * (s - 1.0),
-                )
-            };
-            if p > 0.0 {
-                q = -q;
-            }
-            p = p.abs();
-            if 2.0 * p < (3.0 * xm * q - (tol1 * q).abs()).min((e * q).abs()) {
-                e = d;
-                d = p / q;
-            } else {
-                d = xm;
-                e = d;
-            }
-        } else {
-            d = xm;
-            e = d;
-        }
-        a = b;
-        fa = fb;
-        b += if d.abs() > tol1 { d } else { tol1.copysign(xm) };
-        fb = f(b);
-    }
-    b
 }
 
 /// Groups the components around each algebraic node (see the module docs);
@@ -531,7 +478,9 @@ mod tests {
 
     #[test]
     fn brent_finds_the_root_of_a_falling_function() {
-        let r = brent(|p| 2.0 - p * p, 0.0, 2.0, 2.0, -2.0, 1e-14);
+        let r = hydrocyl_xfactor::brent(|p| 2.0 - p * p, 0.0, 2.0, 1e-14)
+            .unwrap()
+            .x;
         assert!((r - 2.0_f64.sqrt()).abs() < 1e-13, "{r}");
     }
 }

@@ -155,5 +155,6 @@ pub use generalised::{
     steady_pressures_two_chamber, x_factor_loaded, ChamberPressures, PortOrifices, SteadyPressures,
 };
 pub use numerical::{
-    x_factor_brent, x_factor_numerical, x_factor_numerical_checked, BrentSolution, MAX_ITERATIONS,
+    brent, x_factor_brent, x_factor_numerical, x_factor_numerical_checked, BrentSolution,
+    MAX_ITERATIONS,
 };

@@ -11,9 +11,9 @@ pub const MAX_ITERATIONS: usize = 200;
 /// A Brent solution and its cost.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BrentSolution {
-    /// The X factor.
+    /// The root (the X factor, for [`x_factor_brent`]).
     pub x: f64,
-    /// Evaluations of eq 3.4 spent (the two bracket ends included).
+    /// Evaluations of the function spent (the two bracket ends included).
     pub evaluations: usize,
 }
 
@@ -63,9 +63,11 @@ pub fn x_factor_brent(gamma: f64, travel: f64, tol: f64) -> Result<BrentSolution
 
 /// Brent's method on `f` over `[a, b]`, which must bracket a sign change
 /// (checked: an error otherwise is a bug in the caller's bracket, reported as
-/// [`XFactorError::NoConvergence`] with zero iterations).
-pub(crate) fn brent<F: Fn(f64) -> f64>(
-    f: F,
+/// [`XFactorError::NoConvergence`] with zero iterations). The workspace's one
+/// bracketed root finder: the X factor's reference and the assembler's
+/// algebraic nodes (`hydrocyl_system::series`) both call it.
+pub fn brent<F: FnMut(f64) -> f64>(
+    mut f: F,
     a: f64,
     b: f64,
     tol: f64,

@@ -91,7 +91,7 @@ fn load_rig(spec: &str) -> Result<Rig, CliError> {
             .map_err(|e| CliError::Input(format!("{spec}: {e}"))),
         k if k == hydrocyl_system::valve_rig::KIND => valve_rig_from(&v)
             .map(|r| Rig::Valve(Box::new(r)))
-            .map_err(|e| crate::rigfile::locate(e, &v, spec)),
+            .map_err(|e| crate::rigfile::locate(e, spec)),
         k => Err(unsupported(&format!(
             "kind '{k}' (kinds: {}, {})",
             bench::KIND,

@@ -1,44 +1,90 @@
-//! Rig files as the CLI reads them: a preset or a file (duplicate keys
-//! refused, [`rig::load`]), checked with every error naming the JSON path
-//! and, for a file, its line — serde's type and enum errors included, which
-//! the rig kinds report without a path.
+//! Rig files as `hydrocyl simulate` reads them: a preset or a file
+//! (duplicate keys refused, [`rig::load`]), an older rig kind read as its
+//! netlist ([`netlist::migrate`]), then checked once ([`check`]): every
+//! error names the JSON path and, for a file, its line.
 
 use crate::error::CliError;
-use hydrocyl_system::hybrid::WangHybrid;
+use hydrocyl_system::hybrid::variant::{self, HybridVariant};
+use hydrocyl_system::netlist::{self, Schematic};
 use hydrocyl_system::rig::{self, RigError};
-use hydrocyl_system::valve_rig::{self, ValveRig};
+use hydrocyl_system::signal::Signal;
+use hydrocyl_system::Circuit;
 use serde_json::Value;
 
-/// The JSON path of a deserialisation error of `value` read as `T`, with
-/// serde's message, or `None` if it reads.
-fn serde_path<T: serde::de::DeserializeOwned>(value: &Value) -> Option<(String, String)> {
-    match serde_path_to_error::deserialize::<_, T>(value.clone()) {
-        Ok(_) => None,
-        Err(e) => Some((e.path().to_string(), e.into_inner().to_string())),
-    }
-}
-
-/// A rig error with its JSON path found (a serde error of the older rig
-/// kinds names none) and the line in `source` added.
-pub fn locate(e: RigError, value: &Value, source: &str) -> CliError {
-    let e = match e {
-        RigError::Invalid { path, why } if path == "rig" => {
-            let found = match value.get("kind").and_then(Value::as_str) {
-                Some(valve_rig::KIND) => serde_path::<ValveRig>(value),
-                Some(hydrocyl_system::hybrid::KIND) => serde_path::<WangHybrid>(value),
-                _ => None,
-            };
-            match found {
-                Some((p, why)) if p != "." => RigError::Invalid { path: p, why },
-                _ => RigError::Invalid { path, why },
-            }
-        }
-        other => other,
-    };
+/// A rig error with the line of its JSON path in `source` added (when
+/// `source` is a file).
+pub fn locate(e: RigError, source: &str) -> CliError {
     CliError::Input(rig::at_line(e, source).to_string())
 }
 
-/// Checks a rig value of a known kind (see [`locate`]).
-pub fn check(value: &Value, source: &str) -> Result<(), CliError> {
-    rig::check(value).map_err(|e| locate(e, value, source))
+/// Loads a preset or rig file; a file of an older kind (`valve-cylinder`,
+/// `hybrid-pump`) as its netlist, so that `--set` and `--print-rig` take
+/// `<component>.<parameter>` paths on every rig.
+pub fn load(spec: &str) -> Result<Value, CliError> {
+    let v = rig::load(spec).map_err(|e| CliError::Input(e.to_string()))?;
+    match netlist::migrate::migrate(&v) {
+        Ok(Some(n)) => Ok(n),
+        Ok(None) => Ok(v),
+        Err(e) => Err(locate(e, spec)),
+    }
+}
+
+/// A rig read and checked once, ready to be assembled.
+pub enum Checked {
+    /// A netlist: its checked schematic (steady initial pressures filled).
+    Netlist(Box<Schematic>),
+    /// A chapter-8 circuit variant: a base rig with components swapped.
+    Variant(Box<HybridVariant>),
+}
+
+/// Reads and checks a rig value of a kind `simulate` runs (see [`locate`]).
+pub fn check(value: &Value, source: &str) -> Result<Checked, CliError> {
+    let checked = match value.get("kind").and_then(Value::as_str) {
+        Some(variant::KIND) => HybridVariant::from_value(value).map(|v| Checked::Variant(v.into())),
+        Some(netlist::KIND) => netlist::schematic(value).map(|s| Checked::Netlist(s.into())),
+        // a missing or unknown kind: the error names the kinds there are
+        _ => Err(match rig::kind_of(value) {
+            Err(e) => e,
+            Ok(k) => RigError::Invalid {
+                path: "kind".into(),
+                why: format!("`{}` is not a rig kind `simulate` runs", k.kind),
+            },
+        }),
+    };
+    checked.map_err(|e| locate(e, source))
+}
+
+impl Checked {
+    /// The unit in which the rig takes its input (the reading port's, see
+    /// [`Schematic::input_unit`]; a pump drive's `V` for a variant).
+    pub fn input_unit(&self) -> Option<&'static str> {
+        match self {
+            Checked::Netlist(s) => s.input_unit(),
+            Checked::Variant(_) => Some("V"),
+        }
+    }
+
+    /// Every numeric parameter as `(path, value, unit)`.
+    pub fn parameters(&self, value: &Value) -> Vec<rig::Parameter> {
+        match self {
+            Checked::Netlist(s) => netlist::parameters_of(s)
+                .into_iter()
+                .map(|p| rig::Parameter {
+                    path: p.path,
+                    value: p.value,
+                    unit: Some(p.unit),
+                    doc: Some(p.doc),
+                })
+                .collect(),
+            Checked::Variant(_) => rig::parameters(value),
+        }
+    }
+
+    /// Assembles the rig's circuit driven by `command`.
+    pub fn circuit(&self, command: Signal) -> Result<Circuit, RigError> {
+        match self {
+            Checked::Netlist(s) => netlist::assemble(s, command),
+            Checked::Variant(v) => v.circuit(command),
+        }
+    }
 }

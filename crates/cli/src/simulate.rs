@@ -40,7 +40,6 @@ use crate::output::Outputs;
 use crate::progress::Progress;
 use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_identify::plaincsv::{run_columns, write_columns_in_parts, write_rows_in_parts};
-use hydrocyl_system::hybrid::variant;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{self as runner, Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
@@ -75,8 +74,9 @@ pub struct Args {
     /// (required) Output CSV (measured-data format, units in the header).
     #[arg(long, required_unless_present = "print_rig")]
     out: Option<PathBuf>,
-    /// Override a rig parameter by its JSON path, e.g. `--set load.mass_kg=50`
-    /// or `--set initial.p1=2.5e6` (repeatable).
+    /// Override a rig parameter by its path, e.g. `--set load.mass=50` or
+    /// `--set cylinder.initial.p1=2.5e6` (repeatable; `hydrocyl simulate
+    /// --print-rig` lists every path).
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
     /// Integration method: auto (default: dp45 while the run is not stiff,
@@ -182,62 +182,24 @@ fn run_bench(args: &Args, value: &serde_json::Value) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Whether a rig (JSON) is closed loop: it has a `position_controller`
-/// (or, as a `valve-cylinder` file, a `controller`), and is driven by a
-/// position reference.
-pub fn closed_loop(rig: &serde_json::Value) -> bool {
-    rig.get("controller").is_some_and(|c| !c.is_null())
-        || rig
-            .get("components")
-            .and_then(serde_json::Value::as_object)
-            .is_some_and(|c| {
-                c.values().any(|i| {
-                    i.get("type").and_then(serde_json::Value::as_str) == Some("position_controller")
-                })
-            })
-}
-
-/// The unit of a rig's input: the position set-point of a closed-loop rig,
-/// [`CommandUnit::Volt`] when the port that reads the command says so (a
-/// pump drive), else normalised.
-fn command_unit(value: &serde_json::Value) -> CommandUnit {
-    if closed_loop(value) {
-        return CommandUnit::Reference;
-    }
-    let kind = value.get("kind").and_then(|k| k.as_str());
-    if kind == Some(variant::KIND) || kind == Some(hydrocyl_system::hybrid::KIND) {
-        return CommandUnit::Volt;
-    }
-    if kind != Some(hydrocyl_system::netlist::KIND) {
-        return CommandUnit::Normalised;
-    }
-    let Ok(s) = hydrocyl_system::netlist::schematic(value) else {
-        return CommandUnit::Normalised;
-    };
-    let volt = s
-        .instances
-        .iter()
-        .filter(|i| i.ty.name == "command_input")
-        .filter_map(|i| i.nodes.get("out"))
-        .filter_map(|n| s.nodes.get(n))
-        .flat_map(|(_, ports)| ports.iter())
-        .filter_map(|p| p.split_once('.'))
-        .filter_map(|(c, port)| {
-            let inst = s.instance(c)?;
-            inst.ty.ports.iter().find(|q| q.name == port)
-        })
-        .any(|q| q.doc.ends_with("[V]"));
-    if volt {
-        CommandUnit::Volt
-    } else {
-        CommandUnit::Normalised
+/// The unit of a rig's input, from the netlist (the port that reads it,
+/// [`crate::rigfile::Checked::input_unit`]): the position set-point of a
+/// closed-loop rig, a pump drive's voltage, else a normalised spool demand.
+fn command_unit(rig: &crate::rigfile::Checked) -> CommandUnit {
+    match rig.input_unit() {
+        Some("m") => CommandUnit::Reference,
+        Some("V") => CommandUnit::Volt,
+        _ => CommandUnit::Normalised,
     }
 }
 
 /// Rejects an initial chamber pressure below absolute vacuum (gauge
 /// pressures below −101 325 Pa do not exist).
-fn check_initial_pressures(value: &serde_json::Value) -> Result<(), CliError> {
-    for p in rig::parameters(value) {
+fn check_initial_pressures(
+    rig: &crate::rigfile::Checked,
+    value: &serde_json::Value,
+) -> Result<(), CliError> {
+    for p in rig.parameters(value) {
         let pressure = p.unit == Some("Pa")
             || (p.unit.is_none()
                 && p.path
@@ -324,7 +286,7 @@ fn solver_hint(e: rig::RigError) -> CliError {
 /// Runs `hydrocyl simulate`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let rig_err = |e: rig::RigError| CliError::Input(e.to_string());
-    let mut value = rig::load(&args.rig).map_err(rig_err)?;
+    let mut value = crate::rigfile::load(&args.rig)?;
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(rig_err)?;
     }
@@ -332,8 +294,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if kind == Some(bench::KIND) {
         return run_bench(&args, &value);
     }
-    crate::rigfile::check(&value, &args.rig)?;
-    check_initial_pressures(&value)?;
+    let checked = crate::rigfile::check(&value, &args.rig)?;
+    check_initial_pressures(&checked, &value)?;
     if args.print_rig {
         // a netlist is printed with every parameter written out (defaults
         // filled in), under the paths `--set` takes
@@ -375,7 +337,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let mut outputs = Outputs::new(&inputs);
     let id = outputs.file("--out", &out)?;
-    let unit = command_unit(&value);
+    let unit = command_unit(&checked);
     let (t, u) = read_command(&cmd_path, unit)?;
     if unit == CommandUnit::Normalised && !args.quiet {
         warn_clamped(&cmd_path, &t, &u);
@@ -394,7 +356,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Signal::Table { time_s, .. } => time_s.clone(),
         _ => Vec::new(),
     };
-    let mut c = rig::circuit(&value, signal).map_err(|e| CliError::Input(e.to_string()))?;
+    let mut c = checked
+        .circuit(signal)
+        .map_err(|e| CliError::Input(e.to_string()))?;
     let x0 = c.initial_state();
     let mut bar = Progress::new("simulate", rows as u64, args.progress, args.quiet);
     let mut failed: Option<CliError> = None;

@@ -263,6 +263,82 @@ fn rig_files_and_print_rig_round_trip() {
     assert!(st.status.success());
 }
 
+/// A rig file of an older kind (`valve-cylinder`, closed loop) is read as
+/// its netlist: `--print-rig` shows the netlist under the
+/// `<component>.<parameter>` scheme, `--set cylinder.initial.position=...`
+/// reaches it, and it runs on a `reference` column (its controller's input).
+#[test]
+fn an_older_rig_kind_runs_and_prints_as_its_netlist() {
+    let dir = tempfile::tempdir().unwrap();
+    let old = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/measured/festo-hanging-load.rig.json");
+    let st = hydrocyl()
+        .args([
+            "simulate",
+            "--print-rig",
+            "--set",
+            "cylinder.initial.position=-0.05",
+            "--rig",
+        ])
+        .arg(&old)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
+    assert_eq!(v["kind"], "netlist");
+    assert_eq!(v["components"]["cylinder"]["initial"]["position"], -0.05);
+    assert_eq!(v["components"]["controller"]["type"], "position_controller");
+    // the old paths are gone, and the error lists the components
+    let st = hydrocyl()
+        .args([
+            "simulate",
+            "--print-rig",
+            "--set",
+            "initial.position=0",
+            "--rig",
+        ])
+        .arg(&old)
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&st.stderr).contains("cylinder"));
+    let reference: Vec<(f64, f64)> = (0..=200).map(|k| (k as f64 * 1e-3, -0.05)).collect();
+    let cmd = dir.path().join("ref.csv");
+    let mut text = String::from("time,reference\n");
+    for (t, r) in &reference {
+        text.push_str(&format!("{t},{r}\n"));
+    }
+    std::fs::write(&cmd, text).unwrap();
+    let out = dir.path().join("out.csv");
+    let st = hydrocyl()
+        .args(["simulate", "--rig"])
+        .arg(&old)
+        .arg("--command")
+        .arg(&cmd)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let (h, rows) = read_csv(&out);
+    let pos = h.iter().position(|c| c == "position").unwrap();
+    // the controller pulls the rod from -0.09 m towards the set-point
+    assert!(
+        rows[200][pos] > rows[0][pos] + 1e-3,
+        "{} -> {}",
+        rows[0][pos],
+        rows[200][pos]
+    );
+}
+
 /// A friction bench is driven by its motion: simulated on the generated
 /// record whose truth is its declared model, the predicted load-cell force
 /// matches the measured one to the record's sensor noise (σ = 0.5 N on the

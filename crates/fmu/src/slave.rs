@@ -1,7 +1,8 @@
 //! The co-simulation slave in safe Rust: one instance of an FMU. It holds
 //! the rig, the variable values, and (from initialisation on) the rig's
-//! circuit, its state and the communication time; [`Slave::do_step`]
-//! integrates the circuit over one communication step with the rig's solver.
+//! [`Simulation`], stepped between communication points
+//! ([`Simulation::start`], [`Simulation::step_to`]); [`Slave::do_step`]
+//! integrates it over one communication step with the rig's solver.
 //!
 //! The integrator is restarted at every communication point (its step-size
 //! estimate and FSAL stage are not carried over): a step costs the
@@ -13,11 +14,11 @@
 use crate::variables::{
     circuit_with_input, output_channels, Role, SolverParam, Variables, METHODS,
 };
-use hydrocyl_integrators::{solve, Options};
 use hydrocyl_system::external::ExternalInput;
-use hydrocyl_system::rig;
-use hydrocyl_system::run::Solver;
-use hydrocyl_system::{AnyWire, Circuit};
+use hydrocyl_system::rig::{self, RigError};
+use hydrocyl_system::run::RunOptions;
+use hydrocyl_system::simulation::Simulation;
+use hydrocyl_system::AnyWire;
 use serde_json::Value;
 
 /// Where the slave is in the FMI 2.0 co-simulation state machine.
@@ -37,10 +38,9 @@ pub enum Phase {
 
 /// The running circuit.
 struct Sim {
-    circuit: Circuit,
+    sim: Simulation,
     input: ExternalInput,
     wires: Vec<AnyWire>,
-    x: Vec<f64>,
     t: f64,
 }
 
@@ -284,7 +284,7 @@ impl Slave {
         if self.sim.is_some() {
             return Ok(());
         }
-        let (mut circuit, input) =
+        let (circuit, input) =
             circuit_with_input(&self.rig).map_err(|e| format!("assembling the rig: {e}"))?;
         let probes = output_channels(&circuit, &crate::variables::input_name(&self.rig));
         let mut wires = Vec::with_capacity(self.vars.outputs.len());
@@ -294,25 +294,16 @@ impl Slave {
             })?;
             wires.push(p.wire);
         }
-        circuit.set_quadratures(false);
-        circuit.set_ledger(false);
-        let x = circuit.initial_state();
-        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-            return Err(format!(
-                "initial state {} = {} is not finite",
-                circuit.state_names()[i],
-                x[i]
-            ));
-        }
         let t = self.t_start;
         self.history.clear();
         input.set(t, self.values[0], self.slope);
-        circuit.reset(t, &x);
+        // no quadratures, no ledger: the FMU's outputs are the probes
+        let mut sim = Simulation::of_circuit(circuit).options(RunOptions::default());
+        sim.start(t).map_err(|e| e.to_string())?;
         self.sim = Some(Sim {
-            circuit,
+            sim,
             input,
             wires,
-            x,
             t,
         });
         Ok(())
@@ -332,8 +323,9 @@ impl Slave {
                 self.ensure_sim()?;
                 let s = self.sim.as_ref().ok_or("no circuit")?;
                 let mut out = [0.0];
-                s.circuit
-                    .read_wires(s.t, &s.x, &s.wires[i..i + 1], &mut out);
+                s.sim
+                    .circuit()
+                    .read_wires(s.t, s.sim.state(), &s.wires[i..i + 1], &mut out);
                 Ok(out[0])
             }
             _ if v.integer => Err(format!("`{}` is an Integer", v.name)),
@@ -488,20 +480,15 @@ impl Slave {
         }
         let t_end = t + h;
         s.input.set(t, u, slope);
-        let opts = Options {
+        s.sim.set_options(RunOptions {
+            solver: method,
             rtol,
-            atol: s.circuit.atol(rtol),
-            h0: (method == Solver::Rk4).then_some(rk4_step.min(h)),
             h_max,
-            t_eval: Some(vec![t, t_end]),
-            ..Options::default()
-        };
-        let result = solve(method.method(), &mut s.circuit, t, &s.x, t_end, &opts);
-        let failure = match result {
-            Ok(sol) if sol.t.last() == Some(&t_end) => {
-                let last = sol.last().ok_or("empty solution")?;
-                let n = s.x.len();
-                s.x.copy_from_slice(&last[..n]);
+            rk4_step: rk4_step.min(h),
+            ..RunOptions::default()
+        });
+        let failure = match s.sim.step_to(t_end) {
+            Ok(()) => {
                 s.t = t_end;
                 self.history.push([t, h, u, slope]);
                 // the input value at the new communication point
@@ -509,17 +496,15 @@ impl Slave {
                 s.input.set(t_end, self.values[0], slope);
                 return Ok(());
             }
-            Ok(sol) => format!(
-                "the rig stopped the run at t = {} s",
-                sol.t.last().copied().unwrap_or(t)
-            ),
-            Err(e) => format!("solver {}: {e}", method.name()),
+            Err(RigError::Sim(why)) => why,
+            Err(e) => e.to_string(),
         };
         let state: Vec<String> = s
-            .circuit
+            .sim
+            .circuit()
             .state_names()
             .iter()
-            .zip(&s.x)
+            .zip(s.sim.state())
             .map(|(n, v)| format!("{n} = {v:e}"))
             .collect();
         self.phase = Phase::Failed;

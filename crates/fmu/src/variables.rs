@@ -17,28 +17,16 @@ use serde_json::Value;
 /// replaces).
 pub const INPUT: &str = "command";
 
-/// The name of `rig`'s input variable: the output channel of its
-/// `command_input` component — `command` on an open-loop rig, `reference` on
-/// a closed-loop one whose input is the controller's set-point (the
-/// controller's output is then the `command` output) — or [`INPUT`].
+/// The name of `rig`'s input variable: the output column that shows the
+/// netlist's input ([`Schematic::input_channel`](hydrocyl_system::netlist::Schematic::input_channel))
+/// — `command` on an open-loop rig, `reference` on a closed-loop one whose
+/// input is the controller's set-point (the controller's output is then the
+/// `command` output) — or [`INPUT`].
 pub fn input_name(rig: &Value) -> String {
-    let Some(comps) = rig.get("components").and_then(Value::as_object) else {
-        return INPUT.into();
-    };
-    let Some((inst, _)) = comps
-        .iter()
-        .find(|(_, c)| c.get("type").and_then(Value::as_str) == Some("command_input"))
-    else {
-        return INPUT.into();
-    };
-    let probe = format!("{inst}.command");
-    match rig.get("outputs").and_then(Value::as_object) {
-        Some(outs) => outs
-            .iter()
-            .find(|(_, p)| p.as_str() == Some(probe.as_str()))
-            .map_or_else(|| INPUT.into(), |(col, _)| col.clone()),
-        None => probe,
-    }
+    hydrocyl_system::netlist::schematic(rig)
+        .ok()
+        .and_then(|s| s.input_channel())
+        .unwrap_or_else(|| INPUT.into())
 }
 
 /// The solver methods by their `solver.method` number.

@@ -8,7 +8,7 @@
 use crate::circuit::BuildError;
 use crate::run::{Run, RunOptions};
 use crate::signal::Signal;
-use crate::valve_rig::{self, ValveRig};
+use crate::valve_rig::ValveRig;
 use serde_json::Value;
 use thiserror::Error;
 
@@ -146,18 +146,10 @@ pub struct RigKind {
     pub circuit: fn(&Value, Signal) -> Result<crate::Circuit, RigError>,
 }
 
-/// The rig kinds hydrocyl knows. Other rig kinds add an entry here.
+/// The rig kinds hydrocyl assembles. Other rig kinds add an entry here; the
+/// older kinds of [`MIGRATED_KINDS`](crate::netlist::migrate::MIGRATED_KINDS)
+/// are read as netlists ([`crate::netlist::migrate`]).
 pub const RIG_KINDS: &[RigKind] = &[
-    RigKind {
-        kind: valve_rig::KIND,
-        check: |v| valve_rig_from(v).map(|_| ()),
-        circuit: |v, cmd| valve_rig_from(v)?.circuit(cmd),
-    },
-    RigKind {
-        kind: crate::hybrid::KIND,
-        check: |v| crate::hybrid::WangHybrid::from_value(v).map(|_| ()),
-        circuit: |v, cmd| crate::hybrid::WangHybrid::from_value(v)?.build(cmd),
-    },
     RigKind {
         kind: crate::hybrid::variant::KIND,
         check: |v| crate::hybrid::variant::HybridVariant::from_value(v).map(|_| ()),
@@ -177,10 +169,7 @@ pub fn valve_rig_from(v: &Value) -> Result<ValveRig, RigError> {
     if v.get("kind").and_then(Value::as_str) == Some(crate::netlist::KIND) {
         return ValveRig::from_netlist(v);
     }
-    let r: ValveRig = serde_json::from_value(v.clone()).map_err(|e| RigError::Invalid {
-        path: "rig".into(),
-        why: e.to_string(),
-    })?;
+    let r: ValveRig = crate::netlist::migrate::typed(v)?;
     r.validate()?;
     Ok(r)
 }
@@ -272,15 +261,26 @@ pub fn kind_of(v: &Value) -> Result<&'static RigKind, RigError> {
                 RIG_KINDS
                     .iter()
                     .map(|r| r.kind)
+                    .chain(crate::netlist::migrate::MIGRATED_KINDS)
                     .collect::<Vec<_>>()
                     .join(", ")
             ),
         })
 }
 
+/// A rig value of an older kind as its netlist ([`crate::netlist::migrate`]),
+/// any other as it is.
+fn migrated(v: &Value) -> Result<std::borrow::Cow<'_, Value>, RigError> {
+    Ok(match crate::netlist::migrate::migrate(v)? {
+        Some(n) => std::borrow::Cow::Owned(n),
+        None => std::borrow::Cow::Borrowed(v),
+    })
+}
+
 /// Checks a rig value of any kind.
 pub fn check(v: &Value) -> Result<(), RigError> {
-    (kind_of(v)?.check)(v)
+    let v = migrated(v)?;
+    (kind_of(&v)?.check)(&v)
 }
 
 /// Simulates a rig value of any kind: [`Simulation::new`](crate::simulation::Simulation::new)
@@ -300,7 +300,8 @@ pub fn simulate(
 /// Its [`Circuit::initial_state`](crate::Circuit::initial_state) is the
 /// rig's initial state.
 pub fn circuit(v: &Value, command: Signal) -> Result<crate::Circuit, RigError> {
-    (kind_of(v)?.circuit)(v, command)
+    let v = migrated(v)?;
+    (kind_of(&v)?.circuit)(&v, command)
 }
 
 /// One numeric parameter of a rig: its path (as `--set` takes it) and value.

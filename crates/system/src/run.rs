@@ -72,6 +72,17 @@ impl Solver {
     }
 }
 
+impl From<Method> for Solver {
+    fn from(m: Method) -> Self {
+        match m {
+            Method::Auto => Solver::Auto,
+            Method::DormandPrince45 => Solver::Dp45,
+            Method::Rosenbrock => Solver::Rosenbrock,
+            Method::Rk4 => Solver::Rk4,
+        }
+    }
+}
+
 /// Settings of a run.
 #[derive(Clone, Debug)]
 pub struct RunOptions {
@@ -87,6 +98,8 @@ pub struct RunOptions {
     pub quadratures: bool,
     /// Integrate the energy ledger.
     pub ledger: bool,
+    /// Step budget: a run that needs more steps fails with the time reached.
+    pub max_steps: usize,
 }
 
 impl Default for RunOptions {
@@ -98,11 +111,26 @@ impl Default for RunOptions {
             rk4_step: 2e-5,
             quadratures: false,
             ledger: false,
+            max_steps: Options::default().max_steps,
         }
     }
 }
 
 impl RunOptions {
+    /// The integrator's options for `circuit` with output at `t_eval`
+    /// (absolute tolerances from the circuit's state scales).
+    pub fn solver_options(&self, circuit: &Circuit, t_eval: Vec<f64>) -> Options {
+        Options {
+            rtol: self.rtol,
+            atol: circuit.atol(self.rtol),
+            h0: (self.solver == Solver::Rk4).then_some(self.rk4_step),
+            h_max: self.h_max,
+            max_steps: self.max_steps,
+            t_eval: Some(t_eval),
+            ..Options::default()
+        }
+    }
+
     /// The defaults with Dormand–Prince 5(4) named: for results that must
     /// stay those of the thesis's solver whatever the default choice is.
     pub fn dp45() -> Self {
@@ -249,18 +277,7 @@ fn solve_from(
     opts: &RunOptions,
 ) -> Result<Run, SimError> {
     let (t0, t_end) = (t_eval[0], t_eval[t_eval.len() - 1]);
-    let sopts = Options {
-        rtol: opts.rtol,
-        atol: circuit.atol(opts.rtol),
-        h0: if opts.solver == Solver::Rk4 {
-            Some(opts.rk4_step)
-        } else {
-            None
-        },
-        h_max: opts.h_max,
-        t_eval: Some(t_eval.to_vec()),
-        ..Options::default()
-    };
+    let sopts = opts.solver_options(circuit, t_eval.to_vec());
     let start = Instant::now();
     let sol = solve(opts.solver.method(), circuit, t0, x, t_end, &sopts).map_err(|source| {
         SimError::Solve {

@@ -9,6 +9,11 @@
 //! [`Simulation::run`] then integrates it and maps every failure to one
 //! [`RigError`].
 //!
+//! A co-simulation slave (the FMU) steps the same simulation between
+//! communication points instead: [`Simulation::start`], then
+//! [`Simulation::step_to`] as often as the host asks, reading
+//! [`Simulation::time`] and [`Simulation::state`] in between.
+//!
 //! ```
 //! use hydrocyl_system::{rig, signal::Signal, simulation::Simulation, run::RunOptions};
 //!
@@ -26,6 +31,7 @@ use crate::circuit::Circuit;
 use crate::rig::{self, RigError};
 use crate::run::{run, Run, RunOptions, SimError};
 use crate::signal::Signal;
+use hydrocyl_integrators::{solve, OdeSystem};
 use serde_json::Value;
 
 /// One simulation: an assembled circuit, its initial state and the solver
@@ -37,6 +43,8 @@ pub struct Simulation {
     circuit: Circuit,
     initial: Vec<f64>,
     options: RunOptions,
+    /// The time reached and the state there, while stepping.
+    now: Option<(f64, Vec<f64>)>,
 }
 
 impl Simulation {
@@ -55,6 +63,7 @@ impl Simulation {
             circuit,
             initial,
             options: RunOptions::default(),
+            now: None,
         }
     }
 
@@ -82,6 +91,11 @@ impl Simulation {
         &mut self.circuit
     }
 
+    /// Changes the solver options between steps or runs.
+    pub fn set_options(&mut self, options: RunOptions) {
+        self.options = options;
+    }
+
     /// The solver options the runs use.
     pub fn run_options(&self) -> &RunOptions {
         &self.options
@@ -98,8 +112,140 @@ impl Simulation {
         })
     }
 
+    /// Starts stepping at `t0` from the initial state (the circuit reset
+    /// there; the options' quadratures and ledger switches applied). Checks
+    /// the initial state as [`Simulation::run`] does.
+    pub fn start(&mut self, t0: f64) -> Result<(), RigError> {
+        let n = self.circuit.n_states();
+        let bad = |why: String| RigError::Sim(SimError::Settings(why).to_string());
+        if self.initial.len() != n {
+            return Err(bad(format!(
+                "initial state has {} entries, the circuit {n}",
+                self.initial.len()
+            )));
+        }
+        if !t0.is_finite() {
+            return Err(bad(format!("start time {t0} is not finite")));
+        }
+        if let Some(i) = self.initial.iter().position(|v| !v.is_finite()) {
+            return Err(bad(format!(
+                "initial state {} is not finite",
+                self.circuit.state_names()[i]
+            )));
+        }
+        self.circuit.set_quadratures(self.options.quadratures);
+        self.circuit.set_ledger(self.options.ledger);
+        let mut x = vec![0.0; self.circuit.dim()];
+        x[..n].copy_from_slice(&self.initial);
+        self.circuit.reset(t0, &x);
+        self.now = Some((t0, x));
+        Ok(())
+    }
+
+    /// Integrates from the time reached to `t_end` (after [`Simulation::start`]).
+    /// The circuit is not reset, so its components' modes (stick/slip,
+    /// stops, valve states) carry over; the integrator restarts, so no step
+    /// straddles the time reached. On failure the time and state stay where
+    /// they were: [`RigError::Sim`] says why (the solver's error, or the
+    /// circuit stopping the run early).
+    pub fn step_to(&mut self, t_end: f64) -> Result<(), RigError> {
+        let (t, x) = self
+            .now
+            .as_ref()
+            .ok_or_else(|| RigError::Sim("not started (Simulation::start)".into()))?;
+        let t = *t;
+        if !(t_end > t && t_end.is_finite()) {
+            return Err(RigError::Sim(
+                SimError::Settings(format!("step to t = {t_end} s from t = {t} s")).to_string(),
+            ));
+        }
+        let opts = self.options.solver_options(&self.circuit, vec![t, t_end]);
+        let method = self.options.solver;
+        let sol =
+            solve(method.method(), &mut self.circuit, t, x, t_end, &opts).map_err(|source| {
+                RigError::Sim(
+                    SimError::Solve {
+                        method: method.name(),
+                        source,
+                    }
+                    .to_string(),
+                )
+            })?;
+        match (sol.t.last(), sol.last()) {
+            (Some(&te), Some(last)) if te == t_end => {
+                self.now = Some((t_end, last.to_vec()));
+                Ok(())
+            }
+            (reached, _) => Err(RigError::Sim(format!(
+                "the rig stopped the run at t = {} s",
+                reached.copied().unwrap_or(t)
+            ))),
+        }
+    }
+
+    /// The time reached by stepping (`None` before [`Simulation::start`]).
+    pub fn time(&self) -> Option<f64> {
+        self.now.as_ref().map(|(t, _)| *t)
+    }
+
+    /// The state at the time reached, [`Circuit::state_names`] order, then
+    /// any quadratures (empty before [`Simulation::start`]).
+    pub fn state(&self) -> &[f64] {
+        self.now.as_ref().map_or(&[], |(_, x)| x.as_slice())
+    }
+
     /// The circuit, consumed (for callers that keep it after the runs).
     pub fn into_circuit(self) -> Circuit {
         self.circuit
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rig;
+
+    /// Stepping through communication points ends where one run ends, to
+    /// the tolerance (the integrator restarts at each point).
+    #[test]
+    fn steps_end_where_a_run_ends() {
+        let rig = rig::load("leaney-moog").unwrap();
+        let cmd = || Signal::Constant { value: 0.2 };
+        let mut opts = RunOptions::dp45();
+        opts.rtol = 1e-9;
+        let t: Vec<f64> = (0..=40).map(|k| k as f64 * 5e-3).collect();
+        let run = Simulation::new(&rig, cmd())
+            .unwrap()
+            .options(opts.clone())
+            .run(&t)
+            .unwrap();
+        let mut sim = Simulation::new(&rig, cmd()).unwrap().options(opts);
+        assert!(sim.step_to(0.1).is_err(), "stepping needs a start");
+        sim.start(0.0).unwrap();
+        for &tk in &t[1..] {
+            sim.step_to(tk).unwrap();
+        }
+        assert_eq!(sim.time(), Some(0.2));
+        let n = sim.circuit().n_states();
+        let end = run.state(40);
+        for (i, (a, b)) in sim.state()[..n].iter().zip(end).enumerate() {
+            let scale = a.abs().max(b.abs()).max(1e-9);
+            assert!((a - b).abs() < 1e-6 * scale, "state {i}: {a} vs {b}");
+        }
+        assert!(sim.step_to(0.1).is_err(), "no step backwards");
+    }
+
+    /// The step budget is the options': a run that needs more steps fails.
+    #[test]
+    fn the_step_budget_is_kept() {
+        let rig = rig::load("leaney-moog").unwrap();
+        let mut opts = RunOptions::dp45();
+        opts.max_steps = 5;
+        let e = Simulation::new(&rig, Signal::Constant { value: 0.2 })
+            .unwrap()
+            .options(opts)
+            .run(&[0.0, 0.5])
+            .unwrap_err();
+        assert!(e.to_string().contains("steps"), "{e}");
     }
 }

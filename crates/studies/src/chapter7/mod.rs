@@ -53,10 +53,13 @@ pub use fold::{
 pub use measure::{Chapter7Run, Phenomena, SteadyState, Trace, VolumeBalance};
 
 use hydrocyl_friction::{FrictionLaw, Wang};
-use hydrocyl_integrators::{solve, Method, Options, SolveError};
+use hydrocyl_integrators::Method;
 use hydrocyl_system::circuit::BuildError;
 use hydrocyl_system::hybrid::WangHybrid;
+use hydrocyl_system::rig::RigError;
+use hydrocyl_system::run::RunOptions;
 use hydrocyl_system::signal::Signal;
+use hydrocyl_system::simulation::Simulation;
 use serde::Serialize;
 use thiserror::Error;
 
@@ -73,14 +76,14 @@ pub enum RunError {
     Build(#[from] BuildError),
     /// The rig's netlist could not be assembled.
     #[error("building the wang-hybrid rig: {0}")]
-    Rig(#[from] hydrocyl_system::rig::RigError),
+    Rig(#[from] RigError),
     /// The solver failed.
-    #[error("solving the {test}: {source}")]
+    #[error("solving the {test}: {why}")]
     Solve {
         /// The test.
         test: String,
         /// The solver's error.
-        source: SolveError,
+        why: String,
     },
 }
 
@@ -228,28 +231,32 @@ impl Chapter7Test {
     /// position, with `method`, and measures it.
     pub fn run_on(&self, mut rig: WangHybrid, method: Method) -> Result<Chapter7Run, RunError> {
         rig.initial_position = self.initial_position;
-        let mut c = rig.build(self.command(&rig))?;
-        c.set_quadratures(true);
-        let x0 = c.initial_state();
-        c.reset(0.0, &x0);
         let t_end = self.periods as f64 / self.frequency;
         let n = (t_end / self.sample_interval).round() as usize;
-        let rtol = 1.0e-6;
-        let opts = Options {
-            rtol,
-            atol: c.atol(rtol),
+        let t: Vec<f64> = (0..=n).map(|k| k as f64 * self.sample_interval).collect();
+        let mut sim = Simulation::of_circuit(rig.build(self.command(&rig))?).options(RunOptions {
+            solver: method.into(),
+            rtol: 1.0e-6,
             h_max: 1.0e-2,
             max_steps: self.max_steps,
-            t_eval: Some((0..=n).map(|k| k as f64 * self.sample_interval).collect()),
-            ..Options::default()
-        };
-        let sol =
-            solve(method, &mut c, 0.0, &x0, t_end, &opts).map_err(|source| RunError::Solve {
+            quadratures: true,
+            ..RunOptions::default()
+        });
+        let run = sim.run(&t).map_err(|e| match e {
+            RigError::Sim(why) => RunError::Solve {
                 test: format!("{} test", self.label()),
-                source,
-            })?;
+                why,
+            },
+            other => RunError::Rig(other),
+        })?;
         Ok(Chapter7Run::measure(
-            *self, &rig, &mut c, &sol.t, &sol.x, sol.dim, sol.stats,
+            *self,
+            &rig,
+            sim.circuit_mut(),
+            &run.time,
+            &run.states,
+            run.dim,
+            run.stats,
         ))
     }
 

@@ -197,10 +197,7 @@ impl WangHybrid {
         if v.get("kind").and_then(serde_json::Value::as_str) == Some(crate::netlist::KIND) {
             return Self::from_netlist(v);
         }
-        let r: Self = serde_json::from_value(v.clone()).map_err(|e| RigError::Invalid {
-            path: "rig".into(),
-            why: e.to_string(),
-        })?;
+        let r: Self = crate::netlist::migrate::typed(v)?;
         r.validate()?;
         Ok(r)
     }

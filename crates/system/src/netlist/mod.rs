@@ -35,7 +35,9 @@
 //! `<component>.initial.<state>` — in `--set`, [`parameters`] and the docs.
 //! The components' order is the state vector's order.
 
+mod inputs;
 pub mod locate;
+pub mod migrate;
 pub mod reader;
 pub mod registry;
 
@@ -48,6 +50,7 @@ use crate::run::{Run, RunOptions};
 use crate::signal::Signal;
 pub(crate) use catalog::friction_law_of as catalog_friction_law;
 pub(crate) use catalog::friction_terms_of as catalog_friction_terms;
+pub use inputs::INPUT_TYPES;
 pub use reader::{read, NetlistError, Schematic};
 use serde_json::{Map, Value};
 
@@ -75,10 +78,6 @@ fn probe_path(component: &str, declared: &[(&str, &str)], probe: &str) -> String
     format!("{component}.{local}")
 }
 
-/// The component types driven by the run's command: a signal source, or an
-/// imposed-motion source (a friction bench's drive).
-pub const INPUT_TYPES: [&str; 2] = ["command_input", "imposed_motion"];
-
 /// Assembles the circuit of a checked netlist, its command input (one of
 /// [`INPUT_TYPES`]) driven by `command`.
 pub fn assemble(s: &Schematic, command: Signal) -> Result<Circuit, RigError> {
@@ -97,18 +96,53 @@ pub fn assemble_with(
         path: "command".into(),
         why: e.to_string(),
     })?;
-    let inputs: Vec<&str> = s
-        .instances
-        .iter()
-        .filter(|i| INPUT_TYPES.contains(&i.ty.name))
-        .map(|i| i.name.as_str())
-        .collect();
+    let inputs: Vec<&str> = s.inputs().map(|i| i.name.as_str()).collect();
     if inputs.len() > 1 {
         return Err(RigError::Invalid {
             path: format!("components.{}", inputs[1]),
             why: format!(
-                "a netlist has at most one command input ({}) so far",
-                INPUT_TYPES.join(", ")
+                "a netlist with several inputs ({}) is driven by one signal per input, by name",
+                inputs.join(", ")
+            ),
+        });
+    }
+    let drive: Vec<(String, Signal)> = inputs
+        .iter()
+        .map(|n| (n.to_string(), command.clone()))
+        .collect();
+    assemble_driven(s, &drive, edit)
+}
+
+/// Assembles a netlist with several inputs: each input component
+/// ([`INPUT_TYPES`], [`Schematic::inputs`]) driven by the signal given under
+/// its name. Every input must be given, and only inputs; each signal is
+/// checked and named by its component in errors.
+pub fn assemble_inputs(s: &Schematic, inputs: &[(String, Signal)]) -> Result<Circuit, RigError> {
+    for (name, sig) in inputs {
+        sig.validate().map_err(|e| RigError::Invalid {
+            path: format!("inputs.{name}"),
+            why: e.to_string(),
+        })?;
+    }
+    assemble_driven(s, inputs, |_| ())
+}
+
+fn assemble_driven(
+    s: &Schematic,
+    drive: &[(String, Signal)],
+    edit: impl FnOnce(&mut Vec<Box<dyn crate::Component>>),
+) -> Result<Circuit, RigError> {
+    let names: Vec<&str> = s.inputs().map(|i| i.name.as_str()).collect();
+    if let Some((n, _)) = drive.iter().find(|(n, _)| !names.contains(&n.as_str())) {
+        return Err(RigError::Invalid {
+            path: format!("inputs.{n}"),
+            why: format!(
+                "is not an input of the netlist (its inputs: {})",
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
             ),
         });
     }
@@ -116,7 +150,10 @@ pub fn assemble_with(
     for inst in &s.instances {
         let mut inst = inst.clone();
         if INPUT_TYPES.contains(&inst.ty.name) {
-            inst.input = Some(command.clone());
+            inst.input = drive
+                .iter()
+                .find(|(n, _)| *n == inst.name)
+                .map(|(_, sig)| sig.clone());
         }
         let c = (inst.ty.build)(&inst).map_err(|why| RigError::Invalid {
             path: format!("components.{}", inst.name),
@@ -202,7 +239,11 @@ pub struct ParamInfo {
 /// Every parameter and initial state of a netlist, defaults filled in, in
 /// component order.
 pub fn parameters(v: &Value) -> Result<Vec<ParamInfo>, RigError> {
-    let s = schematic(v)?;
+    Ok(parameters_of(&schematic(v)?))
+}
+
+/// [`parameters`] of a checked schematic.
+pub fn parameters_of(s: &Schematic) -> Vec<ParamInfo> {
     let mut out = Vec::new();
     for inst in &s.instances {
         for p in inst.ty.params {
@@ -222,7 +263,7 @@ pub fn parameters(v: &Value) -> Result<Vec<ParamInfo>, RigError> {
             });
         }
     }
-    Ok(out)
+    out
 }
 
 /// Sets parameter `path` (`<component>.<parameter>` or

@@ -1,0 +1,360 @@
+//! The `friction-bench` rig kind: a piston moved by an external drive through
+//! a load cell, chamber pressure(s) measured, the force balance the only
+//! balance.
+//!
+//! ```text
+//!   drive ──▶ load cell (force F) ──▶ rod ─┬─ piston ─┬─▶ position x, + one way
+//!                                          │ p1 A1 (+)│ p2 A2 (−)
+//!                                          └ friction F_f(v, a, p1, p2, z)
+//! ```
+//!
+//! Force balance (thesis eq 5.9 with the drive force added):
+//! `m a = s F + p1 A1 − p2 A2 − F_f − F0`, so the model's prediction of the
+//! measured force is `F̂ = s (m a + F_f + F0 − p1 A1 + p2 A2)` where `s = ±1`
+//! says which way the load-cell force pushes. The motion is the input
+//! (measured position, differentiated by the smoother) and the force is the
+//! output: for a bench whose drive imposes the motion this is the only
+//! well-posed simulation (the inverse model of the robotics IDIM practice).
+//!
+//! The friction law is the declared Coulomb level `Fc` plus the catalog's
+//! force-balance effects, each on or off ([`BenchFriction`]):
+//! * static: `F_f = g(v) tanh(v / v_t)`, `g(v) = Fc + (Fs − Fc) exp(−|v/vs|^α)`
+//!   (the `stribeck` term, eq 5.1's g);
+//! * `lugre_dynamics` (eq 5.1): `F_f = σ0 z + σ1 ż`,
+//!   `ż = v − σ0 |v| z / g(v)` in place of the static curve;
+//! * plus `viscous` `b v`, `pressure_viscous` `K (p1 − p2)² v` (eq 5.4),
+//!   `acceleration_friction` `K H a` (eq 5.12), `coulomb_asymmetry`
+//!   `(dFc/2) |tanh(v/v_t)|` (extending level `Fc + dFc/2`, retracting
+//!   `Fc − dFc/2`) and `external_force` `F0`.
+//!
+//! The bristle state is integrated exactly over each sample step with the
+//! velocity held at the step's mid value (z relaxes exponentially towards
+//! `g(v) sgn(v) / σ0`), so σ0 of 1e7 N/m at 100 Hz is no stiffness problem.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::catalog::{Balance, EffectId};
+use crate::data::ColumnMap;
+
+/// Effects a friction bench can carry (the force balance's).
+pub const BENCH_EFFECTS: [EffectId; 7] = [
+    EffectId::CoulombAsymmetry,
+    EffectId::Stribeck,
+    EffectId::Viscous,
+    EffectId::PressureViscous,
+    EffectId::AccelerationFriction,
+    EffectId::LugreDynamics,
+    EffectId::ExternalForce,
+];
+
+/// A bad rig declaration.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum RigError {
+    /// An effect id not in the catalog.
+    #[error("{place}: unknown effect '{id}'")]
+    UnknownEffect {
+        /// Where.
+        place: String,
+        /// The id.
+        id: String,
+    },
+    /// An effect the rig kind has no balance for.
+    #[error("{place}: effect '{id}' belongs to a balance a friction bench does not have")]
+    NotApplicable {
+        /// Where.
+        place: String,
+        /// The id.
+        id: String,
+    },
+    /// A parameter missing, unknown, not finite or out of range.
+    #[error("{place}: {reason}")]
+    Parameter {
+        /// Where (`effects.stribeck.vs`).
+        place: String,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+/// The bench's friction law: declared Coulomb level plus catalog effects.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BenchFriction {
+    /// Coulomb level Fc \[N\].
+    pub coulomb: f64,
+    /// Smoothing velocity v_t of the static law's tanh \[m·s⁻¹\].
+    pub smoothing_velocity: f64,
+    /// The effects switched on, id → parameter name → value (SI).
+    #[serde(default)]
+    pub effects: BTreeMap<EffectId, BTreeMap<String, f64>>,
+}
+
+/// A friction-bench rig.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrictionBench {
+    /// Rig kind; must be `friction-bench`.
+    #[serde(default = "bench_kind")]
+    pub kind: String,
+    /// Rig name.
+    pub name: String,
+    /// Area on which p1 pushes in + direction \[m²\].
+    #[serde(default)]
+    pub area1: f64,
+    /// Area on which p2 pushes in − direction \[m²\].
+    #[serde(default)]
+    pub area2: f64,
+    /// Moving mass \[kg\].
+    pub mass: f64,
+    /// +1 when a positive load-cell force pushes the piston in + direction, −1 otherwise.
+    pub force_sign: f64,
+    /// The friction law.
+    pub friction: BenchFriction,
+    /// Each sample is a steady state (a table of velocity vs force): the
+    /// measured velocity is used as it is and the acceleration is zero.
+    #[serde(default)]
+    pub steady_state: bool,
+    /// Declared parameters refitted before tracing (`Fc`, `m`, or `effect.param`).
+    #[serde(default)]
+    pub refit: Vec<String>,
+    /// Where the signals are in files whose headers are not the format's.
+    #[serde(default)]
+    pub columns: ColumnMap,
+}
+
+fn bench_kind() -> String {
+    KIND.to_string()
+}
+
+/// The rig-file `kind` of a friction bench.
+pub const KIND: &str = "friction-bench";
+
+/// A parameter of the bench model: a base one (`Fc`, `m`) or an effect's.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum ParamRef {
+    /// The Coulomb level Fc \[N\].
+    Coulomb,
+    /// The moving mass m \[kg\].
+    Mass,
+    /// Parameter `name` of effect `id`.
+    Effect(EffectId, String),
+}
+
+impl ParamRef {
+    /// Parses `Fc`, `m` or `effect.param`.
+    pub fn parse(s: &str) -> Option<ParamRef> {
+        match s {
+            "Fc" => Some(ParamRef::Coulomb),
+            "m" => Some(ParamRef::Mass),
+            _ => {
+                let (e, p) = s.split_once('.')?;
+                let id = EffectId::from_id(e)?;
+                id.params().iter().find(|q| q.name == p)?;
+                Some(ParamRef::Effect(id, p.to_string()))
+            }
+        }
+    }
+
+    /// Its name in reports.
+    pub fn label(&self) -> String {
+        match self {
+            ParamRef::Coulomb => "Fc".into(),
+            ParamRef::Mass => "m".into(),
+            ParamRef::Effect(id, p) => format!("{}.{p}", id.id()),
+        }
+    }
+
+    /// Bounds of a fit.
+    pub fn bounds(&self) -> (f64, f64) {
+        match self {
+            ParamRef::Coulomb => (0.0, f64::INFINITY),
+            ParamRef::Mass => (0.0, f64::INFINITY),
+            ParamRef::Effect(id, p) => id
+                .params()
+                .iter()
+                .find(|q| q.name == p)
+                .map_or((f64::NEG_INFINITY, f64::INFINITY), |q| (q.lower, q.upper)),
+        }
+    }
+}
+
+impl FrictionBench {
+    /// Checks the declaration: every effect applicable, every parameter
+    /// present, finite and within its catalog bounds.
+    pub fn validate(&self) -> Result<(), RigError> {
+        let pos = |name: &str, v: f64, allow_zero: bool| -> Result<(), RigError> {
+            if !v.is_finite() || v < 0.0 || (!allow_zero && v == 0.0) {
+                return Err(RigError::Parameter {
+                    place: name.to_string(),
+                    reason: format!(
+                        "must be finite and {}, got {v}",
+                        if allow_zero { ">= 0" } else { "> 0" }
+                    ),
+                });
+            }
+            Ok(())
+        };
+        if self.kind != KIND {
+            return Err(RigError::Parameter {
+                place: "kind".into(),
+                reason: format!("'{}' is not '{KIND}'", self.kind),
+            });
+        }
+        pos("area1", self.area1, true)?;
+        pos("area2", self.area2, true)?;
+        pos("mass", self.mass, true)?;
+        pos("friction.coulomb", self.friction.coulomb, true)?;
+        pos(
+            "friction.smoothing_velocity",
+            self.friction.smoothing_velocity,
+            false,
+        )?;
+        if self.force_sign != 1.0 && self.force_sign != -1.0 {
+            return Err(RigError::Parameter {
+                place: "force_sign".into(),
+                reason: format!("must be 1 or -1, got {}", self.force_sign),
+            });
+        }
+        for (id, params) in &self.friction.effects {
+            let place = format!("friction.effects.{}", id.id());
+            if id.balance() != Balance::Force {
+                return Err(RigError::NotApplicable {
+                    place,
+                    id: id.id().into(),
+                });
+            }
+            for spec in id.params() {
+                let v = params
+                    .get(spec.name)
+                    .copied()
+                    .ok_or_else(|| RigError::Parameter {
+                        place: place.clone(),
+                        reason: format!("parameter '{}' [{}] missing", spec.name, spec.unit),
+                    })?;
+                if !v.is_finite() || v < spec.lower || v > spec.upper {
+                    return Err(RigError::Parameter {
+                        place: format!("{place}.{}", spec.name),
+                        reason: format!(
+                            "{v} outside [{}, {}] {}",
+                            spec.lower, spec.upper, spec.unit
+                        ),
+                    });
+                }
+            }
+            for k in params.keys() {
+                if !id.params().iter().any(|p| p.name == k) {
+                    return Err(RigError::Parameter {
+                        place: place.clone(),
+                        reason: format!("unknown parameter '{k}'"),
+                    });
+                }
+            }
+        }
+        for r in &self.refit {
+            let p = ParamRef::parse(r).ok_or_else(|| RigError::Parameter {
+                place: "refit".into(),
+                reason: format!("'{r}' is not Fc, m or effect.param"),
+            })?;
+            if let ParamRef::Effect(id, _) = &p {
+                if !self.friction.effects.contains_key(id) {
+                    return Err(RigError::Parameter {
+                        place: "refit".into(),
+                        reason: format!("'{r}': effect '{}' is not on", id.id()),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Parses and validates a rig file's JSON.
+    pub fn from_json(text: &str) -> Result<FrictionBench, String> {
+        let rig: FrictionBench = serde_json::from_str(text).map_err(|e| e.to_string())?;
+        rig.validate().map_err(|e| e.to_string())?;
+        Ok(rig)
+    }
+
+    /// `true` when effect `id` is on.
+    pub fn has(&self, id: EffectId) -> bool {
+        self.friction.effects.contains_key(&id)
+    }
+
+    fn eff(&self, id: EffectId, p: &str) -> f64 {
+        self.friction
+            .effects
+            .get(&id)
+            .and_then(|m| m.get(p))
+            .copied()
+            .unwrap_or(0.0)
+    }
+
+    /// The value of a parameter (0 for an effect that is off).
+    pub fn get(&self, p: &ParamRef) -> f64 {
+        match p {
+            ParamRef::Coulomb => self.friction.coulomb,
+            ParamRef::Mass => self.mass,
+            ParamRef::Effect(id, name) => self.eff(*id, name),
+        }
+    }
+
+    /// Sets a parameter (switching its effect on if it was off).
+    pub fn set(&mut self, p: &ParamRef, v: f64) {
+        match p {
+            ParamRef::Coulomb => self.friction.coulomb = v,
+            ParamRef::Mass => self.mass = v,
+            ParamRef::Effect(id, name) => {
+                self.friction
+                    .effects
+                    .entry(*id)
+                    .or_default()
+                    .insert(name.clone(), v);
+            }
+        }
+    }
+
+    /// The parameters of every effect that is on, plus `Fc` and `m`.
+    pub fn all_params(&self) -> Vec<ParamRef> {
+        let mut v = vec![ParamRef::Coulomb, ParamRef::Mass];
+        for id in self.friction.effects.keys() {
+            for p in id.params() {
+                v.push(ParamRef::Effect(*id, p.name.to_string()));
+            }
+        }
+        v
+    }
+}
+
+mod model;
+mod presets;
+mod signals;
+
+pub use presets::{preset, PRESETS};
+pub use signals::{bench_signals, BenchSignals};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rig_json_is_checked() {
+        let ok = r#"{"name":"b","mass":1,"force_sign":1,
+            "friction":{"coulomb":3,"smoothing_velocity":1e-3,
+              "effects":{"viscous":{"b":10}}}}"#;
+        assert!(FrictionBench::from_json(ok).is_ok());
+        let e = FrictionBench::from_json(&ok.replace("viscous", "warp_drive")).unwrap_err();
+        assert!(e.contains("warp_drive"), "{e}");
+        let e = FrictionBench::from_json(&ok.replace(r#"{"b":10}"#, r#"{}"#)).unwrap_err();
+        assert!(e.contains("'b'") && e.contains("missing"), "{e}");
+        let e = FrictionBench::from_json(&ok.replace(
+            r#""viscous":{"b":10}"#,
+            r#""internal_leakage":{"Cl":1e-12}"#,
+        ))
+        .unwrap_err();
+        assert!(e.contains("does not have"), "{e}");
+        let e = FrictionBench::from_json(&ok.replace(r#""mass":1"#, r#""mass":-1"#)).unwrap_err();
+        assert!(e.contains("mass"), "{e}");
+    }
+}

@@ -1,0 +1,256 @@
+//! The built-in friction-bench presets: the identification view of the
+//! bench netlists of `fixtures/rigs/` ([`FrictionBench::from_netlist`])
+//! plus what identification needs beyond the circuit (column map, refit).
+
+use std::collections::BTreeMap;
+
+use super::{BenchFriction, FrictionBench, KIND};
+use crate::catalog::EffectId;
+use crate::data::{ColumnMap, Signal};
+
+/// Names of the built-in friction-bench presets: netlist files in
+/// `fixtures/rigs/` listed in `hydrocyl_system::rig::PRESETS`.
+pub const PRESETS: [&str; 3] = ["tudelft-seal-25", "tudelft-seal-257", "emps"];
+
+/// What identification needs of a bench preset beyond its circuit: where
+/// the signals are in the measured files, which parameters to refit, and the
+/// smoothing velocity of the static law where the netlist's law has none.
+struct Identification {
+    name: &'static str,
+    columns: &'static [(Signal, &'static str)],
+    refit: &'static [&'static str],
+    smoothing_velocity: f64,
+}
+
+const TUDELFT_COLUMNS: &[(Signal, &str)] = &[
+    (Signal::Time, "time_ms [ms]"),
+    (Signal::Position, "position_mm [mm]"),
+    (Signal::P2, "pressure_bar_gauge [bar]"),
+    (Signal::Force, "force_N [N]"),
+];
+const TUDELFT_REFIT: &[&str] = &["Fc", "lugre_dynamics.sigma0", "viscous.b"];
+
+const IDENTIFICATION: [Identification; 3] = [
+    Identification {
+        name: "tudelft-seal-25",
+        columns: TUDELFT_COLUMNS,
+        refit: TUDELFT_REFIT,
+        smoothing_velocity: 1e-4,
+    },
+    Identification {
+        name: "tudelft-seal-257",
+        columns: TUDELFT_COLUMNS,
+        refit: TUDELFT_REFIT,
+        smoothing_velocity: 1e-4,
+    },
+    Identification {
+        name: "emps",
+        columns: &[
+            (Signal::Time, "t_s"),
+            (Signal::Position, "qm_motor_position_m"),
+            (Signal::Force, "force_N(=gtau*vir)"),
+        ],
+        refit: &["Fc", "m", "viscous.b"],
+        smoothing_velocity: 1e-3,
+    },
+];
+
+/// A built-in friction-bench preset, or `None`: the identification view
+/// ([`FrictionBench::from_netlist`]) of the netlist preset of that name.
+///
+/// * `tudelft-seal-25` / `tudelft-seal-257`: the TU Delft pneumatic seal
+///   rig (Zillen 2021), bore 25 mm / 25.7 mm, one chamber at constant gauge
+///   pressure pushing the piston towards −x, drive through a load cell
+///   pushing +x (so `F = p A + F_f + m a`); declared as LuGre (eq 5.1) with
+///   viscous σ2 and *no pressure term*, Fc, σ0 and b refitted. The moving
+///   mass (0.1 kg) is assumed: the provenance does not give it, and at
+///   these accelerations (< 0.1 m/s²) m a is below 0.01 N.
+/// * `emps`: the EMPS electromechanical axis (Janot et al. 2019): motor
+///   force `gtau · vir` pushes +x, no pressures; declared Coulomb + viscous
+///   with Fc, b and the moving mass m refitted.
+pub fn preset(name: &str) -> Option<FrictionBench> {
+    let id = IDENTIFICATION.iter().find(|i| i.name == name)?;
+    let v = hydrocyl_system::rig::preset(name)?;
+    let mut rig = FrictionBench::from_netlist(&v, id.smoothing_velocity).ok()?;
+    rig.name = name.into();
+    for (sig, col) in id.columns {
+        rig.columns.0.insert(*sig, (*col).into());
+    }
+    rig.refit = id.refit.iter().map(|r| r.to_string()).collect();
+    Some(rig)
+}
+
+impl FrictionBench {
+    /// The identification view of a friction-bench netlist: one
+    /// `imposed_motion` drive (mass, load-cell sign), at most one `piston`
+    /// (areas) and one friction law on the rod, `friction_coulomb_viscous`
+    /// or `friction_lugre` with equal extending and retracting sets (a
+    /// stiction level above the Coulomb level is the `stribeck` effect).
+    /// `smoothing_velocity` is the static law's tanh velocity where the
+    /// netlist's law has none (LuGre). Another circuit is refused by path.
+    pub fn from_netlist(v: &serde_json::Value, smoothing_velocity: f64) -> Result<Self, String> {
+        let s = hydrocyl_system::netlist::read(v)
+            .map_err(|e| hydrocyl_system::rig::RigError::from(e).to_string())?;
+        let of = |ty: &str| -> Vec<&hydrocyl_system::netlist::registry::Instance> {
+            s.instances
+                .iter()
+                .filter(|i| i.ty.name.starts_with(ty))
+                .collect()
+        };
+        let one = |ty: &str| match of(ty).as_slice() {
+            [i] => Ok(*i),
+            l => Err(format!(
+                "components: a friction bench has one `{ty}` component, found {}",
+                l.len()
+            )),
+        };
+        let drive = one("imposed_motion")?;
+        let law = one("friction_")?;
+        let (area1, area2) = match of("piston").as_slice() {
+            [] => (0.0, 0.0),
+            [p] => (p.get("area_1"), p.get("area_2")),
+            _ => return Err("components: a friction bench has at most one `piston`".into()),
+        };
+        if let Some(extra) = s.instances.iter().find(|i| {
+            !["imposed_motion", "piston", "pressure_source"].contains(&i.ty.name)
+                && !std::ptr::eq(*i, law)
+        }) {
+            return Err(format!(
+                "components.{}: a `{}` is not part of a friction bench (imposed_motion, piston, pressure_source, one friction law)",
+                extra.name, extra.ty.name
+            ));
+        }
+        let here = |p: &str| format!("components.{}.{p}", law.name);
+        let mut effects = BTreeMap::new();
+        let mut on = |id: EffectId, params: &[(&str, f64)]| {
+            effects.insert(
+                id,
+                params.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+            );
+        };
+        let (coulomb, vt) = match law.ty.name {
+            "friction_coulomb_viscous" => {
+                on(EffectId::Viscous, &[("b", law.get("viscous"))]);
+                (law.get("coulomb"), law.get("smoothing_velocity"))
+            }
+            "friction_lugre" => {
+                for p in [
+                    "curve.coulomb",
+                    "curve.stiction",
+                    "curve.stribeck_velocity",
+                    "curve.stribeck_exponent",
+                    "sigma2",
+                ] {
+                    let (e, r) = (format!("extending.{p}"), format!("retracting.{p}"));
+                    if law.get(&e) != law.get(&r) {
+                        return Err(format!(
+                            "{}: the bench's law has one set for both directions ({} ≠ {})",
+                            here(&e),
+                            law.get(&e),
+                            law.get(&r)
+                        ));
+                    }
+                }
+                let fc = law.get("extending.curve.coulomb");
+                let fs = law.get("extending.curve.stiction");
+                if fs != fc {
+                    on(
+                        EffectId::Stribeck,
+                        &[
+                            ("Fs", fs),
+                            ("vs", law.get("extending.curve.stribeck_velocity")),
+                            ("alpha", law.get("extending.curve.stribeck_exponent")),
+                        ],
+                    );
+                }
+                on(
+                    EffectId::LugreDynamics,
+                    &[("sigma0", law.get("sigma0")), ("sigma1", law.get("sigma1"))],
+                );
+                on(EffectId::Viscous, &[("b", law.get("extending.sigma2"))]);
+                (fc, smoothing_velocity)
+            }
+            other => {
+                return Err(format!(
+                    "components.{}.type: `{other}` has no friction-bench view (friction_coulomb_viscous or friction_lugre)",
+                    law.name
+                ))
+            }
+        };
+        let k = law.opt("seal.k_pressure").unwrap_or(0.0);
+        let h = law.opt("seal.h_acceleration").unwrap_or(0.0);
+        if k > 0.0 {
+            on(EffectId::PressureViscous, &[("K", k)]);
+        }
+        if h != 0.0 {
+            on(EffectId::AccelerationFriction, &[("H", h)]);
+        }
+        let rig = FrictionBench {
+            kind: KIND.into(),
+            name: s.name.clone(),
+            area1,
+            area2,
+            mass: drive.get("mass"),
+            force_sign: drive.get("force_sign"),
+            friction: BenchFriction {
+                coulomb,
+                smoothing_velocity: vt,
+                effects,
+            },
+            steady_state: false,
+            refit: Vec::new(),
+            columns: ColumnMap::default(),
+        };
+        rig.validate().map_err(|e| e.to_string())?;
+        Ok(rig)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The presets' identification view is the declaration the bench had
+    /// before its circuit became a netlist, field for field (so `diagnose`
+    /// and `cargo xtask validate` fit the same model from the same start).
+    #[test]
+    fn presets_are_the_netlists_seen_as_benches() {
+        let effects = |e: &[(EffectId, &[(&str, f64)])]| -> BTreeMap<_, _> {
+            e.iter()
+                .map(|(id, p)| (*id, p.iter().map(|(k, v)| (k.to_string(), *v)).collect()))
+                .collect()
+        };
+        for (name, bore) in [("tudelft-seal-25", 0.025f64), ("tudelft-seal-257", 0.0257)] {
+            let r = preset(name).unwrap();
+            assert_eq!(r.area1, 0.0);
+            assert_eq!(r.area2, std::f64::consts::PI * (0.5 * bore).powi(2));
+            assert_eq!((r.mass, r.force_sign), (0.1, 1.0));
+            assert_eq!(r.friction.coulomb, 5.0);
+            assert_eq!(r.friction.smoothing_velocity, 1e-4);
+            assert_eq!(
+                r.friction.effects,
+                effects(&[
+                    (EffectId::LugreDynamics, &[("sigma0", 1e5), ("sigma1", 0.0)]),
+                    (EffectId::Viscous, &[("b", 0.0)]),
+                ])
+            );
+            assert_eq!(r.refit, ["Fc", "lugre_dynamics.sigma0", "viscous.b"]);
+            assert_eq!(r.columns.0[&Signal::Time], "time_ms [ms]");
+        }
+        let r = preset("emps").unwrap();
+        assert_eq!(
+            (r.area1, r.area2, r.mass, r.force_sign),
+            (0.0, 0.0, 50.0, 1.0)
+        );
+        assert_eq!(
+            (r.friction.coulomb, r.friction.smoothing_velocity),
+            (10.0, 1e-3)
+        );
+        assert_eq!(
+            r.friction.effects,
+            effects(&[(EffectId::Viscous, &[("b", 100.0)])])
+        );
+        assert_eq!(r.refit, ["Fc", "m", "viscous.b"]);
+        assert!(preset("leaney-moog").is_none());
+    }
+}

@@ -1,0 +1,146 @@
+//! A netlist's external inputs: the components whose signal comes from
+//! outside the circuit (a `--command` record, an FMU input), what each is
+//! called and in which unit it is read — found from the schematic, so that
+//! the CLI, the FMU and the assembler say it once.
+
+use super::reader::Schematic;
+use super::registry::Instance;
+
+/// The component types driven from outside the circuit: a signal source,
+/// or an imposed-motion source (a friction bench's drive, whose input is the
+/// rod's velocity).
+pub const INPUT_TYPES: [&str; 2] = ["command_input", "imposed_motion"];
+
+impl Schematic {
+    /// The input components ([`INPUT_TYPES`]), in component order.
+    pub fn inputs(&self) -> impl Iterator<Item = &Instance> {
+        self.instances
+            .iter()
+            .filter(|i| INPUT_TYPES.contains(&i.ty.name))
+    }
+
+    /// The output column that shows the run's input, when the netlist has
+    /// one input and it publishes its value: the column of the probe
+    /// `<input>.command` (`command` on an open-loop rig, `reference` on a
+    /// closed-loop one, whose controller's output is then `command`).
+    pub fn input_channel(&self) -> Option<String> {
+        let mut inputs = self.inputs();
+        let (input, None) = (inputs.next()?, inputs.next()) else {
+            return None;
+        };
+        if !input.ty.probes.iter().any(|(p, _)| *p == "command") {
+            return None;
+        }
+        let probe = format!("{}.command", input.name);
+        if self.outputs.is_empty() {
+            return Some(probe);
+        }
+        self.outputs
+            .iter()
+            .find(|(_, p)| *p == probe)
+            .map(|(col, _)| col.clone())
+    }
+
+    /// The unit in which the components reading the input take it, from the
+    /// reading port's declaration (`… [V]` for a pump drive, `… [m]` for a
+    /// position controller's set-point, `… [-]` for a spool demand); `None`
+    /// when the netlist has not exactly one input, nothing reads it on a
+    /// signal node, or the reading port names no unit.
+    pub fn input_unit(&self) -> Option<&'static str> {
+        let mut inputs = self.inputs();
+        let (input, None) = (inputs.next()?, inputs.next()) else {
+            return None;
+        };
+        let (_, ports) = self.nodes.get(input.nodes.get("out")?)?;
+        ports
+            .iter()
+            .filter_map(|p| p.split_once('.'))
+            .filter(|(c, _)| *c != input.name)
+            .filter_map(|(c, port)| self.instance(c)?.ty.ports.iter().find(|q| q.name == port))
+            .find_map(|q| {
+                let doc = q.doc.strip_suffix(']')?;
+                doc.rfind('[').map(|o| &doc[o + 1..])
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::rig;
+
+    fn schematic(name: &str) -> super::Schematic {
+        crate::netlist::schematic(&rig::preset(name).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn each_preset_names_its_input_and_unit() {
+        let s = schematic("leaney-moog-closed-loop");
+        assert_eq!(s.input_channel().as_deref(), Some("reference"));
+        assert_eq!(s.input_unit(), Some("m"));
+        let s = schematic("wang-hybrid");
+        assert_eq!(s.input_channel().as_deref(), Some("command"));
+        assert_eq!(s.input_unit(), Some("V"));
+        let s = schematic("leaney-moog");
+        assert_eq!(s.input_channel().as_deref(), Some("command"));
+        assert_eq!(s.input_unit(), Some("-"));
+        // the friction bench's drive takes the velocity; it shows no command
+        let s = schematic("emps");
+        assert_eq!(s.inputs().count(), 1);
+        assert_eq!((s.input_channel(), s.input_unit()), (None, None));
+    }
+
+    /// Two inputs, each driving its own first-order spool: each spool
+    /// follows its own signal, `x(t) = u x_max (1 − e^(−t/τ))`; a missing,
+    /// unknown or one-for-all signal is refused by name.
+    #[test]
+    fn several_inputs_each_drive_their_component() {
+        use crate::netlist::{assemble, assemble_inputs, schematic};
+        use crate::signal::Signal;
+        use crate::simulation::Simulation;
+        let spool = serde_json::json!({
+            "type": "servo_spool_first_order", "stroke": 1e-3, "time_constant": 0.01
+        });
+        let v = serde_json::json!({
+            "kind": "netlist", "name": "two",
+            "components": {
+                "a": { "type": "command_input" }, "b": { "type": "command_input" },
+                "spool_a": spool, "spool_b": spool
+            },
+            "connections": [["a.out", "spool_a.command"], ["b.out", "spool_b.command"]]
+        });
+        let s = schematic(&v).unwrap();
+        assert_eq!(s.inputs().count(), 2);
+        assert_eq!((s.input_channel(), s.input_unit()), (None, None));
+        let drive = vec![
+            ("a".to_string(), Signal::Constant { value: 0.5 }),
+            ("b".to_string(), Signal::Constant { value: -0.25 }),
+        ];
+        let t: Vec<f64> = (0..=50).map(|k| k as f64 * 1e-3).collect();
+        let mut sim = Simulation::of_circuit(assemble_inputs(&s, &drive).unwrap());
+        let run = sim.run(&t).unwrap();
+        for (name, u) in [("spool_a.spool", 0.5), ("spool_b.spool", -0.25)] {
+            let x = run.channel(name).unwrap();
+            for (k, &tk) in t.iter().enumerate() {
+                let exact = u * 1e-3 * (1.0 - (-tk / 0.01).exp());
+                assert!(
+                    (x[k] - exact).abs() < 1e-6 * 1e-3,
+                    "{name} at {tk}: {} vs {exact}",
+                    x[k]
+                );
+            }
+        }
+        let e = assemble_inputs(&s, &drive[..1]).unwrap_err().to_string();
+        assert!(
+            e.contains("components.b") && e.contains("no command"),
+            "{e}"
+        );
+        let mut extra = drive.clone();
+        extra.push(("spool_a".into(), Signal::Constant { value: 0.0 }));
+        let e = assemble_inputs(&s, &extra).unwrap_err().to_string();
+        assert!(e.contains("inputs.spool_a") && e.contains("a, b"), "{e}");
+        let e = assemble(&s, Signal::Constant { value: 0.0 })
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("several inputs"), "{e}");
+    }
+}

@@ -1,0 +1,155 @@
+//! Older rig-file kinds read as netlists: one conversion per kind, so that a
+//! rig file of an older kind runs, prints (`--print-rig`) and takes `--set`
+//! under the netlist's `<component>.<parameter>` scheme like every preset.
+//!
+//! * `valve-cylinder` ([`ValveRig`]): [`ValveRig::to_netlist`], the
+//!   fundamental or generalised valve circuit; initial chamber pressures the
+//!   file leaves `null` stay absent, so the netlist computes them from its
+//!   steady state at rest ([`super::steady`]) after any `--set`.
+//! * `hybrid-pump` ([`WangHybrid`]): [`WangHybrid::to_netlist`], the hybrid
+//!   circuit of `fixtures/rigs/wang-hybrid.json` with the file's values.
+//!
+//! The typed rigs stay the identification and study views of their
+//! circuits (`ValveRig::from_netlist`, `WangHybrid::from_netlist`); the
+//! `friction-bench` kind is identification's own declaration format (its
+//! catalog effects, column map and refit list) and is read by
+//! `hydrocyl-identify`.
+
+use crate::hybrid::{self, WangHybrid};
+use crate::rig::RigError;
+use crate::valve_rig::{self, ValveRig};
+use serde_json::Value;
+
+/// The rig kinds that [`migrate`] converts.
+pub const MIGRATED_KINDS: [&str; 2] = [valve_rig::KIND, hybrid::KIND];
+
+/// Deserialises an older rig kind, naming the JSON path of a type error.
+pub(crate) fn typed<T: serde::de::DeserializeOwned>(v: &Value) -> Result<T, RigError> {
+    serde_path_to_error::deserialize::<_, T>(v.clone()).map_err(|e| {
+        let path = e.path().to_string();
+        RigError::Invalid {
+            path: if path == "." { "rig".into() } else { path },
+            why: e.into_inner().to_string(),
+        }
+    })
+}
+
+/// The netlist of a rig value of an older kind ([`MIGRATED_KINDS`]), or
+/// `None` for any other kind (a netlist is returned as it is by the caller).
+/// Errors name the JSON path in the older file.
+pub fn migrate(v: &Value) -> Result<Option<Value>, RigError> {
+    match v.get("kind").and_then(Value::as_str) {
+        Some(valve_rig::KIND) => {
+            let r: ValveRig = typed(v)?;
+            r.validate()?;
+            let mut n = r.to_netlist()?;
+            // pressures the file leaves to the steady state stay so
+            let absent = ["p1", "p2"].iter().all(|k| {
+                v.pointer(&format!("/initial/{k}"))
+                    .is_none_or(Value::is_null)
+            });
+            if absent {
+                if let Some(init) = n
+                    .pointer_mut("/components/cylinder/initial")
+                    .and_then(Value::as_object_mut)
+                {
+                    for k in ["p1", "p2", "load_pressure"] {
+                        init.remove(k);
+                    }
+                }
+            }
+            Ok(Some(n))
+        }
+        Some(hybrid::KIND) => {
+            let r: WangHybrid = typed(v)?;
+            r.validate()?;
+            let mut n = r.to_netlist()?;
+            for k in ["name", "description"] {
+                if let Some(s) = v.get(k).filter(|s| s.is_string()) {
+                    n[k] = s.clone();
+                }
+            }
+            Ok(Some(n))
+        }
+        _ => Ok(None),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::RunOptions;
+    use crate::signal::Signal;
+
+    /// The largest relative difference between two runs' common channels.
+    fn worst(a: &crate::run::Run, b: &crate::run::Run) -> f64 {
+        let mut w: f64 = 0.0;
+        for c in &a.channels {
+            let Some(d) = b.channel(&c.name) else {
+                continue;
+            };
+            let scale = c.values.iter().fold(1e-12f64, |m, x| m.max(x.abs()));
+            for (x, y) in c.values.iter().zip(d) {
+                w = w.max((x - y).abs() / scale);
+            }
+        }
+        w
+    }
+
+    /// A `valve-cylinder` file and its migrated netlist simulate alike (the
+    /// old kind's own circuit: the typed rig's), and `--set` reaches the
+    /// migrated file under the netlist's paths; its steady initial pressures
+    /// follow a changed supply.
+    #[test]
+    fn a_valve_cylinder_file_migrates_to_an_equal_netlist() {
+        let old = serde_json::to_value(ValveRig::leaney_moog()).unwrap();
+        let new = migrate(&old).unwrap().unwrap();
+        assert_eq!(new["kind"], crate::netlist::KIND);
+        let t: Vec<f64> = (0..=200).map(|k| k as f64 * 1e-3).collect();
+        let cmd = || Signal::Constant { value: 0.3 };
+        let a = ValveRig::leaney_moog()
+            .simulate(cmd(), &t, &RunOptions::default())
+            .unwrap();
+        let b = crate::netlist::simulate(&new, cmd(), &t, &RunOptions::default()).unwrap();
+        assert!(a.channel("velocity").unwrap()[200] > 0.01);
+        let w = worst(&a, &b);
+        assert!(w < 1e-9, "relative difference {w}");
+        // --set on the migrated file, under the netlist's paths
+        let mut set = new.clone();
+        crate::rig::apply_set(&mut set, "cylinder.initial.position=0.05").unwrap();
+        crate::rig::apply_set(&mut set, "supply.pressure=5e6").unwrap();
+        let c = crate::netlist::simulate(&set, cmd(), &t, &RunOptions::default()).unwrap();
+        assert!((c.channel("position").unwrap()[0] - 0.05).abs() < 1e-12);
+        let mut lower = ValveRig::leaney_moog();
+        lower.supply.pressure_pa = 5e6;
+        let p1 = lower.initial_pressures().unwrap().0;
+        assert!((c.channel("p1").unwrap()[0] - p1).abs() < 1e-6 * p1);
+    }
+
+    /// A `hybrid-pump` file and its migrated netlist simulate alike.
+    #[test]
+    fn a_hybrid_pump_file_migrates_to_an_equal_netlist() {
+        let old = serde_json::to_value(WangHybrid::preset()).unwrap();
+        assert_eq!(old["kind"], hybrid::KIND);
+        let new = migrate(&old).unwrap().unwrap();
+        let t: Vec<f64> = (0..=100).map(|k| k as f64 * 2e-3).collect();
+        let cmd = || Signal::Constant { value: 2.0 };
+        let a = WangHybrid::preset()
+            .simulate(cmd(), &t, &RunOptions::default())
+            .unwrap();
+        let b = crate::netlist::simulate(&new, cmd(), &t, &RunOptions::default()).unwrap();
+        assert!(a.channel("position").unwrap()[100] != a.channel("position").unwrap()[0]);
+        let w = worst(&a, &b);
+        assert!(w < 1e-9, "relative difference {w}");
+    }
+
+    #[test]
+    fn errors_name_the_path_in_the_older_file() {
+        let mut old = serde_json::to_value(ValveRig::leaney_moog()).unwrap();
+        old["load"]["mass_kg"] = Value::from("heavy");
+        let e = migrate(&old).unwrap_err().to_string();
+        assert!(e.contains("load.mass_kg"), "{e}");
+        let e = migrate(&serde_json::json!({"kind": "netlist"})).unwrap();
+        assert!(e.is_none());
+    }
+}

@@ -106,7 +106,10 @@ mod tests {
                 "a": { "type": "command_input" }, "b": { "type": "command_input" },
                 "spool_a": spool, "spool_b": spool
             },
-            "connections": [["a.out", "spool_a.command"], ["b.out", "spool_b.command"]]
+            "connections": [
+                ["a.out", "spool_a.command"], ["b.out", "spool_b.command"],
+                ["spool_a.spool", "x_a"], ["spool_b.spool", "x_b"]
+            ]
         });
         let s = schematic(&v).unwrap();
         assert_eq!(s.inputs().count(), 2);

@@ -89,7 +89,8 @@ fn load_rig(spec: &str) -> Result<Rig, CliError> {
         k if k == bench::KIND => FrictionBench::from_json(&v.to_string())
             .map(Rig::Bench)
             .map_err(|e| CliError::Input(format!("{spec}: {e}"))),
-        k if k == hydrocyl_system::valve_rig::KIND => valve_rig_from(&v)
+        // a valve-cylinder file is read as its netlist (rig::load)
+        hydrocyl_system::netlist::KIND => valve_rig_from(&v)
             .map(|r| Rig::Valve(Box::new(r)))
             .map_err(|e| crate::rigfile::locate(e, spec)),
         k => Err(unsupported(&format!(

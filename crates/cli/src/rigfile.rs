@@ -1,7 +1,7 @@
 //! Rig files as `hydrocyl simulate` reads them: a preset or a file
-//! (duplicate keys refused, [`rig::load`]), an older rig kind read as its
-//! netlist ([`netlist::migrate`]), then checked once ([`check`]): every
-//! error names the JSON path and, for a file, its line.
+//! (duplicate keys refused, an older rig kind read as its netlist:
+//! [`rig::load`]), checked once ([`check`]): every error names the JSON path
+//! and, for a file, its line.
 
 use crate::error::CliError;
 use hydrocyl_system::hybrid::variant::{self, HybridVariant};
@@ -15,18 +15,6 @@ use serde_json::Value;
 /// `source` is a file).
 pub fn locate(e: RigError, source: &str) -> CliError {
     CliError::Input(rig::at_line(e, source).to_string())
-}
-
-/// Loads a preset or rig file; a file of an older kind (`valve-cylinder`,
-/// `hybrid-pump`) as its netlist, so that `--set` and `--print-rig` take
-/// `<component>.<parameter>` paths on every rig.
-pub fn load(spec: &str) -> Result<Value, CliError> {
-    let v = rig::load(spec).map_err(|e| CliError::Input(e.to_string()))?;
-    match netlist::migrate::migrate(&v) {
-        Ok(Some(n)) => Ok(n),
-        Ok(None) => Ok(v),
-        Err(e) => Err(locate(e, spec)),
-    }
 }
 
 /// A rig read and checked once, ready to be assembled.

@@ -25,6 +25,11 @@
 //! measured record's motion instead: see [`crate::bench_sim`]. A
 //! `hybrid-variant` rig file (chapter 8's circuit improvements) runs on its
 //! base rig with the variant's components swapped in.
+//! A rig file of an older kind (`valve-cylinder`, `hybrid-pump`) is read as
+//! its netlist ([`rig::load`]): `--set` and `--print-rig` use the
+//! netlist's `<component>.<parameter>` paths on it as on every preset.
+//! The rig is read and checked once ([`crate::rigfile::check`]); the input's
+//! column and unit come from the netlist (the port that reads the input).
 //!
 //! Every input is checked and the output's temporary file created before the
 //! run ([`crate::output`]); the run is streamed in blocks
@@ -286,7 +291,7 @@ fn solver_hint(e: rig::RigError) -> CliError {
 /// Runs `hydrocyl simulate`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let rig_err = |e: rig::RigError| CliError::Input(e.to_string());
-    let mut value = crate::rigfile::load(&args.rig)?;
+    let mut value = rig::load(&args.rig).map_err(rig_err)?;
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(rig_err)?;
     }

@@ -179,7 +179,10 @@ pub fn preset(name: &str) -> Option<Value> {
     PRESETS.iter().find(|p| p.name == name).map(|p| (p.json)())
 }
 
-/// A preset by name, or else a rig file by path.
+/// A preset by name, or else a rig file by path; a file of an older kind
+/// (`valve-cylinder`, `hybrid-pump`) as its netlist
+/// ([`crate::netlist::migrate`]), so `--set` and `--print-rig` take
+/// `<component>.<parameter>` paths on every rig.
 pub fn load(name_or_path: &str) -> Result<Value, RigError> {
     if let Some(v) = preset(name_or_path) {
         return Ok(v);
@@ -207,7 +210,12 @@ pub fn load(name_or_path: &str) -> Result<Value, RigError> {
     }
     let mut v = v;
     crate::hybrid::variant::resolve_base(&mut v, std::path::Path::new(name_or_path).parent());
-    Ok(v)
+    // an older rig kind is read as its netlist
+    match crate::netlist::migrate::migrate(&v) {
+        Ok(Some(n)) => Ok(n),
+        Ok(None) => Ok(v),
+        Err(e) => Err(at_line(e, name_or_path)),
+    }
 }
 
 /// Adds the line of the error's JSON path in the rig file `source` (when

@@ -100,6 +100,10 @@ pub struct RunOptions {
     pub ledger: bool,
     /// Step budget: a run that needs more steps fails with the time reached.
     pub max_steps: usize,
+    /// Read the probes into [`Run::channels`] at every output time; off, a
+    /// run keeps only its raw [`Run::states`] (for a caller that reads the
+    /// circuit itself, e.g. the chapter-7 measurements).
+    pub channels: bool,
 }
 
 impl Default for RunOptions {
@@ -112,6 +116,7 @@ impl Default for RunOptions {
             quadratures: false,
             ledger: false,
             max_steps: Options::default().max_steps,
+            channels: true,
         }
     }
 }
@@ -287,7 +292,11 @@ fn solve_from(
     })?;
     let wall = start.elapsed();
     // probes → channels
-    let probes = circuit.probes();
+    let probes = if opts.channels {
+        circuit.probes()
+    } else {
+        Vec::new()
+    };
     let mut channels: Vec<Channel> = probes
         .iter()
         .map(|p| Channel {
@@ -298,7 +307,7 @@ fn solve_from(
         .collect();
     let wires: Vec<_> = probes.iter().map(|p| p.wire).collect();
     let mut row = vec![0.0; wires.len()];
-    for k in 0..sol.t.len() {
+    for k in (0..sol.t.len()).filter(|_| !wires.is_empty()) {
         circuit.read_wires(sol.t[k], sol.state(k), &wires, &mut row);
         for (c, v) in channels.iter_mut().zip(&row) {
             c.values.push(*v);

@@ -240,6 +240,8 @@ impl Chapter7Test {
             h_max: 1.0e-2,
             max_steps: self.max_steps,
             quadratures: true,
+            // the measurements read the circuit themselves
+            channels: false,
             ..RunOptions::default()
         });
         let run = sim.run(&t).map_err(|e| match e {

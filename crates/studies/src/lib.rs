@@ -33,3 +33,4 @@
 pub mod chapter3;
 pub mod chapter7;
 pub mod chapter8;
+pub mod relief;

@@ -72,7 +72,11 @@ pub fn run() -> bool {
     // relief valves 1 and 2 read every way the text allows (issue 17 item 2)
     let readings = hydrocyl_studies::relief::readings();
     for (i, r) in readings.iter().enumerate() {
-        drives.push((crate::energy_relief::system_name(i), r.drive(), Plan::default()));
+        drives.push((
+            crate::energy_relief::system_name(i),
+            r.drive(),
+            Plan::default(),
+        ));
     }
     for f in VARIANTS {
         match HybridVariant::load(&root.join("fixtures/rigs").join(f)) {

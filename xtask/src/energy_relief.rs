@@ -43,6 +43,16 @@ fn find<'a>(rows: &[&'a Outcome], v: f64, wave: Wave, kg: f64) -> Option<&'a Out
         .copied()
 }
 
+/// The runs of reading `i`.
+fn runs_of<'a>(relief: &[&'a Outcome], i: usize) -> Vec<&'a Outcome> {
+    let name = system_name(i);
+    relief
+        .iter()
+        .filter(|o| o.scenario.system == name)
+        .copied()
+        .collect()
+}
+
 /// The pilot valve's cap `E_out / (p_shift ∫|Q_p| dt)` of one run \[-\].
 fn cap(o: &Outcome, shift: f64) -> f64 {
     o.ledger.cylinder_out_j / (shift * o.pump_volume_m3)
@@ -59,16 +69,28 @@ pub fn report(readings: &[Reading], relief: &[&Outcome], base: &[&Outcome]) -> V
     );
     println!(
         "{:<42} {:>8} {:>9} {:>7} | {:>9} {:>9} {:>9} {:>9} | {:>9} | {:>9}",
-        "reading", "p_c bar", "P_m bar", "Q_m l/m", "50 sine", "50 sq", "100 sine", "100 sq", "RMS-thes", "min cap"
+        "reading",
+        "p_c bar",
+        "P_m bar",
+        "Q_m l/m",
+        "50 sine",
+        "50 sq",
+        "100 sine",
+        "100 sq",
+        "RMS-thes",
+        "min cap"
     );
     let mut rows = Vec::new();
     let mut best: Option<(f64, usize)> = None;
     for (i, r) in readings.iter().enumerate() {
-        let name = system_name(i);
-        let mine: Vec<&Outcome> = relief.iter().filter(|o| o.scenario.system == name).copied().collect();
-        let cell = |v: f64, w: Wave| find(&mine, v, w, 0.0).map_or("—".into(), |o| pct(o.efficiency));
+        let mine = runs_of(relief, i);
+        let cell =
+            |v: f64, w: Wave| find(&mine, v, w, 0.0).map_or("—".into(), |o| pct(o.efficiency));
         let rms = rms_to_thesis(&mine);
-        let min_cap = mine.iter().map(|o| cap(o, shift)).fold(f64::INFINITY, f64::min);
+        let min_cap = mine
+            .iter()
+            .map(|o| cap(o, shift))
+            .fold(f64::INFINITY, f64::min);
         println!(
             "{:<42} {:>8.2} {:>9.2} {:>7.1} | {:>9} {:>9} {:>9} {:>9} | {:>9} | {:>9}",
             r.label(),
@@ -106,7 +128,11 @@ pub fn report(readings: &[Reading], relief: &[&Outcome], base: &[&Outcome]) -> V
             rows.push(v);
         }
     }
-    let hybrid: Vec<&Outcome> = base.iter().filter(|o| o.scenario.system == "hybrid").copied().collect();
+    let hybrid: Vec<&Outcome> = base
+        .iter()
+        .filter(|o| o.scenario.system == "hybrid")
+        .copied()
+        .collect();
     println!(
         "the pilot valve's shift pressure p_shift = {:.2} bar caps the hybrid's efficiency (input >= p_shift |Q_p|): \
          E_out/(p_shift ∫|Q_p| dt) = {}–{} on the preset's rows; on a square wave with the friction Table 5-3 measured \
@@ -118,19 +144,27 @@ pub fn report(readings: &[Reading], relief: &[&Outcome], base: &[&Outcome]) -> V
     );
     if let Some((rms, i)) = best {
         let r = &readings[i];
-        let name = system_name(i);
-        let mine: Vec<&Outcome> = relief.iter().filter(|o| o.scenario.system == name).copied().collect();
+        let mine = runs_of(relief, i);
         println!(
             "closest to Tables 8-2/8-3 (RMS {}; the preset's reading: {}): {}",
             pct(rms),
             pct(rms_to_thesis(&hybrid)),
             r.label()
         );
-        println!("{:>6} {:<6} {:>5} | {:>9} {:>9} {:>9} | {:>9}", "mm/s", "wave", "kg", "reading", "preset", "thesis", "cap");
+        println!(
+            "{:>6} {:<6} {:>5} | {:>9} {:>9} {:>9} | {:>9}",
+            "mm/s", "wave", "kg", "reading", "preset", "thesis", "cap"
+        );
         for o in &mine {
             let s = &o.scenario;
-            let pre = find(&hybrid, s.speed_mm_s, s.wave, s.load_kg).map_or("—".into(), |p| pct(p.efficiency));
-            let th = hydrocyl_studies::chapter8::thesis_efficiency("hybrid", s.speed_mm_s, s.wave, s.load_kg);
+            let pre = find(&hybrid, s.speed_mm_s, s.wave, s.load_kg)
+                .map_or("—".into(), |p| pct(p.efficiency));
+            let th = hydrocyl_studies::chapter8::thesis_efficiency(
+                "hybrid",
+                s.speed_mm_s,
+                s.wave,
+                s.load_kg,
+            );
             println!(
                 "{:>6} {:<6} {:>5} | {:>9} {:>9} {:>9} | {:>9}",
                 format!("±{}", s.speed_mm_s),

@@ -192,7 +192,8 @@ impl Wang {
     pub fn acceleration_energy(&self, v: f64) -> f64 {
         let (mean, half_jump) = self.added_mass_levels();
         let a = ACCELERATION_BLEND_VELOCITY;
-        0.5 * mean * v * v + 0.5 * half_jump * (v * (v * v + a * a).sqrt() - a * a * (v / a).asinh())
+        0.5 * mean * v * v
+            + 0.5 * half_jump * (v * (v * v + a * a).sqrt() - a * a * (v / a).asinh())
     }
 
     /// The static curve, eq 5.8/5.11: `sgn(v) g(v) + K (p1 − p2)² v` \[N\]

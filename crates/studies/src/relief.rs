@@ -189,10 +189,18 @@ mod tests {
         // Q_m = 19.9 l/min; the preset's stated reading at 10.34 bar has 7.54
         let r = reading(RLV_1_CRACKING, PM_AT_1_BAR[1], true).unwrap();
         let bar_per_lpm = 1e5 / (1e-3 / 60.0);
-        assert!((r.ra / bar_per_lpm - 8.01).abs() < 0.01, "{}", r.ra / bar_per_lpm);
+        assert!(
+            (r.ra / bar_per_lpm - 8.01).abs() < 0.01,
+            "{}",
+            r.ra / bar_per_lpm
+        );
         assert!((r.q_max_m3_s * 6e4 - 19.9).abs() < 0.05);
         let s = reading(10.34e5, PM_AT_1_BAR[1], false).unwrap();
-        assert!((s.ra / bar_per_lpm - 7.54).abs() < 0.01, "{}", s.ra / bar_per_lpm);
+        assert!(
+            (s.ra / bar_per_lpm - 7.54).abs() < 0.01,
+            "{}",
+            s.ra / bar_per_lpm
+        );
         // the preset is the derived reading of rlv_1.m at 10.34 bar
         let p = WangHybrid::preset().relief_pilot;
         let d = reading(10.34e5, PM_AT_1_BAR[1], true).unwrap();

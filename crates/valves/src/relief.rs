@@ -288,7 +288,11 @@ mod tests {
         // the preset's 10.34 bar keeps the slope: Pm = 178.7 bar
         let r = ReliefValve::rbae_pilot();
         assert!((r.ra() / rbae_ra() - 1.0).abs() < 1e-12);
-        assert!((r.full_open.si() - 178.7e5).abs() < 0.1e5, "{}", r.full_open.si());
+        assert!(
+            (r.full_open.si() - 178.7e5).abs() < 0.1e5,
+            "{}",
+            r.full_open.si()
+        );
         // the same Ra through eq 6.8 gives back Pm
         let back = ReliefValve::from_performance_curve(r.cracking, r.ra(), r.kv).unwrap();
         assert!((back.full_open.si() - r.full_open.si()).abs() < 1e-6 * r.full_open.si());

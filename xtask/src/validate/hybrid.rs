@@ -451,6 +451,8 @@ fn nrmse(a: &[f64], b: &[f64]) -> f64 {
     let rms = (a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>() / n as f64).sqrt();
     let (lo, hi) = a
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| (l.min(x), h.max(x)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+            (l.min(x), h.max(x))
+        });
     rms / (hi - lo).max(f64::MIN_POSITIVE)
 }

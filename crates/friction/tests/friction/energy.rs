@@ -150,7 +150,10 @@ fn acceleration_term_is_continuous_and_conservative() {
     assert!((c(0.0) - 0.5 * (76.25 + 36.0)).abs() < 1e-9);
     // Lipschitz: the slope is at most Δc/(2A) = 20.125 kg per mm/s
     let slope = (c(1e-6) - c(-1e-6)) / 2e-6;
-    assert!(slope > 0.0 && slope <= 0.5 * (76.25 - 36.0) / A * (1.0 + 1e-6), "{slope}");
+    assert!(
+        slope > 0.0 && slope <= 0.5 * (76.25 - 36.0) / A * (1.0 + 1e-6),
+        "{slope}"
+    );
     // the directions' values away from the band
     assert!((c(0.05) - 76.25).abs() < 0.01 && (c(-0.05) - 36.0).abs() < 0.01);
     // Φ' = c v by central differences, at points inside and outside the band
@@ -158,7 +161,11 @@ fn acceleration_term_is_continuous_and_conservative() {
     for v in [-0.08, -0.01, -2e-3, -5e-4, 3e-4, 1e-3, 7e-3, 0.05] {
         let h = 1e-7;
         let d = (w.acceleration_energy(v + h) - w.acceleration_energy(v - h)) / (2.0 * h);
-        assert!((d - c(v) * v).abs() < 1e-6 * (c(v) * v).abs().max(1e-9), "{v}: {d} vs {}", c(v) * v);
+        assert!(
+            (d - c(v) * v).abs() < 1e-6 * (c(v) * v).abs().max(1e-9),
+            "{v}: {d} vs {}",
+            c(v) * v
+        );
     }
     // without the term both vanish
     let p = w.without_acceleration_term();

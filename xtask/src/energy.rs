@@ -53,24 +53,31 @@ pub fn run() -> bool {
         }
     }
     drives.push(("hybrid".into(), Drive::wang_hybrid(), Plan::default()));
-    // the same two drives with the presets' own friction: Table 5-8 with the
-    // seal term bounded to its identification range (hydrocyl_friction::seal)
-    let with_seal = Plan {
-        friction: FrictionCase::AsRig,
+    // the default rows run the presets' own friction (Table 5-8, the seal term
+    // bounded to its identification range, K H a on); named variants: K = 0
+    // (the matrix before issue 17) and the hybrid without K H a
+    let k0 = Plan {
+        friction: FrictionCase::WithoutSealTerm,
         ..Plan::default()
     };
     if let Some((_, valve, _)) = drives.first().cloned() {
-        drives.push(("valve-seal".into(), valve, with_seal.clone()));
+        drives.push(("valve-k0".into(), valve, k0.clone()));
     }
-    drives.push(("hybrid-seal".into(), Drive::wang_hybrid(), with_seal));
-    // and with Table 5-8's K H a term, which the hybrid preset ships without:
-    // it drives the chambers below vapour pressure at the reversals and its
-    // runs depend on the solver (docs/hybrid.md)
-    let seal_with_h = Plan {
-        friction: FrictionCase::WithTable58AccelerationTerm,
+    drives.push(("hybrid-k0".into(), Drive::wang_hybrid(), k0));
+    let h0 = Plan {
+        friction: FrictionCase::WithoutAccelerationTerm,
         ..Plan::default()
     };
-    drives.push(("hybrid-seal-kha".into(), Drive::wang_hybrid(), seal_with_h));
+    drives.push(("hybrid-h0".into(), Drive::wang_hybrid(), h0));
+    // relief valves 1 and 2 read every way the text allows (issue 17 item 2)
+    let readings = hydrocyl_studies::relief::readings();
+    for (i, r) in readings.iter().enumerate() {
+        drives.push((
+            crate::energy_relief::system_name(i),
+            r.drive(),
+            Plan::default(),
+        ));
+    }
     for f in VARIANTS {
         match HybridVariant::load(&root.join("fixtures/rigs").join(f)) {
             Ok((base, v)) => {
@@ -107,8 +114,8 @@ pub fn run() -> bool {
         println!(
             "with Table 5-8's seal gain K the hybrid drive's steady-extension force reserve falls to \
              {r:.2} N at {:.1} mm/s ({fold}; hydrocyl_studies::chapter7), so a transient \
-             locks it; `valve`/`hybrid` run eq 5.14 with K = 0, `valve-seal`/`hybrid-seal` with K bounded (`hybrid-seal-kha`: and Table 5-8's K H a) \
-             to 5.03 bar (hydrocyl_friction::seal; docs/energy.md)",
+             locks it; `valve`/`hybrid` run Table 5-8 with K bounded to 5.03 bar and K H a on \
+             (hydrocyl_friction::seal; docs/energy.md), `valve-k0`/`hybrid-k0` with K = 0, `hybrid-h0` without K H a",
             1e3 * v
         );
     }
@@ -145,11 +152,20 @@ pub fn run() -> bool {
             }
         })
         .collect();
+    let (relief, outcomes): (Vec<&Outcome>, Vec<&Outcome>) = outcomes
+        .into_iter()
+        .partition(|o| crate::energy_relief::is_relief(&o.scenario.system));
     print_matrix(&outcomes);
     print_ledgers(&outcomes);
     ok &= checks(&outcomes);
+    ok &= crate::energy_relief::closure(&relief, CLOSURE);
+    let friction: Vec<(String, &'static str)> = drives
+        .iter()
+        .map(|(n, _, p)| (n.clone(), p.friction.name()))
+        .collect();
+    let relief_json = crate::energy_relief::report(&readings, &relief, &outcomes);
     let dir = root.join("target/energy");
-    if let Err(e) = write_outputs(&dir, &outcomes) {
+    if let Err(e) = write_outputs(&dir, &outcomes, &relief_json, &friction) {
         println!("FAIL writing {}: {e}", dir.display());
         ok = false;
     } else {
@@ -297,7 +313,7 @@ fn file_stem(s: &Scenario) -> String {
     .replace(['+', ' '], "_")
 }
 
-fn row(o: &Outcome) -> Value {
+pub(crate) fn row(o: &Outcome, friction: &[(String, &'static str)]) -> Value {
     let s = &o.scenario;
     let l = &o.ledger;
     let terms: serde_json::Map<String, Value> = l
@@ -318,7 +334,11 @@ fn row(o: &Outcome) -> Value {
         "cylinder_out_j": l.cylinder_out_j,
         "load_out_j": l.load_out_j,
         "window_s": [l.window_s.0, l.window_s.1],
-        "friction": Plan::default().friction.name(),
+        "friction": friction
+            .iter()
+            .find(|(n, _)| *n == s.system)
+            .map_or(Plan::default().friction.name(), |(_, f)| *f),
+        "pump_volume_m3": o.pump_volume_m3,
         "peak_speeds_mm_s": [o.peak_speeds_mm_s.0, o.peak_speeds_mm_s.1],
         "cavitation_entries": o.cavitation_entries(),
         "stop_impacts": o.stop_impacts(),
@@ -335,9 +355,15 @@ fn write_atomic(path: &Path, text: &str) -> Result<(), String> {
     std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-fn write_outputs(dir: &Path, outs: &[&Outcome]) -> Result<(), String> {
+fn write_outputs(
+    dir: &Path,
+    outs: &[&Outcome],
+    relief: &[Value],
+    friction: &[(String, &'static str)],
+) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
-    let rows: Vec<Value> = outs.iter().map(|o| row(o)).collect();
+    let mut rows: Vec<Value> = outs.iter().map(|o| row(o, friction)).collect();
+    rows.extend(relief.iter().cloned());
     let text = serde_json::to_string_pretty(&rows).map_err(|e| e.to_string())?;
     write_atomic(&dir.join("energy.json"), &text)?;
     for o in outs {

@@ -86,4 +86,4 @@ pub use model::{
     finite_difference_jacobian, FrictionInput, FrictionJacobian, FrictionMode, FrictionModel,
 };
 pub use stribeck::{SteadySet, Stribeck};
-pub use wang::{Wang, WangSet};
+pub use wang::{Wang, WangSet, ACCELERATION_BLEND_VELOCITY};

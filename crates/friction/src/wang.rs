@@ -18,9 +18,12 @@
 //! assembler solves `(m + c) a = …` explicitly. Its power `c a v` is
 //! `d/dt(½ c v²)`: it stores energy like an added mass and returns it, so it is
 //! not friction in the energy sense; the assembler books it with the kinetic
-//! energy. Because `c` changes with the direction (76.25 kg extending, 36 kg
-//! retracting for Table 5-8), the model declares a switching function `g = v`
-//! so no integrator step straddles a reversal.
+//! energy. `c` changes with the direction (76.25 kg extending, 36 kg
+//! retracting for Table 5-8); hydrocyl blends it across v = 0 over ±1 mm/s
+//! ([`ACCELERATION_BLEND_VELOCITY`], a documented regularisation: the jump
+//! makes the acceleration discontinuous and the solvers disagree), and the
+//! model declares a switching function `g = v` so no integrator step
+//! straddles a reversal of the other terms.
 //!
 //! **Disagreements with the thesis.** The thesis's retracting values are
 //! negative (Fc = −80 N, vs = −0.01 m/s, …) to give the force its direction;
@@ -37,6 +40,24 @@ use crate::error::{non_negative, positive, FrictionError};
 use crate::lugre::{bristle_partials, bristle_rate};
 use crate::model::{FrictionInput, FrictionJacobian, FrictionMode, FrictionModel};
 use crate::stribeck::sgn;
+
+/// Half-width of the velocity band over which the acceleration term's added
+/// mass `K H` passes from the retracting to the extending value \[m·s⁻¹\]
+/// (1 mm/s; 98 % of the way at ±5 mm/s, 99.98 % at ±50 mm/s).
+///
+/// Eq 5.14 switches the parameter set with the direction of motion, so with
+/// Table 5-8 the effective mass `m + K H` jumps at every reversal (96.25 kg
+/// extending, 56 kg retracting, for the 20 kg of the rigs): the acceleration
+/// `F/(m + c)` is discontinuous at v = 0. An integrator that locates the
+/// reversal (DP45 with the `g = v` event) steps over it, but a
+/// finite-difference Jacobian taken within ~1e-9 m/s of v = 0 (Rodas4's
+/// `√ε · 0.1 m/s`) straddles the jump and reports `∂a/∂v` of order 1e9 s⁻¹:
+/// the Rosenbrock step then pins v at 0 for milliseconds and auto's run
+/// leaves the fluid model (docs/hybrid.md, item 7). Blending `c` smoothly,
+/// `c(v) = c̄ + (Δc/2) v/√(v² + a²)`, makes the right-hand side Lipschitz
+/// (its largest `∂a/∂v` is `|F| Δc / (2 a (m + c)²)`, ~1e3 s⁻¹ here) and keeps
+/// the term conservative ([`Wang::acceleration_energy`]).
+pub const ACCELERATION_BLEND_VELOCITY: f64 = 1e-3;
 
 /// One direction's parameters of Wang's model.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -155,6 +176,26 @@ impl Wang {
         }
     }
 
+    /// `(c̄, Δc/2)`: the mean of the two directions' added masses `K H` and
+    /// half their difference (extending minus retracting) \[kg\].
+    fn added_mass_levels(&self) -> (f64, f64) {
+        let ce = self.extending.k_pressure * self.extending.h_acceleration;
+        let cr = self.retracting.k_pressure * self.retracting.h_acceleration;
+        (0.5 * (ce + cr), 0.5 * (ce - cr))
+    }
+
+    /// The kinetic energy of the acceleration term at velocity `v`,
+    /// `Φ(v) = ∫₀ᵛ c(u) u du` \[J\], so that `c(v) a v = dΦ/dt` along every
+    /// motion (the term stores and returns energy like a mass). With
+    /// `c(u) = c̄ + (Δc/2) u/√(u² + a²)` (a = [`ACCELERATION_BLEND_VELOCITY`]):
+    /// `Φ = c̄ v²/2 + (Δc/4) (v √(v² + a²) − a² asinh(v/a))`.
+    pub fn acceleration_energy(&self, v: f64) -> f64 {
+        let (mean, half_jump) = self.added_mass_levels();
+        let a = ACCELERATION_BLEND_VELOCITY;
+        0.5 * mean * v * v
+            + 0.5 * half_jump * (v * (v * v + a * a).sqrt() - a * a * (v / a).asinh())
+    }
+
     /// The static curve, eq 5.8/5.11: `sgn(v) g(v) + K (p1 − p2)² v` \[N\]
     /// (with the pressure difference bounded when [`Wang::seal_dp_max`] > 0).
     pub fn static_curve(&self, input: &FrictionInput) -> f64 {
@@ -179,9 +220,13 @@ impl FrictionModel for Wang {
         Force::new(self.sigma0 * z + self.sigma1 * zdot + s.k_pressure * pd * pd * v)
     }
 
+    /// `c(v)`: the two directions' `K H` blended across v = 0 over
+    /// [`ACCELERATION_BLEND_VELOCITY`] (see [`Wang::acceleration_energy`]).
     fn acceleration_coefficient(&self, input: &FrictionInput) -> Mass {
-        let s = self.set_for(input.velocity.si(), input.acceleration.si());
-        Mass::new(s.k_pressure * s.h_acceleration)
+        let (mean, half_jump) = self.added_mass_levels();
+        let v = input.velocity.si();
+        let a = ACCELERATION_BLEND_VELOCITY;
+        Mass::new(mean + half_jump * v / (v * v + a * a).sqrt())
     }
 
     fn state_derivative(&self, input: &FrictionInput, state: &[f64], dstate: &mut [f64]) {

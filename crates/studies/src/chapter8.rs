@@ -214,7 +214,9 @@ impl Drive {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum FrictionCase {
-    /// The rig's own friction law (the presets: eq 5.14, Table 5-8).
+    /// The rig's own friction law (the presets: eq 5.14, Table 5-8, the
+    /// seal term bounded to its identification range, K H a on); the
+    /// default.
     AsRig,
     /// Eq 5.14 with the pressure-energised seal gain K = 0 (which also
     /// removes the acceleration term `K H a`): the bristle and Stribeck curve
@@ -227,7 +229,8 @@ pub enum FrictionCase {
     /// 5.4; the seal term stays, bounded as the rig bounds it).
     WithoutAccelerationTerm,
     /// The rig's own law with Table 5-8's acceleration term `K H a` (eq
-    /// 5.12/5.14; the `wang-hybrid` preset ships without it).
+    /// 5.12/5.14; both presets carry it, so this equals [`FrictionCase::AsRig`]
+    /// for them).
     WithTable58AccelerationTerm,
 }
 
@@ -279,7 +282,7 @@ pub struct Plan {
 impl Default for Plan {
     fn default() -> Self {
         Self {
-            friction: FrictionCase::WithoutSealTerm,
+            friction: FrictionCase::AsRig,
             warmup_periods: 1,
             measured_periods: 2,
             sample_s: 2e-3,
@@ -318,6 +321,9 @@ pub struct Outcome {
     pub wall_s: f64,
     /// Highest extending and retracting speed in the window \[mm/s\].
     pub peak_speeds_mm_s: (f64, f64),
+    /// Volume the pump moved over the window, `∫|Q_p| dt` \[m³\] (0 for
+    /// the valve drive).
+    pub pump_volume_m3: f64,
     /// Power traces over the window.
     #[serde(skip)]
     pub trace: Trace,
@@ -435,6 +441,13 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
             .velocity_m_s
             .push(vel.get(k).copied().unwrap_or(f64::NAN));
     }
+    let pump_volume_m3 = out
+        .channel("pump_flow")
+        .map(|q| {
+            let abs: Vec<f64> = q.iter().map(|x| x.abs()).collect();
+            hydrocyl_energy::ledger::trapezoid(&out.time, &abs, k0, k1)
+        })
+        .unwrap_or(0.0);
     let efficiency = led.efficiency();
     let peak = |sign: f64| {
         1e3 * trace
@@ -445,6 +458,7 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
     };
     Ok(Outcome {
         peak_speeds_mm_s: (peak(1.0), peak(-1.0)),
+        pump_volume_m3,
         thesis_efficiency: thesis_efficiency(&sc.system, sc.speed_mm_s, sc.wave, sc.load_kg),
         scenario: sc.clone(),
         ledger: led,

@@ -17,6 +17,9 @@
 //! * [`chapter8`] — the efficiency matrix of Tables 8-2 and 8-3 (eqs
 //!   8.1–8.8): valve-controlled against hybrid, ±50/±100 mm/s, sine/square,
 //!   no load/20 kg, and the hybrid variants of sections 8.2 and 9.2.
+//! * [`relief`] — the readings of relief valves 1 and 2 (eqs 6.6–6.10,
+//!   `rlv_1.m`: cracking pressure and slope, `P_m` by eq 6.8) and the cap the
+//!   pilot valve's shift pressure puts on the hybrid's efficiency.
 //!
 //! ```
 //! use hydrocyl_studies::chapter8::{run_scenario, Drive, Plan, Scenario, Wave};
@@ -33,3 +36,4 @@
 pub mod chapter3;
 pub mod chapter7;
 pub mod chapter8;
+pub mod relief;

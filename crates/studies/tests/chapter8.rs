@@ -6,8 +6,8 @@ use hydrocyl_energy::ledger::trapezoid;
 use hydrocyl_energy::variant::HybridVariant;
 use hydrocyl_energy::EnergyError;
 use hydrocyl_studies::chapter8::{
-    base_matrix, run_scenario, scenarios_for, thesis_efficiency, Drive, Outcome, Plan, Scenario,
-    Wave,
+    base_matrix, run_scenario, scenarios_for, thesis_efficiency, Drive, FrictionCase, Outcome,
+    Plan, Scenario, Wave,
 };
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -48,6 +48,13 @@ fn matrix() -> &'static Vec<Outcome> {
                 (d, s)
             })
             .collect();
+        // the valve drive with K = 0 (the named variant `valve-k0`): the
+        // closed form of the square wave below
+        for s in scenarios_for("valve-k0") {
+            if s.wave == Wave::Square && s.load_kg == 0.0 {
+                jobs.push((valve.clone(), s));
+            }
+        }
         let (b, v) = HybridVariant::load(&fixture("wang-hybrid-needle.json")).unwrap();
         for s in scenarios_for(&v.name) {
             jobs.push((Drive::Hybrid(Box::new(b.clone()), Some(v.clone())), s));
@@ -69,13 +76,19 @@ fn matrix() -> &'static Vec<Outcome> {
             rtol: 1e-5,
             ..short()
         };
+        let k0 = Plan {
+            friction: FrictionCase::WithoutSealTerm,
+            ..short()
+        };
         std::thread::scope(|scope| {
             let half = jobs.len() / 2;
             let (a, b) = jobs.split_at(half);
             let run_all = |js: &[(Drive, Scenario)]| -> Vec<Outcome> {
                 js.iter()
                     .map(|(d, s)| {
-                        let p = if s.system.starts_with("hybrid-") && s.system != "hybrid-needle" {
+                        let p = if s.system.ends_with("-k0") {
+                            &k0
+                        } else if s.system.starts_with("hybrid-") && s.system != "hybrid-needle" {
                             &fast
                         } else {
                             &plan
@@ -175,15 +188,20 @@ mod chapter8 {
         }
     }
 
-    /// Without load, the valve drive's square-wave efficiency has a closed
-    /// form: the supply gives `Ps A v` over each half period and the cylinder
-    /// puts out the steady friction `g(v) v`, so
+    /// Without load and with K = 0, the valve drive's square-wave efficiency
+    /// has a closed form: the supply gives `Ps A v` over each half period and
+    /// the cylinder puts out the steady friction `g(v) v`, so
     /// `η = (g_ext(v) + g_ret(v)) / (Ps (A1 + A2))` — 2.57 % at 50 mm/s.
     #[test]
     fn valve_square_efficiency_is_friction_over_supply_force() {
         let w = hydrocyl_friction::Wang::table_5_8();
-        for o in matrix().iter().filter(|o| {
-            o.scenario.system == "valve"
+        let runs: Vec<_> = matrix()
+            .iter()
+            .filter(|o| o.scenario.system == "valve-k0")
+            .collect();
+        assert_eq!(runs.len(), 2);
+        for o in runs.into_iter().filter(|o| {
+            o.scenario.system == "valve-k0"
                 && o.scenario.wave == Wave::Square
                 && o.scenario.load_kg == 0.0
         }) {

@@ -47,6 +47,15 @@ use serde::{Deserialize, Serialize};
 pub const RBAE_KV: f64 = 8.2864e-8;
 /// `P_m` of the RBAE performance curve (`rlv_1.m`) \[Pa\].
 pub const RBAE_PM: Pressure = Pressure::new(16.062_537_571_849_01e6);
+/// The cracking pressure `rlv_1.m` computes its `P_m` for, `pc2 = 1e5` \[Pa\].
+pub const RLV_1_CRACKING: Pressure = Pressure::new(1.0e5);
+/// Slope `R_a` of the RBAE curve of `rlv_1.m` (eq 6.9): the line from
+/// (`pc2` = 1 bar, 0) to (`P_m`, `K_v √P_m`), 4.81e10 Pa·s·m⁻³ (8.01 bar per
+/// l/min). The valve's characteristic; `P_m` follows from it through eq 6.8
+/// for any other cracking pressure.
+pub fn rbae_ra() -> f64 {
+    (RBAE_PM - RLV_1_CRACKING).si() / (RBAE_KV * RBAE_PM.si().sqrt())
+}
 /// Cracking pressure of relief valves 1 and 2 in `wang-hybrid`: the DDDC
 /// valve's minimum pilot-shift pressure, 150 psi = 10.34 bar \[Pa\] (rigs.md,
 /// assumed from Table 4-3 and `pcyl4_1.m`).
@@ -123,21 +132,22 @@ impl ReliefValve {
     }
 
     /// Relief valves 1 and 2 of `wang-hybrid`: the RBAE curve of `rlv_1.m`
-    /// (`K_v`, `P_m`) with the pilot-shift cracking pressure (10.34 bar).
+    /// (`K_v` and the slope [`rbae_ra`]) at the pilot-shift cracking pressure
+    /// (10.34 bar), `P_m` from eq 6.8: 178.7 bar (rigs.md: `rlv_1.m`'s 160.6
+    /// bar belongs to its own 1-bar cracking pressure; reusing it at 10.34 bar
+    /// would change the slope to 7.54 bar per l/min).
     pub fn rbae_pilot() -> Self {
         Self {
             cracking: RBAE_PILOT_CRACKING,
-            full_open: RBAE_PM,
+            full_open: full_open_from_curve(RBAE_PILOT_CRACKING, rbae_ra(), RBAE_KV),
             kv: RBAE_KV,
         }
     }
 
     /// Relief valve 3 of `wang-hybrid` (200 bar, "same law"): the RBAE's `K_v`
-    /// and the `R_a` of [`ReliefValve::rbae_pilot`], with `P_m` from eq 6.8 for
-    /// the 200 bar setting (the `rlv_1.m` value `P_m` = 160.6 bar is below 200
-    /// bar, so it cannot be reused as is).
+    /// and slope [`rbae_ra`], with `P_m` from eq 6.8 for the 200 bar setting.
     pub fn rbae_safety() -> Self {
-        let ra = Self::rbae_pilot().ra();
+        let ra = rbae_ra();
         Self {
             cracking: SAFETY_SETTING,
             full_open: full_open_from_curve(SAFETY_SETTING, ra, RBAE_KV),
@@ -271,9 +281,18 @@ mod tests {
 
     #[test]
     fn rbae_curve_reproduces_rlv_1() {
+        // at rlv_1.m's own 1 bar: Pm = 160.6 bar, Qm = Kv √Pm = 3.321e-4 m³/s (19.9 L/min)
+        let at_1 = ReliefValve::from_performance_curve(RLV_1_CRACKING, rbae_ra(), RBAE_KV).unwrap();
+        assert!((at_1.full_open.si() / RBAE_PM.si() - 1.0).abs() < 1e-12);
+        assert!((at_1.q_max().si() - 8.2864e-8 * 16.062_537_571_849_01e6f64.sqrt()).abs() < 1e-15);
+        // the preset's 10.34 bar keeps the slope: Pm = 178.7 bar
         let r = ReliefValve::rbae_pilot();
-        // Qm = Kv √Pm = 3.321e-4 m³/s (19.9 L/min)
-        assert!((r.q_max().si() - 8.2864e-8 * 16.062_537_571_849_01e6f64.sqrt()).abs() < 1e-15);
+        assert!((r.ra() / rbae_ra() - 1.0).abs() < 1e-12);
+        assert!(
+            (r.full_open.si() - 178.7e5).abs() < 0.1e5,
+            "{}",
+            r.full_open.si()
+        );
         // the same Ra through eq 6.8 gives back Pm
         let back = ReliefValve::from_performance_curve(r.cracking, r.ra(), r.kv).unwrap();
         assert!((back.full_open.si() - r.full_open.si()).abs() < 1e-6 * r.full_open.si());

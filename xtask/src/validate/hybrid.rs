@@ -49,8 +49,8 @@ pub fn section() -> Section {
         );
     }
     let rig = WangHybrid::preset();
-    s.note("Friction: Wang's law, eq 5.4 form (K (p1-p2)^2 v, no K H a term) with the Table 5-8/5-9/5-10 set of each load;");
-    s.note("the K H a term locks the square wave at the fold of the seal term (measured below, docs/hybrid.md).");
+    s.note("Friction of the six chapter-7 tests: Wang's law, eq 5.4 form (K (p1-p2)^2 v unbounded, no K H a term) with the");
+    s.note("Table 5-8/5-9/5-10 set of each load; the preset as shipped (last block) bounds K and keeps K H a.");
     s.note("Reference values: the thesis's figures are not in the text, so pressures are compared with its own");
     s.note("steady-state relations (eq 7.3, section 7.1) and friction with its rig measurements (Table 5-3).");
 
@@ -120,13 +120,12 @@ pub fn section() -> Section {
 
 /// The chapter-7 square and sine on the `wang-hybrid` preset as shipped
 /// (20 kg, Table 5-8 with the seal term bounded to its identification range
-/// and without the K H a term, which the preset leaves out; issue 17): only
-/// the start position is the test's.
+/// and its K H a term, the added mass blended across v = 0; issue 17): only
+/// the start position is the test's. DP45, Rosenbrock and auto must agree.
 fn preset_as_shipped(s: &mut Section) {
     use hydrocyl_integrators::Method;
-    s.note("Preset as shipped (20 kg, Table 5-8, seal term K min(|dp|, 5.03 bar)^2 v, no K H a term), 3 periods");
-    s.note("from 60 mm below mid-stroke, DP45 (auto and Rosenbrock agree with it to ~1e-6 NRMSE on this preset;");
-    s.note("with Table 5-8's K H a term they do not, which is why the preset leaves it out, docs/hybrid.md):");
+    s.note("Preset as shipped (20 kg, Table 5-8, seal term K min(|dp|, 5.03 bar)^2 v, K H a with K H blended over");
+    s.note("±1 mm/s at v = 0), 3 periods from 60 mm below mid-stroke, DP45; Rosenbrock and auto checked against it:");
     for shape in [Shape::Square, Shape::Sine] {
         let mut test = Chapter7Test::new(shape, Load::None);
         test.initial_position = -0.06;
@@ -148,13 +147,40 @@ fn preset_as_shipped(s: &mut Section) {
                 continue;
             }
         };
+        for m in [Method::Rosenbrock, Method::Auto] {
+            let what = format!("{label}: {m:?} agrees with DP45 (position NRMSE)");
+            match test.run_on(WangHybrid::preset(), m) {
+                Ok(o) => {
+                    let e = nrmse(&r.trace.position, &o.trace.position);
+                    s.check(&what, format!("{e:.1e}"), "< 1e-5".into(), e < 1e-5);
+                }
+                Err(e) => s.check(&what, e.to_string(), "completes".into(), false),
+            }
+        }
         let p = r.phenomena;
-        s.check(
-            &format!("{label}: stall at each reversal (to retract / to extend)"),
-            format!("{} / {}", ms(p.stall_to_retract), ms(p.stall_to_extend)),
-            "> 0.5 ms each".into(),
-            p.stall_to_retract > 5e-4 && p.stall_to_extend > 5e-4,
-        );
+        let stall = format!("{} / {}", ms(p.stall_to_retract), ms(p.stall_to_extend));
+        if shape == Shape::Sine {
+            s.check(
+                &format!("{label}: stall at each reversal (to retract / to extend)"),
+                stall,
+                "> 0.5 ms each".into(),
+                p.stall_to_retract > 5e-4 && p.stall_to_extend > 5e-4,
+            );
+        } else {
+            // with K H a the piston's added mass carries it through v = 0 at
+            // the retract-to-extend reversal (NaN: no sample below 1 mm/s),
+            // with chamber 1 below vapour pressure at the other (docs/hybrid.md item 7)
+            s.note(&format!(
+                "{label}: stall (|v| < 1 mm/s) to retract / to extend {stall}: the thesis's stall of several ms at each \
+                 reversal is NOT reproduced by the square"
+            ));
+            s.check(
+                &format!("{label}: slower rise when retracting (lag to 90 %, ext / ret)"),
+                format!("{} / {}", ms(p.lag_extend), ms(p.lag_retract)),
+                "retracting longer (section 7.2)".into(),
+                p.lag_retract > p.lag_extend,
+            );
+        }
         drift_and_friction(s, &label, &p);
         s.check(
             &format!("{label}: mass balance"),
@@ -164,7 +190,8 @@ fn preset_as_shipped(s: &mut Section) {
         );
         s.note(&format!(
             "{label}: lag to 90 % of the target, extending {} / retracting {} ({}); steady dp extending {}, \
-             retracting {}; lowest chamber pressure {}",
+             retracting {}; lowest chamber pressure {} ({} cavitation entries: the fluid model has no cavitation, a chamber \
+             below the vapour pressure has left its range)",
             ms(p.lag_extend),
             ms(p.lag_retract),
             if p.lag_retract > p.lag_extend {
@@ -175,6 +202,7 @@ fn preset_as_shipped(s: &mut Section) {
             bar(p.steady_extend.p1 - p.steady_extend.p2),
             bar(p.steady_retract.p1 - p.steady_retract.p2),
             bar(r.min_pressures.iter().map(|m| m.1).fold(f64::INFINITY, f64::min)),
+            r.count("cylinder.cavitation_entries_1") + r.count("cylinder.cavitation_entries_2"),
         ));
     }
 }
@@ -415,4 +443,16 @@ fn plot(path: &Path, r: &Chapter7Run) -> Result<(), String> {
             .map_err(|e| e.to_string())?;
     }
     root.present().map_err(|e| e.to_string())
+}
+
+/// `‖a − b‖_rms / (max a − min a)`.
+fn nrmse(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len()).max(1);
+    let rms = (a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>() / n as f64).sqrt();
+    let (lo, hi) = a
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+            (l.min(x), h.max(x))
+        });
+    rms / (hi - lo).max(f64::MIN_POSITIVE)
 }

@@ -131,3 +131,43 @@ fn a_loaded_bristle_returns_at_most_what_it_stored() {
     // ... but never more than it held.
     assert!(l.min_margin >= 0.0, "{}", l.min_margin);
 }
+
+/// The acceleration term's added mass `c(v)` is continuous across a reversal
+/// (the blend of `ACCELERATION_BLEND_VELOCITY`), takes Table 5-8's `K H` away
+/// from it, and stays conservative: `dΦ/dv = c(v) v` with `Φ(0) = 0`, so
+/// `c a v = dΦ/dt` along any motion.
+#[test]
+fn acceleration_term_is_continuous_and_conservative() {
+    use hydrocyl_friction::ACCELERATION_BLEND_VELOCITY as A;
+    let w = Wang::table_5_8();
+    let c = |v: f64| {
+        w.acceleration_coefficient(&FrictionInput::at_velocity(Velocity::new(v)))
+            .si()
+    };
+    // continuity at v = 0: the two one-sided values meet at the mean
+    let (cp, cm) = (c(1e-12), c(-1e-12));
+    assert!((cp - cm).abs() < 1e-6, "{cp} {cm}");
+    assert!((c(0.0) - 0.5 * (76.25 + 36.0)).abs() < 1e-9);
+    // Lipschitz: the slope is at most Δc/(2A) = 20.125 kg per mm/s
+    let slope = (c(1e-6) - c(-1e-6)) / 2e-6;
+    assert!(
+        slope > 0.0 && slope <= 0.5 * (76.25 - 36.0) / A * (1.0 + 1e-6),
+        "{slope}"
+    );
+    // the directions' values away from the band
+    assert!((c(0.05) - 76.25).abs() < 0.01 && (c(-0.05) - 36.0).abs() < 0.01);
+    // Φ' = c v by central differences, at points inside and outside the band
+    assert_eq!(w.acceleration_energy(0.0), 0.0);
+    for v in [-0.08, -0.01, -2e-3, -5e-4, 3e-4, 1e-3, 7e-3, 0.05] {
+        let h = 1e-7;
+        let d = (w.acceleration_energy(v + h) - w.acceleration_energy(v - h)) / (2.0 * h);
+        assert!(
+            (d - c(v) * v).abs() < 1e-6 * (c(v) * v).abs().max(1e-9),
+            "{v}: {d} vs {}",
+            c(v) * v
+        );
+    }
+    // without the term both vanish
+    let p = w.without_acceleration_term();
+    assert_eq!(p.acceleration_energy(0.05), 0.0);
+}

@@ -165,11 +165,9 @@ impl WangHybrid {
             mass: 20.0,
             external_force: 0.0,
             friction: FrictionLaw::Wang(
-                // without Table 5-8's K H a term: with it the rig's reversals
-                // have no solver-independent solution (docs/hybrid.md)
-                Wang::table_5_8()
-                    .with_seal_bound(hydrocyl_friction::seal::TABLE_5_8_DP_MAX)
-                    .without_acceleration_term(),
+                // Table 5-8 with its K H a term (blended across v = 0,
+                // hydrocyl_friction::ACCELERATION_BLEND_VELOCITY; docs/hybrid.md item 7)
+                Wang::table_5_8().with_seal_bound(hydrocyl_friction::seal::TABLE_5_8_DP_MAX),
             ),
             tank_pressure: 0.0,
             vapour_pressure: -0.99e5,

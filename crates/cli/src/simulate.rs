@@ -22,9 +22,7 @@
 //! imposes the rod's velocity: their `command` column is that velocity
 //! \[m·s⁻¹\] and their output has the load-cell `force`. A `friction-bench`
 //! rig *file* (the identification format of `diagnose`) is driven by a
-//! measured record's motion instead: see [`crate::bench_sim`]. A
-//! `hybrid-variant` rig file (chapter 8's circuit improvements) runs on its
-//! base rig with the variant's components swapped in.
+//! measured record's motion instead: see [`crate::bench_sim`].
 //!
 //! Every input is checked and the output's temporary file created before the
 //! run ([`crate::output`]); the run is streamed in blocks
@@ -40,7 +38,6 @@ use crate::output::Outputs;
 use crate::progress::Progress;
 use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_identify::plaincsv::{run_columns, write_columns_in_parts, write_rows_in_parts};
-use hydrocyl_system::hybrid::variant;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{self as runner, Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
@@ -205,7 +202,7 @@ fn command_unit(value: &serde_json::Value) -> CommandUnit {
         return CommandUnit::Reference;
     }
     let kind = value.get("kind").and_then(|k| k.as_str());
-    if kind == Some(variant::KIND) || kind == Some(hydrocyl_system::hybrid::KIND) {
+    if kind == Some(hydrocyl_system::hybrid::KIND) {
         return CommandUnit::Volt;
     }
     if kind != Some(hydrocyl_system::netlist::KIND) {

@@ -1,24 +1,16 @@
-//! The chapter-8 matrix: the ledger closes on every scenario and variant, the
+//! The chapter-8 matrix: the ledger closes on every scenario, the
 //! hybrid beats the valve drive, the closed forms of the square wave, and
 //! bad scenarios are refused by name.
 
 use hydrocyl_energy::ledger::trapezoid;
-use hydrocyl_energy::variant::HybridVariant;
 use hydrocyl_energy::EnergyError;
 use hydrocyl_studies::chapter8::{
     base_matrix, run_scenario, scenarios_for, thesis_efficiency, Drive, Outcome, Plan, Scenario,
     Wave,
 };
-use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 const CLOSURE: f64 = 1e-3;
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/rigs")
-        .join(name)
-}
 
 /// A short plan for tests: the run starts at rest and the ledger covers the
 /// whole of one period (start-up included), so the runs stay short.
@@ -37,7 +29,7 @@ fn matrix() -> &'static Vec<Outcome> {
     M.get_or_init(|| {
         let valve = Drive::wang_valve_c10().unwrap();
         let hybrid = Drive::wang_hybrid();
-        let mut jobs: Vec<(Drive, Scenario)> = base_matrix()
+        let jobs: Vec<(Drive, Scenario)> = base_matrix()
             .into_iter()
             .map(|s| {
                 let d = if s.system == "valve" {
@@ -48,39 +40,14 @@ fn matrix() -> &'static Vec<Outcome> {
                 (d, s)
             })
             .collect();
-        let (b, v) = HybridVariant::load(&fixture("wang-hybrid-needle.json")).unwrap();
-        for s in scenarios_for(&v.name) {
-            jobs.push((Drive::Hybrid(Box::new(b.clone()), Some(v.clone())), s));
-        }
-        // the solenoid variants chatter and are slow: one scenario each here,
-        // all of them in `cargo xtask energy`
-        for f in ["wang-hybrid-solenoid.json", "wang-hybrid-improved.json"] {
-            let (b, v) = HybridVariant::load(&fixture(f)).unwrap();
-            let s = Scenario {
-                system: v.name.clone(),
-                speed_mm_s: 100.0,
-                wave: Wave::Sine,
-                load_kg: 20.0,
-            };
-            jobs.push((Drive::Hybrid(Box::new(b), Some(v)), s));
-        }
         let plan = short();
-        let fast = Plan {
-            rtol: 1e-5,
-            ..short()
-        };
         std::thread::scope(|scope| {
             let half = jobs.len() / 2;
             let (a, b) = jobs.split_at(half);
             let run_all = |js: &[(Drive, Scenario)]| -> Vec<Outcome> {
                 js.iter()
                     .map(|(d, s)| {
-                        let p = if s.system.starts_with("hybrid-") && s.system != "hybrid-needle" {
-                            &fast
-                        } else {
-                            &plan
-                        };
-                        run_scenario(d, s, p).unwrap_or_else(|e| panic!("{}: {e}", s.label()))
+                        run_scenario(d, s, &plan).unwrap_or_else(|e| panic!("{}: {e}", s.label()))
                     })
                     .collect()
             };
@@ -98,7 +65,7 @@ mod chapter8 {
     #[test]
     fn ledger_closes_on_every_scenario_and_variant() {
         let m = matrix();
-        assert!(m.len() >= 16 + 8 + 2);
+        assert!(m.len() >= 16);
         for o in m {
             let l = &o.ledger;
             assert!(

@@ -44,7 +44,10 @@ pub fn run(dir: &Path) -> bool {
         c.rows.len()
     );
     match append(&dir.join("energy.json"), &c) {
-        Ok(()) => println!("appended the chapter-9 rows to {}/energy.json", dir.display()),
+        Ok(()) => println!(
+            "appended the chapter-9 rows to {}/energy.json",
+            dir.display()
+        ),
         Err(e) => {
             println!("FAIL writing the chapter-9 rows: {e}");
             ok = false;

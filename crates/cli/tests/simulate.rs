@@ -422,16 +422,25 @@ fn chapter9_rig_files_simulate() {
     );
     let (h4, imp) = sim(&rigs.join("wang-hybrid-improved.json"), &[], "imp.csv");
     assert!(imp[k][col(&h4, "velocity")] > 0.02, "improved extends");
-    let (h5, servo) = sim(&rigs.join("wang-hybrid-servo-needle.json"), &[], "servo.csv");
+    let (h5, servo) = sim(
+        &rigs.join("wang-hybrid-servo-needle.json"),
+        &[],
+        "servo.csv",
+    );
     // the opening follows the 2 V command: A_0 + g+ 2 V
-    let rig: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(rigs.join("wang-hybrid-servo-needle.json")).unwrap()).unwrap();
+    let rig: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(rigs.join("wang-hybrid-servo-needle.json")).unwrap(),
+    )
+    .unwrap();
     let n = &rig["components"]["needle_valve"];
     let want = n["area_min"].as_f64().unwrap() + 2.0 * n["gain_positive"].as_f64().unwrap();
     let got = servo[k][col(&h5, "needle_opening")];
     assert!((got - want).abs() < 1e-12, "{got} vs {want}");
     // the closed loop follows a position step of 10 mm from -60 mm
-    let refs: Vec<(f64, f64)> = rows.iter().map(|r| (r.0, if r.0 > 0.2 { -0.05 } else { -0.06 })).collect();
+    let refs: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|r| (r.0, if r.0 > 0.2 { -0.05 } else { -0.06 }))
+        .collect();
     let refs_file = dir.path().join("ref.csv");
     let mut text = String::from("time,reference\n");
     for (t, r) in &refs {
@@ -448,7 +457,11 @@ fn chapter9_rig_files_simulate() {
     assert!((x_end + 0.05).abs() < 1e-3, "closed loop ends at {x_end} m");
     // a retired variant file: one line, exit 2, nothing written
     let old = dir.path().join("old.json");
-    std::fs::write(&old, r#"{"kind": "hybrid-variant", "name": "x", "description": "", "base": "wang-hybrid"}"#).unwrap();
+    std::fs::write(
+        &old,
+        r#"{"kind": "hybrid-variant", "name": "x", "description": "", "base": "wang-hybrid"}"#,
+    )
+    .unwrap();
     let out = dir.path().join("old.csv");
     let st = hydrocyl()
         .args(["simulate", "--rig"])
@@ -462,7 +475,10 @@ fn chapter9_rig_files_simulate() {
     assert_eq!(st.status.code(), Some(2));
     let err = String::from_utf8_lossy(&st.stderr);
     assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(err.contains("retired") && err.contains("needle_valve.area"), "{err}");
+    assert!(
+        err.contains("retired") && err.contains("needle_valve.area"),
+        "{err}"
+    );
     assert!(!out.exists());
 }
 

@@ -33,7 +33,10 @@ fn the_needle_optimum_is_a_minimum_over_a_grid() {
         );
     }
     // the constraint is active: part of the range is infeasible
-    assert!(feasible > 0 && feasible < 15, "{feasible} feasible grid points");
+    assert!(
+        feasible > 0 && feasible < 15,
+        "{feasible} feasible grid points"
+    );
 }
 
 /// The law through two optima: the straight line in speed, or the

@@ -49,14 +49,26 @@ fn solenoid_spool_shifts_first_order_and_each_path_is_an_orifice() {
     for (u, sign) in [(2.0, 1.0), (-2.0, -1.0), (0.05, 0.0)] {
         let v = solenoid_rig(p, tau);
         let cmd = Signal::Constant { value: u };
-        let run = rig::simulate(&v, cmd.clone(), &t, &RunOptions { rtol: 1e-9, ..RunOptions::default() })
-            .unwrap();
+        let run = rig::simulate(
+            &v,
+            cmd.clone(),
+            &t,
+            &RunOptions {
+                rtol: 1e-9,
+                ..RunOptions::default()
+            },
+        )
+        .unwrap();
         let s = run.channel("spool").unwrap();
         let c = rig::circuit(&v, cmd).unwrap();
         let i = c.component_index("valve").unwrap();
         for (k, &tk) in t.iter().enumerate() {
             let want = sign * (1.0 - (-tk / tau).exp());
-            assert!((s[k] - want).abs() < 1e-6, "u {u} t {tk}: {} vs {want}", s[k]);
+            assert!(
+                (s[k] - want).abs() < 1e-6,
+                "u {u} t {tk}: {} vs {want}",
+                s[k]
+            );
             // power dissipated = Σ Δp Q over the open paths at this spool
             let pw = c.power_terms(tk, run.state(k))[i].dissipated;
             let f = s[k].abs();
@@ -65,7 +77,10 @@ fn solenoid_spool_shifts_first_order_and_each_path_is_an_orifice() {
             } else {
                 (p[1] - p[3]) * q(2e-6 * f, p[1] - p[3]) + (p[2] - p[4]) * q(3e-6 * f, p[2] - p[4])
             };
-            assert!((pw - want_p).abs() <= 1e-9 * want_p.abs().max(1.0), "u {u} t {tk}: {pw} vs {want_p}");
+            assert!(
+                (pw - want_p).abs() <= 1e-9 * want_p.abs().max(1.0),
+                "u {u} t {tk}: {pw} vs {want_p}"
+            );
         }
         if sign == 0.0 {
             // below the threshold no solenoid is energised: closed centre
@@ -78,7 +93,12 @@ fn solenoid_spool_shifts_first_order_and_each_path_is_an_orifice() {
 fn servo_needle_opening_follows_the_command() {
     let (a0, amax, gp, gn) = (1e-6, 1e-5, 2e-6, 3e-6);
     let (p_in, p_out) = (8e5, 0.0);
-    for (u, want_a) in [(1.0, a0 + gp), (-2.0, a0 + 2.0 * gn), (0.0, a0), (10.0, amax)] {
+    for (u, want_a) in [
+        (1.0, a0 + gp),
+        (-2.0, a0 + 2.0 * gn),
+        (0.0, a0),
+        (10.0, amax),
+    ] {
         let v = json!({
             "kind": "netlist", "name": "servo-needle-test", "description": "closed-form test",
             "components": {
@@ -97,7 +117,11 @@ fn servo_needle_opening_follows_the_command() {
         });
         // no states: the circuit is evaluated directly
         let c = rig::circuit(&v, Signal::Constant { value: u }).unwrap();
-        let probe = c.probes().into_iter().find(|p| p.name.ends_with("opening")).unwrap();
+        let probe = c
+            .probes()
+            .into_iter()
+            .find(|p| p.name.ends_with("opening"))
+            .unwrap();
         let mut a = [0.0];
         c.read_wires(0.01, &[], &[probe.wire], &mut a);
         assert!((a[0] - want_a).abs() < 1e-15, "u {u}: {} vs {want_a}", a[0]);
@@ -105,6 +129,9 @@ fn servo_needle_opening_follows_the_command() {
         let pw = c.power_terms(0.01, &[])[i].dissipated;
         // the needle meters through 0.8 of its opening (eq 6.14)
         let want_p = p_in * q(0.8 * want_a, p_in - p_out);
-        assert!((pw - want_p).abs() < 1e-9 * want_p, "u {u}: {pw} vs {want_p}");
+        assert!(
+            (pw - want_p).abs() < 1e-9 * want_p,
+            "u {u}: {pw} vs {want_p}"
+        );
     }
 }

@@ -35,7 +35,13 @@ pub fn section() -> Section {
             }
         };
         for load_kg in [0.0, 20.0] {
-            match run_case(&v, &Case { speed_mm_s: 50.0, load_kg }) {
+            match run_case(
+                &v,
+                &Case {
+                    speed_mm_s: 50.0,
+                    load_kg,
+                },
+            ) {
                 Ok(r) => {
                     s.check(
                         &format!("{name} ±50 mm/s {load_kg} kg: ledger"),
@@ -54,12 +60,18 @@ pub fn section() -> Section {
         if let (Some(p), Some(sol)) = (get("wang-hybrid", kg), get("wang-hybrid-solenoid", kg)) {
             s.check(
                 &format!("solenoid four-way vs pilot-shifted, {kg} kg: efficiency"),
-                format!("{:.1} % vs {:.1} %", 100.0 * sol.efficiency, 100.0 * p.efficiency),
+                format!(
+                    "{:.1} % vs {:.1} %",
+                    100.0 * sol.efficiency,
+                    100.0 * p.efficiency
+                ),
                 "higher (no relief 1/2 cracking drop)".into(),
                 sol.efficiency > p.efficiency,
             );
             s.check(
-                &format!("solenoid four-way vs pilot-shifted, {kg} kg: stall to retract / to extend"),
+                &format!(
+                    "solenoid four-way vs pilot-shifted, {kg} kg: stall to retract / to extend"
+                ),
                 format!(
                     "{} / {} vs {} / {}",
                     ms(sol.stall_s.0),
@@ -74,20 +86,33 @@ pub fn section() -> Section {
         if let (Some(p), Some(cl)) = (get("wang-hybrid", kg), get("wang-hybrid-closed-loop", kg)) {
             s.check(
                 &format!("closed position loop, {kg} kg: drift per period"),
-                format!("{:+.3} mm vs open loop {:+.2} mm", 1e3 * cl.drift_m, 1e3 * p.drift_m),
+                format!(
+                    "{:+.3} mm vs open loop {:+.2} mm",
+                    1e3 * cl.drift_m,
+                    1e3 * p.drift_m
+                ),
                 "|closed| < 0.05 mm and < |open| / 5".into(),
                 cl.drift_m.abs() < 5e-5 && cl.drift_m.abs() < p.drift_m.abs() / 5.0,
             );
         }
     }
-    match (load(&rigs, "wang-hybrid-needle"), get("wang-hybrid-needle", 0)) {
+    match (
+        load(&rigs, "wang-hybrid-needle"),
+        get("wang-hybrid-needle", 0),
+    ) {
         (Ok(v), Some(_)) => {
-            let shipped = v["components"]["needle_valve"]["area"].as_f64().unwrap_or(f64::NAN);
+            let shipped = v["components"]["needle_valve"]["area"]
+                .as_f64()
+                .unwrap_or(f64::NAN);
             match optimise(&v, 50.0) {
                 Ok(o) => {
                     s.check(
                         "needle optimiser ±50 mm/s (pilot-shifted): opening",
-                        format!("{:.3} mm², file ships {:.3} mm²", 1e6 * o.best.area_m2, 1e6 * shipped),
+                        format!(
+                            "{:.3} mm², file ships {:.3} mm²",
+                            1e6 * o.best.area_m2,
+                            1e6 * shipped
+                        ),
                         "the file ships the optimum (2 %)".into(),
                         (o.best.area_m2 / shipped - 1.0).abs() < 0.02,
                     );

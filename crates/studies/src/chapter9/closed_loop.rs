@@ -12,7 +12,11 @@ use hydrocyl_system::rig;
 use serde_json::Value;
 
 /// Runs the closed-loop rig at each controller gain `kp` \[V/m\] on `case`.
-pub fn gains(rig_value: &Value, case: &Case, kp: &[f64]) -> Result<Vec<(f64, Measured)>, EnergyError> {
+pub fn gains(
+    rig_value: &Value,
+    case: &Case,
+    kp: &[f64],
+) -> Result<Vec<(f64, Measured)>, EnergyError> {
     kp.iter()
         .map(|&k| {
             let mut v = rig_value.clone();

@@ -73,15 +73,20 @@ pub fn compare(rigs: &Path) -> Result<Comparison, EnergyError> {
         point(&needle_solenoid[0]),
         point(&needle_solenoid[1]),
     )
-        .map_err(rig_err("wang-hybrid-servo-needle"))?;
+    .map_err(rig_err("wang-hybrid-servo-needle"))?;
     let mut rows = Vec::new();
     for name in RIGS {
         let base = load(rigs, name)?;
         for (i, speed_mm_s) in SPEEDS_MM_S.into_iter().enumerate() {
             let sets: Vec<String> = match name {
-                "wang-hybrid-needle" => vec![format!("needle_valve.area={}", needle[i].best.area_m2)],
+                "wang-hybrid-needle" => {
+                    vec![format!("needle_valve.area={}", needle[i].best.area_m2)]
+                }
                 "wang-hybrid-improved" => {
-                    vec![format!("needle_valve.area={}", needle_solenoid[i].best.area_m2)]
+                    vec![format!(
+                        "needle_valve.area={}",
+                        needle_solenoid[i].best.area_m2
+                    )]
                 }
                 "wang-hybrid-servo-needle" => servo.sets().to_vec(),
                 _ => vec![],

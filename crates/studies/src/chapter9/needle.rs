@@ -75,7 +75,13 @@ pub fn evaluate(rig: &Value, speed_mm_s: f64, area: f64) -> Result<Evaluation, E
     let (mut e, mut over, mut steady, mut floor) =
         (0.0, f64::NEG_INFINITY, f64::NEG_INFINITY, f64::INFINITY);
     for load_kg in super::LOADS_KG {
-        let m = run_case(&v, &Case { speed_mm_s, load_kg })?;
+        let m = run_case(
+            &v,
+            &Case {
+                speed_mm_s,
+                load_kg,
+            },
+        )?;
         e += m.energy_in_j;
         over = over.max(m.overrun);
         steady = steady.max(m.steady_overrun);

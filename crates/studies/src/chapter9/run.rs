@@ -112,7 +112,10 @@ pub fn input(v: &Value, case: &Case, t: &[f64]) -> Result<Signal, RigError> {
             why: e.to_string(),
         });
     }
-    let (a1, a2) = (parameter(v, "cylinder.area_1")?, parameter(v, "cylinder.area_2")?);
+    let (a1, a2) = (
+        parameter(v, "cylinder.area_1")?,
+        parameter(v, "cylinder.area_2")?,
+    );
     let k = parameter(v, "pump.gain")?;
     Ok(Signal::Square {
         amplitude: case.speed() * (a1 + a2) / (2.0 * k),
@@ -149,8 +152,11 @@ pub fn run_case(rig: &Value, case: &Case) -> Result<Measured, EnergyError> {
     let out = sim.run(&t).map_err(err)?;
     let (k0, k1) = (n_per, 3 * n_per);
     let led = ledger(sim.circuit(), &out, k0, k1, &RodSide::default())?;
-    let mut losses: Vec<(String, f64)> =
-        led.losses.iter().map(|l| (l.name.clone(), l.energy_j)).collect();
+    let mut losses: Vec<(String, f64)> = led
+        .losses
+        .iter()
+        .map(|l| (l.name.clone(), l.energy_j))
+        .collect();
     losses.sort_by(|a, b| b.1.total_cmp(&a.1));
     let m = measure(&out, case, k0, k1).map_err(err)?;
     Ok(Measured {
@@ -216,7 +222,9 @@ fn measure(out: &Run, case: &Case, k0: usize, k1: usize) -> Result<Measured, Rig
         drift_m: (x[k1] - x[k0]) / 2.0,
         overrun: peak / case.speed() - 1.0,
         steady_overrun: steady / case.speed() - 1.0,
-        min_chamber_pa: (k0..=k1).map(|k| p1[k].min(p2[k])).fold(f64::INFINITY, f64::min),
+        min_chamber_pa: (k0..=k1)
+            .map(|k| p1[k].min(p2[k]))
+            .fold(f64::INFINITY, f64::min),
         losses: Vec::new(),
     })
 }

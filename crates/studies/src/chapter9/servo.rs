@@ -30,7 +30,10 @@ impl ServoLaw {
     /// case (the load running ahead), so the law keeps the slow optimum and
     /// opens less than the fast optimum (more loss there, never less damping).
     pub fn fit(v: &Value, a: (f64, f64), b: (f64, f64)) -> Result<Self, RigError> {
-        let (a1, a2) = (parameter(v, "cylinder.area_1")?, parameter(v, "cylinder.area_2")?);
+        let (a1, a2) = (
+            parameter(v, "cylinder.area_1")?,
+            parameter(v, "cylinder.area_2")?,
+        );
         let k = parameter(v, "pump.gain")?;
         let mut s = (b.1 - a.1) / (b.0 - a.0);
         let mut a0 = a.1 - s * a.0;

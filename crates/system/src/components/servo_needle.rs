@@ -50,7 +50,9 @@ impl OpeningLaw {
     pub fn validate(&self) -> Result<(), String> {
         let ok = |v: f64| v.is_finite() && v >= 0.0;
         if !(ok(self.area_min) && ok(self.gain_positive) && ok(self.gain_negative)) {
-            return Err("`area_min`, `gain_positive` and `gain_negative` must be non-negative".into());
+            return Err(
+                "`area_min`, `gain_positive` and `gain_negative` must be non-negative".into(),
+            );
         }
         if !(self.area_max.is_finite() && self.area_max > self.area_min) {
             return Err(format!(

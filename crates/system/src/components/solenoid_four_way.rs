@@ -136,7 +136,7 @@ impl Component for SolenoidFourWay {
             message,
         };
         self.law.validate().map_err(bad)?;
-        if !(self.initial_spool.abs() <= 1.0) {
+        if self.initial_spool.is_nan() || self.initial_spool.abs() > 1.0 {
             return Err(bad(format!(
                 "`initial.spool` = {} must lie in [-1, 1]",
                 self.initial_spool
@@ -231,8 +231,8 @@ impl Component for SolenoidFourWay {
     fn power(&self, _t: f64, x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         let [p1, p2, pa, pb, pt] = self.pressures(w);
         let [q_pa, q_bt, q_pb, q_at] = self.law.flows(x[0], [p1, p2, pa, pb, pt]);
-        p.dissipated = ((p1 - pa) * q_pa + (pb - pt) * q_bt + (p2 - pb) * q_pb + (pa - pt) * q_at)
-            .si();
+        p.dissipated =
+            ((p1 - pa) * q_pa + (pb - pt) * q_bt + (p2 - pb) * q_pb + (pa - pt) * q_at).si();
     }
     fn probes(&self) -> Vec<Probe> {
         vec![Probe::of("spool", self.spool)]

@@ -3,7 +3,9 @@
 //! DDDC valve (and with it relief valves 1 and 2), and the servo needle
 //! valve whose opening follows the velocity command.
 
-use super::super::registry::{param, ComponentType, Default::*, Instance, ParamSpec, Range, Role, StateSpec};
+use super::super::registry::{
+    param, ComponentType, Default::*, Instance, ParamSpec, Range, Role, StateSpec,
+};
 use super::hydraulic::orifice_params;
 use super::{built, port, HYD, SIG};
 use crate::circuit::Component;
@@ -24,10 +26,34 @@ fn orifice(i: &Instance, prefix: &str) -> Orifice {
 const SOLENOID: [ParamSpec; 7] = {
     let o = orifice_params!("orifice.");
     [
-        param("area_supply", "m^2", Required, Range::POSITIVE, "open area of P1→A and P2→B at full shift"),
-        param("area_return", "m^2", Required, Range::POSITIVE, "open area of A→T and B→T at full shift"),
-        param("threshold", "V", Value(0.05), Range::NON_NEGATIVE, "command magnitude u_d above which a solenoid is energised"),
-        param("time_constant", "s", Value(0.01), Range::POSITIVE, "time constant τ of the spool's shift"),
+        param(
+            "area_supply",
+            "m^2",
+            Required,
+            Range::POSITIVE,
+            "open area of P1→A and P2→B at full shift",
+        ),
+        param(
+            "area_return",
+            "m^2",
+            Required,
+            Range::POSITIVE,
+            "open area of A→T and B→T at full shift",
+        ),
+        param(
+            "threshold",
+            "V",
+            Value(0.05),
+            Range::NON_NEGATIVE,
+            "command magnitude u_d above which a solenoid is energised",
+        ),
+        param(
+            "time_constant",
+            "s",
+            Value(0.01),
+            Range::POSITIVE,
+            "time constant τ of the spool's shift",
+        ),
         o[0],
         o[1],
         o[2],
@@ -55,17 +81,65 @@ fn solenoid(i: &Instance) -> Result<Box<dyn Component>, String> {
 const SERVO_NEEDLE: [ParamSpec; 11] = {
     let o = orifice_params!("orifice.");
     [
-        param("area_min", "m^2", Required, Range::NON_NEGATIVE, "opening A_0 at zero command"),
-        param("area_max", "m^2", Required, Range::POSITIVE, "largest opening A_max"),
-        param("gain_positive", "m^2/V", Required, Range::NON_NEGATIVE, "opening per volt of positive command g₊"),
-        param("gain_negative", "m^2/V", Required, Range::NON_NEGATIVE, "opening per volt of negative command g₋"),
-        param("effective_factor", "-", Required, Range::UNIT, "effective-area factor"),
+        param(
+            "area_min",
+            "m^2",
+            Required,
+            Range::NON_NEGATIVE,
+            "opening A_0 at zero command",
+        ),
+        param(
+            "area_max",
+            "m^2",
+            Required,
+            Range::POSITIVE,
+            "largest opening A_max",
+        ),
+        param(
+            "gain_positive",
+            "m^2/V",
+            Required,
+            Range::NON_NEGATIVE,
+            "opening per volt of positive command g₊",
+        ),
+        param(
+            "gain_negative",
+            "m^2/V",
+            Required,
+            Range::NON_NEGATIVE,
+            "opening per volt of negative command g₋",
+        ),
+        param(
+            "effective_factor",
+            "-",
+            Required,
+            Range::UNIT,
+            "effective-area factor",
+        ),
         o[0],
         o[1],
         o[2],
-        param("reverse_check.cracking", "Pa", Required, Range::NON_NEGATIVE, "reverse check's cracking pressure p_c"),
-        param("reverse_check.opening_range", "Pa", Required, Range::POSITIVE, "reverse check's opening range Δp_o"),
-        param("reverse_check.k_open", "m^3/(s Pa^0.5)", Required, Range::POSITIVE, "reverse check's full-open coefficient K_c"),
+        param(
+            "reverse_check.cracking",
+            "Pa",
+            Required,
+            Range::NON_NEGATIVE,
+            "reverse check's cracking pressure p_c",
+        ),
+        param(
+            "reverse_check.opening_range",
+            "Pa",
+            Required,
+            Range::POSITIVE,
+            "reverse check's opening range Δp_o",
+        ),
+        param(
+            "reverse_check.k_open",
+            "m^3/(s Pa^0.5)",
+            Required,
+            Range::POSITIVE,
+            "reverse check's full-open coefficient K_c",
+        ),
     ]
 };
 

@@ -3,9 +3,8 @@
 
 use hydrocyl_energy::ledger::{ledger, RodSide};
 use hydrocyl_ports::{Area, Density, Pressure};
-use hydrocyl_system::components::{CommandInput, FixedOrifice, PressureSource, Volume};
+use hydrocyl_system::components::{FixedOrifice, PressureSource, Volume};
 use hydrocyl_system::run::{run, RunOptions};
-use hydrocyl_system::signal::Signal;
 use hydrocyl_system::{Circuit, Component};
 use hydrocyl_valves::orifice::Orifice;
 use std::path::{Path, PathBuf};

@@ -188,32 +188,6 @@ mod chapter8 {
             );
         }
     }
-
-    /// The variant with the needle opened for 100 mm/s loses less in the
-    /// needle than the base rig at the same scenario.
-    #[test]
-    fn per_speed_needle_reduces_the_needle_loss_at_100_mm_s() {
-        let m = matrix();
-        for sc in scenarios_for("hybrid")
-            .into_iter()
-            .filter(|s| s.speed_mm_s == 100.0)
-        {
-            let find = |sys: &str| {
-                m.iter().find(|o| {
-                    o.scenario.system == sys
-                        && o.scenario.speed_mm_s == sc.speed_mm_s
-                        && o.scenario.wave == sc.wave
-                        && o.scenario.load_kg == sc.load_kg
-                })
-            };
-            let (base, var) = (find("hybrid").unwrap(), find("hybrid-needle").unwrap());
-            assert!(
-                var.ledger.loss("needle_valve") < base.ledger.loss("needle_valve"),
-                "{}",
-                sc.label()
-            );
-        }
-    }
 }
 
 mod tables {

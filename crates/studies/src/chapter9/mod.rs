@@ -14,7 +14,7 @@
 //! * `wang-hybrid-closed-loop` — a position P controller on the servomotor,
 //!   driven by the position reference of the same motion ([`closed_loop`]).
 //!
-//! [`compare`] runs them all with the parameters the study sets; [`run`] runs one case and measures it (efficiency and ledger of eqs
+//! [`compare()`] runs them all with the parameters the study sets; [`run_case`] runs one case and measures it (efficiency and ledger of eqs
 //! 8.1–8.8, stall at reversal, drift per period, overrun); everything goes
 //! through the public API (`rig::load`, `rig::apply_set`, `Simulation`).
 

@@ -7,7 +7,6 @@
 //! `target/energy/energy.json`, a power-in/out SVG per scenario and a stacked
 //! bar of where the energy went, and reports its wall time.
 
-use hydrocyl_energy::variant::HybridVariant;
 use hydrocyl_studies::chapter8::{
     run_scenario, scenarios_for, Drive, FrictionCase, Outcome, Plan, Scenario,
 };
@@ -16,13 +15,6 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// Variant rig files of sections 8.2/9.2, in `fixtures/rigs/`.
-const VARIANTS: [&str; 3] = [
-    "wang-hybrid-solenoid.json",
-    "wang-hybrid-needle.json",
-    "wang-hybrid-improved.json",
-];
 
 /// The ledger must close to this fraction of the energy in.
 const CLOSURE: f64 = 1e-3;
@@ -77,30 +69,6 @@ pub fn run() -> bool {
             r.drive(),
             Plan::default(),
         ));
-    }
-    for f in VARIANTS {
-        match HybridVariant::load(&root.join("fixtures/rigs").join(f)) {
-            Ok((base, v)) => {
-                // the solenoid variants chatter (docs/energy.md): one measured
-                // period at rtol 1e-5 keeps the matrix inside its time budget
-                // (the efficiencies agree with rtol 1e-6 to four digits)
-                let plan = if v.solenoid_valves.is_some() {
-                    Plan {
-                        measured_periods: 1,
-                        sample_s: 5e-3,
-                        rtol: 1e-5,
-                        ..Plan::default()
-                    }
-                } else {
-                    Plan::default()
-                };
-                drives.push((v.name.clone(), Drive::Hybrid(Box::new(base), Some(v)), plan));
-            }
-            Err(e) => {
-                eprintln!("xtask energy: {e}");
-                return false;
-            }
-        }
     }
     // why the matrix runs without the seal term: the fold of eq 5.4's K term
     {
@@ -171,6 +139,7 @@ pub fn run() -> bool {
     } else {
         println!("wrote {}/energy.json and the SVG plots", dir.display());
     }
+    ok &= crate::energy_ch9::run(&dir);
     println!(
         "xtask energy: wall time {:.1} s (goal < 30 s)",
         start.elapsed().as_secs_f64()

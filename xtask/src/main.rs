@@ -14,6 +14,7 @@ mod bench;
 mod bench_solve;
 mod energy;
 mod energy_relief;
+mod energy_ch9;
 mod report;
 mod test;
 mod validate;

@@ -4,6 +4,7 @@
 
 use crate::report::Section;
 
+mod chapter9;
 mod diagnose;
 mod friction;
 mod hybrid;
@@ -22,6 +23,7 @@ fn sections() -> Vec<(&'static str, SectionFn)> {
         ("valve-rig", valve_rig::section),
         ("hybrid", hybrid::section),
         ("diagnose", diagnose::section),
+        ("chapter9", chapter9::section),
     ]
 }
 

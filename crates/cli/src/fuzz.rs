@@ -27,7 +27,7 @@ fn rig_seeds() -> Vec<String> {
     [
         "rigs/leaney-moog.json",
         "measured/festo-hanging-load.rig.json",
-        "rigs/wang-hybrid-needle.json",
+        "rigs/wang-hybrid-solenoid.json",
     ]
     .iter()
     .filter_map(|f| std::fs::read_to_string(format!("{root}{f}")).ok())

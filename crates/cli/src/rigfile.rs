@@ -4,7 +4,6 @@
 //! and, for a file, its line.
 
 use crate::error::CliError;
-use hydrocyl_system::hybrid::variant::{self, HybridVariant};
 use hydrocyl_system::netlist::{self, Schematic};
 use hydrocyl_system::rig::{self, RigError};
 use hydrocyl_system::signal::Signal;
@@ -21,14 +20,11 @@ pub fn locate(e: RigError, source: &str) -> CliError {
 pub enum Checked {
     /// A netlist: its checked schematic (steady initial pressures filled).
     Netlist(Box<Schematic>),
-    /// A chapter-8 circuit variant: a base rig with components swapped.
-    Variant(Box<HybridVariant>),
 }
 
 /// Reads and checks a rig value of a kind `simulate` runs (see [`locate`]).
 pub fn check(value: &Value, source: &str) -> Result<Checked, CliError> {
     let checked = match value.get("kind").and_then(Value::as_str) {
-        Some(variant::KIND) => HybridVariant::from_value(value).map(|v| Checked::Variant(v.into())),
         Some(netlist::KIND) => netlist::schematic(value).map(|s| Checked::Netlist(s.into())),
         // a missing or unknown kind: the error names the kinds there are
         _ => Err(match rig::kind_of(value) {
@@ -44,16 +40,15 @@ pub fn check(value: &Value, source: &str) -> Result<Checked, CliError> {
 
 impl Checked {
     /// The unit in which the rig takes its input (the reading port's, see
-    /// [`Schematic::input_unit`]; a pump drive's `V` for a variant).
+    /// [`Schematic::input_unit`]).
     pub fn input_unit(&self) -> Option<&'static str> {
         match self {
             Checked::Netlist(s) => s.input_unit(),
-            Checked::Variant(_) => Some("V"),
         }
     }
 
     /// Every numeric parameter as `(path, value, unit)`.
-    pub fn parameters(&self, value: &Value) -> Vec<rig::Parameter> {
+    pub fn parameters(&self) -> Vec<rig::Parameter> {
         match self {
             Checked::Netlist(s) => netlist::parameters_of(s)
                 .into_iter()
@@ -64,7 +59,6 @@ impl Checked {
                     doc: Some(p.doc),
                 })
                 .collect(),
-            Checked::Variant(_) => rig::parameters(value),
         }
     }
 
@@ -72,7 +66,6 @@ impl Checked {
     pub fn circuit(&self, command: Signal) -> Result<Circuit, RigError> {
         match self {
             Checked::Netlist(s) => netlist::assemble(s, command),
-            Checked::Variant(v) => v.circuit(command),
         }
     }
 }

@@ -22,9 +22,7 @@
 //! imposes the rod's velocity: their `command` column is that velocity
 //! \[m·s⁻¹\] and their output has the load-cell `force`. A `friction-bench`
 //! rig *file* (the identification format of `diagnose`) is driven by a
-//! measured record's motion instead: see [`crate::bench_sim`]. A
-//! `hybrid-variant` rig file (chapter 8's circuit improvements) runs on its
-//! base rig with the variant's components swapped in.
+//! measured record's motion instead: see [`crate::bench_sim`].
 //! A rig file of an older kind (`valve-cylinder`, `hybrid-pump`) is read as
 //! its netlist ([`rig::load`]): `--set` and `--print-rig` use the
 //! netlist's `<component>.<parameter>` paths on it as on every preset.
@@ -200,11 +198,8 @@ fn command_unit(rig: &crate::rigfile::Checked) -> CommandUnit {
 
 /// Rejects an initial chamber pressure below absolute vacuum (gauge
 /// pressures below −101 325 Pa do not exist).
-fn check_initial_pressures(
-    rig: &crate::rigfile::Checked,
-    value: &serde_json::Value,
-) -> Result<(), CliError> {
-    for p in rig.parameters(value) {
+fn check_initial_pressures(rig: &crate::rigfile::Checked) -> Result<(), CliError> {
+    for p in rig.parameters() {
         let pressure = p.unit == Some("Pa")
             || (p.unit.is_none()
                 && p.path
@@ -300,7 +295,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         return run_bench(&args, &value);
     }
     let checked = crate::rigfile::check(&value, &args.rig)?;
-    check_initial_pressures(&checked, &value)?;
+    check_initial_pressures(&checked)?;
     if args.print_rig {
         // a netlist is printed with every parameter written out (defaults
         // filled in), under the paths `--set` takes

@@ -430,12 +430,14 @@ fn friction_bench_needs_motion_and_writes_nothing_without_it() {
     assert!(!out.exists());
 }
 
-/// A `hybrid-variant` rig file (chapter 8's improvements) simulates through
-/// its base rig: the needle variant with every opening set to the base's
-/// 4.0e-6 m² is the base rig to the digit, and the solenoid variant removes
-/// the relief valves' cracking drop between pump line and chamber.
+/// The chapter-9 rig files (netlists) simulate through `hydrocyl simulate`:
+/// the needle file at the base opening is the base rig to the digit, the
+/// solenoid four-way valve removes the relief valves' cracking drop between
+/// pump line and chamber, the servo needle and the closed loop run; a
+/// retired `hybrid-variant` file is refused in one line naming its
+/// replacement, nothing written.
 #[test]
-fn hybrid_variants_are_simulated_on_their_base_rig() {
+fn chapter9_rig_files_simulate() {
     let dir = tempfile::tempdir().unwrap();
     let rigs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/rigs");
     let rows: Vec<(f64, f64)> = (0..=300)
@@ -445,13 +447,13 @@ fn hybrid_variants_are_simulated_on_their_base_rig() {
         })
         .collect();
     let cmd = write_command(dir.path(), "cmd.csv", &rows);
-    let sim = |rig: &Path, sets: &[&str], name: &str| {
+    let sim_with = |rig: &Path, cmd: &Path, sets: &[&str], name: &str| {
         let out = dir.path().join(name);
         let mut c = hydrocyl();
         c.args(["simulate", "--solver", "rosenbrock", "--rig"])
             .arg(rig)
             .arg("--command")
-            .arg(&cmd)
+            .arg(cmd)
             .arg("--out")
             .arg(&out);
         for s in sets {
@@ -465,19 +467,17 @@ fn hybrid_variants_are_simulated_on_their_base_rig() {
         );
         read_csv(&out)
     };
+    let sim = |rig: &Path, sets: &[&str], name: &str| sim_with(rig, &cmd, sets, name);
     let (h, base) = sim(&rigs.join("wang-hybrid.json"), &[], "base.csv");
     let (h2, same) = sim(
         &rigs.join("wang-hybrid-needle.json"),
-        &[
-            "needle_area_by_speed.0.area_m2=4.0e-6",
-            "needle_area_by_speed.1.area_m2=4.0e-6",
-        ],
+        &["needle_valve.area=4.0e-6"],
         "needle.csv",
     );
     assert_eq!(h, h2);
     assert_eq!(
         base, same,
-        "the needle variant at the base opening is the base rig"
+        "the needle file at the base opening is the base rig"
     );
     let (h3, sol) = sim(&rigs.join("wang-hybrid-solenoid.json"), &[], "sol.csv");
     // the relief valves' flow channels are gone with the relief valves
@@ -496,6 +496,66 @@ fn hybrid_variants_are_simulated_on_their_base_rig() {
         "solenoid valve open: {}",
         drop(&h3, &sol)
     );
+    let (h4, imp) = sim(&rigs.join("wang-hybrid-improved.json"), &[], "imp.csv");
+    assert!(imp[k][col(&h4, "velocity")] > 0.02, "improved extends");
+    let (h5, servo) = sim(
+        &rigs.join("wang-hybrid-servo-needle.json"),
+        &[],
+        "servo.csv",
+    );
+    // the opening follows the 2 V command: A_0 + g+ 2 V
+    let rig: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(rigs.join("wang-hybrid-servo-needle.json")).unwrap(),
+    )
+    .unwrap();
+    let n = &rig["components"]["needle_valve"];
+    let want = n["area_min"].as_f64().unwrap() + 2.0 * n["gain_positive"].as_f64().unwrap();
+    let got = servo[k][col(&h5, "needle_opening")];
+    assert!((got - want).abs() < 1e-12, "{got} vs {want}");
+    // the closed loop follows a position step of 10 mm from -60 mm
+    let refs: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|r| (r.0, if r.0 > 0.2 { -0.05 } else { -0.06 }))
+        .collect();
+    let refs_file = dir.path().join("ref.csv");
+    let mut text = String::from("time,reference\n");
+    for (t, r) in &refs {
+        text.push_str(&format!("{t},{r}\n"));
+    }
+    std::fs::write(&refs_file, text).unwrap();
+    let (h6, cl) = sim_with(
+        &rigs.join("wang-hybrid-closed-loop.json"),
+        &refs_file,
+        &["cylinder.initial.position=-0.06"],
+        "cl.csv",
+    );
+    let x_end = cl.last().unwrap()[col(&h6, "position")];
+    assert!((x_end + 0.05).abs() < 1e-3, "closed loop ends at {x_end} m");
+    // a retired variant file: one line, exit 2, nothing written
+    let old = dir.path().join("old.json");
+    std::fs::write(
+        &old,
+        r#"{"kind": "hybrid-variant", "name": "x", "description": "", "base": "wang-hybrid"}"#,
+    )
+    .unwrap();
+    let out = dir.path().join("old.csv");
+    let st = hydrocyl()
+        .args(["simulate", "--rig"])
+        .arg(&old)
+        .arg("--command")
+        .arg(&cmd)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("retired") && err.contains("needle_valve.area"),
+        "{err}"
+    );
+    assert!(!out.exists());
 }
 
 /// A netlist error names the JSON path and its line in the file; nothing

@@ -1,7 +1,6 @@
 //! # hydrocyl-energy — where the energy of a drive goes
 //!
-//! The energy ledger of a run (thesis chapter 8, eqs 8.1–8.8) and the
-//! hybrid drive's variants of sections 8.2 and 9.2.
+//! The energy ledger of a run (thesis chapter 8, eqs 8.1–8.8).
 //!
 //! ```text
 //!        source power                         load power
@@ -31,8 +30,8 @@
 //!   integrals: "the area between the power curves and time axis").
 //!
 //! The chapter-8 scenario matrix (Tables 8-2 and 8-3) is a study on this
-//! ledger and lives in `hydrocyl-studies` (`chapter8`); the improvements of
-//! sections 8.2 and 9.2 are in [`variant`]. Units: SI (J, W, s) everywhere.
+//! ledger and lives in `hydrocyl-studies` (`chapter8`), and so do the
+//! improvements of sections 8.2 and 9.2 (`chapter9`). Units: SI (J, W, s) everywhere.
 //! Charging a closed volume from a 70-bar source through an orifice loses
 //! half the energy drawn, whatever the orifice:
 //!
@@ -66,9 +65,6 @@
 
 pub mod error;
 pub mod ledger;
-pub mod switched;
-pub mod variant;
 
 pub use error::EnergyError;
 pub use ledger::{Ledger, RodSide, Term};
-pub use variant::HybridVariant;

@@ -2,12 +2,9 @@
 //! bad input (the chapter-8 matrix is tested in `hydrocyl-studies`).
 
 use hydrocyl_energy::ledger::{ledger, RodSide};
-use hydrocyl_energy::switched::SwitchedOrifice;
-use hydrocyl_energy::variant::HybridVariant;
 use hydrocyl_ports::{Area, Density, Pressure};
-use hydrocyl_system::components::{CommandInput, FixedOrifice, PressureSource, Volume};
+use hydrocyl_system::components::{FixedOrifice, PressureSource, Volume};
 use hydrocyl_system::run::{run, RunOptions};
-use hydrocyl_system::signal::Signal;
 use hydrocyl_system::{Circuit, Component};
 use hydrocyl_valves::orifice::Orifice;
 use std::path::{Path, PathBuf};
@@ -76,69 +73,10 @@ mod closed_forms {
             );
         }
     }
-
-    /// A solenoid valve shut by the sign of its command passes nothing; open,
-    /// it charges the volume with the same half-lost energy.
-    #[test]
-    fn switched_orifice_follows_the_command_sign() {
-        let (ps, v, b) = (5.0e6, 1.0e-4, 7.0e8);
-        for (command, direction, charges) in [
-            (1.0, 1.0, true),
-            (-1.0, 1.0, false),
-            (-1.0, -1.0, true),
-            (1.0, -1.0, false),
-        ] {
-            let valve =
-                SwitchedOrifice::new("solenoid", "u", "P", "V", Area::new(1e-6), oil(), direction);
-            let mut c = Circuit::build(vec![
-                Box::new(CommandInput::new(
-                    "command",
-                    "u",
-                    Signal::Constant { value: command },
-                )),
-                Box::new(PressureSource::new("supply", "P", Pressure::new(ps), None)),
-                Box::new(valve),
-                Box::new(Volume::new("volume", "V", v, b, 0.0, Some("pv"))),
-            ])
-            .unwrap();
-            let t: Vec<f64> = (0..=100).map(|k| k as f64 * 5e-3).collect();
-            let x0 = c.initial_state();
-            let r = run(&mut c, &x0, &t, &RunOptions::dp45()).unwrap();
-            let pv = *r.channel("pv").unwrap().last().unwrap();
-            if charges {
-                assert!(
-                    (pv - ps).abs() < 1e-4 * ps,
-                    "u {command} dir {direction}: {pv}"
-                );
-            } else {
-                assert_eq!(pv, 0.0, "u {command} dir {direction}");
-            }
-        }
-    }
 }
 
 mod bad_input {
     use super::*;
-
-    #[test]
-    fn malformed_variant_files_name_the_problem() {
-        let e = HybridVariant::from_json("{\"kind\": \"hybrid-variant\"", "x.json").unwrap_err();
-        assert!(e.to_string().contains("x.json") && e.to_string().contains("line 1"));
-        let good = std::fs::read_to_string(fixture("wang-hybrid-needle.json")).unwrap();
-        let bad = good.replace("8.5e-6", "-8.5e-6");
-        let e = HybridVariant::from_json(&bad, "n.json").unwrap_err();
-        assert!(e.to_string().contains("area_m2"), "{e}");
-        let bad = good.replace("\"wang-hybrid\"", "\"no-such-rig\"");
-        let v = HybridVariant::from_json(&bad, "n.json").unwrap();
-        let e = v.base_rig(None).unwrap_err();
-        assert!(e.to_string().contains("no-such-rig"), "{e}");
-        let bad = good.replace("\"wang-hybrid\"", "\"wang-valve-c10\"");
-        let v = HybridVariant::from_json(&bad, "n.json").unwrap();
-        let e = v.base_rig(None).unwrap_err();
-        assert!(e.to_string().contains("not a hybrid rig"), "{e}");
-        let e = HybridVariant::load(Path::new("/no/such/file.json")).unwrap_err();
-        assert!(e.to_string().contains("cannot read"), "{e}");
-    }
 
     #[test]
     fn a_run_without_the_ledger_is_refused() {

@@ -24,17 +24,16 @@ def command_for(rig):
         return t, 0.01 * np.minimum(t / 0.05, 1.0), "command"
     if "position_controller" in types:
         return t, np.where(t < 0.01, 0.0, 0.01), "reference"
-    pump = "pump" in spec.get("components", {}) or spec.get("kind") == "hybrid-variant"
+    pump = "pump" in spec.get("components", {})
     level = 2.0 if pump else 0.3
     return t, np.where(t < 0.01, 0.0, level), "command"
 
 
 def netlist_files(repo):
-    """Every rig file of fixtures/rigs/ a user runs: the netlists and the
-    hybrid drive's variant files."""
+    """Every rig file of fixtures/rigs/ a user runs (all netlists)."""
     files = sorted((repo / "fixtures/rigs").glob("*.json"))
     files += sorted((repo / "fixtures/rigs/examples").glob("*.json"))
-    kinds = ("netlist", "hybrid-variant")
+    kinds = ("netlist",)
     return [f for f in files if json.loads(f.read_text()).get("kind") in kinds]
 
 
@@ -66,9 +65,9 @@ def test_every_netlist_file_loads_and_runs(repo):
 
 
 def test_variant_files_run_and_equal_the_cli(cli, repo, tmp_path):
-    """The hybrid drive's variant files (chapter 8's circuit improvements)
+    """The hybrid drive's chapter-9 variants (netlists `wang-hybrid-*.json`)
     load from any folder, run, and equal `hydrocyl simulate` on them."""
-    files = [f for f in netlist_files(repo) if json.loads(f.read_text())["kind"] == "hybrid-variant"]
+    files = [f for f in netlist_files(repo) if f.stem.startswith("wang-hybrid-")]
     assert files
     for f in files:
         rig = hydrocyl.Rig.load(str(f))

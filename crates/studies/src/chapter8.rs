@@ -1,5 +1,4 @@
-//! The chapter-8 scenarios: a drive (valve-controlled, hybrid, or a hybrid
-//! variant), a speed, a wave and a load; running one gives its ledger, its
+//! The chapter-8 scenarios: a drive (valve-controlled or hybrid), a speed, a wave and a load; running one gives its ledger, its
 //! efficiency (eqs 8.1–8.7) and its power traces.
 //!
 //! Choices where the thesis is silent (docs/energy.md):
@@ -17,7 +16,6 @@
 
 use hydrocyl_energy::error::EnergyError;
 use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
-use hydrocyl_energy::variant::HybridVariant;
 use hydrocyl_friction::FrictionLaw;
 use hydrocyl_system::hybrid::WangHybrid;
 use hydrocyl_system::rig::RigError;
@@ -183,8 +181,9 @@ pub fn thesis_efficiency(system: &str, speed_mm_s: f64, wave: Wave, load_kg: f64
 pub enum Drive {
     /// A valve-controlled rig (`valve-cylinder` kind, e.g. `wang-valve-c10`).
     Valve(Box<ValveRig>),
-    /// The hybrid pump-controlled rig, optionally modified by a variant.
-    Hybrid(Box<WangHybrid>, Option<HybridVariant>),
+    /// The hybrid pump-controlled rig (its circuit variants of section 9.2
+    /// are netlists run by `chapter9`).
+    Hybrid(Box<WangHybrid>),
 }
 
 impl Drive {
@@ -206,7 +205,7 @@ impl Drive {
 
     /// The `wang-hybrid` preset.
     pub fn wang_hybrid() -> Self {
-        Drive::Hybrid(Box::new(WangHybrid::preset()), None)
+        Drive::Hybrid(Box::new(WangHybrid::preset()))
     }
 }
 
@@ -380,26 +379,17 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
             let cmd = wave_signal(sc.wave, amplitude, period, bias);
             (r.circuit(cmd).map_err(rig_err(&label))?, Solver::Dp45)
         }
-        Drive::Hybrid(rig, variant) => {
+        Drive::Hybrid(rig) => {
             let mut r = (**rig).clone();
             r.external_force = force;
             plan.friction.apply(&mut r.friction);
             r.initial_position = sc.start_position();
-            if let Some(var) = variant {
-                var.apply_to_rig(&mut r, Some(sc.speed_mm_s));
-            }
             let (a1, a2) = (r.cylinder.area_1.si(), r.cylinder.area_2.si());
             let k = r.pump.gain;
             let amplitude = v * (a1 + a2) / (2.0 * k);
             let bias = v * (a1 - a2) / (2.0 * k);
             let cmd = wave_signal(sc.wave, amplitude, period, bias);
-            let c = r
-                .build_with(cmd, |comps| {
-                    if let Some(var) = variant {
-                        var.swap_components(comps);
-                    }
-                })
-                .map_err(rig_err(&label))?;
+            let c = r.build(cmd).map_err(rig_err(&label))?;
             (c, Solver::Rosenbrock)
         }
     };

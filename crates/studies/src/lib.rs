@@ -16,10 +16,14 @@
 //!   the fold of the pressure-energised seal term of eq 5.4.
 //! * [`chapter8`] — the efficiency matrix of Tables 8-2 and 8-3 (eqs
 //!   8.1–8.8): valve-controlled against hybrid, ±50/±100 mm/s, sine/square,
-//!   no load/20 kg, and the hybrid variants of sections 8.2 and 9.2.
+//!   no load/20 kg.
 //! * [`relief`] — the readings of relief valves 1 and 2 (eqs 6.6–6.10,
 //!   `rlv_1.m`: cracking pressure and slope, `P_m` by eq 6.8) and the cap the
 //!   pilot valve's shift pressure puts on the hybrid's efficiency.
+//! * [`chapter9`] — the further work of section 9.2 in simulation: the
+//!   solenoid four-way valve, the needle opening optimised per speed, a servo
+//!   needle valve and a closed position loop, each against the pilot-shifted
+//!   drive (stall, efficiency, drift).
 //!
 //! ```
 //! use hydrocyl_studies::chapter8::{run_scenario, Drive, Plan, Scenario, Wave};
@@ -37,3 +41,4 @@ pub mod chapter3;
 pub mod chapter7;
 pub mod chapter8;
 pub mod relief;
+pub mod chapter9;

@@ -78,7 +78,7 @@ impl Reading {
     pub fn drive(&self) -> Drive {
         let mut rig = WangHybrid::preset();
         rig.relief_pilot = self.valve();
-        Drive::Hybrid(Box::new(rig), None)
+        Drive::Hybrid(Box::new(rig))
     }
 }
 

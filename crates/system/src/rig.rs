@@ -151,11 +151,6 @@ pub struct RigKind {
 /// are read as netlists ([`crate::netlist::migrate`]).
 pub const RIG_KINDS: &[RigKind] = &[
     RigKind {
-        kind: crate::hybrid::variant::KIND,
-        check: |v| crate::hybrid::variant::HybridVariant::from_value(v).map(|_| ()),
-        circuit: |v, cmd| crate::hybrid::variant::HybridVariant::from_value(v)?.circuit(cmd),
-    },
-    RigKind {
         kind: crate::netlist::KIND,
         check: |v| crate::netlist::read(v).map(|_| ()).map_err(RigError::from),
         circuit: crate::netlist::circuit,
@@ -173,6 +168,10 @@ pub fn valve_rig_from(v: &Value) -> Result<ValveRig, RigError> {
     r.validate()?;
     Ok(r)
 }
+
+/// The `kind` of the retired base-rig-plus-swaps variant files (issue 13):
+/// loading one fails with a note naming the netlists that replace it.
+const RETIRED_VARIANT_KIND: &str = "hybrid-variant";
 
 /// The JSON of preset `name`, if there is one.
 pub fn preset(name: &str) -> Option<Value> {
@@ -198,7 +197,7 @@ pub fn load(name_or_path: &str) -> Result<Value, RigError> {
                 .join(", ")
         ),
     })?;
-    let v = serde_json::from_str(&text).map_err(|e| RigError::Invalid {
+    let v: Value = serde_json::from_str(&text).map_err(|e| RigError::Invalid {
         path: name_or_path.into(),
         why: format!("not valid JSON: {e}"),
     })?;
@@ -208,8 +207,15 @@ pub fn load(name_or_path: &str) -> Result<Value, RigError> {
             why: format!("duplicate key at line {line} (a key may appear once in an object)"),
         });
     }
-    let mut v = v;
-    crate::hybrid::variant::resolve_base(&mut v, std::path::Path::new(name_or_path).parent());
+    if v.get("kind").and_then(Value::as_str) == Some(RETIRED_VARIANT_KIND) {
+        return Err(RigError::Invalid {
+            path: format!("{name_or_path}: kind"),
+            why: "the `hybrid-variant` kind is retired: its circuits are netlists now \
+                  (fixtures/rigs/wang-hybrid-{solenoid,needle,improved}.json), and the needle \
+                  opening per speed is the parameter `needle_valve.area` (`--set needle_valve.area=<m^2>`)"
+                .into(),
+        });
+    }
     // an older rig kind is read as its netlist
     match crate::netlist::migrate::migrate(&v) {
         Ok(Some(n)) => Ok(n),

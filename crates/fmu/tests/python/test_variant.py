@@ -1,5 +1,5 @@
 """A rig file that is not a preset exports too: the hybrid drive's solenoid
-variant (a `hybrid-variant` file, chapter 8's improvement (a)) passes
+variant (a netlist with the `solenoid_four_way` valve, section 9.2) passes
 `fmpy validate`, and FMPy's run of it equals `hydrocyl simulate` on the same
 constant drive voltage."""
 
@@ -24,7 +24,7 @@ def test_a_variant_file_exports_validates_and_equals_the_cli(tmp_path):
     assert "No problems found" in r.stdout, r.stdout + r.stderr
     names = {v.name for v in read_model_description(str(fmu)).modelVariables}
     assert {"command", "position", "p1", "p2"} <= names
-    assert "relief_1.cracked" not in names  # the variant's solenoid valves replace reliefs 1 and 2
+    assert "relief_1.cracked" not in names  # the solenoid four-way valve makes reliefs 1 and 2 unnecessary
 
     t_end, dt, u = 0.5, 1e-3, 2.0  # 2 V: extending
     t = np.round(np.arange(0.0, t_end + dt / 2, dt), 12)

@@ -13,6 +13,8 @@
 //! | [`GeneralisedCylinder`] | A, B pressures (algebraic) | P_LE | spool, P, T, rod | flows at P, T; force |
 //! | [`Mass`] | rod x, v | x, v | forces on rod | – |
 //! | [`Friction`] | – | model's (z) | rod v; A, B pressures | −F, added mass |
+//! | [`SolenoidFourWay`] | – | s | command; P1, P2, A, B, T | flows at P1, P2, A, B, T |
+//! | [`ServoNeedle`] | – | – | command; inlet, outlet | flow inlet→outlet |
 //! | [`PositionController`] | command signal (algebraic) | (∫e) | reference, rod x | – |
 
 mod controller;
@@ -22,9 +24,10 @@ mod friction;
 mod generalised;
 mod mass;
 mod orifice;
+mod servo_needle;
+mod solenoid_four_way;
 mod sources;
 mod spool;
-mod switched_orifice;
 mod volume;
 
 pub use controller::{PositionController, PositionLaw};
@@ -34,7 +37,8 @@ pub use friction::Friction;
 pub use generalised::{GeneralisedCylinder, XMethod};
 pub use mass::Mass;
 pub use orifice::FixedOrifice;
+pub use servo_needle::{OpeningLaw, ServoNeedle};
+pub use solenoid_four_way::{SolenoidFourWay, SolenoidLaw, SolenoidNodes};
 pub use sources::{CommandInput, PressureSource};
 pub use spool::ServoSpool;
-pub use switched_orifice::SwitchedOrifice;
 pub use volume::Volume;

@@ -39,7 +39,6 @@
 
 pub mod components;
 mod netlist;
-pub mod variant;
 
 pub use components::{
     CheckComponent, NeedleComponent, PilotNodes, PilotValve, PumpComponent, ReliefComponent,

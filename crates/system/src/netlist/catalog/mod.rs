@@ -11,6 +11,7 @@ mod hybrid;
 mod hydraulic;
 mod mechanical;
 mod servo;
+mod switched;
 
 pub(super) const HYD: Domain = Domain::Hydraulic;
 pub(super) const MECH: Domain = Domain::Mechanical;
@@ -72,6 +73,7 @@ static ALL: LazyLock<Vec<ComponentType>> = LazyLock::new(|| {
         hybrid::TYPES,
         control::TYPES,
         bench::TYPES,
+        switched::TYPES,
     ]
     .concat()
 });

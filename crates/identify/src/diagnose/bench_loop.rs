@@ -582,6 +582,7 @@ pub fn diagnose_bench(
         declared_refit,
         effects_added: added,
         effects_rejected: rejected,
+        effects_applicable: Vec::new(),
         effects_not_applicable: EffectId::ALL
             .iter()
             .filter(|e| !BENCH_EFFECTS.contains(e))

@@ -3,6 +3,9 @@
 //! channels, the weighted output error and the NRMSE per channel.
 
 use super::*;
+use hydrocyl_system::rig;
+use hydrocyl_system::simulation::Simulation;
+use serde_json::Value;
 /// The channels compared, in report order.
 pub(super) const CHANNELS: [Signal; 4] =
     [Signal::Position, Signal::Velocity, Signal::P1, Signal::P2];
@@ -133,45 +136,61 @@ pub(super) fn prepare(
 
 /// Sets the rig's initial state from the record: measured position, velocity
 /// and chamber pressures at the first sample (the steady pressures of the
-/// rig when p1/p2 are not measured), spool at the first command.
-pub(super) fn with_initial(rig: &ValveRig, p: &Prepared) -> ValveRig {
+/// rig when p1/p2 are not measured), spool at the first command (or the
+/// controller's output at the first sample).
+pub(super) fn with_initial(rig: &Model, p: &Prepared) -> Model {
     let mut r = rig.clone();
     if let Some(x0) = p.x0 {
-        let half = 0.5 * r.cylinder.stroke_m;
-        r.initial.position = x0.clamp(-half, half);
+        let half = 0.5 * r.stroke();
+        r.set_x0(x0.clamp(-half, half));
     }
     if let Some(v0) = p.v0 {
-        r.initial.velocity = v0;
+        r.set_v0(v0);
     }
-    let u0 = match (p.command0, &r.controller) {
+    let ctrl = r.roles.controller.clone();
+    let u0 = match (p.command0, &ctrl) {
         (Some(u), _) => u,
-        (None, Some(c)) => (c.gain_per_m * (p.input[0] - r.initial.position) + c.bias)
-            .clamp(c.output_min, c.output_max),
+        (None, Some(c)) => {
+            let q = |k: &str, d: f64| r.param(c, k).unwrap_or(d);
+            (q("gain", 0.0) * (p.input[0] - r.x0()) + q("bias", 0.0))
+                .clamp(q("output_min", -1.0), q("output_max", 1.0))
+        }
         (None, None) => 0.0,
     };
-    r.initial.spool = (u0 * r.valve.stroke_m).clamp(-r.valve.stroke_m, r.valve.stroke_m);
-    r.initial.p1 = p.p10;
-    r.initial.p2 = p.p20;
+    if let Some(s) = r.roles.spool.clone() {
+        let xm = r.spool_stroke();
+        r.set_param(&s, "initial.position", Value::from((u0 * xm).clamp(-xm, xm)));
+    }
+    if r.roles.cylinder_type == "cylinder" {
+        let c = r.roles.cylinder.clone();
+        r.set_param(&c, "initial.p1", p.p10.map_or(Value::Null, Value::from));
+        r.set_param(&c, "initial.p2", p.p20.map_or(Value::Null, Value::from));
+    }
     r
 }
 
 /// Simulates and returns, per measured channel, the simulated series.
 ///
 /// `sensor_lag` is applied here as a measurement model on the simulated
-/// samples ([`lag_samples`]) rather than by the rig's sensor states: the rig
-/// is run with ideal sensors. A lag state with τ far below the integrator's
+/// samples ([`lag_samples`]) rather than by sensor states: the rig is run
+/// with ideal sensors. A lag state with τ far below the integrator's
 /// step makes the system stiff (the fit's first finite-difference steps
 /// start from τ = 0), and the sampled filter is smooth in τ down to 0. On
 /// 1 kHz records of this rig the two agree to well under the sensor noise
 /// (the planted `sensor_lag` test generates its record with the states).
-pub(super) fn simulate(rig: &ValveRig, p: &Prepared) -> Result<Vec<Vec<f64>>, String> {
+pub(super) fn simulate(rig: &Model, p: &Prepared) -> Result<Vec<Vec<f64>>, String> {
     simulate_prefix(rig, p, p.t.len())
 }
 
 /// [`simulate`] over the first `n` samples only (the training part needs no
 /// more; at least two samples are simulated).
+///
+/// The circuit is assembled once. At a stop restart (`stops`) the next
+/// segment starts from the last state of the one before with the piston
+/// put on the stop at rest: every other state — spool, chambers, lines,
+/// pump, bristles, the controller's integral — carries on.
 pub(super) fn simulate_prefix(
-    rig: &ValveRig,
+    rig: &Model,
     p: &Prepared,
     n: usize,
 ) -> Result<Vec<Vec<f64>>, String> {
@@ -182,14 +201,18 @@ pub(super) fn simulate_prefix(
         rtol: p.rtol,
         ..RunOptions::default()
     };
-    let tau = rig.sensors.pressure_lag_s;
+    let tau = rig.lag;
     if !(tau.is_finite() && tau >= 0.0) {
         return Err(format!(
-            "sensors.pressure_lag_s must be finite and non-negative, got {tau}"
+            "the sensor lag must be finite and non-negative, got {tau}"
         ));
     }
-    let mut seg = rig.clone();
-    seg.sensors.pressure_lag_s = 0.0;
+    let circuit = rig::circuit(&rig.net, cmd).map_err(|e| e.to_string())?;
+    let names = circuit.state_names();
+    let load = &rig.roles.load;
+    let at = |s: &str| names.iter().position(|n| *n == format!("{load}.{s}"));
+    let (kx, kv) = (at("x"), at("v"));
+    let mut sim = Simulation::of_circuit(circuit).options(opts);
     let mut out: Vec<Vec<f64>> = vec![Vec::with_capacity(n); p.meas.len()];
     // One segment per stretch between restarts at stop exits (`stops`).
     let mut cuts = p
@@ -201,9 +224,7 @@ pub(super) fn simulate_prefix(
     loop {
         let next = cuts.next();
         let b = next.map_or(n - 1, |r| r.index);
-        let run = seg
-            .simulate(cmd.clone(), &t[a..=b], &opts)
-            .map_err(|e| e.to_string())?;
+        let run = sim.run(&t[a..=b]).map_err(|e| e.to_string())?;
         // the restart sample belongs to the next segment
         let keep = if next.is_some() { b - a } else { b - a + 1 };
         for (o, (ch, _)) in out.iter_mut().zip(&p.meas) {
@@ -213,13 +234,12 @@ pub(super) fn simulate_prefix(
             o.extend_from_slice(&v[..keep]);
         }
         let Some(r) = next else { break };
-        let last = |name: &str| run.channel(name).and_then(|v| v.last().copied());
-        let xm = seg.valve.stroke_m;
-        seg.initial.position = r.position;
-        seg.initial.velocity = 0.0;
-        seg.initial.spool = last("spool").unwrap_or(0.0).clamp(-xm, xm);
-        seg.initial.p1 = last("p1");
-        seg.initial.p2 = last("p2");
+        let mut x = run.state(run.time.len() - 1).to_vec();
+        if let (Some(kx), Some(kv)) = (kx, kv) {
+            x[kx] = r.position;
+            x[kv] = 0.0;
+        }
+        sim = sim.initial_state(x);
         a = b;
     }
     if tau > 0.0 {
@@ -266,7 +286,7 @@ pub(super) enum Part {
 }
 
 pub(super) fn residual(
-    rig: &ValveRig,
+    rig: &Model,
     p: &Prepared,
     holdout: f64,
     part: Part,
@@ -296,7 +316,7 @@ pub(super) fn residual(
     Ok(())
 }
 
-pub(super) fn rss(rig: &ValveRig, p: &Prepared, holdout: f64, part: Part) -> f64 {
+pub(super) fn rss(rig: &Model, p: &Prepared, holdout: f64, part: Part) -> f64 {
     let mut r = Vec::new();
     match residual(rig, p, holdout, part, &mut r) {
         Ok(()) => r.iter().map(|v| v * v).sum(),
@@ -304,7 +324,7 @@ pub(super) fn rss(rig: &ValveRig, p: &Prepared, holdout: f64, part: Part) -> f64
     }
 }
 
-pub(super) fn channel_nrmse(rig: &ValveRig, p: &Prepared) -> BTreeMap<String, f64> {
+pub(super) fn channel_nrmse(rig: &Model, p: &Prepared) -> BTreeMap<String, f64> {
     simulate(rig, p).map_or_else(|_| BTreeMap::new(), |sims| nrmse_of(p, &sims))
 }
 

@@ -199,6 +199,9 @@ pub struct Report {
     pub wall_times_s: BTreeMap<String, f64>,
     /// Wall time of the loop \[s\].
     pub elapsed_s: f64,
+    /// Simulations of the rig the diagnosis ran (whole or part of the
+    /// record; 0 for the friction bench, whose fit is its inverse model).
+    pub simulations: usize,
 }
 
 /// Wall time per stage of the loop, for the report.

@@ -620,6 +620,7 @@ pub fn diagnose_rig_traced(
         ),
         wall_times_s: clock.finish(),
         elapsed_s: start.elapsed().as_secs_f64(),
+        simulations: p.count.load(std::sync::atomic::Ordering::Relaxed),
     };
     Ok(ValveOutcome {
         report,

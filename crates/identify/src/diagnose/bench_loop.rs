@@ -583,6 +583,7 @@ pub fn diagnose_bench(
         effects_added: added,
         effects_rejected: rejected,
         effects_applicable: Vec::new(),
+        simulations: 0,
         effects_not_applicable: EffectId::ALL
             .iter()
             .filter(|e| !BENCH_EFFECTS.contains(e))

@@ -230,6 +230,7 @@ pub(super) fn delay_probe(rig: &Model, p: &Prepared, holdout: f64) -> Option<Pro
             p10: p.p10,
             p20: p.p20,
             restarts: p.restarts.clone(),
+            count: p.count.clone(),
         };
         q.input[0] = p.input[0];
         let r = rss(rig, &q, holdout, Part::All);

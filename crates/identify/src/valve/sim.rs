@@ -39,6 +39,8 @@ pub(super) struct Prepared {
     pub(super) p20: Option<f64>,
     /// Restarts of the simulation where the measured piston leaves a stop.
     pub(super) restarts: Vec<stops::Restart>,
+    /// Simulations run so far (shared by every copy).
+    pub(super) count: std::sync::Arc<std::sync::atomic::AtomicUsize>,
 }
 
 pub(super) fn prepare(
@@ -121,6 +123,7 @@ pub(super) fn prepare(
             p10,
             p20,
             restarts,
+            count: Default::default(),
             t,
             input,
             closed,
@@ -207,6 +210,8 @@ pub(super) fn simulate_prefix(
             "the sensor lag must be finite and non-negative, got {tau}"
         ));
     }
+    p.count
+        .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let circuit = rig::circuit(&rig.net, cmd).map_err(|e| e.to_string())?;
     let names = circuit.state_names();
     let load = &rig.roles.load;

@@ -3,6 +3,7 @@
 //! and on the valve rig.
 
 mod checks;
+mod hybrid;
 mod closed_loop;
 mod planted;
 mod valve;

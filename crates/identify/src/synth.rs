@@ -453,11 +453,14 @@ pub fn valve_record_closed_loop(
     };
     let mut integral = 0.0;
     let mut u = Vec::with_capacity(r.len());
-    for (k, (r, x)) in r.iter().zip(x).enumerate() {
-        let e = r - x;
-        u.push(law.output(e, integral));
-        let h = rec.time.get(k + 1).map_or(0.0, |t1| t1 - rec.time[k]);
-        integral += h * law.integral_rate(e, integral);
+    // trapezoidal integral of the error between samples
+    let e: Vec<f64> = r.iter().zip(x).map(|(r, x)| r - x).collect();
+    for k in 0..e.len() {
+        u.push(law.output(e[k], integral));
+        if let (Some(t1), Some(e1)) = (rec.time.get(k + 1), e.get(k + 1)) {
+            let rate = law.integral_rate(0.5 * (e[k] + e1), integral);
+            integral += (t1 - rec.time[k]) * rate;
+        }
     }
     rec.signals.insert(Signal::Command, u);
     rec.signals.insert(Signal::Reference, r);

@@ -341,3 +341,92 @@ pub(super) fn nrmse_of(p: &Prepared, sims: &[Vec<f64>]) -> BTreeMap<String, f64>
         .map(|((ch, meas), s)| (ch.name().to_string(), nrmse(meas, s)))
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::Record;
+    use std::collections::BTreeMap;
+
+    /// A PI-controlled piston driven onto its extending stop (reference
+    /// beyond it) rests there while the integral winds up to the output
+    /// limit; when the reference comes back, the integral holds the piston
+    /// on the stop until it unwinds. The loop restarts the simulation in the
+    /// middle of the rest: with every state carried on (the integral among
+    /// them) the restarted run is the uninterrupted one; with the integral
+    /// reset (as before) the restarted controller leaves the stop at once.
+    #[test]
+    fn a_stop_restart_carries_the_pi_integral() {
+        let v = hydrocyl_system::rig::preset("leaney-moog-closed-loop").unwrap();
+        let mut m = Model::new(&v).unwrap();
+        let c = m.roles.controller.clone().unwrap();
+        m.set_param(&c, "integral_time", Value::from(0.5));
+        let half = 0.5 * m.stroke();
+        m.set_x0(half - 0.02);
+        let t: Vec<f64> = (0..3000).map(|k| k as f64 * 1e-3).collect();
+        let r: Vec<f64> = t
+            .iter()
+            .map(|&t| if t < 1.5 { half + 0.04 } else { half - 0.06 })
+            .collect();
+        let cmd = CmdSignal::table(t.clone(), r.clone()).unwrap();
+        let opts = RunOptions {
+            rtol: 1e-8,
+            ..RunOptions::default()
+        };
+        let truth = rig::simulate(&m.net, cmd, &t, &opts).unwrap();
+        let ch = |n: &str| truth.channel(n).unwrap().to_vec();
+        let mut signals = BTreeMap::new();
+        for (s, n) in [
+            (Signal::Position, "position"),
+            (Signal::P1, "p1"),
+            (Signal::P2, "p2"),
+            (Signal::Command, "command"),
+        ] {
+            signals.insert(s, ch(n));
+        }
+        signals.insert(Signal::Reference, r);
+        let rec = Record {
+            source: "pi".into(),
+            time: t.clone(),
+            signals,
+            ignored: vec![],
+        };
+        let (mut p, _) = prepare(&rec, None, &[], m.stroke()).unwrap();
+        p.rtol = 1e-8;
+        assert_eq!(p.restarts.len(), 1, "one rest on the stop");
+        let k = p.restarts[0].index;
+        let x = ch("position");
+        let u = ch("command");
+        // the integral at the restart is what holds the piston there
+        let names = rig::circuit(&m.net, CmdSignal::Constant { value: 0.0 })
+            .unwrap()
+            .state_names();
+        let ki = names.iter().position(|n| *n == format!("{c}.integral")).unwrap();
+        let i_rest = truth.state(k)[ki];
+        assert!(i_rest > 0.02, "integral at the restart {i_rest} m s");
+        let sims = simulate(&m, &p).unwrap();
+        let (sx, su) = (&sims[0], &sims[4]);
+        assert_eq!(p.meas[0].0, Signal::Position);
+        assert_eq!(p.meas[4].0, Signal::Command);
+        let dx = (k..x.len()).map(|i| (sx[i] - x[i]).abs()).fold(0.0, f64::max);
+        let du = (k..u.len()).map(|i| (su[i] - u[i]).abs()).fold(0.0, f64::max);
+        assert!(dx < 1e-5 && du < 1e-3, "after the restart: |dx| {dx} m, |du| {du}");
+        // the same restart with the integral zeroed leaves the stop early
+        let mut zero = m.clone();
+        zero.set_param(&c, "integral_time", Value::from(0.5));
+        let mut q = p.clone();
+        q.restarts.clear();
+        let from = truth.state(k).to_vec();
+        let mut x0 = from.clone();
+        x0[ki] = 0.0;
+        let circuit = rig::circuit(&zero.net, CmdSignal::table(t.clone(), p.input.clone()).unwrap()).unwrap();
+        let run = Simulation::of_circuit(circuit)
+            .options(opts)
+            .initial_state(x0)
+            .run(&t[k..])
+            .unwrap();
+        let xr = run.channel("position").unwrap();
+        let d0 = xr.iter().zip(&x[k..]).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(d0 > 1e-3, "a reset integral departs by {d0} m");
+    }
+}

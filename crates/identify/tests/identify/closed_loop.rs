@@ -155,29 +155,3 @@ fn an_internal_leak_is_found_under_a_pi_controller() {
     eprintln!("{}", r.human());
     check_found(&r, id, n, v);
 }
-
-/// A PI-controlled piston driven onto its extending stop (reference beyond
-/// it) rests there while the integral winds up to the output limit; when
-/// the reference comes back, the integral keeps the piston on the stop
-/// until it unwinds. The simulation restarts at the rest (`stops`): the
-/// integral must carry over, or the restarted controller leaves the stop at
-/// once and the simulated position and command part from the record.
-#[test]
-fn the_pi_integral_survives_a_stop_restart() {
-    let truth = declared_pi();
-    let half = 0.5 * truth.cylinder.stroke_m;
-    let reference = move |t: f64| if t < 1.5 { half + 0.04 } else { half - 0.06 };
-    let mut t = truth.clone();
-    t.initial.position = half - 0.02;
-    let rec = valve_record_closed_loop(&t, 3000, 1e-3, 87, &reference).unwrap();
-    let x = rec.get(hydrocyl_identify::data::Signal::Position).unwrap();
-    let on_stop = x.iter().filter(|x| (*x - half).abs() < 1e-4).count();
-    assert!(on_stop > 500, "the piston rests on the stop: {on_stop} samples");
-    let r = diagnose_valve(&truth, &rec, &DiagnoseOptions::default(), &mut |_, _, _| {}).unwrap();
-    eprintln!("{}", r.human());
-    assert!(ids(&r).is_empty(), "{}", r.human());
-    for (ch, floor) in r.noise_floor.iter().filter(|(_, f)| **f > 0.0) {
-        let before = &r.nrmse_before[ch];
-        assert!(*before <= 1.5 * floor, "{ch}: {before} vs {floor}\n{}", r.human());
-    }
-}

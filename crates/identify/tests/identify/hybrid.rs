@@ -91,8 +91,8 @@ fn an_external_force_is_found_on_the_hybrid_rig() {
 
 #[test]
 fn an_additive_pressure_viscous_term_is_found_on_the_hybrid_rig() {
-    // on top of Wang's own seal terms: 2e-8 m³·s/N is ~50 N at 5 MPa and
-    // 40 mm/s... at this record's pressures, a term of some 10-40 N
+    // on top of Wang's own seal terms, bounded like them at the preset's
+    // seal.dp_max = 0.5 MPa: up to 2e-8 (5e5)² 0.04 = 200 N at 40 mm/s
     let r = diagnose(&record(&[(EffectId::PressureViscous, "K", 2e-8)], 94));
     eprintln!("{}", r.human());
     check_found(&r, EffectId::PressureViscous, "K", 2e-8);

@@ -480,8 +480,8 @@ pub fn netlist_record(
 ) -> Result<Record, String> {
     let t: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
     let u: Vec<f64> = t.iter().map(|&t| command(t)).collect();
-    let cmd = hydrocyl_system::signal::Signal::table(t.clone(), u.clone())
-        .map_err(|e| e.to_string())?;
+    let cmd =
+        hydrocyl_system::signal::Signal::table(t.clone(), u.clone()).map_err(|e| e.to_string())?;
     let run = hydrocyl_system::rig::simulate(
         truth,
         cmd,

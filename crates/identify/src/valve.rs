@@ -56,8 +56,8 @@ mod stops;
 
 use effects::*;
 pub use effects::{is_on, rig_facts};
-pub use model::Model;
 use fit::*;
+pub use model::Model;
 pub use sim::lag_samples;
 use sim::*;
 
@@ -469,8 +469,7 @@ pub fn diagnose_rig_traced(
             p: &p,
             holdout: opts.holdout,
         };
-        let mut accepted: Option<(EffectId, Model, EffectReport, ParamList, lm::LmResult)> =
-            None;
+        let mut accepted: Option<(EffectId, Model, EffectReport, ParamList, lm::LmResult)> = None;
         for (id, _, _) in eligible.iter().skip(MAX_REFITS_PER_ROUND) {
             if let Some(r) = last.get_mut(id) {
                 r.reason = Some(format!(
@@ -694,7 +693,11 @@ mod tests {
         // the bulk modulus reaches the chambers and both lines
         assert_eq!(
             hybrid.paths_of(EffectId::BulkModulus),
-            ["cylinder.bulk_modulus", "line_1.bulk_modulus", "line_2.bulk_modulus"]
+            [
+                "cylinder.bulk_modulus",
+                "line_1.bulk_modulus",
+                "line_2.bulk_modulus"
+            ]
         );
         // the pump's gain is scaled by kw
         let mut h = hybrid.clone();
@@ -716,7 +719,11 @@ mod tests {
         assert!(!on(&r, EffectId::CoulombAsymmetry) && !on(&r, EffectId::Stribeck));
         set(&mut r, EffectId::CoulombAsymmetry, "dFc", 0.0);
         set(&mut r, EffectId::Stribeck, "Fs", 0.0);
-        assert!(matches!(r.friction, FrictionLaw::Stribeck(_)), "{:?}", r.friction);
+        assert!(
+            matches!(r.friction, FrictionLaw::Stribeck(_)),
+            "{:?}",
+            r.friction
+        );
         for v in vs {
             assert!(
                 (force(&cv, v) - force(&r.friction, v)).abs() < 1e-12,

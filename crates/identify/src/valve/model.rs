@@ -252,7 +252,10 @@ impl Model {
             cylinder_type: type_of(net, &cylinder).unwrap_or_default(),
             cylinder,
             load,
-            spool: first_of(net, &["servo_spool_first_order", "servo_spool_second_order"]),
+            spool: first_of(
+                net,
+                &["servo_spool_first_order", "servo_spool_second_order"],
+            ),
             controller: first_of(net, &["position_controller"]),
             friction: first_of(net, &FRICTION_TYPES),
             declared: net.clone(),
@@ -381,7 +384,8 @@ impl Model {
 
     /// The cylinder's stroke \[m\].
     pub fn stroke(&self) -> f64 {
-        self.param(&self.roles.cylinder, "stroke").unwrap_or(f64::NAN)
+        self.param(&self.roles.cylinder, "stroke")
+            .unwrap_or(f64::NAN)
     }
 
     /// The spool stroke \[m\] (0 without a servo spool).

@@ -162,7 +162,11 @@ pub(super) fn with_initial(rig: &Model, p: &Prepared) -> Model {
     };
     if let Some(s) = r.roles.spool.clone() {
         let xm = r.spool_stroke();
-        r.set_param(&s, "initial.position", Value::from((u0 * xm).clamp(-xm, xm)));
+        r.set_param(
+            &s,
+            "initial.position",
+            Value::from((u0 * xm).clamp(-xm, xm)),
+        );
     }
     if r.roles.cylinder_type == "cylinder" {
         let c = r.roles.cylinder.clone();
@@ -210,8 +214,7 @@ pub(super) fn simulate_prefix(
             "the sensor lag must be finite and non-negative, got {tau}"
         ));
     }
-    p.count
-        .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    p.count.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let circuit = rig::circuit(&rig.net, cmd).map_err(|e| e.to_string())?;
     let names = circuit.state_names();
     let load = &rig.roles.load;
@@ -401,32 +404,46 @@ mod tests {
         let names = rig::circuit(&m.net, CmdSignal::Constant { value: 0.0 })
             .unwrap()
             .state_names();
-        let ki = names.iter().position(|n| *n == format!("{c}.integral")).unwrap();
+        let ki = names
+            .iter()
+            .position(|n| *n == format!("{c}.integral"))
+            .unwrap();
         let i_rest = truth.state(k)[ki];
         assert!(i_rest > 0.02, "integral at the restart {i_rest} m s");
         let sims = simulate(&m, &p).unwrap();
         let (sx, su) = (&sims[0], &sims[4]);
         assert_eq!(p.meas[0].0, Signal::Position);
         assert_eq!(p.meas[4].0, Signal::Command);
-        let dx = (k..x.len()).map(|i| (sx[i] - x[i]).abs()).fold(0.0, f64::max);
-        let du = (k..u.len()).map(|i| (su[i] - u[i]).abs()).fold(0.0, f64::max);
-        assert!(dx < 1e-5 && du < 1e-3, "after the restart: |dx| {dx} m, |du| {du}");
+        let dx = (k..x.len())
+            .map(|i| (sx[i] - x[i]).abs())
+            .fold(0.0, f64::max);
+        let du = (k..u.len())
+            .map(|i| (su[i] - u[i]).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            dx < 1e-5 && du < 1e-3,
+            "after the restart: |dx| {dx} m, |du| {du}"
+        );
         // the same restart with the integral zeroed leaves the stop early
-        let mut zero = m.clone();
-        zero.set_param(&c, "integral_time", Value::from(0.5));
-        let mut q = p.clone();
-        q.restarts.clear();
         let from = truth.state(k).to_vec();
         let mut x0 = from.clone();
         x0[ki] = 0.0;
-        let circuit = rig::circuit(&zero.net, CmdSignal::table(t.clone(), p.input.clone()).unwrap()).unwrap();
+        let circuit = rig::circuit(
+            &m.net,
+            CmdSignal::table(t.clone(), p.input.clone()).unwrap(),
+        )
+        .unwrap();
         let run = Simulation::of_circuit(circuit)
             .options(opts)
             .initial_state(x0)
             .run(&t[k..])
             .unwrap();
         let xr = run.channel("position").unwrap();
-        let d0 = xr.iter().zip(&x[k..]).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        let d0 = xr
+            .iter()
+            .zip(&x[k..])
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
         assert!(d0 > 1e-3, "a reset integral departs by {d0} m");
     }
 }

@@ -30,7 +30,13 @@ fn record(planted: &[(EffectId, &str, f64)], seed: u64) -> Record {
 }
 
 fn diagnose(rec: &Record) -> Report {
-    diagnose_rig(&declared(), rec, &DiagnoseOptions::default(), &mut |_, _, _| {}).unwrap()
+    diagnose_rig(
+        &declared(),
+        rec,
+        &DiagnoseOptions::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap()
 }
 
 fn ids(r: &Report) -> Vec<&str> {
@@ -49,7 +55,11 @@ fn check_found(r: &Report, id: EffectId, name: &str, value: f64) {
     );
     for (ch, floor) in r.noise_floor.iter().filter(|(_, f)| **f > 0.0) {
         let after = &r.nrmse_after[ch];
-        assert!(*after <= 1.5 * floor, "{ch}: {after} vs floor {floor}\n{}", r.human());
+        assert!(
+            *after <= 1.5 * floor,
+            "{ch}: {after} vs floor {floor}\n{}",
+            r.human()
+        );
     }
 }
 
@@ -58,8 +68,17 @@ fn a_clean_hybrid_record_finds_nothing_and_says_what_applies() {
     let r = diagnose(&record(&[], 91));
     eprintln!("{}", r.human());
     assert!(ids(&r).is_empty(), "{}", r.human());
-    let na: Vec<&str> = r.effects_not_applicable.iter().map(|e| e.id.as_str()).collect();
-    for id in ["valve_null_bias", "supply_droop", "valve_dead_band", "stribeck"] {
+    let na: Vec<&str> = r
+        .effects_not_applicable
+        .iter()
+        .map(|e| e.id.as_str())
+        .collect();
+    for id in [
+        "valve_null_bias",
+        "supply_droop",
+        "valve_dead_band",
+        "stribeck",
+    ] {
         assert!(na.contains(&id), "{id} should not apply: {na:?}");
     }
     let why = &r
@@ -70,7 +89,12 @@ fn a_clean_hybrid_record_finds_nothing_and_says_what_applies() {
         .why;
     assert!(why.contains("four_way_valve"), "{why}");
     let ap: Vec<&str> = r.effects_applicable.iter().map(|e| e.id.as_str()).collect();
-    for id in ["internal_leakage", "external_force", "pressure_viscous", "flow_gain_error"] {
+    for id in [
+        "internal_leakage",
+        "external_force",
+        "pressure_viscous",
+        "flow_gain_error",
+    ] {
         assert!(ap.contains(&id), "{id} should apply: {ap:?}");
     }
 }

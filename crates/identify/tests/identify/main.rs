@@ -3,7 +3,7 @@
 //! and on the valve rig.
 
 mod checks;
-mod hybrid;
 mod closed_loop;
+mod hybrid;
 mod planted;
 mod valve;

@@ -39,29 +39,7 @@ fn diagnose(rec: &Record) -> Report {
     .unwrap()
 }
 
-fn ids(r: &Report) -> Vec<&str> {
-    r.effects_added.iter().map(|e| e.id.as_str()).collect()
-}
-
-fn check_found(r: &Report, id: EffectId, name: &str, value: f64) {
-    assert_eq!(ids(r), [id.id()], "{}", r.human());
-    let e = &r.effects_added[0];
-    assert!(
-        (e.params[name] - value).abs() <= e.ci95[name].unwrap(),
-        "{name} = {} ± {:?}, planted {value}\n{}",
-        e.params[name],
-        e.ci95[name],
-        r.human()
-    );
-    for (ch, floor) in r.noise_floor.iter().filter(|(_, f)| **f > 0.0) {
-        let after = &r.nrmse_after[ch];
-        assert!(
-            *after <= 1.5 * floor,
-            "{ch}: {after} vs floor {floor}\n{}",
-            r.human()
-        );
-    }
-}
+use crate::{check_found, ids};
 
 #[test]
 fn a_clean_hybrid_record_finds_nothing_and_says_what_applies() {

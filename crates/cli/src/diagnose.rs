@@ -9,9 +9,8 @@ use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_identify::catalog::EffectId;
 use hydrocyl_identify::data::{ColumnMap, Record};
 use hydrocyl_identify::diagnose::{diagnose_bench, DiagnoseOptions, RecordTrace};
-use hydrocyl_identify::valve::diagnose_valve_traced;
+use hydrocyl_identify::valve::{diagnose_rig_traced, Model};
 use hydrocyl_system::rig::valve_rig_from;
-use hydrocyl_system::valve_rig::ValveRig;
 
 use crate::error::CliError;
 use crate::output::Outputs;
@@ -60,7 +59,17 @@ pub struct Args {
 /// A rig `diagnose` can run.
 enum Rig {
     Bench(FrictionBench),
-    Valve(Box<ValveRig>),
+    /// Any netlist with a cylinder on a mass (the valve rig, the hybrid rig,
+    /// a user's circuit), or a `valve-cylinder` rig file as its netlist.
+    Net(Box<Model>),
+}
+
+fn net_rig(v: &serde_json::Value) -> Result<Model, String> {
+    if v.get("kind").and_then(|k| k.as_str()) == Some(hydrocyl_system::valve_rig::KIND) {
+        let r = valve_rig_from(v).map_err(|e| e.to_string())?;
+        return Model::from_valve_rig(&r);
+    }
+    Model::new(v)
 }
 
 fn load_rig(spec: &str) -> Result<Rig, CliError> {
@@ -69,12 +78,12 @@ fn load_rig(spec: &str) -> Result<Rig, CliError> {
     }
     let unsupported = |e: &dyn std::fmt::Display| {
         CliError::Input(format!(
-            "--rig {spec}: not supported for this rig kind (diagnose takes the valve-cylinder circuit or a friction bench): {e}"
+            "--rig {spec}: not supported for this rig kind (diagnose takes a netlist with a `cylinder` on a `mass`, a valve-cylinder rig file or a friction bench): {e}"
         ))
     };
     if let Some(v) = hydrocyl_system::rig::preset(spec) {
-        return valve_rig_from(&v)
-            .map(|r| Rig::Valve(Box::new(r)))
+        return net_rig(&v)
+            .map(|r| Rig::Net(Box::new(r)))
             .map_err(|e| unsupported(&e));
     }
     if !Path::new(spec).exists() {
@@ -89,13 +98,14 @@ fn load_rig(spec: &str) -> Result<Rig, CliError> {
         k if k == bench::KIND => FrictionBench::from_json(&v.to_string())
             .map(Rig::Bench)
             .map_err(|e| CliError::Input(format!("{spec}: {e}"))),
-        // a valve-cylinder file is read as its netlist (rig::load)
-        hydrocyl_system::netlist::KIND => valve_rig_from(&v)
-            .map(|r| Rig::Valve(Box::new(r)))
-            .map_err(|e| crate::rigfile::locate(e, spec)),
+        // an older rig kind (`valve-cylinder`) is read as its netlist (rig::load)
+        k if k == hydrocyl_system::netlist::KIND => net_rig(&v)
+            .map(|r| Rig::Net(Box::new(r)))
+            .map_err(|e| unsupported(&e)),
         k => Err(unsupported(&format!(
-            "kind '{k}' (kinds: {}, {})",
+            "kind '{k}' (kinds: {}, {}, {})",
             bench::KIND,
+            hydrocyl_system::netlist::KIND,
             hydrocyl_system::valve_rig::KIND
         ))),
     }
@@ -151,7 +161,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let columns = match &rig {
         Rig::Bench(b) => b.columns.clone(),
-        Rig::Valve(_) => ColumnMap::default(),
+        Rig::Net(_) => ColumnMap::default(),
     };
     let records = args
         .data
@@ -185,14 +195,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 .map_err(|e| CliError::Input(e.to_string()))?;
             (o.report, o.traces)
         }
-        Rig::Valve(v) => {
+        Rig::Net(v) => {
             if records.len() != 1 {
                 return Err(CliError::Input(format!(
-                    "--data: the valve rig is diagnosed on one record at a time ({} given)",
+                    "--data: a circuit rig is diagnosed on one record at a time ({} given)",
                     records.len()
                 )));
             }
-            let o = diagnose_valve_traced(v, &records[0], &opts, &mut progress)
+            let o = diagnose_rig_traced(v, &records[0], &opts, &mut progress)
                 .map_err(|e| CliError::Input(e.to_string()))?;
             (o.report, o.traces)
         }

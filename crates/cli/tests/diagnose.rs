@@ -199,7 +199,15 @@ fn valve_rig_finds_the_planted_leak() {
     assert!(out.stdout.is_empty(), "--quiet printed");
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
-    assert_eq!(json["rig_kind"], "valve-cylinder");
+    assert_eq!(json["rig_kind"], "netlist");
+    // where each effect acts, as `<component>.<parameter>` paths
+    let leak = json["effects_applicable"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["id"] == "internal_leakage")
+        .unwrap();
+    assert_eq!(leak["paths"][0], "cylinder.internal_leakage");
     assert_eq!(json["effects_added"][0]["id"], "internal_leakage");
     for ch in ["position", "velocity", "p1", "p2"] {
         assert!(json["nrmse_before"][ch].is_number(), "{ch}");

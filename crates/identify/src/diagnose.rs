@@ -113,6 +113,16 @@ pub struct EffectReport {
     pub reason: Option<String>,
 }
 
+/// An effect that applies to the rig, and where it acts.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Applicable {
+    /// Effect id.
+    pub id: String,
+    /// The `<component>.<parameter>` paths it writes (`<friction> (law)` for
+    /// an edit of the friction law; none for the sensor model).
+    pub paths: Vec<String>,
+}
+
 /// A catalog effect not tried on a rig, and why.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct NotApplicable {
@@ -171,6 +181,9 @@ pub struct Report {
     pub effects_rejected: Vec<EffectReport>,
     /// Catalog effects not tried on this rig, each with the reason.
     pub effects_not_applicable: Vec<NotApplicable>,
+    /// The effects that apply to the rig, with the `<component>.<parameter>`
+    /// paths each one writes (netlist rigs; empty for the friction bench).
+    pub effects_applicable: Vec<Applicable>,
     /// Residual sum of squares after, as a share of before.
     pub unexplained_share: f64,
     /// An out-of-catalog shape the unexplained residual resembles, if a probe
@@ -186,6 +199,9 @@ pub struct Report {
     pub wall_times_s: BTreeMap<String, f64>,
     /// Wall time of the loop \[s\].
     pub elapsed_s: f64,
+    /// Simulations of the rig the diagnosis ran (whole or part of the
+    /// record; 0 for the friction bench, whose fit is its inverse model).
+    pub simulations: usize,
 }
 
 /// Wall time per stage of the loop, for the report.

@@ -424,7 +424,9 @@ pub fn valve_reference(t: f64) -> f64 {
 /// simulated on `reference` \[m\] for `n` samples at `dt` (rtol 1e-8),
 /// position noise 20 µm and pressure noise 20 kPa; the recorded `command`
 /// is the controller's law applied to the reference and the *measured*
-/// (noisy) position, as a real controller computes it.
+/// (noisy) position, as a real controller computes it (a PI controller's
+/// integral summed over the samples, held while the output is clipped and
+/// the error pushes it further out).
 pub fn valve_record_closed_loop(
     truth: &hydrocyl_system::valve_rig::ValveRig,
     n: usize,
@@ -435,9 +437,6 @@ pub fn valve_record_closed_loop(
     let c = truth
         .controller
         .ok_or("the truth rig has no controller: a closed-loop record needs one")?;
-    if c.integral_time_s > 0.0 {
-        return Err("closed-loop records are generated for P controllers only".into());
-    }
     let mut rec = valve_record_with(truth, n, dt, seed, 0.0, reference)?;
     rec.source = "synthetic-valve-closed-loop".into();
     let r = rec
@@ -445,12 +444,72 @@ pub fn valve_record_closed_loop(
         .remove(&Signal::Command)
         .ok_or("no input column")?;
     let x = rec.signals.get(&Signal::Position).ok_or("no position")?;
-    let u = r
-        .iter()
-        .zip(x)
-        .map(|(r, x)| (c.gain_per_m * (r - x) + c.bias).clamp(c.output_min, c.output_max))
-        .collect();
+    let law = hydrocyl_system::components::PositionLaw {
+        gain: c.gain_per_m,
+        integral_time: c.integral_time_s,
+        bias: c.bias,
+        output_min: c.output_min,
+        output_max: c.output_max,
+    };
+    let mut integral = 0.0;
+    let mut u = Vec::with_capacity(r.len());
+    // trapezoidal integral of the error between samples
+    let e: Vec<f64> = r.iter().zip(x).map(|(r, x)| r - x).collect();
+    for k in 0..e.len() {
+        u.push(law.output(e[k], integral));
+        if let (Some(t1), Some(e1)) = (rec.time.get(k + 1), e.get(k + 1)) {
+            let rate = law.integral_rate(0.5 * (e[k] + e1), integral);
+            integral += (t1 - rec.time[k]) * rate;
+        }
+    }
     rec.signals.insert(Signal::Command, u);
     rec.signals.insert(Signal::Reference, r);
     Ok(rec)
+}
+
+/// Generates a record of any netlist rig `truth` driven by `command` (the
+/// run's input) for `n` samples at `dt` (rtol 1e-8, the default solver):
+/// columns `command`, `position` (noise 20 µm), `p1` and `p2` (noise
+/// 20 kPa), noise seeded by `seed`.
+pub fn netlist_record(
+    truth: &serde_json::Value,
+    n: usize,
+    dt: f64,
+    seed: u64,
+    command: &dyn Fn(f64) -> f64,
+) -> Result<Record, String> {
+    let t: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
+    let u: Vec<f64> = t.iter().map(|&t| command(t)).collect();
+    let cmd =
+        hydrocyl_system::signal::Signal::table(t.clone(), u.clone()).map_err(|e| e.to_string())?;
+    let run = hydrocyl_system::rig::simulate(
+        truth,
+        cmd,
+        &t,
+        &hydrocyl_system::run::RunOptions {
+            rtol: 1e-8,
+            ..hydrocyl_system::run::RunOptions::default()
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    let ch = |name: &str| -> Result<Vec<f64>, String> {
+        run.channel(name)
+            .map(<[f64]>::to_vec)
+            .ok_or_else(|| format!("no channel {name}"))
+    };
+    let noisy = |v: Vec<f64>, s: f64, k: u64| -> Vec<f64> {
+        let e = gaussian_noise(v.len(), seed.wrapping_add(k));
+        v.iter().zip(&e).map(|(a, e)| a + s * e).collect()
+    };
+    let mut signals = BTreeMap::new();
+    signals.insert(Signal::Command, u);
+    signals.insert(Signal::Position, noisy(ch("position")?, 2e-5, 0));
+    signals.insert(Signal::P1, noisy(ch("p1")?, 2e4, 1));
+    signals.insert(Signal::P2, noisy(ch("p2")?, 2e4, 2));
+    Ok(Record {
+        source: "synthetic-netlist".into(),
+        time: t,
+        signals,
+        ignored: vec![],
+    })
 }

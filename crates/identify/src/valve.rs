@@ -33,8 +33,6 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use hydrocyl_friction::{FrictionLaw, LuGre, SteadySet, Stribeck, StribeckCurve};
-use hydrocyl_ports::{Force, Velocity};
 use hydrocyl_system::run::RunOptions;
 use hydrocyl_system::signal::Signal as CmdSignal;
 use hydrocyl_system::valve_rig::ValveRig;
@@ -43,7 +41,8 @@ use crate::catalog::EffectId;
 use crate::data::{Record, Signal};
 use crate::data_checks::{check_record, ProblemKind, RigFacts};
 use crate::diagnose::{
-    nrmse, DiagnoseError, DiagnoseOptions, EffectReport, NotApplicable, Probe, RecordTrace, Report,
+    nrmse, Applicable, DiagnoseError, DiagnoseOptions, EffectReport, NotApplicable, Probe,
+    RecordTrace, Report,
 };
 use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, smooth_gcv, smooth_with};
@@ -51,50 +50,78 @@ use crate::smooth::{noise_sigma, smooth_gcv, smooth_with};
 mod accept;
 mod effects;
 mod fit;
+pub mod model;
 mod sim;
 mod stops;
 
 use effects::*;
-pub use effects::{get, is_on, rig_facts, set};
+pub use effects::{is_on, rig_facts};
 use fit::*;
+pub use model::Model;
 pub use sim::lag_samples;
 use sim::*;
+
+/// A rig whose catalog effects can be read and set: a [`Model`] (any
+/// netlist), or a `valve-cylinder` rig value (through its netlist).
+pub trait Effects {
+    /// Value of catalog parameter `name` of effect `id` (SI); `None` where
+    /// the rig has no component the effect acts on.
+    fn effect(&self, id: EffectId, name: &str) -> Option<f64>;
+    /// Sets catalog parameter `name` of effect `id` (nothing where the rig
+    /// has no component it acts on).
+    fn set_effect(&mut self, id: EffectId, name: &str, v: f64);
+}
+
+impl Effects for Model {
+    fn effect(&self, id: EffectId, name: &str) -> Option<f64> {
+        effects::read_effect(self, id, name)
+    }
+    fn set_effect(&mut self, id: EffectId, name: &str, v: f64) {
+        effects::write_effect(self, id, name, v);
+    }
+}
+
+impl Effects for ValveRig {
+    fn effect(&self, id: EffectId, name: &str) -> Option<f64> {
+        Model::from_valve_rig(self)
+            .ok()
+            .and_then(|m| m.effect(id, name))
+    }
+    /// Through the rig's netlist and back; a rig that does not convert
+    /// (it does not validate) is left as it is.
+    fn set_effect(&mut self, id: EffectId, name: &str, v: f64) {
+        if let Ok(mut m) = Model::from_valve_rig(self) {
+            m.set_effect(id, name, v);
+            if let Ok(r) = m.to_valve_rig() {
+                *self = r;
+            }
+        }
+    }
+}
+
+/// Value of catalog parameter `name` of effect `id` in `rig` (SI).
+pub fn get<R: Effects + ?Sized>(rig: &R, id: EffectId, name: &str) -> Option<f64> {
+    rig.effect(id, name)
+}
+
+/// Sets catalog parameter `name` of effect `id` in `rig`.
+pub fn set<R: Effects + ?Sized>(rig: &mut R, id: EffectId, name: &str, v: f64) {
+    rig.set_effect(id, name, v);
+}
 
 /// Most candidates refitted in one round of the loop (the best by traced
 /// share first); each refit is a full Levenberg–Marquardt fit.
 const MAX_REFITS_PER_ROUND: usize = 3;
 
-/// Effects the valve rig exposes as parameters.
-pub const VALVE_EFFECTS: [EffectId; 15] = [
-    EffectId::CoulombAsymmetry,
-    EffectId::Stribeck,
-    EffectId::PressureViscous,
-    EffectId::AccelerationFriction,
-    EffectId::LugreDynamics,
-    EffectId::ValveNullBias,
-    EffectId::FlowGainError,
-    EffectId::InternalLeakage,
-    EffectId::ExternalLeakage,
-    EffectId::BulkModulus,
-    EffectId::ExternalForce,
-    EffectId::Viscous,
-    EffectId::SupplyDroop,
-    EffectId::SensorLag,
-    EffectId::ValveDeadBand,
-];
-
-/// Why effect `id` is not tried on this valve rig.
-fn not_applicable_why(id: EffectId, rig: &ValveRig, opts: &DiagnoseOptions) -> String {
+/// Why effect `id` is not tried on this rig.
+fn not_applicable_why(id: EffectId, rig: &Model, opts: &DiagnoseOptions) -> String {
     if opts.candidates.as_ref().is_some_and(|c| !c.contains(&id)) {
         return "left out by --effects".into();
     }
-    if !VALVE_EFFECTS.contains(&id) {
-        return "not a parameter of the valve rig".into();
+    match rig.applies(id) {
+        Err(why) => why,
+        Ok(()) => "its parameters cannot be read on this rig".into(),
     }
-    format!(
-        "its parameters are not switchable on the declared friction law `{}` (coulomb-viscous, stribeck and lugre are)",
-        rig.friction.name()
-    )
 }
 
 /// Everything the loop on the valve rig produces: the report, the series for
@@ -107,7 +134,7 @@ pub struct ValveOutcome {
     /// Measured vs simulated before and after, per channel (SI units).
     pub traces: Vec<RecordTrace>,
     /// The final model: the declared rig with the added effects, refitted.
-    pub rig: ValveRig,
+    pub rig: Model,
 }
 
 /// Runs the loop on a valve-controlled rig and one record (command,
@@ -119,6 +146,28 @@ pub fn diagnose_valve(
     progress: &mut dyn FnMut(&str, usize, usize),
 ) -> Result<Report, DiagnoseError> {
     diagnose_valve_traced(declared, rec, opts, progress).map(|o| o.report)
+}
+
+/// [`diagnose_rig_traced`] on a `valve-cylinder` rig value (its netlist).
+pub fn diagnose_valve_traced(
+    declared: &ValveRig,
+    rec: &Record,
+    opts: &DiagnoseOptions,
+    progress: &mut dyn FnMut(&str, usize, usize),
+) -> Result<ValveOutcome, DiagnoseError> {
+    let m = Model::from_valve_rig(declared).map_err(DiagnoseError::Rig)?;
+    diagnose_rig_traced(&m, rec, opts, progress)
+}
+
+/// Runs the loop on any netlist rig with a cylinder on a mass (the valve
+/// rig, the hybrid rig, a user's circuit) and one record.
+pub fn diagnose_rig(
+    declared: &Model,
+    rec: &Record,
+    opts: &DiagnoseOptions,
+    progress: &mut dyn FnMut(&str, usize, usize),
+) -> Result<Report, DiagnoseError> {
+    diagnose_rig_traced(declared, rec, opts, progress).map(|o| o.report)
 }
 
 /// Measured, before and after series of every compared channel, from the
@@ -145,27 +194,30 @@ fn traces(rec: &Record, p: &Prepared, before: &[Vec<f64>], after: &[Vec<f64>]) -
         .collect()
 }
 
-/// [`diagnose_valve`], also returning the measured and simulated series
+/// [`diagnose_rig`], also returning the measured and simulated series
 /// before and after (the runs the report's NRMSEs come from) and the final rig.
-pub fn diagnose_valve_traced(
-    declared: &ValveRig,
+pub fn diagnose_rig_traced(
+    declared: &Model,
     rec: &Record,
     opts: &DiagnoseOptions,
     progress: &mut dyn FnMut(&str, usize, usize),
 ) -> Result<ValveOutcome, DiagnoseError> {
     let start = Instant::now();
     let mut clock = crate::diagnose::StageClock::new();
-    match (rec.get(Signal::Reference).is_some(), declared.controller.is_some()) {
+    match (
+        rec.get(Signal::Reference).is_some(),
+        declared.roles.controller.is_some(),
+    ) {
         (true, false) => {
             return Err(DiagnoseError::Rig(format!(
                 "{}: the record has a `reference` column (closed loop), but rig `{}` has no controller: use a closed-loop rig (e.g. the `leaney-moog-closed-loop` preset)",
-                rec.source, declared.name
+                rec.source, declared.roles.name
             )))
         }
         (false, true) => {
             return Err(DiagnoseError::Rig(format!(
                 "{}: rig `{}` is closed loop (it has a controller), but the record has no `reference` column to drive it",
-                rec.source, declared.name
+                rec.source, declared.roles.name
             )))
         }
         _ => {}
@@ -179,7 +231,7 @@ pub fn diagnose_valve_traced(
     if data_problems.iter().any(|p| p.kind == ProblemKind::Sign) {
         excluded.push(Signal::Velocity);
     }
-    let (p, info) = prepare(rec, opts.half_window, &excluded, declared.cylinder.stroke_m)?;
+    let (p, info) = prepare(rec, opts.half_window, &excluded, declared.stroke())?;
     if p.weights.iter().all(|w| *w == 0.0) {
         let why = if data_problems.is_empty() {
             "no measured channel to compare (position, velocity, p1, p2)".to_string()
@@ -233,7 +285,7 @@ pub fn diagnose_valve_traced(
         .clone()
         .unwrap_or_else(|| EffectId::ALL.to_vec())
         .into_iter()
-        .filter(|e| VALVE_EFFECTS.contains(e))
+        .filter(|e| declared.applies(*e).is_ok())
         .filter(|e| e.params().iter().all(|q| get(&rig0, *e, q.name).is_some()))
         .collect();
     // Noise floor of each compared channel as an NRMSE (the weights' floor
@@ -267,7 +319,7 @@ pub fn diagnose_valve_traced(
             .filter(|id| !added.iter().any(|a| a.id == id.id()))
             .collect();
         // `K H a` needs the pressure term's K (eq 5.12)
-        if model.friction_terms.k_pressure == 0.0 {
+        if k_pressure(&model) == 0.0 {
             let id = EffectId::AccelerationFriction;
             if let Some(k) = todo.iter().position(|e| *e == id) {
                 todo.remove(k);
@@ -289,11 +341,11 @@ pub fn diagnose_valve_traced(
             }
         }
         // One job per candidate and start (see `trace_starts`).
-        let jobs: Vec<(EffectId, ValveRig)> = todo
+        let jobs: Vec<(EffectId, Model)> = todo
             .iter()
             .flat_map(|&id| trace_starts(&model, id).into_iter().map(move |r| (id, r)))
             .collect();
-        let trace_one = |job: &(EffectId, ValveRig)| -> (ValveRig, EffectReport, f64) {
+        let trace_one = |job: &(EffectId, Model)| -> (Model, EffectReport, f64) {
             let id = job.0;
             let params: ParamList = id.params().iter().map(|q| (id, q.name)).collect();
             // The candidate is traced together with the effects already added
@@ -357,15 +409,15 @@ pub fn diagnose_valve_traced(
         // (results taken in catalog order, so the outcome does not depend on
         // the number of threads). Of a candidate's starts, the one ending
         // lowest on the training part is kept.
-        let mut traced: Vec<Option<(EffectId, ValveRig, EffectReport, f64)>> =
+        let mut traced: Vec<Option<(EffectId, Model, EffectReport, f64)>> =
             trace_parallel(&jobs, &trace_one)
                 .into_iter()
                 .zip(&jobs)
                 .map(|((t, r, x), (id, _))| Some((*id, t, r, x)))
                 .collect();
-        let mut chosen: Vec<(EffectId, ValveRig, EffectReport)> = Vec::new();
+        let mut chosen: Vec<(EffectId, Model, EffectReport)> = Vec::new();
         for &id in &todo {
-            let mut pick: Option<(ValveRig, EffectReport, f64)> = None;
+            let mut pick: Option<(Model, EffectReport, f64)> = None;
             for slot in traced.iter_mut() {
                 if slot.as_ref().is_some_and(|s| s.0 == id) {
                     if let Some((_, t, r, x)) = slot.take() {
@@ -380,7 +432,7 @@ pub fn diagnose_valve_traced(
             }
         }
         // Candidates that explain a share worth having, best first.
-        let mut eligible: Vec<(EffectId, ValveRig, EffectReport)> = Vec::new();
+        let mut eligible: Vec<(EffectId, Model, EffectReport)> = Vec::new();
         for (id, trial, rep) in chosen {
             if rep.reason.is_none() {
                 eligible.push((id, trial, rep.clone()));
@@ -417,8 +469,7 @@ pub fn diagnose_valve_traced(
             p: &p,
             holdout: opts.holdout,
         };
-        let mut accepted: Option<(EffectId, ValveRig, EffectReport, ParamList, lm::LmResult)> =
-            None;
+        let mut accepted: Option<(EffectId, Model, EffectReport, ParamList, lm::LmResult)> = None;
         for (id, _, _) in eligible.iter().skip(MAX_REFITS_PER_ROUND) {
             if let Some(r) = last.get_mut(id) {
                 r.reason = Some(format!(
@@ -475,16 +526,7 @@ pub fn diagnose_valve_traced(
     if !stale.is_empty() {
         for id in &stale {
             for q in id.params() {
-                let neutral = if *id == EffectId::FlowGainError {
-                    1.0
-                } else {
-                    0.0
-                };
-                let v = if *id == EffectId::BulkModulus {
-                    declared.fluid.bulk_modulus_pa
-                } else {
-                    neutral
-                };
+                let v = accept::neutral(*id, q.name, declared);
                 set(&mut model, *id, q.name, v);
             }
             free.retain(|(e, _)| e != id);
@@ -536,8 +578,8 @@ pub fn diagnose_valve_traced(
     }
     let traces = traces(rec, &p, &sims_before, &sims_after);
     let report = Report {
-        rig: declared.name.clone(),
-        rig_kind: "valve-cylinder".into(),
+        rig: declared.roles.name.clone(),
+        rig_kind: "netlist".into(),
         records: vec![rec.source.clone()],
         samples: rec.len(),
         data_problems,
@@ -551,6 +593,13 @@ pub fn diagnose_valve_traced(
         declared_refit: vec![],
         effects_added: added,
         effects_rejected: last.into_values().collect(),
+        effects_applicable: candidates
+            .iter()
+            .map(|e| Applicable {
+                id: e.id().to_string(),
+                paths: declared.paths_of(*e),
+            })
+            .collect(),
         effects_not_applicable: EffectId::ALL
             .iter()
             .filter(|e| !candidates.contains(e))
@@ -570,6 +619,7 @@ pub fn diagnose_valve_traced(
         ),
         wall_times_s: clock.finish(),
         elapsed_s: start.elapsed().as_secs_f64(),
+        simulations: p.count.load(std::sync::atomic::Ordering::Relaxed),
     };
     Ok(ValveOutcome {
         report,
@@ -580,32 +630,100 @@ pub fn diagnose_valve_traced(
 
 #[cfg(test)]
 mod tests {
-    use super::{as_stribeck, get, is_on, lag_samples, set};
+    use super::model::{targets, Model, FRICTION_TYPES};
+    use super::{get, is_on, lag_samples, set};
     use crate::catalog::EffectId;
     use hydrocyl_friction::{FrictionInput, FrictionLaw, FrictionModel};
     use hydrocyl_ports::Velocity;
+    use hydrocyl_system::netlist::registry;
     use hydrocyl_system::valve_rig::ValveRig;
+
+    fn on(r: &ValveRig, id: EffectId) -> bool {
+        is_on(&Model::from_valve_rig(r).unwrap(), id)
+    }
 
     fn force(law: &FrictionLaw, v: f64) -> f64 {
         law.force(&FrictionInput::at_velocity(Velocity::new(v)), &[])
             .si()
     }
 
+    /// Every target of the catalog names a parameter its component type has.
+    #[test]
+    fn every_target_is_a_registry_parameter() {
+        for id in EffectId::ALL {
+            for q in id.params() {
+                for tg in targets(id, q.name) {
+                    let ty = registry::lookup(tg.ty).unwrap_or_else(|| panic!("{}", tg.ty));
+                    assert!(ty.param(tg.param).is_some(), "{}.{}", tg.ty, tg.param);
+                }
+            }
+        }
+        for ty in FRICTION_TYPES {
+            assert!(registry::lookup(ty).is_some(), "{ty}");
+        }
+    }
+
+    /// Which effects apply is read from the components: the valve rig has
+    /// all of them; the hybrid rig (pump, no servovalve, Wang's law) the
+    /// cylinder's, the load's, the pump's and the seal terms, and the
+    /// others name the component type they need.
+    #[test]
+    fn the_effects_that_apply_follow_the_components() {
+        let valve = Model::new(&hydrocyl_system::rig::preset("leaney-moog").unwrap()).unwrap();
+        for id in EffectId::ALL {
+            assert!(valve.applies(id).is_ok(), "{id:?}: {:?}", valve.applies(id));
+        }
+        let hybrid = Model::new(&hydrocyl_system::rig::preset("wang-hybrid").unwrap()).unwrap();
+        let yes = [
+            EffectId::InternalLeakage,
+            EffectId::ExternalLeakage,
+            EffectId::BulkModulus,
+            EffectId::ExternalForce,
+            EffectId::PressureViscous,
+            EffectId::AccelerationFriction,
+            EffectId::FlowGainError,
+            EffectId::SensorLag,
+        ];
+        for id in EffectId::ALL {
+            let ok = hybrid.applies(id);
+            assert_eq!(ok.is_ok(), yes.contains(&id), "{id:?}: {ok:?}");
+        }
+        let why = hybrid.applies(EffectId::ValveNullBias).unwrap_err();
+        assert!(why.contains("four_way_valve"), "{why}");
+        // the bulk modulus reaches the chambers and both lines
+        assert_eq!(
+            hybrid.paths_of(EffectId::BulkModulus),
+            [
+                "cylinder.bulk_modulus",
+                "line_1.bulk_modulus",
+                "line_2.bulk_modulus"
+            ]
+        );
+        // the pump's gain is scaled by kw
+        let mut h = hybrid.clone();
+        assert_eq!(get(&h, EffectId::FlowGainError, "kw"), Some(1.0));
+        set(&mut h, EffectId::FlowGainError, "kw", 1.1);
+        let g = h.param("pump", "gain").unwrap();
+        assert!((g / 1.07e-5 - 1.1).abs() < 1e-12, "{g}");
+        assert!(is_on(&h, EffectId::FlowGainError));
+    }
+
     #[test]
     fn friction_effects_map_onto_a_stribeck_law() {
         let rig = ValveRig::leaney_moog();
         let cv = rig.friction;
-        let st = FrictionLaw::Stribeck(as_stribeck(&cv).unwrap());
         let vs = [-0.2, -0.01, -1e-3, -1e-5, 0.0, 1e-5, 1e-3, 0.01, 0.2];
-        // the conversion of the declared coulomb-viscous law is exact
-        for v in vs {
-            assert!((force(&cv, v) - force(&st, v)).abs() < 1e-12, "v {v}");
-        }
-        // off: both effects read 0; setting them to 0 changes nothing
+        // off: both effects read 0; setting them to 0 rewrites the
+        // coulomb-viscous law as the equivalent Stribeck law, exactly
         let mut r = rig.clone();
-        assert!(!is_on(&r, EffectId::CoulombAsymmetry) && !is_on(&r, EffectId::Stribeck));
+        assert!(!on(&r, EffectId::CoulombAsymmetry) && !on(&r, EffectId::Stribeck));
         set(&mut r, EffectId::CoulombAsymmetry, "dFc", 0.0);
         set(&mut r, EffectId::Stribeck, "Fs", 0.0);
+        assert!(
+            matches!(r.friction, FrictionLaw::Stribeck(_)),
+            "{:?}",
+            r.friction
+        );
         for v in vs {
             assert!(
                 (force(&cv, v) - force(&r.friction, v)).abs() < 1e-12,
@@ -620,7 +738,7 @@ mod tests {
         assert!((force(&r.friction, -0.2) - (-30.0 - b * 0.2)).abs() < 1e-9);
         // a hump on top keeps the asymmetry: g(0+) = Fs + dFc/2
         set(&mut r, EffectId::Stribeck, "Fs", 150.0);
-        assert!(is_on(&r, EffectId::Stribeck));
+        assert!(on(&r, EffectId::Stribeck));
         assert_eq!(get(&r, EffectId::Stribeck, "Fs"), Some(150.0));
         // (vs = 10 mm/s and α = 1 from the conversion, v_t = 1 mm/s)
         for v in [5e-3, -5e-3] {
@@ -631,7 +749,7 @@ mod tests {
         }
         // and the hump switches off again at Fs = 0
         set(&mut r, EffectId::Stribeck, "Fs", 0.0);
-        assert!(!is_on(&r, EffectId::Stribeck));
+        assert!(!on(&r, EffectId::Stribeck));
         assert!((force(&r.friction, 0.2) - (70.0 + b * 0.2)).abs() < 1e-9);
         // bristles in (the curves and σ2 kept), and out again
         set(&mut r, EffectId::LugreDynamics, "sigma0", 2e5);
@@ -646,7 +764,7 @@ mod tests {
         }
         assert_eq!(get(&r, EffectId::CoulombAsymmetry, "dFc"), Some(40.0));
         set(&mut r, EffectId::LugreDynamics, "sigma0", 0.0);
-        assert!(!is_on(&r, EffectId::LugreDynamics));
+        assert!(!on(&r, EffectId::LugreDynamics));
         assert!((force(&r.friction, 0.2) - (70.0 + b * 0.2)).abs() < 1e-9);
     }
 

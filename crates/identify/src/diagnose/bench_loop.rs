@@ -582,6 +582,8 @@ pub fn diagnose_bench(
         declared_refit,
         effects_added: added,
         effects_rejected: rejected,
+        effects_applicable: Vec::new(),
+        simulations: 0,
         effects_not_applicable: EffectId::ALL
             .iter()
             .filter(|e| !BENCH_EFFECTS.contains(e))

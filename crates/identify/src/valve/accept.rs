@@ -15,17 +15,17 @@
 
 use std::collections::BTreeMap;
 
-use hydrocyl_system::valve_rig::ValveRig;
+use super::Model;
 
 use super::{channel_nrmse, get, mean_coulomb, negligible, rss, ParamList, Part, Prepared};
 use crate::catalog::EffectId;
 use crate::lm::LmResult;
 
 /// The neutral ("off") value of parameter `name` of effect `id`.
-pub(super) fn neutral(id: EffectId, name: &str, declared: &ValveRig) -> f64 {
+pub(super) fn neutral(id: EffectId, name: &str, declared: &Model) -> f64 {
     match (id, name) {
         (EffectId::FlowGainError, _) => 1.0,
-        (EffectId::BulkModulus, _) => declared.fluid.bulk_modulus_pa,
+        (EffectId::BulkModulus, _) => get(declared, id, name).unwrap_or(0.0),
         _ => 0.0,
     }
 }
@@ -33,7 +33,7 @@ pub(super) fn neutral(id: EffectId, name: &str, declared: &ValveRig) -> f64 {
 /// The parameter whose distance from "off" is the effect's size, and that
 /// distance: the first parameter's, except the larger leak of
 /// `external_leakage` and the hump `Fs − Fc` of `stribeck`.
-fn size(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> (&'static str, f64) {
+fn size(id: EffectId, rig: &Model, declared: &Model) -> (&'static str, f64) {
     let v = |n: &str| get(rig, id, n).unwrap_or(0.0);
     match id {
         EffectId::ExternalLeakage => {
@@ -55,9 +55,9 @@ fn size(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> (&'static str, f64
 /// channels' NRMSE and their noise floors.
 pub(super) struct Baseline<'a> {
     /// The model before the candidate.
-    pub model: &'a ValveRig,
+    pub model: &'a Model,
     /// The declared rig (neutral values, negligible sizes).
-    pub declared: &'a ValveRig,
+    pub declared: &'a Model,
     /// NRMSE per channel of `model`.
     pub nrmse: BTreeMap<String, f64>,
     /// Noise floor per compared channel (NRMSE of the sensor noise, at least
@@ -75,7 +75,7 @@ pub(super) fn verdict(
     id: EffectId,
     free: &ParamList,
     res: &LmResult,
-    refit: &ValveRig,
+    refit: &Model,
     base: &Baseline<'_>,
 ) -> Result<(), String> {
     for (k, (eid, n)) in free.iter().enumerate() {

@@ -1,65 +1,20 @@
-//! The valve rig's catalog effects as rig parameters: reading and setting
-//! them, their typical sizes, negligible sizes, fit bounds and trace starts,
-//! and what the data checks need to know about the rig.
+//! The catalog effects on a netlist rig: reading and setting them (through
+//! the parameter targets of [`model`](super::model), or the friction-law
+//! edits), their typical sizes, negligible sizes, fit bounds and trace
+//! starts, and what the data checks need to know about the rig.
 
 use super::*;
-/// Value of catalog parameter `name` of effect `id` in the rig (SI).
-pub fn get(rig: &ValveRig, id: EffectId, name: &str) -> Option<f64> {
-    Some(match (id, name) {
-        (EffectId::ValveNullBias, "xb") => rig.valve.null_bias_m,
-        (EffectId::FlowGainError, "kw") => rig.valve.flow_gain,
-        (EffectId::InternalLeakage, "Cl") => rig.cylinder.internal_leakage_m3_per_s_pa,
-        (EffectId::ExternalLeakage, "Ce1") => rig.cylinder.external_leakage_1_m3_per_s_pa,
-        (EffectId::ExternalLeakage, "Ce2") => rig.cylinder.external_leakage_2_m3_per_s_pa,
-        (EffectId::BulkModulus, "B") => rig.fluid.bulk_modulus_pa,
-        (EffectId::ExternalForce, "F0") => rig.load.external_force_n,
-        (EffectId::SupplyDroop, "Rs") => rig.supply.droop_resistance_pa_s_per_m3,
-        (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s,
-        (EffectId::ValveDeadBand, "xd") => rig.valve.dead_band_m,
-        (EffectId::PressureViscous, "K") => rig.friction_terms.k_pressure,
-        (EffectId::AccelerationFriction, "H") => rig.friction_terms.h_acceleration,
-        (EffectId::Viscous, "b") => match &rig.friction {
-            FrictionLaw::CoulombViscous(c) => c.viscous,
-            law => friction_sets(law)?.0.sigma2,
-        },
-        (EffectId::CoulombAsymmetry, "dFc") => {
-            let (e, r) = friction_sets(&rig.friction)?;
-            e.curve.coulomb.si() - r.curve.coulomb.si()
-        }
-        (EffectId::Stribeck, n) => {
-            let (e, r) = friction_sets(&rig.friction)?;
-            if !has_hump(&e, &r) {
-                0.0
-            } else {
-                match n {
-                    // the mean stiction level: Fc (mean) + the hump, which
-                    // both directions share
-                    "Fs" => 0.5 * (e.curve.stiction.si() + r.curve.stiction.si()),
-                    "vs" => e.curve.stribeck_velocity.si(),
-                    "alpha" => e.curve.stribeck_exponent,
-                    _ => return None,
-                }
-            }
-        }
-        (EffectId::LugreDynamics, n) => match &rig.friction {
-            FrictionLaw::LuGre(l) => match n {
-                "sigma0" => l.sigma0,
-                "sigma1" => l.sigma1,
-                _ => return None,
-            },
-            law => {
-                friction_sets(law)?;
-                0.0
-            }
-        },
-        _ => return None,
-    })
-}
+use serde_json::{json, Value};
 
-/// `true` when the direction sets have a hump (stiction level away from
-/// the Coulomb level in either direction).
-pub(super) fn has_hump(e: &SteadySet, r: &SteadySet) -> bool {
-    e.curve.stiction != e.curve.coulomb || r.curve.stiction != r.curve.coulomb
+/// One direction's Stribeck set of a friction law: Coulomb and stiction
+/// levels, Stribeck velocity and exponent, viscous σ2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Set {
+    pub fc: f64,
+    pub fs: f64,
+    pub vs: f64,
+    pub alpha: f64,
+    pub s2: f64,
 }
 
 /// Smoothing velocity of `sgn(v)` given to a static law made from a LuGre
@@ -67,150 +22,226 @@ pub(super) fn has_hump(e: &SteadySet, r: &SteadySet) -> bool {
 /// declared one is not kept) \[m·s⁻¹\]: the `leaney-moog` value.
 pub(super) const STATIC_SMOOTHING: f64 = 1e-3;
 
-/// The two direction sets (Stribeck curve and σ2) of the rig's friction
-/// law: a LuGre's or a Stribeck law's own, the coulomb-viscous law's exact
-/// Stribeck equivalent ([`as_stribeck`]); `None` for the other laws.
-pub(super) fn friction_sets(law: &FrictionLaw) -> Option<(SteadySet, SteadySet)> {
-    match law {
-        FrictionLaw::LuGre(l) => Some((l.extending, l.retracting)),
-        _ => as_stribeck(law).map(|s| (s.extending, s.retracting)),
-    }
-}
-
-/// Edits the two direction sets in place: a LuGre law's, else those of the
-/// law as a Stribeck law (the coulomb-viscous law is converted exactly).
-pub(super) fn with_sets(law: &mut FrictionLaw, f: impl FnOnce(&mut SteadySet, &mut SteadySet)) {
-    match law {
-        FrictionLaw::LuGre(l) => f(&mut l.extending, &mut l.retracting),
-        _ => {
-            if let Some(mut s) = as_stribeck(law) {
-                f(&mut s.extending, &mut s.retracting);
-                *law = FrictionLaw::Stribeck(s);
-            }
-        }
-    }
-}
-
-/// The valve rig's friction law as a [`Stribeck`] law (two direction sets),
-/// converting the declared coulomb-viscous law exactly: `Fc tanh(v/v_t) + b v`
-/// is the Stribeck law with `Fs = Fc` (no hump) and `σ2 = b` in both
-/// directions (its `vs` = 10 mm/s and `α` = 1 are then inert). Other laws:
-/// `None` (their friction effects are not switchable here).
-pub(super) fn as_stribeck(law: &FrictionLaw) -> Option<Stribeck> {
-    match law {
-        FrictionLaw::Stribeck(s) => Some(*s),
-        FrictionLaw::CoulombViscous(c) => {
-            let set = SteadySet {
-                curve: StribeckCurve {
-                    coulomb: c.coulomb,
-                    stiction: c.coulomb,
-                    stribeck_velocity: Velocity::new(0.01),
-                    stribeck_exponent: 1.0,
-                },
-                sigma2: c.viscous,
+/// The two direction sets of the rig's friction law: a LuGre's, a
+/// Stribeck law's or a Wang law's own; the coulomb-viscous law's exact
+/// Stribeck equivalent (`Fc tanh(v/v_t) + b v` is the Stribeck law with
+/// `Fs = Fc`, no hump, `σ2 = b` both ways; its `vs` = 10 mm/s and `α` = 1
+/// are then inert). `None` for the other laws.
+pub(super) fn friction_sets(m: &Model) -> Option<(Set, Set)> {
+    let f = m.roles.friction.as_deref()?;
+    let r = |p: &str| m.param(f, p);
+    match m.friction_type()?.as_str() {
+        "friction_coulomb_viscous" => {
+            let s = Set {
+                fc: r("coulomb")?,
+                fs: r("coulomb")?,
+                vs: 0.01,
+                alpha: 1.0,
+                s2: r("viscous")?,
             };
-            Some(Stribeck {
-                extending: set,
-                retracting: set,
-                smoothing_velocity: c.smoothing_velocity,
-            })
+            Some((s, s))
+        }
+        "friction_stribeck" | "friction_lugre" | "friction_wang" => {
+            let set = |d: &str| {
+                Some(Set {
+                    fc: r(&format!("{d}.curve.coulomb"))?,
+                    fs: r(&format!("{d}.curve.stiction"))?,
+                    vs: r(&format!("{d}.curve.stribeck_velocity"))?,
+                    alpha: r(&format!("{d}.curve.stribeck_exponent"))?,
+                    s2: r(&format!("{d}.sigma2")).unwrap_or(0.0),
+                })
+            };
+            Some((set("extending")?, set("retracting")?))
         }
         _ => None,
     }
 }
 
-/// Mean Coulomb level of the two directions \[N\] (the declared Fc).
-pub(super) fn mean_coulomb(rig: &ValveRig) -> f64 {
-    friction_sets(&rig.friction).map_or(0.0, |(e, r)| {
-        0.5 * (e.curve.coulomb.si() + r.curve.coulomb.si())
+fn set_json(s: &Set) -> Value {
+    json!({
+        "curve": {
+            "coulomb": s.fc,
+            "stiction": s.fs,
+            "stribeck_velocity": s.vs,
+            "stribeck_exponent": s.alpha,
+        },
+        "sigma2": s.s2,
     })
 }
 
-/// Sets catalog parameter `name` of effect `id` in the rig.
-pub fn set(rig: &mut ValveRig, id: EffectId, name: &str, v: f64) {
+/// Rewrites the friction component with the law `ty` (`friction_stribeck`
+/// or `friction_lugre`) on sets `e`, `r`, keeping its ports' connections,
+/// its seal terms and (for LuGre) `sigma`s.
+fn rewrite(m: &mut Model, ty: &str, e: &Set, r: &Set, sigmas: Option<(f64, f64)>) {
+    let Some(f) = m.roles.friction.clone() else {
+        return;
+    };
+    let Some(c) = m.net["components"].get_mut(&f) else {
+        return;
+    };
+    let smoothing = c
+        .get("smoothing_velocity")
+        .and_then(Value::as_f64)
+        .unwrap_or(STATIC_SMOOTHING);
+    let Some(obj) = c.as_object_mut() else {
+        return;
+    };
+    for k in [
+        "coulomb",
+        "viscous",
+        "smoothing_velocity",
+        "extending",
+        "retracting",
+        "sigma0",
+        "sigma1",
+    ] {
+        obj.remove(k);
+    }
+    obj.insert("type".into(), Value::from(ty));
+    obj.insert("extending".into(), set_json(e));
+    obj.insert("retracting".into(), set_json(r));
+    match sigmas {
+        Some((s0, s1)) => {
+            obj.insert("sigma0".into(), Value::from(s0));
+            obj.insert("sigma1".into(), Value::from(s1));
+        }
+        None => {
+            obj.insert("smoothing_velocity".into(), Value::from(smoothing));
+        }
+    }
+}
+
+/// Edits the two direction sets: a LuGre's or a Stribeck law's in place;
+/// a coulomb-viscous law becomes the equivalent Stribeck law first.
+fn with_sets(m: &mut Model, f: impl FnOnce(&mut Set, &mut Set)) {
+    let Some((mut e, mut r)) = friction_sets(m) else {
+        return;
+    };
+    f(&mut e, &mut r);
+    match m.friction_type().as_deref() {
+        Some("friction_lugre") => {
+            let fr = m.roles.friction.clone().unwrap_or_default();
+            let s0 = m.param(&fr, "sigma0").unwrap_or(0.0);
+            let s1 = m.param(&fr, "sigma1").unwrap_or(0.0);
+            rewrite(m, "friction_lugre", &e, &r, Some((s0, s1)));
+        }
+        Some("friction_stribeck" | "friction_coulomb_viscous") => {
+            rewrite(m, "friction_stribeck", &e, &r, None);
+        }
+        _ => {}
+    }
+}
+
+/// `true` when the direction sets have a hump.
+fn has_hump(e: &Set, r: &Set) -> bool {
+    e.fs != e.fc || r.fs != r.fc
+}
+
+/// Mean Coulomb level of the two directions \[N\] (the declared Fc).
+pub(super) fn mean_coulomb(m: &Model) -> f64 {
+    friction_sets(m).map_or(0.0, |(e, r)| 0.5 * (e.fc + r.fc))
+}
+
+/// Value of catalog parameter `name` of effect `id` in the model (SI);
+/// `None` where the rig has no component it acts on.
+pub(super) fn read_effect(m: &Model, id: EffectId, name: &str) -> Option<f64> {
+    if m.applies(id).is_err() {
+        return None;
+    }
+    match id {
+        EffectId::SensorLag => Some(m.lag),
+        EffectId::CoulombAsymmetry => {
+            let (e, r) = friction_sets(m)?;
+            Some(e.fc - r.fc)
+        }
+        EffectId::Stribeck => {
+            let (e, r) = friction_sets(m)?;
+            if !has_hump(&e, &r) {
+                return Some(0.0);
+            }
+            match name {
+                // the mean stiction level: Fc (mean) + the hump
+                "Fs" => Some(0.5 * (e.fs + r.fs)),
+                "vs" => Some(e.vs),
+                "alpha" => Some(e.alpha),
+                _ => None,
+            }
+        }
+        EffectId::LugreDynamics => {
+            friction_sets(m)?;
+            if m.friction_type().as_deref() != Some("friction_lugre") {
+                return Some(0.0);
+            }
+            let f = m.roles.friction.as_deref()?;
+            match name {
+                "sigma0" | "sigma1" => m.param(f, name),
+                _ => None,
+            }
+        }
+        _ => m.read_target(id, name),
+    }
+}
+
+/// Sets catalog parameter `name` of effect `id` in the model.
+pub(super) fn write_effect(m: &mut Model, id: EffectId, name: &str, v: f64) {
     match (id, name) {
-        (EffectId::ValveNullBias, "xb") => rig.valve.null_bias_m = v,
-        (EffectId::FlowGainError, "kw") => rig.valve.flow_gain = v,
-        (EffectId::InternalLeakage, "Cl") => rig.cylinder.internal_leakage_m3_per_s_pa = v,
-        (EffectId::ExternalLeakage, "Ce1") => rig.cylinder.external_leakage_1_m3_per_s_pa = v,
-        (EffectId::ExternalLeakage, "Ce2") => rig.cylinder.external_leakage_2_m3_per_s_pa = v,
-        (EffectId::BulkModulus, "B") => rig.fluid.bulk_modulus_pa = v,
-        (EffectId::ExternalForce, "F0") => rig.load.external_force_n = v,
-        (EffectId::SupplyDroop, "Rs") => rig.supply.droop_resistance_pa_s_per_m3 = v,
-        (EffectId::SensorLag, "tau") => rig.sensors.pressure_lag_s = v,
-        (EffectId::ValveDeadBand, "xd") => rig.valve.dead_band_m = v,
-        (EffectId::PressureViscous, "K") => rig.friction_terms.k_pressure = v,
-        (EffectId::AccelerationFriction, "H") => rig.friction_terms.h_acceleration = v,
-        (EffectId::Viscous, "b") => match &mut rig.friction {
-            FrictionLaw::CoulombViscous(c) => c.viscous = v,
-            law => with_sets(law, |e, r| {
-                e.sigma2 = v;
-                r.sigma2 = v;
-            }),
-        },
-        (EffectId::CoulombAsymmetry, "dFc") => with_sets(&mut rig.friction, |e, r| {
+        (EffectId::SensorLag, _) => m.lag = v,
+        (EffectId::CoulombAsymmetry, _) => with_sets(m, |e, r| {
             // extending Fc + dFc/2, retracting Fc − dFc/2 (as on the friction
             // bench), each direction's hump kept
-            let mean = 0.5 * (e.curve.coulomb.si() + r.curve.coulomb.si());
-            for (set, level) in [(e, mean + 0.5 * v), (r, mean - 0.5 * v)] {
-                let hump = set.curve.stiction.si() - set.curve.coulomb.si();
-                set.curve.coulomb = Force::new(level);
-                set.curve.stiction = Force::new(level + hump);
+            let mean = 0.5 * (e.fc + r.fc);
+            for (s, level) in [(e, mean + 0.5 * v), (r, mean - 0.5 * v)] {
+                let hump = s.fs - s.fc;
+                s.fc = level;
+                s.fs = level + hump;
             }
         }),
-        (EffectId::Stribeck, n) => with_sets(&mut rig.friction, |e, r| {
+        (EffectId::Stribeck, n) => with_sets(m, |e, r| {
             let on = has_hump(e, r);
             match n {
                 // Fs = 0 is the catalog's "off": no hump
                 "Fs" => {
-                    let mean = 0.5 * (e.curve.coulomb.si() + r.curve.coulomb.si());
+                    let mean = 0.5 * (e.fc + r.fc);
                     let hump = if v == 0.0 { 0.0 } else { v - mean };
-                    for set in [e, r] {
-                        set.curve.stiction = Force::new(set.curve.coulomb.si() + hump);
+                    for s in [e, r] {
+                        s.fs = s.fc + hump;
                     }
                 }
                 // vs and alpha are inert without a hump; 0 (off) leaves them
                 "vs" if on || v != 0.0 => {
-                    e.curve.stribeck_velocity = Velocity::new(v);
-                    r.curve.stribeck_velocity = Velocity::new(v);
+                    e.vs = v;
+                    r.vs = v;
                 }
                 "alpha" if on || v != 0.0 => {
-                    e.curve.stribeck_exponent = v;
-                    r.curve.stribeck_exponent = v;
+                    e.alpha = v;
+                    r.alpha = v;
                 }
                 _ => {}
             }
         }),
         // σ0 = 0 is the catalog's "off": the static law with the same
         // curves; σ0 ≠ 0 puts the bristles in, keeping the curves and σ2
-        (EffectId::LugreDynamics, "sigma0") => match &mut rig.friction {
-            FrictionLaw::LuGre(l) if v != 0.0 => l.sigma0 = v,
-            FrictionLaw::LuGre(l) => {
-                rig.friction = FrictionLaw::Stribeck(Stribeck {
-                    extending: l.extending,
-                    retracting: l.retracting,
-                    smoothing_velocity: Velocity::new(STATIC_SMOOTHING),
-                });
-            }
-            law if v != 0.0 => {
-                if let Some((e, r)) = friction_sets(law) {
-                    *law = FrictionLaw::LuGre(LuGre {
-                        sigma0: v,
-                        sigma1: 0.0,
-                        extending: e,
-                        retracting: r,
-                    });
-                }
-            }
-            _ => {}
-        },
-        // σ1 is inert without bristles
-        (EffectId::LugreDynamics, "sigma1") => {
-            if let FrictionLaw::LuGre(l) = &mut rig.friction {
-                l.sigma1 = v;
+        (EffectId::LugreDynamics, "sigma0") => {
+            let Some((e, r)) = friction_sets(m) else {
+                return;
+            };
+            let lugre = m.friction_type().as_deref() == Some("friction_lugre");
+            let f = m.roles.friction.clone().unwrap_or_default();
+            match (lugre, v != 0.0) {
+                (true, true) => m.set_param(&f, "sigma0", Value::from(v)),
+                (true, false) => rewrite(m, "friction_stribeck", &e, &r, None),
+                (false, true) => rewrite(m, "friction_lugre", &e, &r, Some((v, 0.0))),
+                (false, false) => {}
             }
         }
-        _ => {}
+        // σ1 is inert without bristles
+        (EffectId::LugreDynamics, "sigma1") => {
+            if m.friction_type().as_deref() == Some("friction_lugre") {
+                let f = m.roles.friction.clone().unwrap_or_default();
+                m.set_param(&f, "sigma1", Value::from(v));
+            }
+        }
+        _ => m.write_target(id, name, v),
     }
 }
 
@@ -226,7 +257,7 @@ pub fn set(rig: &mut ValveRig, id: EffectId, name: &str, v: f64) {
 ///   worse fit, with an interval that excluded the truth), so both are tried.
 ///
 /// Generic values, not the planted ones.
-pub(super) fn trace_starts(rig: &ValveRig, id: EffectId) -> Vec<ValveRig> {
+pub(super) fn trace_starts(rig: &Model, id: EffectId) -> Vec<Model> {
     let mut r = rig.clone();
     if is_on(rig, id) {
         return vec![r];
@@ -253,7 +284,7 @@ pub(super) fn trace_starts(rig: &ValveRig, id: EffectId) -> Vec<ValveRig> {
 }
 
 /// `true` when effect `id` is on (a parameter away from its neutral value).
-pub fn is_on(rig: &ValveRig, id: EffectId) -> bool {
+pub fn is_on(rig: &Model, id: EffectId) -> bool {
     id.params().iter().any(|p| {
         get(rig, id, p.name).is_some_and(|v| match id {
             EffectId::FlowGainError => v != 1.0,
@@ -263,12 +294,12 @@ pub fn is_on(rig: &ValveRig, id: EffectId) -> bool {
 }
 
 /// A typical magnitude of a parameter (scales the fit and its first step).
-pub(super) fn typical(id: EffectId, name: &str, rig: &ValveRig) -> f64 {
+pub(super) fn typical(id: EffectId, name: &str, rig: &Model) -> f64 {
     match (id, name) {
-        (EffectId::ValveNullBias | EffectId::ValveDeadBand, _) => 0.01 * rig.valve.stroke_m,
+        (EffectId::ValveNullBias | EffectId::ValveDeadBand, _) => 0.01 * rig.spool_stroke(),
         (EffectId::FlowGainError, _) => 1.0,
         (EffectId::InternalLeakage | EffectId::ExternalLeakage, _) => 1e-12,
-        (EffectId::BulkModulus, _) => rig.fluid.bulk_modulus_pa,
+        (EffectId::BulkModulus, _) => get(rig, EffectId::BulkModulus, "B").unwrap_or(1e9),
         (EffectId::ExternalForce, _) => 100.0,
         (EffectId::Viscous, _) => 1000.0,
         (EffectId::CoulombAsymmetry, _) | (EffectId::Stribeck, "Fs") => mean_coulomb(rig).max(1.0),
@@ -279,14 +310,10 @@ pub(super) fn typical(id: EffectId, name: &str, rig: &ValveRig) -> f64 {
         // a droop of 1 bar at 6 l/min
         (EffectId::SupplyDroop, _) => 1e9,
         (EffectId::SensorLag, _) => 5e-3,
-        // 10 N at half the supply across the piston and 10 mm/s
-        (EffectId::PressureViscous, _) => {
-            10.0 / ((0.5 * rig.supply.pressure_pa).powi(2) * 0.01).max(1e-300)
-        }
+        // 10 N at half the supply (or the seal's Δp bound) across the piston and 10 mm/s
+        (EffectId::PressureViscous, _) => 10.0 / (seal_dp(rig).powi(2) * 0.01).max(1e-300),
         // K H = 10 % of the moving mass
-        (EffectId::AccelerationFriction, _) => {
-            0.1 * rig.load.mass_kg / rig.friction_terms.k_pressure.max(1e-300)
-        }
+        (EffectId::AccelerationFriction, _) => 0.1 * rig.mass() / k_pressure(rig).max(1e-300),
     }
 }
 
@@ -294,35 +321,28 @@ pub(super) fn typical(id: EffectId, name: &str, rig: &ValveRig) -> f64 {
 /// be told from the declared rig by any measurement (a flow gain 0.1 % off
 /// nominal, a leakage passing 1e-14 m³/s per Pa). A fit that lands below it
 /// is absorbing simulation or initial-state error, not finding an effect.
-pub(super) fn negligible(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> bool {
+pub(super) fn negligible(id: EffectId, rig: &Model, declared: &Model) -> bool {
     let v = |n: &str| get(rig, id, n).unwrap_or(0.0);
     match id {
-        EffectId::ValveNullBias => v("xb").abs() < 1e-3 * rig.valve.stroke_m,
-        EffectId::ValveDeadBand => v("xd") < 1e-3 * rig.valve.stroke_m,
+        EffectId::ValveNullBias => v("xb").abs() < 1e-3 * rig.spool_stroke(),
+        EffectId::ValveDeadBand => v("xd") < 1e-3 * rig.spool_stroke(),
         EffectId::FlowGainError => (v("kw") - 1.0).abs() < 5e-3,
         EffectId::InternalLeakage => v("Cl") < 1e-14,
         EffectId::ExternalLeakage => v("Ce1").max(v("Ce2")) < 1e-14,
-        EffectId::BulkModulus => (v("B") / declared.fluid.bulk_modulus_pa - 1.0).abs() < 0.02,
+        EffectId::BulkModulus => {
+            (v("B") / get(declared, id, "B").unwrap_or(f64::NAN) - 1.0).abs() < 0.02
+        }
         EffectId::ExternalForce => v("F0").abs() < 5.0,
         EffectId::Viscous => v("b").abs() < 10.0,
         // droop below 0.5 % of the supply at the valve's full-opening flow
         // (half the supply across each edge)
-        EffectId::SupplyDroop => {
-            let m = rig.metering();
-            let q_full = m.orifice.coefficient()
-                * m.area_gradient()
-                * (rig.valve.stroke_m + rig.valve.underlap_m)
-                * (0.5 * rig.supply.pressure_pa).max(0.0).sqrt();
-            v("Rs") * q_full < 5e-3 * rig.supply.pressure_pa
-        }
+        EffectId::SupplyDroop => v("Rs") * full_opening_flow(rig) < 5e-3 * rig.supply(),
         // a lag under 0.1 ms is below any record's resolution here
         EffectId::SensorLag => v("tau") < 1e-4,
         // under 1 N at half the supply across the piston and 10 mm/s
-        EffectId::PressureViscous => v("K") * (0.5 * rig.supply.pressure_pa).powi(2) * 0.01 < 1.0,
+        EffectId::PressureViscous => v("K") * seal_dp(rig).powi(2) * 0.01 < 1.0,
         // an added mass K H under 1 % of the moving mass
-        EffectId::AccelerationFriction => {
-            rig.friction_terms.k_pressure * v("H") < 0.01 * rig.load.mass_kg
-        }
+        EffectId::AccelerationFriction => k_pressure(rig) * v("H") < 0.01 * rig.mass(),
         // friction terms under 5 % of the declared Coulomb level
         EffectId::CoulombAsymmetry => v("dFc").abs() < 0.05 * mean_coulomb(declared),
         EffectId::Stribeck => {
@@ -337,11 +357,11 @@ pub(super) fn negligible(id: EffectId, rig: &ValveRig, declared: &ValveRig) -> b
 
 /// Fit bounds of a valve-rig parameter (the catalog's, with the spool
 /// offset limited to the spool stroke).
-pub(super) fn bounds(id: EffectId, name: &str, rig: &ValveRig) -> (f64, f64) {
+pub(super) fn bounds(id: EffectId, name: &str, rig: &Model) -> (f64, f64) {
     match id {
-        EffectId::ValveNullBias => (-rig.valve.stroke_m, rig.valve.stroke_m),
+        EffectId::ValveNullBias => (-rig.spool_stroke(), rig.spool_stroke()),
         // a dead zone up to half the spool stroke
-        EffectId::ValveDeadBand => (0.0, 0.5 * rig.valve.stroke_m),
+        EffectId::ValveDeadBand => (0.0, 0.5 * rig.spool_stroke()),
         // both directions keep a positive Coulomb level
         EffectId::CoulombAsymmetry => {
             let fc = mean_coulomb(rig);
@@ -377,18 +397,69 @@ pub(super) fn bounds(id: EffectId, name: &str, rig: &ValveRig) -> (f64, f64) {
     }
 }
 
-/// What the data checks need to know about a valve rig: the stroke, the
-/// supply above tank and the steady velocity per unit command at full
-/// demand (mean of the two directions; none with a drooping supply).
-pub fn rig_facts(rig: &ValveRig) -> RigFacts {
-    let xm = rig.valve.stroke_m;
-    let gain = match (rig.steady_velocity(xm), rig.steady_velocity(-xm)) {
-        (Ok(up), Ok(down)) if up > 0.0 && down < 0.0 => Some(0.5 * (up - down)),
-        _ => None,
+/// The pressure difference the seal terms are sized at: half the supply,
+/// or the friction component's bound `seal.dp_max` where it is lower \[Pa\].
+fn seal_dp(rig: &Model) -> f64 {
+    let half = 0.5 * rig.supply();
+    match rig
+        .roles
+        .friction
+        .as_deref()
+        .and_then(|f| rig.param(f, "seal.dp_max"))
+    {
+        Some(b) if b > 0.0 => half.min(b),
+        _ => half,
+    }
+}
+
+/// The additive seal term's K of the model (0 when off or absent).
+pub(super) fn k_pressure(rig: &Model) -> f64 {
+    get(rig, EffectId::PressureViscous, "K").unwrap_or(0.0)
+}
+
+/// Flow of the servovalve's supply edge at full opening with half the
+/// supply across it \[m³/s\] (0 without a `four_way_valve`).
+fn full_opening_flow(rig: &Model) -> f64 {
+    let Some(cs) = rig.net.get("components").and_then(Value::as_object) else {
+        return 0.0;
     };
+    let Some((name, _)) = cs
+        .iter()
+        .find(|(_, c)| c.get("type").and_then(Value::as_str) == Some("four_way_valve"))
+    else {
+        return 0.0;
+    };
+    let p = |k: &str| rig.param(name, k);
+    let (Some(cd), Some(rho), Some(d)) =
+        (p("orifice.cd"), p("orifice.density"), p("spool_diameter"))
+    else {
+        return 0.0;
+    };
+    let kw = p("flow_gain").unwrap_or(1.0);
+    let u = p("underlap").unwrap_or(0.0);
+    cd * (2.0 / rho).sqrt()
+        * std::f64::consts::PI
+        * d
+        * kw
+        * (rig.spool_stroke() + u)
+        * (0.5 * rig.supply()).max(0.0).sqrt()
+}
+
+/// What the data checks need to know about a rig: the stroke, the supply
+/// above tank ([`Model::supply`]) and, where the netlist is the
+/// valve-cylinder circuit, the steady velocity per unit command at full
+/// demand (mean of the two directions; none with a drooping supply).
+pub fn rig_facts(rig: &Model) -> RigFacts {
+    let gain = ValveRig::from_netlist(&rig.net).ok().and_then(|v| {
+        let xm = v.valve.stroke_m;
+        match (v.steady_velocity(xm), v.steady_velocity(-xm)) {
+            (Ok(up), Ok(down)) if up > 0.0 && down < 0.0 => Some(0.5 * (up - down)),
+            _ => None,
+        }
+    });
     RigFacts {
-        stroke: rig.cylinder.stroke_m,
-        supply: rig.supply.pressure_pa - rig.supply.tank_pressure_pa,
+        stroke: rig.stroke(),
+        supply: rig.supply(),
         velocity_gain: gain,
     }
 }

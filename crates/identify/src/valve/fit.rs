@@ -14,7 +14,7 @@ pub(super) type ParamList = Vec<(EffectId, &'static str)>;
 /// tenth of a second). The result's last two entries are the initial
 /// position and velocity.
 pub(super) fn fit(
-    rig: &mut ValveRig,
+    rig: &mut Model,
     params: &ParamList,
     p: &Prepared,
     holdout: f64,
@@ -33,13 +33,13 @@ pub(super) fn fit(
         .collect();
     // the initial position stays within the stroke (a record may start
     // with the piston on a stop)
-    let xi = rig.initial.position;
-    let half = 0.5 * rig.cylinder.stroke_m;
+    let xi = rig.x0();
+    let half = 0.5 * rig.stroke();
     x0.push(xi);
     lo.push((xi - 0.01).max(-half));
     hi.push((xi + 0.01).min(half));
     typ.push(1e-3);
-    let vi = rig.initial.velocity;
+    let vi = rig.v0();
     x0.push(vi);
     lo.push(vi - 0.2);
     hi.push(vi + 0.2);
@@ -51,8 +51,8 @@ pub(super) fn fit(
             for ((id, n), v) in params.iter().zip(x) {
                 set(&mut work, *id, n, *v);
             }
-            work.initial.position = x[k];
-            work.initial.velocity = x[k + 1];
+            work.set_x0(x[k]);
+            work.set_v0(x[k + 1]);
             residual(&work, p, holdout, part, r)
         },
         &x0,
@@ -69,8 +69,8 @@ pub(super) fn fit(
     for ((id, n), v) in params.iter().zip(&res.x) {
         set(rig, *id, n, *v);
     }
-    rig.initial.position = res.x[k];
-    rig.initial.velocity = res.x[k + 1];
+    rig.set_x0(res.x[k]);
+    rig.set_v0(res.x[k + 1]);
     Ok(res)
 }
 
@@ -81,7 +81,7 @@ pub(super) fn fit(
 /// of a full Levenberg–Marquardt fit; the effect that is added is refitted
 /// properly afterwards.
 pub(super) fn gauss_newton_trace(
-    rig: &mut ValveRig,
+    rig: &mut Model,
     params: &ParamList,
     p: &Prepared,
     holdout: f64,
@@ -102,15 +102,15 @@ pub(super) fn gauss_newton_trace(
                 h
             } else if j == params.len() {
                 // step away from a stop the piston may start on
-                let h = if t.initial.position + 1e-5 > 0.5 * rig.cylinder.stroke_m {
+                let h = if t.x0() + 1e-5 > 0.5 * rig.stroke() {
                     -1e-5
                 } else {
                     1e-5
                 };
-                t.initial.position += h;
+                t.set_x0(t.x0() + h);
                 h
             } else {
-                t.initial.velocity += 1e-4;
+                t.set_v0(t.v0() + 1e-4);
                 1e-4
             };
             let mut r1 = Vec::new();
@@ -139,9 +139,9 @@ pub(super) fn gauss_newton_trace(
                 let v = (get(rig, *id, n).unwrap_or(0.0) + alpha * delta[j]).clamp(lo, hi);
                 set(&mut t, *id, n, v);
             }
-            let half = 0.5 * rig.cylinder.stroke_m;
-            t.initial.position = (t.initial.position + alpha * delta[k - 2]).clamp(-half, half);
-            t.initial.velocity += alpha * delta[k - 1];
+            let half = 0.5 * rig.stroke();
+            t.set_x0((t.x0() + alpha * delta[k - 2]).clamp(-half, half));
+            t.set_v0(t.v0() + alpha * delta[k - 1]);
             if rss(&t, p, holdout, part) < rss0 {
                 accepted = Some(t);
                 break;
@@ -204,7 +204,7 @@ pub(super) fn trace_parallel<I: Sync, T: Send>(
 
 /// Out-of-catalog probe: the command reaching the rig late by τ (a
 /// transport delay), τ on a grid up to 60 ms, initial position refitted.
-pub(super) fn delay_probe(rig: &ValveRig, p: &Prepared, holdout: f64) -> Option<Probe> {
+pub(super) fn delay_probe(rig: &Model, p: &Prepared, holdout: f64) -> Option<Probe> {
     if p.closed {
         // the input is the reference, not the command the valve receives
         return None;
@@ -230,6 +230,7 @@ pub(super) fn delay_probe(rig: &ValveRig, p: &Prepared, holdout: f64) -> Option<
             p10: p.p10,
             p20: p.p20,
             restarts: p.restarts.clone(),
+            count: p.count.clone(),
         };
         q.input[0] = p.input[0];
         let r = rss(rig, &q, holdout, Part::All);

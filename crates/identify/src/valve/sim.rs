@@ -3,6 +3,9 @@
 //! channels, the weighted output error and the NRMSE per channel.
 
 use super::*;
+use hydrocyl_system::rig;
+use hydrocyl_system::simulation::Simulation;
+use serde_json::Value;
 /// The channels compared, in report order.
 pub(super) const CHANNELS: [Signal; 4] =
     [Signal::Position, Signal::Velocity, Signal::P1, Signal::P2];
@@ -36,6 +39,8 @@ pub(super) struct Prepared {
     pub(super) p20: Option<f64>,
     /// Restarts of the simulation where the measured piston leaves a stop.
     pub(super) restarts: Vec<stops::Restart>,
+    /// Simulations run so far (shared by every copy).
+    pub(super) count: std::sync::Arc<std::sync::atomic::AtomicUsize>,
 }
 
 pub(super) fn prepare(
@@ -118,6 +123,7 @@ pub(super) fn prepare(
             p10,
             p20,
             restarts,
+            count: Default::default(),
             t,
             input,
             closed,
@@ -133,45 +139,65 @@ pub(super) fn prepare(
 
 /// Sets the rig's initial state from the record: measured position, velocity
 /// and chamber pressures at the first sample (the steady pressures of the
-/// rig when p1/p2 are not measured), spool at the first command.
-pub(super) fn with_initial(rig: &ValveRig, p: &Prepared) -> ValveRig {
+/// rig when p1/p2 are not measured), spool at the first command (or the
+/// controller's output at the first sample).
+pub(super) fn with_initial(rig: &Model, p: &Prepared) -> Model {
     let mut r = rig.clone();
     if let Some(x0) = p.x0 {
-        let half = 0.5 * r.cylinder.stroke_m;
-        r.initial.position = x0.clamp(-half, half);
+        let half = 0.5 * r.stroke();
+        r.set_x0(x0.clamp(-half, half));
     }
     if let Some(v0) = p.v0 {
-        r.initial.velocity = v0;
+        r.set_v0(v0);
     }
-    let u0 = match (p.command0, &r.controller) {
+    let ctrl = r.roles.controller.clone();
+    let u0 = match (p.command0, &ctrl) {
         (Some(u), _) => u,
-        (None, Some(c)) => (c.gain_per_m * (p.input[0] - r.initial.position) + c.bias)
-            .clamp(c.output_min, c.output_max),
+        (None, Some(c)) => {
+            let q = |k: &str, d: f64| r.param(c, k).unwrap_or(d);
+            (q("gain", 0.0) * (p.input[0] - r.x0()) + q("bias", 0.0))
+                .clamp(q("output_min", -1.0), q("output_max", 1.0))
+        }
         (None, None) => 0.0,
     };
-    r.initial.spool = (u0 * r.valve.stroke_m).clamp(-r.valve.stroke_m, r.valve.stroke_m);
-    r.initial.p1 = p.p10;
-    r.initial.p2 = p.p20;
+    if let Some(s) = r.roles.spool.clone() {
+        let xm = r.spool_stroke();
+        r.set_param(
+            &s,
+            "initial.position",
+            Value::from((u0 * xm).clamp(-xm, xm)),
+        );
+    }
+    if r.roles.cylinder_type == "cylinder" {
+        let c = r.roles.cylinder.clone();
+        r.set_param(&c, "initial.p1", p.p10.map_or(Value::Null, Value::from));
+        r.set_param(&c, "initial.p2", p.p20.map_or(Value::Null, Value::from));
+    }
     r
 }
 
 /// Simulates and returns, per measured channel, the simulated series.
 ///
 /// `sensor_lag` is applied here as a measurement model on the simulated
-/// samples ([`lag_samples`]) rather than by the rig's sensor states: the rig
-/// is run with ideal sensors. A lag state with τ far below the integrator's
+/// samples ([`lag_samples`]) rather than by sensor states: the rig is run
+/// with ideal sensors. A lag state with τ far below the integrator's
 /// step makes the system stiff (the fit's first finite-difference steps
 /// start from τ = 0), and the sampled filter is smooth in τ down to 0. On
 /// 1 kHz records of this rig the two agree to well under the sensor noise
 /// (the planted `sensor_lag` test generates its record with the states).
-pub(super) fn simulate(rig: &ValveRig, p: &Prepared) -> Result<Vec<Vec<f64>>, String> {
+pub(super) fn simulate(rig: &Model, p: &Prepared) -> Result<Vec<Vec<f64>>, String> {
     simulate_prefix(rig, p, p.t.len())
 }
 
 /// [`simulate`] over the first `n` samples only (the training part needs no
 /// more; at least two samples are simulated).
+///
+/// The circuit is assembled once. At a stop restart (`stops`) the next
+/// segment starts from the last state of the one before with the piston
+/// put on the stop at rest: every other state — spool, chambers, lines,
+/// pump, bristles, the controller's integral — carries on.
 pub(super) fn simulate_prefix(
-    rig: &ValveRig,
+    rig: &Model,
     p: &Prepared,
     n: usize,
 ) -> Result<Vec<Vec<f64>>, String> {
@@ -182,14 +208,19 @@ pub(super) fn simulate_prefix(
         rtol: p.rtol,
         ..RunOptions::default()
     };
-    let tau = rig.sensors.pressure_lag_s;
+    let tau = rig.lag;
     if !(tau.is_finite() && tau >= 0.0) {
         return Err(format!(
-            "sensors.pressure_lag_s must be finite and non-negative, got {tau}"
+            "the sensor lag must be finite and non-negative, got {tau}"
         ));
     }
-    let mut seg = rig.clone();
-    seg.sensors.pressure_lag_s = 0.0;
+    p.count.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let circuit = rig::circuit(&rig.net, cmd).map_err(|e| e.to_string())?;
+    let names = circuit.state_names();
+    let load = &rig.roles.load;
+    let at = |s: &str| names.iter().position(|n| *n == format!("{load}.{s}"));
+    let (kx, kv) = (at("x"), at("v"));
+    let mut sim = Simulation::of_circuit(circuit).options(opts);
     let mut out: Vec<Vec<f64>> = vec![Vec::with_capacity(n); p.meas.len()];
     // One segment per stretch between restarts at stop exits (`stops`).
     let mut cuts = p
@@ -201,9 +232,7 @@ pub(super) fn simulate_prefix(
     loop {
         let next = cuts.next();
         let b = next.map_or(n - 1, |r| r.index);
-        let run = seg
-            .simulate(cmd.clone(), &t[a..=b], &opts)
-            .map_err(|e| e.to_string())?;
+        let run = sim.run(&t[a..=b]).map_err(|e| e.to_string())?;
         // the restart sample belongs to the next segment
         let keep = if next.is_some() { b - a } else { b - a + 1 };
         for (o, (ch, _)) in out.iter_mut().zip(&p.meas) {
@@ -213,13 +242,12 @@ pub(super) fn simulate_prefix(
             o.extend_from_slice(&v[..keep]);
         }
         let Some(r) = next else { break };
-        let last = |name: &str| run.channel(name).and_then(|v| v.last().copied());
-        let xm = seg.valve.stroke_m;
-        seg.initial.position = r.position;
-        seg.initial.velocity = 0.0;
-        seg.initial.spool = last("spool").unwrap_or(0.0).clamp(-xm, xm);
-        seg.initial.p1 = last("p1");
-        seg.initial.p2 = last("p2");
+        let mut x = run.state(run.time.len() - 1).to_vec();
+        if let (Some(kx), Some(kv)) = (kx, kv) {
+            x[kx] = r.position;
+            x[kv] = 0.0;
+        }
+        sim = sim.initial_state(x);
         a = b;
     }
     if tau > 0.0 {
@@ -266,7 +294,7 @@ pub(super) enum Part {
 }
 
 pub(super) fn residual(
-    rig: &ValveRig,
+    rig: &Model,
     p: &Prepared,
     holdout: f64,
     part: Part,
@@ -296,7 +324,7 @@ pub(super) fn residual(
     Ok(())
 }
 
-pub(super) fn rss(rig: &ValveRig, p: &Prepared, holdout: f64, part: Part) -> f64 {
+pub(super) fn rss(rig: &Model, p: &Prepared, holdout: f64, part: Part) -> f64 {
     let mut r = Vec::new();
     match residual(rig, p, holdout, part, &mut r) {
         Ok(()) => r.iter().map(|v| v * v).sum(),
@@ -304,7 +332,7 @@ pub(super) fn rss(rig: &ValveRig, p: &Prepared, holdout: f64, part: Part) -> f64
     }
 }
 
-pub(super) fn channel_nrmse(rig: &ValveRig, p: &Prepared) -> BTreeMap<String, f64> {
+pub(super) fn channel_nrmse(rig: &Model, p: &Prepared) -> BTreeMap<String, f64> {
     simulate(rig, p).map_or_else(|_| BTreeMap::new(), |sims| nrmse_of(p, &sims))
 }
 
@@ -315,4 +343,107 @@ pub(super) fn nrmse_of(p: &Prepared, sims: &[Vec<f64>]) -> BTreeMap<String, f64>
         .zip(sims)
         .map(|((ch, meas), s)| (ch.name().to_string(), nrmse(meas, s)))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::Record;
+    use std::collections::BTreeMap;
+
+    /// A PI-controlled piston driven onto its extending stop (reference
+    /// beyond it) rests there while the integral winds up to the output
+    /// limit; when the reference comes back, the integral holds the piston
+    /// on the stop until it unwinds. The loop restarts the simulation in the
+    /// middle of the rest: with every state carried on (the integral among
+    /// them) the restarted run is the uninterrupted one; with the integral
+    /// reset (as before) the restarted controller leaves the stop at once.
+    #[test]
+    fn a_stop_restart_carries_the_pi_integral() {
+        let v = hydrocyl_system::rig::preset("leaney-moog-closed-loop").unwrap();
+        let mut m = Model::new(&v).unwrap();
+        let c = m.roles.controller.clone().unwrap();
+        m.set_param(&c, "integral_time", Value::from(0.5));
+        let half = 0.5 * m.stroke();
+        m.set_x0(half - 0.02);
+        let t: Vec<f64> = (0..3000).map(|k| k as f64 * 1e-3).collect();
+        let r: Vec<f64> = t
+            .iter()
+            .map(|&t| if t < 1.5 { half + 0.04 } else { half - 0.06 })
+            .collect();
+        let cmd = CmdSignal::table(t.clone(), r.clone()).unwrap();
+        let opts = RunOptions {
+            rtol: 1e-8,
+            ..RunOptions::default()
+        };
+        let truth = rig::simulate(&m.net, cmd, &t, &opts).unwrap();
+        let ch = |n: &str| truth.channel(n).unwrap().to_vec();
+        let mut signals = BTreeMap::new();
+        for (s, n) in [
+            (Signal::Position, "position"),
+            (Signal::P1, "p1"),
+            (Signal::P2, "p2"),
+            (Signal::Command, "command"),
+        ] {
+            signals.insert(s, ch(n));
+        }
+        signals.insert(Signal::Reference, r);
+        let rec = Record {
+            source: "pi".into(),
+            time: t.clone(),
+            signals,
+            ignored: vec![],
+        };
+        let (mut p, _) = prepare(&rec, None, &[], m.stroke()).unwrap();
+        p.rtol = 1e-8;
+        assert_eq!(p.restarts.len(), 1, "one rest on the stop");
+        let k = p.restarts[0].index;
+        let x = ch("position");
+        let u = ch("command");
+        // the integral at the restart is what holds the piston there
+        let names = rig::circuit(&m.net, CmdSignal::Constant { value: 0.0 })
+            .unwrap()
+            .state_names();
+        let ki = names
+            .iter()
+            .position(|n| *n == format!("{c}.integral"))
+            .unwrap();
+        let i_rest = truth.state(k)[ki];
+        assert!(i_rest > 0.02, "integral at the restart {i_rest} m s");
+        let sims = simulate(&m, &p).unwrap();
+        let (sx, su) = (&sims[0], &sims[4]);
+        assert_eq!(p.meas[0].0, Signal::Position);
+        assert_eq!(p.meas[4].0, Signal::Command);
+        let dx = (k..x.len())
+            .map(|i| (sx[i] - x[i]).abs())
+            .fold(0.0, f64::max);
+        let du = (k..u.len())
+            .map(|i| (su[i] - u[i]).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            dx < 1e-5 && du < 1e-3,
+            "after the restart: |dx| {dx} m, |du| {du}"
+        );
+        // the same restart with the integral zeroed leaves the stop early
+        let from = truth.state(k).to_vec();
+        let mut x0 = from.clone();
+        x0[ki] = 0.0;
+        let circuit = rig::circuit(
+            &m.net,
+            CmdSignal::table(t.clone(), p.input.clone()).unwrap(),
+        )
+        .unwrap();
+        let run = Simulation::of_circuit(circuit)
+            .options(opts)
+            .initial_state(x0)
+            .run(&t[k..])
+            .unwrap();
+        let xr = run.channel("position").unwrap();
+        let d0 = xr
+            .iter()
+            .zip(&x[k..])
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(d0 > 1e-3, "a reset integral departs by {d0} m");
+    }
 }

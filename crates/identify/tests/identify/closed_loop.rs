@@ -41,32 +41,7 @@ fn planted(id: EffectId) -> Vec<(EffectId, &'static str, f64)> {
         .collect()
 }
 
-fn ids(r: &Report) -> Vec<&str> {
-    r.effects_added.iter().map(|e| e.id.as_str()).collect()
-}
-
-/// The first planted parameter is found within its 95 % interval, and every
-/// compared channel (the command among them) ends within 1.5 noise floors.
-fn check_found(r: &Report, id: EffectId, name: &str, value: f64) {
-    assert_eq!(ids(r), [id.id()], "{}", r.human());
-    let e = &r.effects_added[0];
-    assert!(
-        (e.params[name] - value).abs() <= e.ci95[name].unwrap(),
-        "{name} = {} ± {:?}, planted {value}\n{}",
-        e.params[name],
-        e.ci95[name],
-        r.human()
-    );
-    // (a velocity derived from the position has no floor: not compared)
-    for (ch, floor) in r.noise_floor.iter().filter(|(_, f)| **f > 0.0) {
-        let after = &r.nrmse_after[ch];
-        assert!(
-            *after <= 1.5 * floor,
-            "{ch}: {after} vs floor {floor}\n{}",
-            r.human()
-        );
-    }
-}
+use crate::{check_found, ids};
 
 #[test]
 fn a_closed_loop_record_compares_the_command_and_stays_on_the_measurement() {
@@ -128,4 +103,30 @@ fn a_closed_loop_record_needs_a_closed_loop_rig() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("closed loop"), "{e}");
+}
+
+/// The preset with a PI controller (integral time 0.5 s).
+fn declared_pi() -> ValveRig {
+    let mut r = declared();
+    if let Some(c) = r.controller.as_mut() {
+        c.integral_time_s = 0.5;
+    }
+    r
+}
+
+#[test]
+fn an_internal_leak_is_found_under_a_pi_controller() {
+    let (id, n, v) = planted(EffectId::InternalLeakage)[0];
+    let mut t = declared_pi();
+    set(&mut t, id, n, v);
+    let rec = valve_record_closed_loop(&t, 4000, 1e-3, 86, &valve_reference).unwrap();
+    let r = diagnose_valve(
+        &declared_pi(),
+        &rec,
+        &DiagnoseOptions::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    eprintln!("{}", r.human());
+    check_found(&r, id, n, v);
 }

@@ -4,5 +4,38 @@
 
 mod checks;
 mod closed_loop;
+mod hybrid;
 mod planted;
 mod valve;
+
+use hydrocyl_identify::catalog::EffectId;
+use hydrocyl_identify::diagnose::Report;
+
+/// The ids of the effects added, in order.
+fn ids(r: &Report) -> Vec<&str> {
+    r.effects_added.iter().map(|e| e.id.as_str()).collect()
+}
+
+/// Only `id` is added, its parameter `name` within its 95 % interval of the
+/// planted `value`, and every compared channel (a closed-loop record's
+/// command among them) ends within 1.5 noise floors (a velocity derived from
+/// the position has no floor: not compared).
+fn check_found(r: &Report, id: EffectId, name: &str, value: f64) {
+    assert_eq!(ids(r), [id.id()], "{}", r.human());
+    let e = &r.effects_added[0];
+    assert!(
+        (e.params[name] - value).abs() <= e.ci95[name].unwrap(),
+        "{name} = {} ± {:?}, planted {value}\n{}",
+        e.params[name],
+        e.ci95[name],
+        r.human()
+    );
+    for (ch, floor) in r.noise_floor.iter().filter(|(_, f)| **f > 0.0) {
+        let after = &r.nrmse_after[ch];
+        assert!(
+            *after <= 1.5 * floor,
+            "{ch}: {after} vs floor {floor}\n{}",
+            r.human()
+        );
+    }
+}

@@ -63,6 +63,8 @@ pub struct PositionController {
     output_name: String,
     /// The law.
     pub law: PositionLaw,
+    /// Initial integral of the error \[m·s\] (PI only).
+    integral0: f64,
     reference: Wire<f64>,
     rod: MechanicalNode,
     out: Wire<f64>,
@@ -78,10 +80,18 @@ impl PositionController {
             rod_name: rod.into(),
             output_name: output.into(),
             law,
+            integral0: 0.0,
             reference: Wire::UNBOUND,
             rod: MechanicalNode::UNBOUND,
             out: Wire::UNBOUND,
         }
+    }
+
+    /// Starts the integral of the error at `i` \[m·s\] (a PI controller's
+    /// state carried over from an earlier run; ignored by a P controller).
+    pub fn with_integral(mut self, i: f64) -> Self {
+        self.integral0 = i;
+        self
     }
 
     fn has_integral(&self) -> bool {
@@ -127,6 +137,11 @@ impl Component for PositionController {
         // an integral of 1 mm over the integral time
         for v in s {
             *v = 1e-3 * self.law.integral_time.max(1e-3);
+        }
+    }
+    fn initial_state(&self, x: &mut [f64]) {
+        if let Some(v) = x.first_mut() {
+            *v = self.integral0;
         }
     }
     fn evaluate(&self, _t: f64, x: &[f64], w: &mut Wires) {

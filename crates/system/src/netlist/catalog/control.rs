@@ -20,16 +20,20 @@ fn controller(i: &Instance) -> Result<Box<dyn Component>, String> {
             law.output_min, law.output_max
         ));
     }
-    if i.initial("integral").is_some_and(|v| v != 0.0) {
-        return Err("initial.integral other than 0 is not supported yet".into());
+    let integral = i.initial("integral").unwrap_or(0.0);
+    if !integral.is_finite() {
+        return Err(format!("initial.integral = {integral} must be finite"));
     }
-    built(PositionController::new(
-        &i.name,
-        i.node("reference"),
-        i.node("rod"),
-        i.node("command"),
-        law,
-    ))
+    built(
+        PositionController::new(
+            &i.name,
+            i.node("reference"),
+            i.node("rod"),
+            i.node("command"),
+            law,
+        )
+        .with_integral(integral),
+    )
 }
 
 /// The component types of this family.
@@ -58,7 +62,7 @@ pub const TYPES: &[ComponentType] = &[ComponentType {
         name: "integral",
         unit: "m s",
         default: Value(0.0),
-        doc: "initial integral of the error (PI only; 0)",
+        doc: "initial integral of the error ∫(r − x) dt (PI only; a restart carries it on)",
     }],
     build: controller,
     hints: None,

@@ -105,6 +105,9 @@
 //! `t_eval`, it holds exactly the requested times, interpolated from the
 //! dense output (values at `t0` and at step ends are exact). An event that
 //! returns [`EventAction::Stop`] ends the solution at the event time.
+//! [`solve_streaming`] is the same solve with the output times given and the
+//! outputs taken while it runs (a record of any length in the memory of a
+//! block; the same steps and outputs as [`solve`]).
 //!
 //! ## Example: a ball dropped from 1 m onto a floor
 //!
@@ -150,6 +153,9 @@ pub mod linalg;
 pub mod problems;
 mod rk4;
 mod rodas;
+mod stream;
+
+pub use stream::{solve_streaming, Stream, StreamIo};
 
 use driver::Controller;
 

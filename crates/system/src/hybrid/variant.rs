@@ -202,16 +202,11 @@ impl HybridVariant {
     /// in. Any other command keeps the base rig's needle opening.
     pub fn circuit(&self, command: Signal) -> Result<Circuit, RigError> {
         let mut r = self.base_rig(None)?;
-        let speed = match &command {
-            Signal::Table { value, .. } => {
-                let (hi, lo) = value
-                    .iter()
-                    .fold((0.0f64, 0.0f64), |(hi, lo), &u| (hi.max(u), lo.min(u)));
-                let k = r.pump.gain;
-                Some(1e3 * k * (hi / r.cylinder.area_1.si()).max(-lo / r.cylinder.area_2.si()))
-            }
-            _ => None,
-        };
+        let speed = command.value_range().map(|(lo, hi)| {
+            let (hi, lo) = (hi.max(0.0), lo.min(0.0));
+            let k = r.pump.gain;
+            1e3 * k * (hi / r.cylinder.area_1.si()).max(-lo / r.cylinder.area_2.si())
+        });
         self.apply_to_rig(&mut r, speed);
         r.build_with(command, |comps| self.swap_components(comps))
     }

@@ -13,6 +13,7 @@
 mod bench;
 mod bench_solve;
 mod energy;
+mod progress;
 mod report;
 mod test;
 mod validate;
@@ -25,6 +26,9 @@ use clap::{Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     task: Task,
+    /// Draw progress bars (energy, validate) even when stderr is not a terminal.
+    #[arg(long, global = true)]
+    progress: bool,
 }
 
 #[derive(Subcommand)]
@@ -64,6 +68,7 @@ enum Task {
 
 fn main() {
     let cli = Cli::parse();
+    progress::force(cli.progress);
     let ok = match cli.task {
         Task::Validate { only } => validate::run(only.as_deref()),
         Task::Xfactor => xfactor::run(),

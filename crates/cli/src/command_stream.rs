@@ -242,9 +242,11 @@ pub fn scan(path: &Path, unit: CommandUnit) -> Result<Option<(Scan, Chunks)>, Cl
     if s.rows < 2 {
         return Ok(None);
     }
-    let again = Chunks::open(path, unit)?.ok_or_else(|| CliError::Input(format!(
-        "{}: the command file changed while it was read",
-        path.display()
-    )))?;
+    let again = Chunks::open(path, unit)?.ok_or_else(|| {
+        CliError::Input(format!(
+            "{}: the command file changed while it was read",
+            path.display()
+        ))
+    })?;
     Ok(Some((s, again)))
 }

@@ -458,9 +458,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Input::Table(_, times) => {
             runner::run_streaming(&mut c, &x0, times, &opts, BLOCK, &mut sink)
         }
-        Input::Stream(table, chunks) => runner::run_command_stream(
-            &mut c, &x0, table, chunks, t1, &opts, BLOCK, &mut sink,
-        ),
+        Input::Stream(table, chunks) => {
+            runner::run_command_stream(&mut c, &x0, table, chunks, t1, &opts, BLOCK, &mut sink)
+        }
     };
     bar.finish();
     let run = match (streamed, failed) {

@@ -301,6 +301,51 @@ mod tests {
         assert!(p.columns(&[0]).is_some(), "unwanted cells are not parsed");
     }
 
+    /// The cell parser takes what `str::parse::<f64>` takes, the same value.
+    #[test]
+    fn cells_parse_as_the_standard_library_does() {
+        for cell in [
+            "1.",
+            ".5",
+            "+1.5",
+            "-0",
+            "1e5",
+            "1E5",
+            "1e+5",
+            "1e-5",
+            "  3.25 ",
+            "1_0",
+            "0x10",
+            "1e",
+            "e5",
+            ".",
+            "+",
+            "-",
+            "",
+            "1.5.2",
+            "inf",
+            "-inf",
+            "NaN",
+            "infinity",
+            "1e400",
+            "1e-400",
+            "00012",
+            "2.2250738585072011e-308",
+            "9007199254740993",
+            "1,5",
+            "1 5",
+            "0.1000000000000000055511151231257827",
+            "\t7\t",
+        ] {
+            let std = cell.trim().parse::<f64>().ok().filter(|v| v.is_finite());
+            assert_eq!(
+                number(cell.as_bytes()).map(f64::to_bits),
+                std.map(f64::to_bits),
+                "cell `{cell}`"
+            );
+        }
+    }
+
     #[test]
     fn written_text_reads_back_exactly() {
         let a = [0.0, 1e-300, -3.25, 1.0 / 3.0, 6.02e23];

@@ -26,8 +26,12 @@ pub trait Stream<S: ?Sized> {
     /// fixed step for RK4), and an output time pushed later than the
     /// integration has passed is an error. An `Err` stops the solve with
     /// [`SolveError::Interrupted`].
-    fn between_steps(&mut self, sys: &mut S, t: f64, io: &mut StreamIo<'_, '_>)
-        -> Result<(), String>;
+    fn between_steps(
+        &mut self,
+        sys: &mut S,
+        t: f64,
+        io: &mut StreamIo<'_, '_>,
+    ) -> Result<(), String>;
 }
 
 /// The output side of a streamed solve, as one [`Stream::between_steps`]

@@ -21,7 +21,12 @@ struct Collect {
 }
 
 impl<S: OdeSystem + ?Sized> Stream<S> for Collect {
-    fn between_steps(&mut self, _: &mut S, t: f64, io: &mut StreamIo<'_, '_>) -> Result<(), String> {
+    fn between_steps(
+        &mut self,
+        _: &mut S,
+        t: f64,
+        io: &mut StreamIo<'_, '_>,
+    ) -> Result<(), String> {
         self.calls += 1;
         if io.finished() {
             // a solve a stopping event ended early takes no more times
@@ -74,7 +79,8 @@ fn both<S: OdeSystem + Clone>(
         calls: 0,
         takes: 0,
     };
-    let streamed = solve_streaming(method, &mut sys.clone(), 0.0, x0, t_end, &opts, &mut c).unwrap();
+    let streamed =
+        solve_streaming(method, &mut sys.clone(), 0.0, x0, t_end, &opts, &mut c).unwrap();
     (plain, c, streamed)
 }
 
@@ -101,7 +107,11 @@ fn streamed_equals_plain_for_every_method() {
         assert_eq!(c.x, plain.x, "{method:?}: streamed states differ");
         assert_eq!(streamed.stats, plain.stats, "{method:?}");
         assert!(streamed.t.is_empty() && streamed.x.is_empty());
-        assert!(c.takes > 20, "{method:?}: outputs taken in blocks ({})", c.takes);
+        assert!(
+            c.takes > 20,
+            "{method:?}: outputs taken in blocks ({})",
+            c.takes
+        );
         assert!(c.calls > plain.stats.steps, "{method:?}: a call per step");
     }
 }
@@ -117,7 +127,14 @@ fn streamed_equals_plain_across_events() {
         h_max: 0.1,
         ..Options::default()
     };
-    let (plain, c, streamed) = both(&ball, Method::DormandPrince45, &[1.0, 0.0], t_end, &times, &opts);
+    let (plain, c, streamed) = both(
+        &ball,
+        Method::DormandPrince45,
+        &[1.0, 0.0],
+        t_end,
+        &times,
+        &opts,
+    );
     assert!(plain.stats.events >= 5);
     assert_eq!(c.t, plain.t);
     assert_eq!(c.x, plain.x);
@@ -128,7 +145,12 @@ fn streamed_equals_plain_across_events() {
 struct Late;
 
 impl<S: OdeSystem + ?Sized> Stream<S> for Late {
-    fn between_steps(&mut self, _: &mut S, t: f64, io: &mut StreamIo<'_, '_>) -> Result<(), String> {
+    fn between_steps(
+        &mut self,
+        _: &mut S,
+        t: f64,
+        io: &mut StreamIo<'_, '_>,
+    ) -> Result<(), String> {
         if t > 0.5 {
             io.push_times(&[0.25])?;
         }

@@ -322,8 +322,19 @@ pub fn run_streaming(
     sink: &mut dyn FnMut(&Run) -> Result<(), String>,
 ) -> Result<Run, SimError> {
     check_times(t_eval)?;
-    let mut times = Times::Slice { t: t_eval, pushed: 0 };
-    stream(circuit, x0, &mut times, t_eval[t_eval.len() - 1], opts, block, sink)
+    let mut times = Times::Slice {
+        t: t_eval,
+        pushed: 0,
+    };
+    stream(
+        circuit,
+        x0,
+        &mut times,
+        t_eval[t_eval.len() - 1],
+        opts,
+        block,
+        sink,
+    )
 }
 
 /// The samples of a command record, read while the run goes (a source for
@@ -685,7 +696,13 @@ mod tests {
         let t: Vec<f64> = (0..=n).map(|k| k as f64 * 1e-3).collect();
         let u = t
             .iter()
-            .map(|t| if (t / 2.0).rem_euclid(1.0) < 0.5 { 0.137 } else { -0.198 })
+            .map(|t| {
+                if (t / 2.0).rem_euclid(1.0) < 0.5 {
+                    0.137
+                } else {
+                    -0.198
+                }
+            })
             .collect();
         (t, u)
     }
@@ -783,7 +800,11 @@ mod tests {
                 .iter()
                 .zip(&b.values)
                 .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
-            assert!(worst <= 1e-12 * peak, "channel {}: {worst:e} of {peak:e}", b.name);
+            assert!(
+                worst <= 1e-12 * peak,
+                "channel {}: {worst:e} of {peak:e}",
+                b.name
+            );
         }
         assert_eq!(total.stats, whole.stats);
         assert!(!window.underrun());

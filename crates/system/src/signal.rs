@@ -3,9 +3,9 @@
 //! set from outside between solver calls (a co-simulation input).
 
 use crate::external::ExternalInput;
-pub use streamed::StreamedTable;
 use serde::{Deserialize, Serialize};
 use std::cell::Cell;
+pub use streamed::StreamedTable;
 use thiserror::Error;
 
 mod streamed;

@@ -107,7 +107,7 @@ pub struct Args {
     /// Print nothing but errors (no progress, no warnings, no summary).
     #[arg(long)]
     quiet: bool,
-    /// Command files larger than this [bytes] are read a buffer at a time
+    /// Command files larger than this many bytes are read a buffer at a time
     /// during the run instead of whole (tests set it low).
     #[arg(long, hide = true, default_value_t = 16 << 20)]
     stream_above: u64,

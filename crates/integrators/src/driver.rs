@@ -439,32 +439,8 @@ fn emit_t_eval<St: Stepper>(
     }
 }
 
-/// Runs one solve with the given stepper.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn run<S: OdeSystem + ?Sized, St: Stepper>(
-    stepper: St,
-    controller: Controller,
-    start_order: f64,
-    sys: &mut S,
-    t0: f64,
-    x0: &[f64],
-    t_end: f64,
-    opts: &Options,
-) -> Result<Solution, SolveError> {
-    run_with(
-        stepper,
-        controller,
-        start_order,
-        sys,
-        t0,
-        x0,
-        t_end,
-        opts,
-        &mut Nothing,
-    )
-}
-
-/// [`run`] calling `between` between the steps (see [`Between`]).
+/// Runs one solve with the given stepper, calling `between` between the
+/// steps (see [`Between`]).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
     mut stepper: St,

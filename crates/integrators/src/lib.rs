@@ -157,8 +157,6 @@ mod stream;
 
 pub use stream::{solve_streaming, Stream, StreamIo};
 
-use driver::Controller;
-
 /// Integrates `sys` from `(t0, x0)` to `t_end` with `method`.
 ///
 /// Output: every accepted step (and, at an event, the state before and after
@@ -182,47 +180,5 @@ pub fn solve<S: OdeSystem + ?Sized>(
     t_end: f64,
     opts: &Options,
 ) -> Result<Solution, SolveError> {
-    let n = sys.dim();
-    match method {
-        Method::DormandPrince45 => driver::run(
-            dopri::DormandPrince::new(n),
-            auto::DP_CONTROLLER,
-            5.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            opts,
-        ),
-        Method::Rosenbrock => driver::run(
-            rodas::Rodas4::new(n, sys.n_quadratures().min(n)),
-            auto::RODAS_CONTROLLER,
-            4.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            opts,
-        ),
-        Method::Auto => driver::run(
-            auto::Auto::new(n, sys.n_quadratures().min(n)),
-            auto::DP_CONTROLLER,
-            5.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            opts,
-        ),
-        Method::Rk4 => driver::run(
-            rk4::Rk4::new(n),
-            Controller::Pi { q: 5.0, beta: 0.0 },
-            4.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            opts,
-        ),
-    }
+    stream::dispatch(method, sys, t0, x0, t_end, opts, &mut driver::Nothing)
 }

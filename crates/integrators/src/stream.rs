@@ -148,58 +148,12 @@ pub fn solve_streaming<S: OdeSystem + ?Sized>(
     opts: &Options,
     stream: &mut dyn Stream<S>,
 ) -> Result<Solution, SolveError> {
-    let n = sys.dim();
     let opts = Options {
         t_eval: Some(Vec::new()),
         ..opts.clone()
     };
     let mut between = Adapter { stream, t_end };
-    let mut sol = match method {
-        Method::DormandPrince45 => driver::run_with(
-            dopri::DormandPrince::new(n),
-            auto::DP_CONTROLLER,
-            5.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            &opts,
-            &mut between,
-        ),
-        Method::Rosenbrock => driver::run_with(
-            rodas::Rodas4::new(n, sys.n_quadratures().min(n)),
-            auto::RODAS_CONTROLLER,
-            4.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            &opts,
-            &mut between,
-        ),
-        Method::Auto => driver::run_with(
-            auto::Auto::new(n, sys.n_quadratures().min(n)),
-            auto::DP_CONTROLLER,
-            5.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            &opts,
-            &mut between,
-        ),
-        Method::Rk4 => driver::run_with(
-            rk4::Rk4::new(n),
-            Controller::Pi { q: 5.0, beta: 0.0 },
-            4.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            &opts,
-            &mut between,
-        ),
-    }?;
+    let mut sol = dispatch(method, sys, t0, x0, t_end, &opts, &mut between)?;
     let mut times = Cow::Owned(Vec::new());
     let mut next = 0;
     let mut io = StreamIo {
@@ -217,4 +171,64 @@ pub fn solve_streaming<S: OdeSystem + ?Sized>(
     sol.t.clear();
     sol.x.clear();
     Ok(sol)
+}
+
+/// The solve of `method` with `between` called between the steps (the one
+/// place a method meets its stepper, controller and starting order).
+pub(crate) fn dispatch<S: OdeSystem + ?Sized, B: Between<S>>(
+    method: Method,
+    sys: &mut S,
+    t0: f64,
+    x0: &[f64],
+    t_end: f64,
+    opts: &Options,
+    between: &mut B,
+) -> Result<Solution, SolveError> {
+    let n = sys.dim();
+    match method {
+        Method::DormandPrince45 => driver::run_with(
+            dopri::DormandPrince::new(n),
+            auto::DP_CONTROLLER,
+            5.0,
+            sys,
+            t0,
+            x0,
+            t_end,
+            opts,
+            between,
+        ),
+        Method::Rosenbrock => driver::run_with(
+            rodas::Rodas4::new(n, sys.n_quadratures().min(n)),
+            auto::RODAS_CONTROLLER,
+            4.0,
+            sys,
+            t0,
+            x0,
+            t_end,
+            opts,
+            between,
+        ),
+        Method::Auto => driver::run_with(
+            auto::Auto::new(n, sys.n_quadratures().min(n)),
+            auto::DP_CONTROLLER,
+            5.0,
+            sys,
+            t0,
+            x0,
+            t_end,
+            opts,
+            between,
+        ),
+        Method::Rk4 => driver::run_with(
+            rk4::Rk4::new(n),
+            Controller::Pi { q: 5.0, beta: 0.0 },
+            4.0,
+            sys,
+            t0,
+            x0,
+            t_end,
+            opts,
+            between,
+        ),
+    }
 }

@@ -321,10 +321,13 @@ fn csv_reader(text: &str) -> csv::Reader<&[u8]> {
         .from_reader(text.as_bytes())
 }
 
-/// The `hydrocyl` binary: `$HYDROCYL_BIN`, else built now in this profile.
-fn hydrocyl_binary() -> Result<PathBuf, String> {
+/// The `hydrocyl` binary and the profile it was built with:
+/// `$HYDROCYL_BIN` ("given"), else the release build, brought up to date now
+/// (`cargo build --release -p hydrocyl-cli`; a no-op when it is): a user
+/// runs a release build (`cargo install`), so the whole process is timed on one.
+fn hydrocyl_binary() -> Result<(PathBuf, &'static str), String> {
     if let Ok(p) = std::env::var("HYDROCYL_BIN") {
-        return Ok(PathBuf::from(p));
+        return Ok((PathBuf::from(p), "given by HYDROCYL_BIN"));
     }
     let root = Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
@@ -333,6 +336,7 @@ fn hydrocyl_binary() -> Result<PathBuf, String> {
     let st = Command::new(cargo)
         .args([
             "build",
+            "--release",
             "--quiet",
             "-p",
             "hydrocyl-cli",
@@ -343,19 +347,19 @@ fn hydrocyl_binary() -> Result<PathBuf, String> {
         .status()
         .map_err(|e| e.to_string())?;
     if !st.success() {
-        return Err("cargo build -p hydrocyl-cli failed".into());
+        return Err("cargo build --release -p hydrocyl-cli failed".into());
     }
     let target = std::env::var("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|_| root.join("target"));
-    Ok(target.join("debug").join("hydrocyl"))
+    Ok((target.join("release").join("hydrocyl"), "release profile"))
 }
 
 /// The whole `hydrocyl simulate` process on the 1 kHz 10 s and 100 s
 /// command files (1 kHz output), against the process doing nothing
 /// (`hydrocyl --version`): median and fastest of 21 runs.
 fn whole_process() -> Result<(), String> {
-    let bin = hydrocyl_binary()?;
+    let (bin, profile) = hydrocyl_binary()?;
     let dir = std::env::temp_dir().join(format!("hydrocyl-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let time = |args: &[&str]| -> Result<(f64, f64), String> {
@@ -376,7 +380,7 @@ fn whole_process() -> Result<(), String> {
     };
     let (idle, idle_min) = time(&["--version"])?;
     println!(
-        "hydrocyl simulate, whole process ({}): process start {idle:.2} ms (fastest {idle_min:.2})",
+        "hydrocyl simulate, whole process ({}, {profile}): process start {idle:.2} ms (fastest {idle_min:.2})",
         bin.display()
     );
     for t_end in [10.0, 100.0] {

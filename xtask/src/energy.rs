@@ -98,16 +98,17 @@ pub fn run() -> bool {
         rayon::current_num_threads(),
         Plan::default().friction.name()
     );
+    let bar = crate::progress::bar("energy scenarios", jobs.len());
     let results: Vec<(Scenario, Result<Outcome, String>)> = jobs
         .par_iter()
         .map(|(i, sc)| {
             let (_, d, plan) = &drives[*i];
-            (
-                sc.clone(),
-                run_scenario(d, sc, plan).map_err(|e| e.to_string()),
-            )
+            let r = run_scenario(d, sc, plan).map_err(|e| e.to_string());
+            bar.inc(1);
+            (sc.clone(), r)
         })
         .collect();
+    bar.finish_and_clear();
     let mut ok = true;
     let outcomes: Vec<&Outcome> = results
         .iter()

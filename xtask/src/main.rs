@@ -15,6 +15,7 @@ mod bench_solve;
 mod energy;
 mod energy_relief;
 mod energy_ch9;
+mod progress;
 mod report;
 mod test;
 mod validate;
@@ -27,6 +28,9 @@ use clap::{Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     task: Task,
+    /// Draw progress bars (energy, validate) even when stderr is not a terminal.
+    #[arg(long, global = true)]
+    progress: bool,
 }
 
 #[derive(Subcommand)]
@@ -66,6 +70,7 @@ enum Task {
 
 fn main() {
     let cli = Cli::parse();
+    progress::force(cli.progress);
     let ok = match cli.task {
         Task::Validate { only } => validate::run(only.as_deref()),
         Task::Xfactor => xfactor::run(),

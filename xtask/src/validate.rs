@@ -30,19 +30,26 @@ fn sections() -> Vec<(&'static str, SectionFn)> {
 /// Runs the sections whose name contains `only` (all when `None`); returns
 /// `true` when every check passed.
 pub fn run(only: Option<&str>) -> bool {
+    let start = std::time::Instant::now();
     let mut all_ok = true;
     let mut n_checks = 0;
     let mut n_failed = 0;
-    for (name, f) in sections() {
-        if only.is_some_and(|o| !name.contains(o)) {
-            continue;
-        }
+    let chosen: Vec<_> = sections()
+        .into_iter()
+        .filter(|(name, _)| only.is_none_or(|o| name.contains(o)))
+        .collect();
+    let bar = crate::progress::bar("validate sections", chosen.len());
+    for (name, f) in chosen {
+        bar.set_message(name);
         let s = f();
-        s.print();
+        bar.inc(1);
+        bar.suspend(|| s.print());
         n_checks += s.checks.len();
         n_failed += s.checks.iter().filter(|c| !c.pass).count();
         all_ok &= s.passed();
     }
+    bar.finish_and_clear();
     println!("\nvalidate: {} checks, {} failed", n_checks, n_failed);
+    crate::progress::wall("validate", start);
     all_ok
 }

@@ -66,11 +66,15 @@ impl CommandUnit {
 
 /// Where the command file's columns are.
 #[derive(Debug)]
-struct Columns {
-    time: usize,
-    time_factor: f64,
-    command: usize,
-    command_factor: f64,
+pub struct Columns {
+    /// Index of the `time` column.
+    pub time: usize,
+    /// Its factor to seconds.
+    pub time_factor: f64,
+    /// Index of the `command` (or `reference`) column.
+    pub command: usize,
+    /// Its factor to the rig's unit.
+    pub command_factor: f64,
 }
 
 /// Splits `name [unit]`.
@@ -81,8 +85,8 @@ fn name_unit(h: &str) -> (&str, Option<&str>) {
     }
 }
 
-/// Finds the `time` and `command` columns among `headers`.
-fn columns<'a>(
+/// Finds the `time` and `command` columns among `headers` of file `file`.
+pub fn columns_of<'a>(
     file: &str,
     headers: impl Iterator<Item = &'a str>,
     unit: CommandUnit,
@@ -199,7 +203,7 @@ pub fn parse_command(
         .headers()
         .map_err(|e| CliError::Input(format!("{file}: row 1: {e}")))?
         .clone();
-    let c = columns(file, headers.iter(), unit)?;
+    let c = columns_of(file, headers.iter(), unit)?;
     if let Some(r) = read_plain(text, &c) {
         return Ok(r);
     }

@@ -5,6 +5,7 @@
 
 mod bench_sim;
 mod command;
+mod command_stream;
 mod components;
 mod diagnose;
 mod error;

@@ -38,6 +38,7 @@
 //! for any ordinary file).
 
 use crate::command::{read_command, CommandUnit};
+use crate::command_stream;
 use crate::error::CliError;
 use crate::output::Outputs;
 use crate::progress::Progress;
@@ -45,7 +46,7 @@ use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_identify::plaincsv::{run_columns, write_columns_in_parts, write_rows_in_parts};
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{self as runner, Run, RunOptions, Solver};
-use hydrocyl_system::signal::Signal;
+use hydrocyl_system::signal::{Signal, StreamedTable};
 use std::path::{Path, PathBuf};
 
 /// The output columns, for `hydrocyl simulate --help`.
@@ -109,6 +110,10 @@ pub struct Args {
     /// Print nothing but errors (no progress, no warnings, no summary).
     #[arg(long)]
     quiet: bool,
+    /// Command files larger than this many bytes are read a buffer at a time
+    /// during the run instead of whole (tests set it low).
+    #[arg(long, hide = true, default_value_t = 16 << 20)]
+    stream_above: u64,
 }
 
 /// Output times per block of a streamed run: the memory a run needs grows
@@ -251,24 +256,25 @@ fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result<(), CliErr
     )))
 }
 
-/// Warns when a normalised valve command leaves ±1: the spool stops at its
+/// Warns when a normalised valve command leaves ±1 (`outside` samples, the
+/// largest in magnitude `peak` = (value, time)): the spool stops at its
 /// stroke, so the valve acts on ±1.
-fn warn_clamped(file: &Path, t: &[f64], u: &[f64]) {
-    let Some((k, &v)) = u
-        .iter()
-        .enumerate()
-        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
-    else {
-        return;
-    };
-    if v.abs() > 1.0 {
-        let n = u.iter().filter(|x| x.abs() > 1.0).count();
+fn warn_clamped(file: &Path, outside: usize, peak: (f64, f64)) {
+    if outside > 0 {
         eprintln!(
-            "hydrocyl: warning: {}: {n} command samples outside ±1 (largest {v} at t = {} s); the valve clamps them to ±1 (the spool's stroke)",
+            "hydrocyl: warning: {}: {outside} command samples outside ±1 (largest {} at t = {} s); the valve clamps them to ±1 (the spool's stroke)",
             file.display(),
-            t[k]
+            peak.0,
+            peak.1
         );
     }
+}
+
+/// The command of a run: a table read whole (and its times, the output
+/// times), or a long file streamed into a window.
+enum Input {
+    Table(Signal, Vec<f64>),
+    Stream(StreamedTable, command_stream::Chunks),
 }
 
 /// Adds the remedy to a step-limit failure of an explicit method.
@@ -338,23 +344,55 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut outputs = Outputs::new(&inputs);
     let id = outputs.file("--out", &out)?;
     let unit = command_unit(&checked);
-    let (t, u) = read_command(&cmd_path, unit)?;
-    if unit == CommandUnit::Normalised && !args.quiet {
-        warn_clamped(&cmd_path, &t, &u);
-    }
-    let rows = t.len();
-    let (t0, t1) = (t[0], t[rows - 1]);
-    let signal =
-        Signal::table(t, u).map_err(|e| CliError::Input(format!("{}: {e}", cmd_path.display())))?;
     let opts = RunOptions {
         solver,
         rtol: args.rtol,
         rk4_step: args.rk4_step,
         ..RunOptions::default()
     };
-    let t = match &signal {
-        Signal::Table { time_s, .. } => time_s.clone(),
-        _ => Vec::new(),
+    // a long file is checked in a first pass and read during the run a
+    // buffer at a time; a short one (or one that is not plain CSV) is read whole
+    let size = std::fs::metadata(&cmd_path).map_or(0, |m| m.len());
+    let long = if size > args.stream_above {
+        command_stream::scan(&cmd_path, unit)?
+    } else {
+        None
+    };
+    let (rows, t0, t1, mut input) = match long {
+        Some((scan, chunks)) => {
+            if unit == CommandUnit::Normalised && !args.quiet {
+                warn_clamped(&cmd_path, scan.outside, scan.peak);
+            }
+            let table = StreamedTable::new(4 * BLOCK);
+            table.set_range(scan.min, scan.max);
+            (scan.rows, scan.t0, scan.t1, Input::Stream(table, chunks))
+        }
+        None => {
+            let (t, u) = read_command(&cmd_path, unit)?;
+            if unit == CommandUnit::Normalised && !args.quiet {
+                let outside = u.iter().filter(|x| x.abs() > 1.0).count();
+                let peak = t
+                    .iter()
+                    .zip(&u)
+                    .fold((0.0, f64::NAN), |(p, tp), (&tk, &uk)| {
+                        if uk.abs() > f64::abs(p) {
+                            (uk, tk)
+                        } else {
+                            (p, tp)
+                        }
+                    });
+                warn_clamped(&cmd_path, outside, peak);
+            }
+            let (rows, t0, t1) = (t.len(), t[0], t[t.len() - 1]);
+            let times = t.clone();
+            let signal = Signal::table(t, u)
+                .map_err(|e| CliError::Input(format!("{}: {e}", cmd_path.display())))?;
+            (rows, t0, t1, Input::Table(signal, times))
+        }
+    };
+    let signal = match &input {
+        Input::Table(s, _) => s.clone(),
+        Input::Stream(table, _) => Signal::Streamed(table.clone()),
     };
     let mut c = checked
         .circuit(signal)
@@ -380,7 +418,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
             m
         })
     };
-    let streamed = runner::run_streaming(&mut c, &x0, &t, &opts, BLOCK, &mut sink);
+    let streamed = match &mut input {
+        Input::Table(_, times) => {
+            runner::run_streaming(&mut c, &x0, times, &opts, BLOCK, &mut sink)
+        }
+        Input::Stream(table, chunks) => {
+            runner::run_command_stream(&mut c, &x0, table, chunks, t1, &opts, BLOCK, &mut sink)
+        }
+    };
     bar.finish();
     let run = match (streamed, failed) {
         (_, Some(e)) => return Err(e),

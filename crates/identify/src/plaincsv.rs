@@ -12,9 +12,11 @@
 //! are the ones `str::parse::<f64>` gives for the trimmed cells, as on the
 //! full path, and every error comes from the full path.
 //!
-//! Numbers are parsed with the standard library's `f64::from_str`, which is
-//! the Eisel–Lemire / `fast_float` algorithm; they are written with
-//! [`zmij`] (shortest text that parses back to the same `f64`).
+//! Numbers are parsed with [`fast_float2`] (the Eisel–Lemire algorithm of
+//! the standard library's `f64::from_str`, the same values, about twice as
+//! fast); they are written with [`zmij`] (shortest text that parses back to
+//! the same `f64`). [`Rows`] reads data lines in pieces, for a file read a
+//! buffer at a time.
 
 /// A CSV text without quoting, split into its header and its data lines.
 #[derive(Clone, Debug)]
@@ -36,11 +38,8 @@ impl<'a> PlainCsv<'a> {
             return None;
         }
         // one pass: no quote, no lone carriage return (a line end to the full reader)
-        let bytes = text.as_bytes();
-        for (i, &b) in bytes.iter().enumerate() {
-            if b == b'"' || (b == b'\r' && bytes.get(i + 1) != Some(&b'\n')) {
-                return None;
-            }
+        if !Rows::plain_bytes(text.as_bytes()) {
+            return None;
         }
         let (header, body) = match text.find('\n') {
             Some(i) => (strip_cr(&text[..i]), &text[i + 1..]),
@@ -67,20 +66,66 @@ impl<'a> PlainCsv<'a> {
     /// row has a number of cells other than the header's, a blank line
     /// precedes more data, or a wanted cell is not a finite number.
     pub fn columns(&self, wanted: &[usize]) -> Option<Vec<Vec<f64>>> {
-        let width = self.width();
-        // column index → output slot
-        let mut slot = vec![usize::MAX; width];
-        for (k, &j) in wanted.iter().enumerate() {
-            *slot.get_mut(j)? = k;
-        }
-        let rows_hint = self.body.len() / (8 * width).max(1) + 1;
+        let rows = Rows::new(self.width(), wanted)?;
+        let rows_hint = self.body.len() / (8 * rows.width).max(1) + 1;
         let mut out: Vec<Vec<f64>> = wanted
             .iter()
             .map(|_| Vec::with_capacity(rows_hint))
             .collect();
-        // one pass over the bytes; `,` and `\n` are ASCII, so every cut is
-        // on a character boundary
-        let (text, b) = (self.body, self.body.as_bytes());
+        match rows.parse(self.body.as_bytes(), &mut out)? {
+            Body::Rows | Body::BlankEnd => Some(out),
+        }
+    }
+
+    /// The data lines after the header line (its terminator included).
+    pub fn body(&self) -> &'a str {
+        self.body
+    }
+}
+
+/// How a piece of CSV data lines ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Body {
+    /// With a data row (or nothing).
+    Rows,
+    /// With blank lines: more data after them is not plain.
+    BlankEnd,
+}
+
+/// The row reader of [`PlainCsv`], for data lines given whole or in pieces
+/// that end at a line end (a long file read a buffer at a time).
+#[derive(Clone, Debug)]
+pub struct Rows {
+    width: usize,
+    /// Column index → output slot (`usize::MAX`: not wanted).
+    slot: Vec<usize>,
+}
+
+impl Rows {
+    /// Rows of `width` cells of which the columns `wanted` are read;
+    /// `None` when a wanted column is not among them.
+    pub fn new(width: usize, wanted: &[usize]) -> Option<Self> {
+        let mut slot = vec![usize::MAX; width];
+        for (k, &j) in wanted.iter().enumerate() {
+            *slot.get_mut(j)? = k;
+        }
+        Some(Self { width, slot })
+    }
+
+    /// Whether bytes are plain: no quote, no carriage return but before a
+    /// line feed (a lone one ends a line for the full reader).
+    pub fn plain_bytes(bytes: &[u8]) -> bool {
+        !bytes
+            .iter()
+            .enumerate()
+            .any(|(i, &b)| b == b'"' || (b == b'\r' && bytes.get(i + 1) != Some(&b'\n')))
+    }
+
+    /// Appends the wanted cells of the lines in `b` (whole lines) to `out`
+    /// (one vector per wanted column). `None` as for [`PlainCsv::columns`];
+    /// a blank line is plain only when nothing but blank lines follows it,
+    /// here or in a later piece ([`Body::BlankEnd`]).
+    pub fn parse(&self, b: &[u8], out: &mut [Vec<f64>]) -> Option<Body> {
         let len = b.len();
         let mut pos = 0;
         while pos < len {
@@ -88,7 +133,7 @@ impl<'a> PlainCsv<'a> {
                 // the full reader skips blank lines, which shifts its row
                 // numbers away from the line numbers: only a blank end is plain
                 if b[pos..].iter().all(|&c| c == b'\n' || c == b'\r') {
-                    break;
+                    return Some(Body::BlankEnd);
                 }
                 return None;
             }
@@ -104,12 +149,9 @@ impl<'a> PlainCsv<'a> {
                 } else {
                     pos
                 };
-                let k = *slot.get(n)?;
+                let k = *self.slot.get(n)?;
                 if k != usize::MAX {
-                    let v: f64 = text[start..end].trim().parse().ok()?;
-                    if !v.is_finite() {
-                        return None;
-                    }
+                    let v = number(&b[start..end])?;
                     out[k].push(v);
                 }
                 n += 1;
@@ -118,12 +160,24 @@ impl<'a> PlainCsv<'a> {
                     break;
                 }
             }
-            if n != width {
+            if n != self.width {
                 return None;
             }
         }
-        Some(out)
+        Some(Body::Rows)
     }
+}
+
+/// A cell's finite number (surrounding white space allowed), parsed as
+/// `str::parse::<f64>` does (the Eisel–Lemire algorithm, `fast-float2`);
+/// `None` for anything else.
+#[inline]
+fn number(cell: &[u8]) -> Option<f64> {
+    let cell = cell.trim_ascii();
+    // only what the standard library's parser also takes: fast-float2 reads
+    // `inf`/`nan` spellings and a leading `+` as it does, and refuses the rest
+    let v: f64 = fast_float2::parse(cell).ok()?;
+    v.is_finite().then_some(v)
 }
 
 /// Appends `v` as the shortest decimal text that parses back to `v`.
@@ -245,6 +299,51 @@ mod tests {
         let p = PlainCsv::new("time,u\n0,NaN\n").unwrap();
         assert!(p.columns(&[1]).is_none(), "not finite");
         assert!(p.columns(&[0]).is_some(), "unwanted cells are not parsed");
+    }
+
+    /// The cell parser takes what `str::parse::<f64>` takes, the same value.
+    #[test]
+    fn cells_parse_as_the_standard_library_does() {
+        for cell in [
+            "1.",
+            ".5",
+            "+1.5",
+            "-0",
+            "1e5",
+            "1E5",
+            "1e+5",
+            "1e-5",
+            "  3.25 ",
+            "1_0",
+            "0x10",
+            "1e",
+            "e5",
+            ".",
+            "+",
+            "-",
+            "",
+            "1.5.2",
+            "inf",
+            "-inf",
+            "NaN",
+            "infinity",
+            "1e400",
+            "1e-400",
+            "00012",
+            "2.2250738585072011e-308",
+            "9007199254740993",
+            "1,5",
+            "1 5",
+            "0.1000000000000000055511151231257827",
+            "\t7\t",
+        ] {
+            let std = cell.trim().parse::<f64>().ok().filter(|v| v.is_finite());
+            assert_eq!(
+                number(cell.as_bytes()).map(f64::to_bits),
+                std.map(f64::to_bits),
+                "cell `{cell}`"
+            );
+        }
     }
 
     #[test]

@@ -237,4 +237,13 @@ pub enum SolveError {
     /// The inputs to the solver were invalid.
     #[error("invalid solver input: {0}")]
     InvalidInput(String),
+    /// The caller of a streamed solve ([`crate::solve_streaming`]) stopped
+    /// it (its output could not be written, its input could not be read).
+    #[error("stopped at t = {t} s: {why}")]
+    Interrupted {
+        /// Time reached.
+        t: f64,
+        /// The caller's reason.
+        why: String,
+    },
 }

@@ -6,6 +6,41 @@ use crate::api::{
     Crossing, EventAction, EventRecord, OdeSystem, Options, Solution, SolveError, Stats,
 };
 use crate::events::{locate_root, Bracket};
+use std::borrow::Cow;
+
+/// What a solve does between its steps: nothing for [`crate::solve`]; a
+/// streamed solve ([`crate::solve_streaming`]) hands the outputs written so
+/// far to its caller and takes more output times.
+pub(crate) trait Between<S: ?Sized> {
+    /// Called before the output at `t0`, before every step from `t`, and
+    /// once after the last step. `times[*next..]` are the output times not
+    /// yet written; `sol` holds the outputs written since the last call.
+    fn between(
+        &mut self,
+        sys: &mut S,
+        t: f64,
+        times: &mut Cow<'_, [f64]>,
+        next: &mut usize,
+        sol: &mut Solution,
+    ) -> Result<(), SolveError>;
+}
+
+/// The plain solve: every output stays in the [`Solution`].
+pub(crate) struct Nothing;
+
+impl<S: ?Sized> Between<S> for Nothing {
+    #[inline(always)]
+    fn between(
+        &mut self,
+        _: &mut S,
+        _: f64,
+        _: &mut Cow<'_, [f64]>,
+        _: &mut usize,
+        _: &mut Solution,
+    ) -> Result<(), SolveError> {
+        Ok(())
+    }
+}
 
 /// One integration method: attempts a step, and after acceptance offers a
 /// continuous extension (dense output) over the accepted step.
@@ -404,9 +439,10 @@ fn emit_t_eval<St: Stepper>(
     }
 }
 
-/// Runs one solve with the given stepper.
+/// Runs one solve with the given stepper, calling `between` between the
+/// steps (see [`Between`]).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn run<S: OdeSystem + ?Sized, St: Stepper>(
+pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
     mut stepper: St,
     controller: Controller,
     start_order: f64,
@@ -415,6 +451,7 @@ pub(crate) fn run<S: OdeSystem + ?Sized, St: Stepper>(
     x0: &[f64],
     t_end: f64,
     opts: &Options,
+    between: &mut B,
 ) -> Result<Solution, SolveError> {
     let n = sys.dim();
     let adaptive = stepper.adaptive();
@@ -458,8 +495,9 @@ pub(crate) fn run<S: OdeSystem + ?Sized, St: Stepper>(
     }
 
     // Output at t0.
-    let t_eval: &[f64] = opts.t_eval.as_deref().unwrap_or(&[]);
+    let mut t_eval: Cow<'_, [f64]> = Cow::Borrowed(opts.t_eval.as_deref().unwrap_or(&[]));
     let mut next_out = 0usize;
+    between.between(sys, t, &mut t_eval, &mut next_out, &mut sol)?;
     if opts.t_eval.is_some() {
         while next_out < t_eval.len() && t_eval[next_out] <= t0 {
             sol.t.push(t_eval[next_out]);
@@ -480,6 +518,7 @@ pub(crate) fn run<S: OdeSystem + ?Sized, St: Stepper>(
     let t_close = |t: f64| 4.0 * f64::EPSILON * t.abs().max(t_end.abs()).max(1e-300);
 
     while t_end - t > t_close(t) {
+        between.between(sys, t, &mut t_eval, &mut next_out, &mut sol)?;
         if stats.steps + stats.rejected >= opts.max_steps {
             sol.stats = stats;
             return Err(SolveError::TooManySteps {
@@ -641,7 +680,7 @@ pub(crate) fn run<S: OdeSystem + ?Sized, St: Stepper>(
                 if opts.t_eval.is_some() {
                     emit_t_eval(
                         &stepper,
-                        t_eval,
+                        &t_eval,
                         &mut next_out,
                         t,
                         h,
@@ -674,7 +713,7 @@ pub(crate) fn run<S: OdeSystem + ?Sized, St: Stepper>(
                 if opts.t_eval.is_some() {
                     emit_t_eval(
                         &stepper,
-                        t_eval,
+                        &t_eval,
                         &mut next_out,
                         t,
                         h,
@@ -741,6 +780,7 @@ pub(crate) fn run<S: OdeSystem + ?Sized, St: Stepper>(
         }
     }
     // Output times at t_end not yet written (t reached t_end within rounding).
+    between.between(sys, t, &mut t_eval, &mut next_out, &mut sol)?;
     if opts.t_eval.is_some() {
         while next_out < t_eval.len() && t_eval[next_out] <= t_end && t >= t_end - t_close(t) {
             sol.t.push(t_eval[next_out]);

@@ -105,6 +105,9 @@
 //! `t_eval`, it holds exactly the requested times, interpolated from the
 //! dense output (values at `t0` and at step ends are exact). An event that
 //! returns [`EventAction::Stop`] ends the solution at the event time.
+//! [`solve_streaming`] is the same solve with the output times given and the
+//! outputs taken while it runs (a record of any length in the memory of a
+//! block; the same steps and outputs as [`solve`]).
 //!
 //! ## Example: a ball dropped from 1 m onto a floor
 //!
@@ -150,8 +153,9 @@ pub mod linalg;
 pub mod problems;
 mod rk4;
 mod rodas;
+mod stream;
 
-use driver::Controller;
+pub use stream::{solve_streaming, Stream, StreamIo};
 
 /// Integrates `sys` from `(t0, x0)` to `t_end` with `method`.
 ///
@@ -176,47 +180,5 @@ pub fn solve<S: OdeSystem + ?Sized>(
     t_end: f64,
     opts: &Options,
 ) -> Result<Solution, SolveError> {
-    let n = sys.dim();
-    match method {
-        Method::DormandPrince45 => driver::run(
-            dopri::DormandPrince::new(n),
-            auto::DP_CONTROLLER,
-            5.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            opts,
-        ),
-        Method::Rosenbrock => driver::run(
-            rodas::Rodas4::new(n, sys.n_quadratures().min(n)),
-            auto::RODAS_CONTROLLER,
-            4.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            opts,
-        ),
-        Method::Auto => driver::run(
-            auto::Auto::new(n, sys.n_quadratures().min(n)),
-            auto::DP_CONTROLLER,
-            5.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            opts,
-        ),
-        Method::Rk4 => driver::run(
-            rk4::Rk4::new(n),
-            Controller::Pi { q: 5.0, beta: 0.0 },
-            4.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            opts,
-        ),
-    }
+    stream::dispatch(method, sys, t0, x0, t_end, opts, &mut driver::Nothing)
 }

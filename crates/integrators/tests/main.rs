@@ -9,3 +9,4 @@ mod events;
 mod linalg;
 mod stats;
 mod stiff;
+mod stream;

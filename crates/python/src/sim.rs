@@ -99,7 +99,8 @@ fn failure_time(e: &SolveError) -> Option<f64> {
         SolveError::StepTooSmall { t, .. }
         | SolveError::TooManySteps { t, .. }
         | SolveError::NonFinite { t, .. }
-        | SolveError::Singular { t } => Some(*t),
+        | SolveError::Singular { t }
+        | SolveError::Interrupted { t, .. } => Some(*t),
         SolveError::InvalidInput(_) => None,
     }
 }

@@ -5,7 +5,10 @@
 use crate::external::ExternalInput;
 use serde::{Deserialize, Serialize};
 use std::cell::Cell;
+pub use streamed::StreamedTable;
 use thiserror::Error;
+
+mod streamed;
 
 /// A bad signal definition; names the field and the value.
 #[derive(Clone, Debug, Error, PartialEq)]
@@ -103,6 +106,11 @@ pub enum Signal {
     /// files (never serialised).
     #[serde(skip)]
     External(ExternalInput),
+    /// A table too long to hold, read while the run goes: a window the host
+    /// fills ahead of the integration ([`StreamedTable`]). Not part of rig
+    /// or command files (never serialised).
+    #[serde(skip)]
+    Streamed(StreamedTable),
 }
 
 impl Signal {
@@ -140,7 +148,7 @@ impl Signal {
         };
         match self {
             Signal::Constant { value } => fin("value", *value),
-            Signal::External(_) => Ok(()),
+            Signal::External(_) | Signal::Streamed(_) => Ok(()),
             Signal::Step {
                 time_s,
                 before,
@@ -241,6 +249,7 @@ impl Signal {
         match self {
             Signal::Constant { value } => *value,
             Signal::External(input) => input.value(t),
+            Signal::Streamed(table) => table.value_hinted(t, hint),
             Signal::Step {
                 time_s,
                 before,
@@ -307,6 +316,22 @@ impl Signal {
 }
 
 impl Signal {
+    /// The smallest and largest value of a sampled command (a table, or a
+    /// streamed table whose host gave its range); `None` for the others.
+    pub fn value_range(&self) -> Option<(f64, f64)> {
+        match self {
+            Signal::Table { value, .. } => Some(
+                value
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &u| {
+                        (lo.min(u), hi.max(u))
+                    }),
+            ),
+            Signal::Streamed(table) => table.range(),
+            _ => None,
+        }
+    }
+
     /// The time derivative at `t` (right-hand: the slope of the interval
     /// that starts at `t` for a table or ramp; 0 across a step's or a
     /// square's jump, which have no finite derivative) \[1/s\]. What an
@@ -315,6 +340,7 @@ impl Signal {
         match self {
             Signal::Constant { .. } | Signal::Step { .. } | Signal::Square { .. } => 0.0,
             Signal::External(input) => input.get().2,
+            Signal::Streamed(table) => table.slope_hinted(t, hint),
             Signal::Sine {
                 amplitude,
                 period_s,

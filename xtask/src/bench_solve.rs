@@ -84,7 +84,8 @@ fn profile() -> &'static str {
 /// The tolerances of the work-precision table: decades from 1e-3 to 1e-9,
 /// with the half decades between 1e-3 and 1e-6 where the velocity target
 /// NRMSE 1e-4 falls.
-const WORK_PRECISION_RTOLS: [f64; 10] = [1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 1e-7, 1e-8, 1e-9];
+const WORK_PRECISION_RTOLS: [f64; 10] =
+    [1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 1e-7, 1e-8, 1e-9];
 
 /// Work-precision table of the valve rig, 10 s: wall time, steps and the
 /// NRMSE of every channel against a DP45 run at rtol 1e-11 in this run.

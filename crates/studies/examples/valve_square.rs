@@ -3,6 +3,9 @@
 //! `reps` times with DP45 at the given rtol (as `cargo xtask bench` does).
 //!
 //! `cargo run --release -p hydrocyl-studies --example valve_square -- [rtol] [reps] [solver]`
+//!
+//! `VALVE_RHS=1` times the right-hand side alone, `VALVE_STEPS=1|2` prints
+//! the step sizes, `VALVE_ERR=1` where in time the velocity error lies.
 
 use hydrocyl_system::run::{nrmse, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
@@ -47,7 +50,10 @@ fn main() {
             c.rhs(t, &x, &mut dx);
             acc += dx[1];
         }
-        println!("rhs: {:.1} ns per call ({acc:e})", start.elapsed().as_secs_f64() * 1e9 / n as f64);
+        println!(
+            "rhs: {:.1} ns per call ({acc:e})",
+            start.elapsed().as_secs_f64() * 1e9 / n as f64
+        );
         return;
     }
     if std::env::var("VALVE_STEPS").is_ok() {
@@ -88,7 +94,11 @@ fn main() {
         let mut idx: Vec<usize> = (0..200).collect();
         idx.sort_by(|&i, &j| win[j].total_cmp(&win[i]));
         for &i in &idx[..12] {
-            println!("  window {:.2} s: {:.1} % of the squared error", i as f64 * 0.05, 100.0 * win[i] / tot);
+            println!(
+                "  window {:.2} s: {:.1} % of the squared error",
+                i as f64 * 0.05,
+                100.0 * win[i] / tot
+            );
         }
     }
     println!(
@@ -102,10 +112,9 @@ fn main() {
     );
 }
 
-/// Step sizes over time (`VALVE_STEPS=1`): every accepted step of the solve.
-#[allow(dead_code)]
-pub fn steps(rig: &ValveRig, command: Signal, rtol: f64) {
-    use hydrocyl_integrators::{solve, Method, OdeSystem, Options};
+/// Step sizes over time (`VALVE_STEPS=1` a histogram, `=2` every step).
+fn steps(rig: &ValveRig, command: Signal, rtol: f64) {
+    use hydrocyl_integrators::{solve, Method, Options};
     let mut c = rig.circuit(command).expect("circuit");
     let x0 = c.initial_state();
     c.reset(0.0, &x0);
@@ -114,7 +123,6 @@ pub fn steps(rig: &ValveRig, command: Signal, rtol: f64) {
         atol: c.atol(rtol),
         ..Options::default()
     };
-    let _ = c.dim();
     let s = solve(Method::DormandPrince45, &mut c, 0.0, &x0, 10.0, &o).expect("solve");
     let mut hist = [0usize; 12];
     for k in 1..s.t.len() {
@@ -125,5 +133,8 @@ pub fn steps(rig: &ValveRig, command: Signal, rtol: f64) {
             println!("{:.6} {:.3e}", s.t[k], h);
         }
     }
-    println!("h histogram by decade (1e-0..1e-11): {hist:?}; rejected {}", s.stats.rejected);
+    println!(
+        "h histogram by decade (1e-0..1e-11): {hist:?}; rejected {}",
+        s.stats.rejected
+    );
 }

@@ -159,10 +159,17 @@ mod tests {
 
     #[test]
     fn a_sampled_square_has_a_kink_at_each_end_of_each_edge() {
-        // ±1, period 2 s: edges from 0.999 to 1.000 s, 1.999 to 2.000 s, ...
-        let square = table(|t| if (t / 2.0).rem_euclid(1.0) < 0.5 { 1.0 } else { -1.0 });
+        // ±1, period 2 s: edges from 0.999 to 1.000 s, 1.999 to 2.000 s,
+        // ...; the last edge starts at 3.999 s and ends at the table's end
+        let square = table(|t| {
+            if (t / 2.0).rem_euclid(1.0) < 0.5 {
+                1.0
+            } else {
+                -1.0
+            }
+        });
         let k = kinks(&square);
-        let expected = [0.999, 1.0, 1.999, 2.0, 2.999, 3.0];
+        let expected = [0.999, 1.0, 1.999, 2.0, 2.999, 3.0, 3.999];
         assert_eq!(k.len(), expected.len(), "{k:?}");
         for (a, b) in k.iter().zip(expected) {
             assert!((a - b).abs() < 1e-12, "{k:?}");
@@ -197,13 +204,19 @@ mod tests {
 
     #[test]
     fn the_circuit_offers_the_next_kink_of_its_command() {
-        let square = table(|t| if (t / 2.0).rem_euclid(1.0) < 0.5 { 1.0 } else { -1.0 });
-        let c = crate::Circuit::build(vec![Box::new(CommandInput::new("cmd", "u", square))])
-            .unwrap();
+        let square = table(|t| {
+            if (t / 2.0).rem_euclid(1.0) < 0.5 {
+                1.0
+            } else {
+                -1.0
+            }
+        });
+        let c =
+            crate::Circuit::build(vec![Box::new(CommandInput::new("cmd", "u", square))]).unwrap();
         // the table's own sample times
         let (a, b) = (999.0 * 1e-3, 1000.0 * 1e-3);
         assert_eq!(c.next_breakpoint(0.0), a);
         assert_eq!(c.next_breakpoint(a), b);
-        assert_eq!(c.next_breakpoint(3.5), f64::INFINITY);
+        assert_eq!(c.next_breakpoint(3999.0 * 1e-3), f64::INFINITY);
     }
 }

@@ -49,6 +49,18 @@ pub trait OdeSystem {
         0
     }
 
+    /// The first time after `t` at which the right-hand side's smoothness
+    /// breaks while its value stays continuous (a kink: the corner of a
+    /// piecewise-linear input, the ends of a ramp), or `+∞` (the default)
+    /// when there is none. The adaptive methods end a step exactly there
+    /// instead of stepping across it, so that no step and no dense output
+    /// spans the kink (a step across one has a low-order local error and is
+    /// rejected or spoils the interpolated output near it). A jump of the
+    /// right-hand side itself is an event's job, not a breakpoint's.
+    fn next_breakpoint(&self, _t: f64) -> f64 {
+        f64::INFINITY
+    }
+
     /// Number of switching functions.
     fn n_events(&self) -> usize {
         0

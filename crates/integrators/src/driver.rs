@@ -572,9 +572,18 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
         let mut last = false;
         let remaining = t_end - t;
         let stretch = if adaptive { 1.01 } else { 1.0 + 1e-9 };
+        // Land exactly on the next breakpoint (adaptive methods); the step the
+        // controller wanted is kept for after it.
+        let mut breakpoint = None;
         if h * stretch >= remaining {
             h = remaining;
             last = true;
+        } else if adaptive {
+            let bp = sys.next_breakpoint(t);
+            if bp - t <= h * stretch && t_end - bp > t_close(bp) && bp > t {
+                breakpoint = Some((bp, h));
+                h = bp - t;
+            }
         }
 
         if stepper.attempt(&*sys, t, &x, h, &mut x_new, &mut err, &mut stats) == Attempt::Singular {
@@ -621,11 +630,17 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
         // Accepted.
         stats.steps += 1;
         stepper.accept(&*sys, t, &x, h, &x_new, &mut stats);
-        let t_new = if last { t_end } else { t + h };
-        let h_next = if adaptive {
-            ctrl.accepted(h, err_norm)
-        } else {
-            h
+        let t_new = match (last, breakpoint) {
+            (true, _) => t_end,
+            (false, Some((bp, _))) => bp,
+            (false, None) => t + h,
+        };
+        let h_next = match (adaptive, breakpoint) {
+            (false, _) => h,
+            (true, None) => ctrl.accepted(h, err_norm),
+            // a step shortened to land on a breakpoint says little about the
+            // step to take next: no smaller than the one wanted before it
+            (true, Some((_, wanted))) => ctrl.accepted(h, err_norm).max(wanted),
         };
 
         // Event detection over [t, t_new].

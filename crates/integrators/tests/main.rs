@@ -1,6 +1,7 @@
 //! hydrocyl-integrators' integration tests, in one binary to save link time.
 
 mod auto;
+mod breakpoints;
 mod common;
 mod convergence;
 mod dense;

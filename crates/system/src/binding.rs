@@ -36,6 +36,9 @@ pub struct Netlist {
     pub(crate) index: HashMap<String, usize>,
     pub(crate) owners: HashMap<usize, Owned>,
     pub(crate) accumulators: Vec<usize>,
+    /// (component, wire) for every wire a component may write: the
+    /// accumulators it binds and the wires it owns.
+    pub(crate) writes: Vec<(usize, usize)>,
     pub(crate) reads: Vec<(usize, usize, &'static str, String)>,
     pub(crate) mismatch: Option<BuildError>,
     /// Algebraic nodes: (declaring component, node, name).
@@ -92,6 +95,7 @@ impl Netlist {
                 causality: c,
             },
         );
+        self.writes.push((self.current, w));
         Ok(())
     }
 
@@ -104,6 +108,7 @@ impl Netlist {
         if !self.accumulators.contains(&i) {
             self.accumulators.push(i);
         }
+        self.writes.push((self.current, i));
         Acc(i, PhantomData)
     }
 
@@ -195,6 +200,7 @@ impl Netlist {
                 causality: Causality::Algebraic,
             },
         );
+        self.writes.push((self.current, w.0));
         w
     }
 }

@@ -181,6 +181,12 @@ pub trait Component {
         false
     }
 
+    /// The first time after `t` where an input of this component has a
+    /// kink (see [`OdeSystem::next_breakpoint`]), or `+∞`.
+    fn next_breakpoint(&self, _t: f64) -> f64 {
+        f64::INFINITY
+    }
+
     /// Number of switching functions.
     fn n_events(&self) -> usize {
         0
@@ -542,7 +548,7 @@ impl Circuit {
         // a run from a given state solves its algebraic nodes the same way
         // whatever ran before
         for g in &self.groups {
-            g.guess.set(f64::NAN);
+            g.forget();
         }
         self.fill(t, x);
         for g in &self.groups {
@@ -610,7 +616,10 @@ impl OdeSystem for Circuit {
         let w = self.wires.borrow();
         for (i, c) in self.comps.iter().enumerate() {
             let r = self.offsets[i]..self.offsets[i + 1];
-            c.derivatives(t, &x[r.clone()], &w, &mut dx[r]);
+            // a component without states has no derivatives to write
+            if !r.is_empty() {
+                c.derivatives(t, &x[r.clone()], &w, &mut dx[r]);
+            }
         }
         if self.quad {
             let o = self.quadrature_offset();
@@ -639,6 +648,13 @@ impl OdeSystem for Circuit {
                 dx[k + 3] = p.load;
             }
         }
+    }
+
+    fn next_breakpoint(&self, t: f64) -> f64 {
+        self.comps
+            .iter()
+            .map(|c| c.next_breakpoint(t))
+            .fold(f64::INFINITY, f64::min)
     }
 
     fn n_events(&self) -> usize {

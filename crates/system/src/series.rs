@@ -102,6 +102,12 @@ pub(crate) struct SeriesGroup {
     pub(crate) members: Vec<usize>,
     /// Pressure wires (table indices) the members read elsewhere: the bracket.
     bracket: Vec<usize>,
+    /// Every wire a member may write (their accumulators and owned wires,
+    /// the node's pressure among them): what a trial restores.
+    writes: Vec<usize>,
+    /// `∂ΣQ_in/∂p` at the last solution: the first Newton step of the next
+    /// solve uses it (NaN: ask the members).
+    slope: Cell<f64>,
     pub(crate) solves: Cell<u64>,
     pub(crate) evaluations: Cell<u64>,
     pub(crate) fallbacks: Cell<u64>,
@@ -110,9 +116,16 @@ pub(crate) struct SeriesGroup {
 }
 
 impl SeriesGroup {
+    /// Forgets the last solution and slope (a run from a given state solves
+    /// the same way whatever ran before).
+    pub(crate) fn forget(&self) {
+        self.guess.set(f64::NAN);
+        self.slope.set(f64::NAN);
+    }
+
     /// Solves the node: `eval(w)` runs the members on `w`, `slope(w)` sums
     /// their [`Component::inflow_slope`] (None if one has none); `snap` is
-    /// scratch.
+    /// scratch. Each trial restores only the wires the members write.
     pub(crate) fn solve(
         &self,
         w: &mut Wires,
@@ -121,7 +134,9 @@ impl SeriesGroup {
         slope: impl Fn(&Wires) -> Option<f64>,
     ) {
         snap.clear();
-        snap.extend_from_slice(&w.v);
+        snap.extend(self.writes.iter().map(|&i| w.v[i]));
+        #[cfg(debug_assertions)]
+        let before = w.v.clone();
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for &i in &self.bracket {
             lo = lo.min(w.v[i]);
@@ -129,7 +144,9 @@ impl SeriesGroup {
         }
         let (last, n) = (Cell::new(f64::NAN), Cell::new(0u64));
         let mut f = |p: f64, w: &mut Wires| {
-            w.v.copy_from_slice(snap);
+            for (&i, &v) in self.writes.iter().zip(snap.iter()) {
+                w.v[i] = v;
+            }
             w.set(self.node.pressure, Pressure::new(p));
             eval(w);
             last.set(p);
@@ -147,10 +164,14 @@ impl SeriesGroup {
             } else {
                 0.5 * (lo + hi)
             };
-            match newton(&mut f, &slope, w, p0, (lo, hi), tol) {
-                Some(p) => p,
+            match newton(&mut f, &slope, w, p0, (lo, hi), tol, self.slope.get()) {
+                Some((p, s)) => {
+                    self.slope.set(s);
+                    p
+                }
                 None => {
                     self.fallbacks.set(self.fallbacks.get() + 1);
+                    self.slope.set(f64::NAN);
                     let (flo, fhi) = (f(lo, w), f(hi, w));
                     if flo <= 0.0 {
                         lo
@@ -168,6 +189,13 @@ impl SeriesGroup {
         if last.get() != p {
             f(p, w);
         }
+        #[cfg(debug_assertions)]
+        for (i, (a, b)) in before.iter().zip(&w.v).enumerate() {
+            debug_assert!(
+                a.to_bits() == b.to_bits() || self.writes.contains(&i),
+                "a member of an algebraic node wrote wire {i}, which it did not bind"
+            );
+        }
         self.solves.set(self.solves.get() + 1);
         self.evaluations.set(self.evaluations.get() + n.get());
     }
@@ -176,6 +204,13 @@ impl SeriesGroup {
 /// Newton's method for the root of the falling `f` in `(lo, hi)` from `p0`,
 /// safeguarded by bisection of the bracket it narrows; `None` if a member has
 /// no slope or it does not converge (the caller falls back to Brent).
+///
+/// The slope of a step is the secant through the last two trials when there
+/// are two, the members' analytic slope otherwise, except that the first
+/// step takes `warm` (the slope at the previous solve's root) when it is a
+/// usable (negative) number: near the root the secant is as good as the
+/// analytic slope, and a warm-started solve then costs the residual
+/// evaluations alone. Returns the root and the slope there.
 fn newton(
     f: &mut impl FnMut(f64, &mut Wires) -> f64,
     slope: &impl Fn(&Wires) -> Option<f64>,
@@ -183,13 +218,15 @@ fn newton(
     p0: f64,
     (mut a, mut b): (f64, f64),
     tol: f64,
-) -> Option<f64> {
+    warm: f64,
+) -> Option<(f64, f64)> {
     let mut p = p0;
     let mut last_step = f64::INFINITY;
-    for _ in 0..NEWTON_ITERATIONS {
+    let mut prev: Option<(f64, f64)> = None;
+    for k in 0..NEWTON_ITERATIONS {
         let r = f(p, w);
         if r == 0.0 {
-            return Some(p);
+            return Some((p, prev.map_or(warm, |(_, s)| s)));
         }
         // the inflow falls with p: a positive residual puts the root above p
         if r > 0.0 {
@@ -197,13 +234,22 @@ fn newton(
         } else {
             b = p;
         }
-        let s = slope(w)?;
+        let secant = prev.and_then(|(pp, rp): (f64, f64)| {
+            let s = (r - rp) / (p - pp);
+            (s < 0.0 && s.is_finite()).then_some(s)
+        });
+        let s = match secant {
+            Some(s) => s,
+            None if k == 0 && warm < 0.0 && warm.is_finite() => warm,
+            None => slope(w)?,
+        };
         let step = if s < 0.0 { -r / s } else { f64::NAN };
         // converged, or at the rounding floor (a step that stopped shrinking)
         if step.abs() <= tol || (step.abs() <= 1e3 * tol && step.abs() >= 0.5 * last_step) {
-            return Some(p);
+            return Some((p, s));
         }
         last_step = step.abs();
+        prev = Some((p, r));
         let next = p + step;
         p = if next > a && next < b {
             next
@@ -211,7 +257,7 @@ fn newton(
             0.5 * (a + b)
         };
         if b - a <= tol {
-            return Some(p);
+            return Some((p, s));
         }
     }
     None
@@ -267,6 +313,15 @@ fn groups(
             .collect();
         bracket.sort_unstable();
         bracket.dedup();
+        let mut writes: Vec<usize> = net
+            .writes
+            .iter()
+            .filter(|(c, _)| members.contains(c))
+            .map(|(_, w)| *w)
+            .chain([p.0])
+            .collect();
+        writes.sort_unstable();
+        writes.dedup();
         if bracket.is_empty() {
             return Err(err(format!(
                 "algebraic node `{name}` is connected to no other hydraulic node"
@@ -277,6 +332,8 @@ fn groups(
             node: *node,
             members: order,
             bracket,
+            writes,
+            slope: Cell::new(f64::NAN),
             solves: Cell::new(0),
             evaluations: Cell::new(0),
             fallbacks: Cell::new(0),

@@ -303,10 +303,18 @@ impl Metering {
     ) -> MeteringFlows {
         let a = self.areas(xs);
         let o = &self.orifice;
-        let q_p1 = o.flow(a.av1, pp, pa);
-        let q_1t = o.flow(a.av2, pa, pt);
-        let q_2t = o.flow(a.av1, pb, pt);
-        let q_p2 = o.flow(a.av2, pp, pb);
+        // away from null one pair of edges is shut: no square roots for it
+        let flow = |area: Area, up, down| {
+            if area.si() == 0.0 {
+                VolumeFlow::ZERO
+            } else {
+                o.flow(area, up, down)
+            }
+        };
+        let q_p1 = flow(a.av1, pp, pa);
+        let q_1t = flow(a.av2, pa, pt);
+        let q_2t = flow(a.av1, pb, pt);
+        let q_p2 = flow(a.av2, pp, pb);
         let dissipated = (pp - pa) * q_p1 + (pa - pt) * q_1t + (pb - pt) * q_2t + (pp - pb) * q_p2;
         MeteringFlows {
             qa: q_p1 - q_1t,
@@ -397,6 +405,7 @@ impl Metering {
     /// \[Pa·s·m⁻³\] from source pressure `ps0`: the flows at the drooped
     /// supply pressure (returned alongside), with the droop's loss
     /// `rs Q_P²` added to `dissipated`.
+    #[inline]
     pub fn flows_drooped(
         &self,
         xs: Position,

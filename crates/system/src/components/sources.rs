@@ -5,7 +5,7 @@ use crate::circuit::{
 };
 use crate::signal::Signal;
 use hydrocyl_ports::{HydraulicPort, Pressure};
-use std::cell::Cell;
+use std::cell::{Cell, OnceCell};
 
 /// A node held at a fixed pressure: a supply (pressure-compensated pump with
 /// accumulator) or the tank. It delivers whatever flow the circuit draws.
@@ -66,7 +66,48 @@ pub struct CommandInput {
     /// The signal.
     pub signal: Signal,
     hint: Cell<usize>,
+    /// The signal's kinks ([`kinks`]), found on first use.
+    kinks: OnceCell<Vec<f64>>,
     out: Wire<f64>,
+}
+
+/// A corner of a table counts as a kink when the change of slope at it, times
+/// the shorter of its two intervals, is at least this share of the table's
+/// range: a square or step edge given as samples (the change is the whole
+/// edge), not the corners of a sampled smooth or noisy signal (a 1 kHz sine
+/// changes by ~1e-5 of its range, measurement noise by its own share).
+pub const KINK_SHARE: f64 = 0.1;
+
+/// The times where `signal` is continuous but its slope jumps by a lot (see
+/// [`KINK_SHARE`]): the ends of a ramp, the corners of a table that edge a
+/// step or a ramp of the command. A solver ends its steps there
+/// ([`hydrocyl_integrators::OdeSystem::next_breakpoint`]). Jumps of the value
+/// itself (a step, a square, a sawtooth's drop) are not kinks.
+pub fn kinks(signal: &Signal) -> Vec<f64> {
+    match signal {
+        Signal::Ramp { t0_s, t1_s, .. } => vec![*t0_s, *t1_s],
+        Signal::Table { time_s, value } if time_s.len() >= 3 => {
+            let (lo, hi) = value
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                    (l.min(v), h.max(v))
+                });
+            let range = hi - lo;
+            if range <= 0.0 {
+                return Vec::new();
+            }
+            (1..time_s.len() - 1)
+                .filter(|&i| {
+                    let (d0, d1) = (time_s[i] - time_s[i - 1], time_s[i + 1] - time_s[i]);
+                    let s0 = (value[i] - value[i - 1]) / d0;
+                    let s1 = (value[i + 1] - value[i]) / d1;
+                    (s1 - s0).abs() * d0.min(d1) >= KINK_SHARE * range
+                })
+                .map(|i| time_s[i])
+                .collect()
+        }
+        _ => Vec::new(),
+    }
 }
 
 impl CommandInput {
@@ -77,6 +118,7 @@ impl CommandInput {
             output_name: output.into(),
             signal,
             hint: Cell::new(0),
+            kinks: OnceCell::new(),
             out: Wire::UNBOUND,
         }
     }
@@ -93,7 +135,88 @@ impl Component for CommandInput {
     fn publish(&self, t: f64, _x: &[f64], w: &mut Wires) {
         w.set(self.out, self.signal.value_hinted(t, &self.hint));
     }
+    fn next_breakpoint(&self, t: f64) -> f64 {
+        let k = self.kinks.get_or_init(|| kinks(&self.signal));
+        k.get(k.partition_point(|&b| b <= t))
+            .copied()
+            .unwrap_or(f64::INFINITY)
+    }
     fn probes(&self) -> Vec<Probe> {
         vec![Probe::of("command", self.out)]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hydrocyl_integrators::OdeSystem;
+
+    fn table(f: impl Fn(f64) -> f64) -> Signal {
+        let t: Vec<f64> = (0..=4000).map(|k| k as f64 * 1e-3).collect();
+        let v = t.iter().map(|&t| f(t)).collect();
+        Signal::table(t, v).unwrap()
+    }
+
+    #[test]
+    fn a_sampled_square_has_a_kink_at_each_end_of_each_edge() {
+        // ±1, period 2 s: edges from 0.999 to 1.000 s, 1.999 to 2.000 s,
+        // ...; the last edge starts at 3.999 s and ends at the table's end
+        let square = table(|t| {
+            if (t / 2.0).rem_euclid(1.0) < 0.5 {
+                1.0
+            } else {
+                -1.0
+            }
+        });
+        let k = kinks(&square);
+        let expected = [0.999, 1.0, 1.999, 2.0, 2.999, 3.0, 3.999];
+        assert_eq!(k.len(), expected.len(), "{k:?}");
+        for (a, b) in k.iter().zip(expected) {
+            assert!((a - b).abs() < 1e-12, "{k:?}");
+        }
+    }
+
+    #[test]
+    fn a_sampled_sine_and_a_noisy_constant_have_none() {
+        let sine = table(|t| (std::f64::consts::TAU * 0.5 * t).sin());
+        assert!(kinks(&sine).is_empty());
+        // ±2 % noise on a signal with range 1 (a deterministic hash as noise)
+        let noisy = table(|t| {
+            let h = ((t * 1e3).round() as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 40;
+            (t / 4.0) + 0.02 * (h as f64 / (1u64 << 24) as f64 - 0.5)
+        });
+        assert!(kinks(&noisy).is_empty());
+        // a ramp's two ends; no kinks in a step (a jump, not a kink)
+        let ramp = Signal::Ramp {
+            from: 0.0,
+            to: 1.0,
+            t0_s: 1.0,
+            t1_s: 2.0,
+        };
+        assert_eq!(kinks(&ramp), vec![1.0, 2.0]);
+        let step = Signal::Step {
+            time_s: 1.0,
+            before: 0.0,
+            after: 1.0,
+        };
+        assert!(kinks(&step).is_empty());
+    }
+
+    #[test]
+    fn the_circuit_offers_the_next_kink_of_its_command() {
+        let square = table(|t| {
+            if (t / 2.0).rem_euclid(1.0) < 0.5 {
+                1.0
+            } else {
+                -1.0
+            }
+        });
+        let c =
+            crate::Circuit::build(vec![Box::new(CommandInput::new("cmd", "u", square))]).unwrap();
+        // the table's own sample times
+        let (a, b) = (999.0 * 1e-3, 1000.0 * 1e-3);
+        assert_eq!(c.next_breakpoint(0.0), a);
+        assert_eq!(c.next_breakpoint(a), b);
+        assert_eq!(c.next_breakpoint(3999.0 * 1e-3), f64::INFINITY);
     }
 }

@@ -124,7 +124,7 @@ pub fn section() -> Section {
 /// the start position is the test's. DP45, Rosenbrock and auto must agree.
 fn preset_as_shipped(s: &mut Section) {
     use hydrocyl_integrators::Method;
-    s.note("Preset as shipped (20 kg, Table 5-8, seal term K min(|dp|, dp_max)^2 v with dp_max 2.72 bar ext / 5.03 bar ret, K H a with K H blended over");
+    s.note("Preset as shipped (20 kg, Table 5-8, seal term K min(|dp|, 5.03 bar)^2 v, K H a with K H blended over");
     s.note("±1 mm/s at v = 0), 3 periods from 60 mm below mid-stroke, DP45; Rosenbrock and auto checked against it:");
     for shape in [Shape::Square, Shape::Sine] {
         let mut test = Chapter7Test::new(shape, Load::None);

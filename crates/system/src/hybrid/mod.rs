@@ -167,11 +167,7 @@ impl WangHybrid {
             friction: FrictionLaw::Wang(
                 // Table 5-8 with its K H a term (blended across v = 0,
                 // hydrocyl_friction::ACCELERATION_BLEND_VELOCITY; docs/hybrid.md item 7)
-                // and the seal term bounded per direction (hydrocyl_friction::seal)
-                Wang::table_5_8().with_seal_bounds(
-                    hydrocyl_friction::seal::TABLE_5_8_DP_MAX_EXTEND,
-                    hydrocyl_friction::seal::TABLE_5_8_DP_MAX,
-                ),
+                Wang::table_5_8().with_seal_bound(hydrocyl_friction::seal::TABLE_5_8_DP_MAX),
             ),
             tank_pressure: 0.0,
             vapour_pressure: -0.99e5,

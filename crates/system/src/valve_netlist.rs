@@ -231,7 +231,10 @@ impl ValveRig {
         sets.push(("friction.seal.h_acceleration".into(), t.h_acceleration));
         // one set of bounds for every seal term of the component
         sets.push(("friction.seal.dp_max".into(), t.dp_max.max(bound[0])));
-        let (ext, ret) = (t.dp_max_extend.max(bound[1]), t.dp_max_retract.max(bound[2]));
+        let (ext, ret) = (
+            t.dp_max_extend.max(bound[1]),
+            t.dp_max_retract.max(bound[2]),
+        );
         if ext > 0.0 {
             sets.push(("friction.seal.dp_max_extend".into(), ext));
         }

@@ -146,7 +146,10 @@ impl WangHybrid {
         c["friction"] = friction;
         // the bounds of Wang's own seal term (0 = the thesis's unbounded form /
         // the common bound)
-        for (key, b) in ["dp_max", "dp_max_extend", "dp_max_retract"].iter().zip(dp_max) {
+        for (key, b) in ["dp_max", "dp_max_extend", "dp_max_retract"]
+            .iter()
+            .zip(dp_max)
+        {
             if b > 0.0 {
                 c["friction"]["seal"][*key] = json!(b);
             }

@@ -30,6 +30,13 @@ pub struct SealTerms {
     /// \[Pa\] (module [`crate::seal`]); 0 = unbounded, the thesis's eq 5.4.
     #[serde(default)]
     pub dp_max: f64,
+    /// Bound while extending (v > 0) \[Pa\]; 0 = `dp_max`
+    /// ([`crate::seal::bound_for`]).
+    #[serde(default, skip_serializing_if = "crate::seal::is_unbounded")]
+    pub dp_max_extend: f64,
+    /// Bound while retracting (v < 0) \[Pa\]; 0 = `dp_max`.
+    #[serde(default, skip_serializing_if = "crate::seal::is_unbounded")]
+    pub dp_max_retract: f64,
 }
 
 impl SealTerms {
@@ -43,12 +50,25 @@ impl SealTerms {
         const M: &str = "seal terms";
         non_negative(M, "K (k_pressure)", self.k_pressure)?;
         non_negative(M, "H (h_acceleration)", self.h_acceleration)?;
-        non_negative(M, "dp_max", self.dp_max)
+        non_negative(M, "dp_max", self.dp_max)?;
+        non_negative(M, "dp_max_extend", self.dp_max_extend)?;
+        non_negative(M, "dp_max_retract", self.dp_max_retract)
+    }
+
+    /// The bounded pressure difference and its slope at this input.
+    fn seal_dp(&self, input: &FrictionInput) -> (f64, f64) {
+        let bound = crate::seal::bound_for(
+            input.velocity.si() > 0.0,
+            self.dp_max,
+            self.dp_max_extend,
+            self.dp_max_retract,
+        );
+        crate::seal::bounded(input.p1.si() - input.p2.si(), bound)
     }
 
     /// `K min(|p1 − p2|, Δp_max)² v` \[N\].
     fn pressure_force(&self, input: &FrictionInput) -> f64 {
-        let (dp, _) = crate::seal::bounded(input.p1.si() - input.p2.si(), self.dp_max);
+        let (dp, _) = self.seal_dp(input);
         self.k_pressure * dp * dp * input.velocity.si()
     }
 }
@@ -92,7 +112,7 @@ impl<M: FrictionModel> FrictionModel for WithSealTerms<M> {
     fn jacobian(&self, input: &FrictionInput, state: &[f64]) -> FrictionJacobian {
         let mut j = self.inner.jacobian(input, state);
         let k = self.terms.k_pressure;
-        let (dp, slope) = crate::seal::bounded(input.p1.si() - input.p2.si(), self.terms.dp_max);
+        let (dp, slope) = self.terms.seal_dp(input);
         let v = input.velocity.si();
         j.df_dv += k * dp * dp;
         j.df_dp1 += 2.0 * k * dp * slope * v;
@@ -156,7 +176,7 @@ mod tests {
         let terms = SealTerms {
             k_pressure: 1e-9,
             h_acceleration: 3e9,
-            dp_max: 0.0,
+            ..SealTerms::default()
         };
         let m = WithSealTerms { inner, terms };
         let input = FrictionInput {
@@ -173,8 +193,7 @@ mod tests {
         assert!(SealTerms::default().is_off());
         let bad = SealTerms {
             k_pressure: -1.0,
-            h_acceleration: 0.0,
-            dp_max: 0.0,
+            ..SealTerms::default()
         };
         assert!(bad.validate().is_err());
         // bounded to 2 MPa: the 3 MPa difference counts as 2 MPa, and the
@@ -189,5 +208,23 @@ mod tests {
         let f = bounded.force(&input, &[]).si() - inner.force(&input, &[]).si();
         assert!((f - 1e-9 * 4e12 * 0.05).abs() < 1e-9, "{f}");
         assert_jacobian(&bounded, &input);
+        // per direction: extending takes 1 MPa, retracting falls back to 2 MPa
+        let per = WithSealTerms {
+            inner,
+            terms: SealTerms {
+                dp_max: 2e6,
+                dp_max_extend: 1e6,
+                ..terms
+            },
+        };
+        let f = per.force(&input, &[]).si() - inner.force(&input, &[]).si();
+        assert!((f - 1e-9 * 1e12 * 0.05).abs() < 1e-9, "{f}");
+        let back = FrictionInput {
+            velocity: Velocity::new(-0.05),
+            ..input
+        };
+        let f = per.force(&back, &[]).si() - inner.force(&back, &[]).si();
+        assert!((f + 1e-9 * 4e12 * 0.05).abs() < 1e-9, "{f}");
+        assert_jacobian(&per, &back);
     }
 }

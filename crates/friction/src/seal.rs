@@ -22,6 +22,18 @@
 //! `Δp = √((F − g(v)) / (K v))`. Over Table 5-3 this gives 1.1–2.7 bar
 //! extending and 2.0–5.0 bar retracting ([`TABLE_5_3`]); the largest, 5.03
 //! bar at −49 mm/s, is Δp_max.
+//!
+//! **Per direction.** The two directions were identified over different
+//! ranges (2.72 bar at most extending, 5.03 bar retracting), and with one
+//! bound the extending seal term is used up to 5.03 bar, outside its data: on
+//! the chapter-7 square the hybrid drive then lands on the upper branch of a
+//! fold (447 N at 50 mm/s against the rig's 220 N). So every seal term takes
+//! an optional bound per direction, `Δp_max,ext` for v > 0 and `Δp_max,ret`
+//! for v < 0 ([`bound_for`], [`identification_dp_max_per_direction`]); 0
+//! falls back to the common `Δp_max`. No blend across v = 0 is needed: the
+//! term is `K Δp² v`, so the force is continuous whatever the bound does at
+//! v = 0 (only ∂F/∂v steps there, as it already does with Table 5-8's two
+//! K values).
 
 use crate::wang::Wang;
 
@@ -42,6 +54,22 @@ pub const TABLE_5_3: [(f64, f64); 8] = [
 /// [`identification_dp_max`] rounded to 1 Pa: the bound the presets with
 /// Table 5-8 friction use \[Pa\] (a test keeps them equal).
 pub const TABLE_5_8_DP_MAX: f64 = 502_888.0;
+
+/// [`identification_dp_max_per_direction`]'s extending bound rounded to
+/// 1 Pa \[Pa\] (a test keeps them equal); the retracting one is
+/// [`TABLE_5_8_DP_MAX`].
+pub const TABLE_5_8_DP_MAX_EXTEND: f64 = 271_667.0;
+
+/// The bound of one direction: `extend` (v > 0, or `extending`) or
+/// `retract`, the common `dp_max` where that is 0 \[Pa\] (0 = unbounded).
+pub fn bound_for(extending: bool, dp_max: f64, extend: f64, retract: f64) -> f64 {
+    let own = if extending { extend } else { retract };
+    if own > 0.0 {
+        own
+    } else {
+        dp_max
+    }
+}
 
 /// `(min(|dp|, dp_max) sgn(dp), slope)` — the pressure difference the seal
 /// term sees and its derivative with respect to `dp` (1 inside the bound,
@@ -85,6 +113,16 @@ pub fn identification_dp_max() -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The largest pressure difference of Table 5-8's identification data per
+/// direction, `(extending, retracting)`: the maxima of [`implied_dp`] over
+/// the v > 0 and v < 0 points of [`TABLE_5_3`] (≈ 2.72 / 5.03 bar) \[Pa\].
+pub fn identification_dp_max_per_direction() -> (f64, f64) {
+    let law = Wang::table_5_8();
+    let max = |pts: Vec<(f64, f64)>| implied_dp(&law, &pts).into_iter().fold(0.0, f64::max);
+    let (ext, ret): (Vec<_>, Vec<_>) = TABLE_5_3.iter().partition(|p| p.0 > 0.0);
+    (max(ext), max(ret))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -100,6 +138,25 @@ mod tests {
         // lies under the curve
         assert!(dps[..4].iter().all(|&d| d > 1.0e5 && d < 2.8e5), "{dps:?}");
         assert_eq!(dps[4], 0.0);
+    }
+
+    #[test]
+    fn the_extending_bound_is_2_7_bar_at_the_fastest_extending_point() {
+        let dps = implied_dp(&Wang::table_5_8(), &TABLE_5_3);
+        let (ext, ret) = identification_dp_max_per_direction();
+        assert_eq!(ext, dps[0]);
+        assert_eq!(ret, identification_dp_max());
+        assert!((ext - 2.72e5).abs() < 0.01e5, "{ext}");
+        assert!((ext - TABLE_5_8_DP_MAX_EXTEND).abs() < 1.0, "{ext}");
+        assert!((ret - TABLE_5_8_DP_MAX).abs() < 1.0, "{ret}");
+    }
+
+    #[test]
+    fn bound_for_takes_the_direction_and_falls_back_to_the_common_one() {
+        assert_eq!(bound_for(true, 5e5, 2e5, 4e5), 2e5);
+        assert_eq!(bound_for(false, 5e5, 2e5, 4e5), 4e5);
+        assert_eq!(bound_for(true, 5e5, 0.0, 4e5), 5e5);
+        assert_eq!(bound_for(false, 0.0, 2e5, 0.0), 0.0);
     }
 
     #[test]

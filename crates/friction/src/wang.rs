@@ -96,6 +96,13 @@ pub struct Wang {
     /// 0 = unbounded, the thesis's eq 5.4.
     #[serde(default, skip_serializing_if = "crate::seal::is_unbounded")]
     pub seal_dp_max: f64,
+    /// Bound while extending (v > 0) \[Pa\]; 0 = [`Wang::seal_dp_max`]
+    /// ([`crate::seal::bound_for`]).
+    #[serde(default, skip_serializing_if = "crate::seal::is_unbounded")]
+    pub seal_dp_max_extend: f64,
+    /// Bound while retracting (v < 0) \[Pa\]; 0 = [`Wang::seal_dp_max`].
+    #[serde(default, skip_serializing_if = "crate::seal::is_unbounded")]
+    pub seal_dp_max_retract: f64,
 }
 
 fn set(fc: f64, fs: f64, delta: f64, k: f64, h: f64) -> WangSet {
@@ -122,6 +129,8 @@ impl Wang {
             extending: set(110.0, 180.0, 0.1087, 2.5e-8, 3.05e9),
             retracting: set(80.0, 188.0, 0.1138, 4.0e-9, 9.0e9),
             seal_dp_max: 0.0,
+            seal_dp_max_extend: 0.0,
+            seal_dp_max_retract: 0.0,
         }
     }
 
@@ -159,10 +168,27 @@ impl Wang {
         self
     }
 
+    /// The same model with the seal term bounded per direction \[Pa\]:
+    /// `extend` for v > 0, `retract` for v < 0 (0 = [`Wang::seal_dp_max`]).
+    pub fn with_seal_bounds(mut self, extend: f64, retract: f64) -> Self {
+        self.seal_dp_max_extend = extend;
+        self.seal_dp_max_retract = retract;
+        self
+    }
+
     /// The pressure difference the seal term sees and its slope
-    /// `d(bounded)/d(p1 − p2)` (0 or 1).
+    /// `d(bounded)/d(p1 − p2)` (0 or 1), with the bound of the direction
+    /// whose set [`Wang::set_for`] takes.
     fn seal_dp(&self, input: &FrictionInput) -> (f64, f64) {
-        crate::seal::bounded(input.p1.si() - input.p2.si(), self.seal_dp_max)
+        let v = input.velocity.si();
+        let extending = v > 0.0 || (v == 0.0 && input.acceleration.si() >= 0.0);
+        let bound = crate::seal::bound_for(
+            extending,
+            self.seal_dp_max,
+            self.seal_dp_max_extend,
+            self.seal_dp_max_retract,
+        );
+        crate::seal::bounded(input.p1.si() - input.p2.si(), bound)
     }
 
     /// The set for velocity `v`; at v = 0 the acceleration's sign decides
@@ -243,6 +269,8 @@ impl FrictionModel for Wang {
     fn validate(&self) -> Result<(), FrictionError> {
         positive("wang", "sigma0", self.sigma0)?;
         non_negative("wang", "seal_dp_max", self.seal_dp_max)?;
+        non_negative("wang", "seal_dp_max_extend", self.seal_dp_max_extend)?;
+        non_negative("wang", "seal_dp_max_retract", self.seal_dp_max_retract)?;
         non_negative("wang", "sigma1", self.sigma1)?;
         self.extending.validate("wang (extending)")?;
         self.retracting.validate("wang (retracting)")

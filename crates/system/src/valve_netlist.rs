@@ -90,16 +90,19 @@ fn template(text: &str) -> Value {
 }
 
 /// A friction law as a netlist component object (`friction_<model>`), and
-/// the bound of its seal term (Wang's `seal_dp_max`, which the netlist
-/// names `seal.dp_max`; 0 = unbounded).
-pub(crate) fn friction_component(law: &FrictionLaw) -> (Value, f64) {
+/// the bounds of its seal term `[common, extending, retracting]` (Wang's
+/// `seal_dp_max*`, which the netlist names `seal.dp_max*`; 0 = unbounded /
+/// the common one).
+pub(crate) fn friction_component(law: &FrictionLaw) -> (Value, [f64; 3]) {
     let mut v = serde_json::to_value(law).expect("a friction law serialises");
     let obj = v.as_object_mut().expect("a tagged object");
     obj.remove("model");
-    let bound = obj
-        .remove("seal_dp_max")
-        .and_then(|b| b.as_f64())
-        .unwrap_or(0.0);
+    let mut take = |k: &str| obj.remove(k).and_then(|b| b.as_f64()).unwrap_or(0.0);
+    let bound = [
+        take("seal_dp_max"),
+        take("seal_dp_max_extend"),
+        take("seal_dp_max_retract"),
+    ];
     let mut out = serde_json::Map::new();
     out.insert(
         "type".into(),
@@ -226,8 +229,18 @@ impl ValveRig {
         let t = self.friction_terms;
         sets.push(("friction.seal.k_pressure".into(), t.k_pressure));
         sets.push(("friction.seal.h_acceleration".into(), t.h_acceleration));
-        // one bound for every seal term of the component
-        sets.push(("friction.seal.dp_max".into(), t.dp_max.max(bound)));
+        // one set of bounds for every seal term of the component
+        sets.push(("friction.seal.dp_max".into(), t.dp_max.max(bound[0])));
+        let (ext, ret) = (
+            t.dp_max_extend.max(bound[1]),
+            t.dp_max_retract.max(bound[2]),
+        );
+        if ext > 0.0 {
+            sets.push(("friction.seal.dp_max_extend".into(), ext));
+        }
+        if ret > 0.0 {
+            sets.push(("friction.seal.dp_max_retract".into(), ret));
+        }
         for (path, x) in sets {
             netlist::set(&mut v, &path, Value::from(x))?;
         }

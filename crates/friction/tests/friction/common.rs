@@ -59,6 +59,8 @@ pub fn wang_from(p: &[f64; 6]) -> Wang {
         extending: set(1.0),
         retracting: set(0.8),
         seal_dp_max: 0.0,
+        seal_dp_max_extend: 0.0,
+        seal_dp_max_retract: 0.0,
     }
 }
 

@@ -144,9 +144,15 @@ impl WangHybrid {
         });
         let (friction, dp_max) = crate::valve_netlist::friction_component(&self.friction);
         c["friction"] = friction;
-        if dp_max > 0.0 {
-            // the bound of Wang's own seal term (0 = the thesis's unbounded form)
-            c["friction"]["seal"] = json!({ "dp_max": dp_max });
+        // the bounds of Wang's own seal term (0 = the thesis's unbounded form /
+        // the common bound)
+        for (key, b) in ["dp_max", "dp_max_extend", "dp_max_retract"]
+            .iter()
+            .zip(dp_max)
+        {
+            if b > 0.0 {
+                c["friction"]["seal"][*key] = json!(b);
+            }
         }
         c["tank"] = json!({ "type": "pressure_source", "pressure": tank });
         for r in ["relief_1", "relief_2"] {

@@ -106,7 +106,7 @@ const SIGMA1: ParamSpec = param(
 
 /// The additive seal terms every law may carry (catalog
 /// `pressure_viscous`, `acceleration_friction`; 0 = off).
-const SEAL: [ParamSpec; 3] = [
+const SEAL: [ParamSpec; 5] = [
     param(
         "seal.k_pressure",
         "m^3 s/N",
@@ -127,6 +127,20 @@ const SEAL: [ParamSpec; 3] = [
         Value(0.0),
         Range::NON_NEGATIVE,
         "bound of |p1 − p2| in every seal term, K min(|p1 − p2|, Δp_max)² v; 0 = unbounded (eq 5.4)",
+    ),
+    param(
+        "seal.dp_max_extend",
+        "Pa",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "Δp_max while extending (v > 0); 0 = seal.dp_max",
+    ),
+    param(
+        "seal.dp_max_retract",
+        "Pa",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "Δp_max while retracting (v < 0); 0 = seal.dp_max",
     ),
 ];
 
@@ -154,7 +168,7 @@ const COULOMB_VISCOUS_LAW: [ParamSpec; 3] = [
     ),
 ];
 
-const COULOMB_VISCOUS: [ParamSpec; 6] = join(COULOMB_VISCOUS_LAW, SEAL);
+const COULOMB_VISCOUS: [ParamSpec; 8] = join(COULOMB_VISCOUS_LAW, SEAL);
 
 const STRIBECK_LAW: [ParamSpec; 11] = join(
     join::<4, 4, 8>(curve!("extending.curve"), curve!("retracting.curve")),
@@ -171,7 +185,7 @@ const STRIBECK_LAW: [ParamSpec; 11] = join(
     ],
 );
 
-const STRIBECK: [ParamSpec; 14] = join(STRIBECK_LAW, SEAL);
+const STRIBECK: [ParamSpec; 16] = join(STRIBECK_LAW, SEAL);
 
 const KARNOPP_LAW: [ParamSpec; 5] = join(
     curve!("curve"),
@@ -201,8 +215,8 @@ const DAHL_LAW: [ParamSpec; 3] = [
         "viscous coefficient σ2",
     ),
 ];
-const DAHL: [ParamSpec; 6] = join(DAHL_LAW, SEAL);
-const KARNOPP: [ParamSpec; 8] = join(KARNOPP_LAW, SEAL);
+const DAHL: [ParamSpec; 8] = join(DAHL_LAW, SEAL);
+const KARNOPP: [ParamSpec; 10] = join(KARNOPP_LAW, SEAL);
 
 const LUGRE_LAW: [ParamSpec; 12] = join(
     [SIGMA0, SIGMA1],
@@ -249,8 +263,8 @@ const WANG_LAW: [ParamSpec; 14] = join(
     ),
 );
 
-const LUGRE: [ParamSpec; 15] = join(LUGRE_LAW, SEAL);
-const WANG: [ParamSpec; 17] = join(WANG_LAW, SEAL);
+const LUGRE: [ParamSpec; 17] = join(LUGRE_LAW, SEAL);
+const WANG: [ParamSpec; 19] = join(WANG_LAW, SEAL);
 
 /// The additive seal terms of an instance of one of these types.
 pub(crate) fn terms_of(inst: &Instance) -> SealTerms {
@@ -258,6 +272,8 @@ pub(crate) fn terms_of(inst: &Instance) -> SealTerms {
         k_pressure: inst.opt("seal.k_pressure").unwrap_or(0.0),
         h_acceleration: inst.opt("seal.h_acceleration").unwrap_or(0.0),
         dp_max: inst.opt("seal.dp_max").unwrap_or(0.0),
+        dp_max_extend: inst.opt("seal.dp_max_extend").unwrap_or(0.0),
+        dp_max_retract: inst.opt("seal.dp_max_retract").unwrap_or(0.0),
     }
 }
 
@@ -288,11 +304,15 @@ fn build_with<T: DeserializeOwned>(
     built(Friction::new(&inst.name, inst.node("rod"), chambers, model))
 }
 
-/// Wang's own seal term takes the component's `seal.dp_max` bound too.
+/// Wang's own seal term takes the component's `seal.dp_max*` bounds too.
 fn bound_seal(law: FrictionLaw, inst: &Instance) -> FrictionLaw {
     match law {
         FrictionLaw::Wang(w) => {
-            FrictionLaw::Wang(w.with_seal_bound(inst.opt("seal.dp_max").unwrap_or(0.0)))
+            let t = terms_of(inst);
+            FrictionLaw::Wang(
+                w.with_seal_bound(t.dp_max)
+                    .with_seal_bounds(t.dp_max_extend, t.dp_max_retract),
+            )
         }
         other => other,
     }

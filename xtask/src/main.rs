@@ -13,8 +13,8 @@
 mod bench;
 mod bench_solve;
 mod energy;
-mod energy_relief;
 mod energy_ch9;
+mod energy_relief;
 mod progress;
 mod report;
 mod test;

@@ -40,5 +40,5 @@
 pub mod chapter3;
 pub mod chapter7;
 pub mod chapter8;
-pub mod relief;
 pub mod chapter9;
+pub mod relief;

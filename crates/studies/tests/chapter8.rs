@@ -58,7 +58,11 @@ fn matrix() -> &'static Vec<Outcome> {
             let run_all = |js: &[(Drive, Scenario)]| -> Vec<Outcome> {
                 js.iter()
                     .map(|(d, s)| {
-                        let p = if s.system.ends_with("-k0") { &k0 } else { &plan };
+                        let p = if s.system.ends_with("-k0") {
+                            &k0
+                        } else {
+                            &plan
+                        };
                         run_scenario(d, s, p).unwrap_or_else(|e| panic!("{}: {e}", s.label()))
                     })
                     .collect()

@@ -149,13 +149,11 @@ pub struct RigKind {
 /// The rig kinds hydrocyl assembles. Other rig kinds add an entry here; the
 /// older kinds of [`MIGRATED_KINDS`](crate::netlist::migrate::MIGRATED_KINDS)
 /// are read as netlists ([`crate::netlist::migrate`]).
-pub const RIG_KINDS: &[RigKind] = &[
-    RigKind {
-        kind: crate::netlist::KIND,
-        check: |v| crate::netlist::read(v).map(|_| ()).map_err(RigError::from),
-        circuit: crate::netlist::circuit,
-    },
-];
+pub const RIG_KINDS: &[RigKind] = &[RigKind {
+    kind: crate::netlist::KIND,
+    check: |v| crate::netlist::read(v).map(|_| ()).map_err(RigError::from),
+    circuit: crate::netlist::circuit,
+}];
 
 /// Deserialises and validates a `valve-cylinder` rig: a rig file of that
 /// kind, or a netlist of the valve-cylinder circuit

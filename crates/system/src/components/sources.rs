@@ -68,6 +68,9 @@ pub struct CommandInput {
     hint: Cell<usize>,
     /// The signal's kinks ([`kinks`]), found on first use.
     kinks: OnceCell<Vec<f64>>,
+    /// A streamed table's scan: the index to resume from and the corner
+    /// found last (`-∞` when none is pending).
+    stream_scan: Cell<(usize, f64)>,
     out: Wire<f64>,
 }
 
@@ -119,6 +122,7 @@ impl CommandInput {
             signal,
             hint: Cell::new(0),
             kinks: OnceCell::new(),
+            stream_scan: Cell::new((0, f64::NEG_INFINITY)),
             out: Wire::UNBOUND,
         }
     }
@@ -136,6 +140,17 @@ impl Component for CommandInput {
         w.set(self.out, self.signal.value_hinted(t, &self.hint));
     }
     fn next_breakpoint(&self, t: f64) -> f64 {
+        if let Signal::Streamed(table) = &self.signal {
+            // the window holds the samples ahead: scan only what is new
+            let (from, found) = self.stream_scan.get();
+            if found > t {
+                return found;
+            }
+            let (k, next) = table.next_kink(from, t, KINK_SHARE);
+            let pending = if k.is_finite() { k } else { f64::NEG_INFINITY };
+            self.stream_scan.set((next, pending));
+            return k;
+        }
         let k = self.kinks.get_or_init(|| kinks(&self.signal));
         k.get(k.partition_point(|&b| b <= t))
             .copied()

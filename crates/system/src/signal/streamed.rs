@@ -210,6 +210,34 @@ impl StreamedTable {
         Ok(g)
     }
 
+    /// The first corner after `t` among the samples held from global index
+    /// `from` on where the slope jumps by at least `share` of the record's
+    /// range times the shorter interval (the test of
+    /// [`kinks`](crate::components::sources::kinks) on a whole table), and
+    /// the index to resume the scan from. `+∞` when no such corner is held
+    /// yet (or the range is not set).
+    pub fn next_kink(&self, from: usize, t: f64, share: f64) -> (f64, usize) {
+        let range = match self.range() {
+            Some((lo, hi)) if hi > lo => hi - lo,
+            _ => return (f64::INFINITY, from),
+        };
+        let (lo, hi) = (self.0.lo.load(Relaxed), self.0.hi.load(Relaxed));
+        let mut i = from.max(lo + 1);
+        while i + 1 < hi {
+            let ti = self.t_at(i);
+            if ti > t {
+                let (d0, d1) = (ti - self.t_at(i - 1), self.t_at(i + 1) - ti);
+                let s0 = (self.v_at(i) - self.v_at(i - 1)) / d0;
+                let s1 = (self.v_at(i + 1) - self.v_at(i)) / d1;
+                if (s1 - s0).abs() * d0.min(d1) >= share * range {
+                    return (ti, i);
+                }
+            }
+            i += 1;
+        }
+        (f64::INFINITY, i)
+    }
+
     /// The value at `t` (first-order hold).
     #[inline]
     pub fn value_hinted(&self, t: f64, hint: &Cell<usize>) -> f64 {

@@ -13,15 +13,15 @@ fn rigs() -> &'static Path {
 
 /// On the solenoid drive at ±50 mm/s, where the damping limit binds (the
 /// 20 kg load runs ahead of the pump with a wide needle), the optimiser's
-/// opening is feasible and no point of a 15-point grid over the same range
-/// does better.
+/// opening is feasible and no point of a 22-point grid over the same range
+/// (not aligned with the optimiser's own 29-point grid) does better.
 #[test]
 fn the_needle_optimum_is_a_minimum_over_a_grid() {
     let v = load(rigs(), "wang-hybrid-improved").unwrap();
     let o = optimise(&v, 50.0).unwrap();
     assert!(o.best.objective_j.is_finite(), "{:?}", o.best);
     let mut feasible = 0;
-    for a in grid(15) {
+    for a in grid(22) {
         let e = evaluate(&v, 50.0, a).unwrap();
         feasible += usize::from(e.objective_j.is_finite());
         assert!(
@@ -34,7 +34,7 @@ fn the_needle_optimum_is_a_minimum_over_a_grid() {
     }
     // the constraint is active: part of the range is infeasible
     assert!(
-        feasible > 0 && feasible < 15,
+        feasible > 0 && feasible < 22,
         "{feasible} feasible grid points"
     );
 }

@@ -801,6 +801,14 @@ mod tests {
 
         // a command read in chunks into a window, as the CLI streams a file
         let window = StreamedTable::new(8192);
+        // the host sets the record's range, as the CLI does from its first
+        // pass (a table's corners are judged against it)
+        let (lo, hi) = u
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                (l.min(v), h.max(v))
+            });
+        window.set_range(lo, hi);
         let mut c = rig::circuit(&value, Signal::Streamed(window.clone())).unwrap();
         let mut source = Chunked {
             t: t.clone(),

@@ -213,7 +213,7 @@ impl StreamedTable {
     /// The first corner after `t` among the samples held from global index
     /// `from` on where the slope jumps by at least `share` of the record's
     /// range times the shorter interval (the test of
-    /// [`kinks`](crate::components::sources::kinks) on a whole table), and
+    /// the command source's `kinks` on a whole table), and
     /// the index to resume the scan from. `+∞` when no such corner is held
     /// yet (or the range is not set).
     pub fn next_kink(&self, from: usize, t: f64, share: f64) -> (f64, usize) {

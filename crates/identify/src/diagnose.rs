@@ -63,6 +63,29 @@ impl Default for DiagnoseOptions {
     }
 }
 
+impl DiagnoseOptions {
+    /// Why a traced candidate fails the screen on its explained share of
+    /// the residual, its held-out share and its ΔBIC; `None` when it passes.
+    pub fn screen(&self, share: f64, held: f64, dbic: f64) -> Option<String> {
+        if share < self.min_share {
+            Some(format!(
+                "explains {:.1} % < {:.1} %",
+                100.0 * share,
+                100.0 * self.min_share
+            ))
+        } else if held < 0.5 * self.min_share {
+            Some(format!(
+                "held-out share {:.1} %: does not generalise",
+                100.0 * held
+            ))
+        } else if dbic >= 0.0 {
+            Some(format!("BIC does not fall (ΔBIC = {dbic:.1})"))
+        } else {
+            None
+        }
+    }
+}
+
 /// Why the loop could not run.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum DiagnoseError {

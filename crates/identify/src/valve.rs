@@ -386,19 +386,8 @@ pub fn diagnose_rig_traced(
                 rep.reason = Some(format!("fit failed: {e}"));
             } else if sim_failed {
                 rep.reason = Some("the rig does not simulate at the traced values".into());
-            } else if share < opts.min_share {
-                rep.reason = Some(format!(
-                    "explains {:.1} % < {:.1} %",
-                    100.0 * share,
-                    100.0 * opts.min_share
-                ));
-            } else if held < 0.5 * opts.min_share {
-                rep.reason = Some(format!(
-                    "held-out share {:.1} %: does not generalise",
-                    100.0 * held
-                ));
-            } else if dbic >= 0.0 {
-                rep.reason = Some(format!("BIC does not fall (ΔBIC = {dbic:.1})"));
+            } else if let Some(why) = opts.screen(share, held, dbic) {
+                rep.reason = Some(why);
             } else if negligible(id, &trial, declared) {
                 rep.reason =
                     Some("fitted size negligible (indistinguishable from the declared rig)".into());

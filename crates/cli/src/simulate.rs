@@ -273,7 +273,7 @@ fn warn_clamped(file: &Path, outside: usize, peak: (f64, f64)) {
 /// The command of a run: a table read whole (and its times, the output
 /// times), or a long file streamed into a window.
 enum Input {
-    Table(Signal, Vec<f64>),
+    Table(Vec<f64>),
     Stream(StreamedTable, command_stream::Chunks),
 }
 
@@ -358,14 +358,21 @@ pub fn run(args: Args) -> Result<(), CliError> {
     } else {
         None
     };
-    let (rows, t0, t1, mut input) = match long {
+    let (rows, t0, t1, signal, mut input) = match long {
         Some((scan, chunks)) => {
             if unit == CommandUnit::Normalised && !args.quiet {
                 warn_clamped(&cmd_path, scan.outside, scan.peak);
             }
             let table = StreamedTable::new(4 * BLOCK);
             table.set_range(scan.min, scan.max);
-            (scan.rows, scan.t0, scan.t1, Input::Stream(table, chunks))
+            let signal = Signal::Streamed(table.clone());
+            (
+                scan.rows,
+                scan.t0,
+                scan.t1,
+                signal,
+                Input::Stream(table, chunks),
+            )
         }
         None => {
             let (t, u) = read_command(&cmd_path, unit)?;
@@ -387,12 +394,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
             let times = t.clone();
             let signal = Signal::table(t, u)
                 .map_err(|e| CliError::Input(format!("{}: {e}", cmd_path.display())))?;
-            (rows, t0, t1, Input::Table(signal, times))
+            (rows, t0, t1, signal, Input::Table(times))
         }
-    };
-    let signal = match &input {
-        Input::Table(s, _) => s.clone(),
-        Input::Stream(table, _) => Signal::Streamed(table.clone()),
     };
     let mut c = checked
         .circuit(signal)
@@ -419,9 +422,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         })
     };
     let streamed = match &mut input {
-        Input::Table(_, times) => {
-            runner::run_streaming(&mut c, &x0, times, &opts, BLOCK, &mut sink)
-        }
+        Input::Table(times) => runner::run_streaming(&mut c, &x0, times, &opts, BLOCK, &mut sink),
         Input::Stream(table, chunks) => {
             runner::run_command_stream(&mut c, &x0, table, chunks, t1, &opts, BLOCK, &mut sink)
         }

@@ -72,9 +72,8 @@ impl<'a> PlainCsv<'a> {
             .iter()
             .map(|_| Vec::with_capacity(rows_hint))
             .collect();
-        match rows.parse(self.body.as_bytes(), &mut out)? {
-            Body::Rows | Body::BlankEnd => Some(out),
-        }
+        rows.parse(self.body.as_bytes(), &mut out)?;
+        Some(out)
     }
 
     /// The data lines after the header line (its terminator included).

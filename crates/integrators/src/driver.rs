@@ -580,7 +580,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
             last = true;
         } else if adaptive {
             let bp = sys.next_breakpoint(t);
-            if bp - t <= h * stretch && t_end - bp > t_close(bp) && bp > t {
+            if bp - t <= h * stretch && t_end - bp > t_close(bp) && bp - t > t_close(t) {
                 breakpoint = Some((bp, h));
                 h = bp - t;
             }

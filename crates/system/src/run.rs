@@ -411,9 +411,13 @@ fn check_times(t_eval: &[f64]) -> Result<(), SimError> {
     if t_eval.len() < 2 {
         return Err(SimError::Settings("need at least two output times".into()));
     }
-    if let Some(i) =
-        (0..t_eval.len()).find(|&i| !t_eval[i].is_finite() || (i > 0 && t_eval[i] <= t_eval[i - 1]))
-    {
+    if let Some(i) = t_eval.iter().position(|t| !t.is_finite()) {
+        return Err(SimError::Settings(format!(
+            "output time {} (sample {i}) is not finite",
+            t_eval[i]
+        )));
+    }
+    if let Some(i) = (1..t_eval.len()).find(|&i| t_eval[i] <= t_eval[i - 1]) {
         return Err(SimError::Settings(format!(
             "output time {} (sample {i}) does not increase",
             t_eval[i]

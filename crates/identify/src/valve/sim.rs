@@ -154,9 +154,16 @@ pub(super) fn with_initial(rig: &Model, p: &Prepared) -> Model {
     let u0 = match (p.command0, &ctrl) {
         (Some(u), _) => u,
         (None, Some(c)) => {
+            // the controller's own law, with its initial integral
             let q = |k: &str, d: f64| r.param(c, k).unwrap_or(d);
-            (q("gain", 0.0) * (p.input[0] - r.x0()) + q("bias", 0.0))
-                .clamp(q("output_min", -1.0), q("output_max", 1.0))
+            let law = hydrocyl_system::components::PositionLaw {
+                gain: q("gain", 0.0),
+                integral_time: q("integral_time", 0.0),
+                bias: q("bias", 0.0),
+                output_min: q("output_min", -1.0),
+                output_max: q("output_max", 1.0),
+            };
+            law.output(p.input[0] - r.x0(), q("initial.integral", 0.0))
         }
         (None, None) => 0.0,
     };

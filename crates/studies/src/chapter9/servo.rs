@@ -35,13 +35,26 @@ impl ServoLaw {
             parameter(v, "cylinder.area_2")?,
         );
         let k = parameter(v, "pump.gain")?;
+        if !(a.0 > 0.0 && b.0 > a.0) {
+            return Err(RigError::Invalid {
+                path: "servo law".into(),
+                why: format!(
+                    "needs two optima at increasing positive speeds, got {} and {} m/s",
+                    a.0, b.0
+                ),
+            });
+        }
         let mut s = (b.1 - a.1) / (b.0 - a.0);
         let mut a0 = a.1 - s * a.0;
-        if a0 < 0.0 {
+        if s < 0.0 {
+            // the faster optimum is narrower: a constant opening at the
+            // narrower of the two (never wider than either optimum)
+            a0 = a.1.min(b.1);
+            s = 0.0;
+        } else if a0 < 0.0 {
             a0 = 0.0;
             s = a.1 / a.0;
         }
-        let s = s.max(0.0);
         Ok(Self {
             area_min: a0,
             gain_positive: s * k / a1,

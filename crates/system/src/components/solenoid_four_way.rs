@@ -219,10 +219,13 @@ impl Component for SolenoidFourWay {
         _t: f64,
         _x: &mut [f64],
         _w: &Wires,
-        _which: usize,
+        which: usize,
         _dir: Crossing,
     ) -> EventAction {
-        self.switches += 1;
+        // with no dead zone the two switching functions are one: count once
+        if which == 0 || self.law.threshold > 0.0 {
+            self.switches += 1;
+        }
         EventAction::Continue
     }
     fn reset(&mut self, _t: f64, _x: &[f64], _w: &Wires) {

@@ -118,7 +118,13 @@ pub fn assemble_with(
 /// its name. Every input must be given, and only inputs; each signal is
 /// checked and named by its component in errors.
 pub fn assemble_inputs(s: &Schematic, inputs: &[(String, Signal)]) -> Result<Circuit, RigError> {
-    for (name, sig) in inputs {
+    for (k, (name, sig)) in inputs.iter().enumerate() {
+        if inputs[..k].iter().any(|(n, _)| n == name) {
+            return Err(RigError::Invalid {
+                path: format!("inputs.{name}"),
+                why: "given twice (one signal per input)".into(),
+            });
+        }
         sig.validate().map_err(|e| RigError::Invalid {
             path: format!("inputs.{name}"),
             why: e.to_string(),

@@ -24,6 +24,11 @@ fn controller(i: &Instance) -> Result<Box<dyn Component>, String> {
     if !integral.is_finite() {
         return Err(format!("initial.integral = {integral} must be finite"));
     }
+    if integral != 0.0 && (law.integral_time <= 0.0 || law.integral_time.is_nan()) {
+        return Err(format!(
+            "initial.integral = {integral} needs a PI controller (integral_time > 0)"
+        ));
+    }
     built(
         PositionController::new(
             &i.name,

@@ -203,6 +203,6 @@ pub const TYPES: &[ComponentType] = &[
         states: &[],
         build: servo_needle,
         hints: None,
-        probes: &[("opening", "-")],
+        probes: &[("opening", "m^2")],
     },
 ];

@@ -185,20 +185,31 @@ fn valve_diagnose_time() -> Result<(), String> {
 
 /// Runs the benchmarks; returns `false` only when a benchmark could not run
 /// (a benchmark has no pass/fail threshold).
-pub fn run() -> bool {
+/// `only`: run only the sections whose name contains it; `keep`: the
+/// folder where the whole-process row writes and keeps its command files.
+pub fn run(only: Option<&str>, keep: Option<&std::path::Path>) -> bool {
     println!("cargo xtask bench: ratios against a reference in the same run on this machine");
-    orifice_typed_vs_raw();
-    xfactor_analytical_vs_brent();
+    let wanted = |name: &str| only.is_none_or(|o| name.contains(o));
+    if wanted("orifice") {
+        orifice_typed_vs_raw();
+    }
+    if wanted("xfactor") {
+        xfactor_analytical_vs_brent();
+    }
     let mut ok = true;
-    for (name, r) in [
-        ("valve rig", valve_rig_real_time()),
-        ("diagnose", valve_diagnose_time()),
-    ] {
-        if let Err(e) = r {
+    let sections: [(&str, fn() -> Result<(), String>); 2] = [
+        ("valve rig", valve_rig_real_time),
+        ("diagnose", valve_diagnose_time),
+    ];
+    for (name, f) in sections {
+        if !wanted(name) {
+            continue;
+        }
+        if let Err(e) = f() {
             eprintln!("cargo xtask bench: {name}: {e}");
             ok = false;
         }
     }
-    ok &= crate::bench_solve::run();
+    ok &= crate::bench_solve::run(&wanted, keep);
     ok
 }

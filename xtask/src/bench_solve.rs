@@ -375,10 +375,15 @@ fn hydrocyl_binary() -> Result<(PathBuf, &'static str), String> {
 
 /// The whole `hydrocyl simulate` process on the 1 kHz 10 s and 100 s
 /// command files (1 kHz output), against the process doing nothing
-/// (`hydrocyl --version`): median and fastest of 21 runs.
-fn whole_process() -> Result<(), String> {
+/// (`hydrocyl --version`): median and fastest of 21 runs. The command files
+/// go to `keep` and stay there when it is given (to profile the process on
+/// them), else to a temporary folder removed at the end.
+fn whole_process(keep: Option<&Path>) -> Result<(), String> {
     let (bin, profile) = hydrocyl_binary()?;
-    let dir = std::env::temp_dir().join(format!("hydrocyl-bench-{}", std::process::id()));
+    let dir = keep.map_or_else(
+        || std::env::temp_dir().join(format!("hydrocyl-bench-{}", std::process::id())),
+        Path::to_path_buf,
+    );
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let time = |args: &[&str]| -> Result<(f64, f64), String> {
         let mut v = Vec::new();
@@ -437,21 +442,28 @@ fn whole_process() -> Result<(), String> {
             );
         }
     }
-    let _ = std::fs::remove_dir_all(&dir);
+    if keep.is_none() {
+        let _ = std::fs::remove_dir_all(&dir);
+    }
     Ok(())
 }
 
-/// Runs the issue-19 benchmarks; `false` when one could not run.
-pub fn run() -> bool {
+/// Runs the issue-19 benchmarks whose name is `wanted`; `false` when one
+/// could not run. `keep`: see [`whole_process`].
+pub fn run(wanted: &dyn Fn(&str) -> bool, keep: Option<&Path>) -> bool {
     let mut ok = true;
-    for (name, r) in [
-        ("csv", csv_per_row()),
-        ("cost per step", cost_per_step()),
-        ("work-precision", work_precision()),
-        ("hybrid solver choice", hybrid_solver_choice()),
-        ("whole process", whole_process()),
-    ] {
-        if let Err(e) = r {
+    let sections: [(&str, &dyn Fn() -> Result<(), String>); 5] = [
+        ("csv", &csv_per_row),
+        ("cost per step", &cost_per_step),
+        ("work-precision", &work_precision),
+        ("hybrid solver choice", &hybrid_solver_choice),
+        ("whole process", &|| whole_process(keep)),
+    ];
+    for (name, f) in sections {
+        if !wanted(name) {
+            continue;
+        }
+        if let Err(e) = f() {
             eprintln!("cargo xtask bench: {name}: {e}");
             ok = false;
         }

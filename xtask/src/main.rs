@@ -46,7 +46,16 @@ enum Task {
     /// The chapter-8 energy-efficiency matrix of the valve and hybrid drives.
     Energy,
     /// Speed ratios against reference runs on this machine, in the same run.
-    Bench,
+    Bench {
+        /// Run only the sections whose name contains this text (e.g. `csv`,
+        /// `process`, `cost`).
+        #[arg(long)]
+        only: Option<String>,
+        /// Write the whole-process row's command files into this folder and
+        /// keep them (for profiling `hydrocyl simulate` on them).
+        #[arg(long)]
+        keep_files: Option<std::path::PathBuf>,
+    },
     /// Every test: `cargo test --workspace`, then the Python package (wheel
     /// built by maturin into target/py-venv, pytest).
     Test {
@@ -75,7 +84,7 @@ fn main() {
         Task::Validate { only } => validate::run(only.as_deref()),
         Task::Xfactor => xfactor::run(),
         Task::Energy => energy::run(),
-        Task::Bench => bench::run(),
+        Task::Bench { only, keep_files } => bench::run(only.as_deref(), keep_files.as_deref()),
         Task::Test {
             python_only,
             rust_only,

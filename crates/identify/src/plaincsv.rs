@@ -114,10 +114,8 @@ impl Rows {
     /// Whether bytes are plain: no quote, no carriage return but before a
     /// line feed (a lone one ends a line for the full reader).
     pub fn plain_bytes(bytes: &[u8]) -> bool {
-        !bytes
-            .iter()
-            .enumerate()
-            .any(|(i, &b)| b == b'"' || (b == b'\r' && bytes.get(i + 1) != Some(&b'\n')))
+        memchr::memchr(b'"', bytes).is_none()
+            && memchr::memchr_iter(b'\r', bytes).all(|i| bytes.get(i + 1) == Some(&b'\n'))
     }
 
     /// Appends the wanted cells of the lines in `b` (whole lines) to `out`
@@ -138,24 +136,19 @@ impl Rows {
             }
             let mut n = 0;
             loop {
-                let start = pos;
-                while pos < len && b[pos] != b',' && b[pos] != b'\n' {
-                    pos += 1;
-                }
-                let at_line_end = pos == len || b[pos] == b'\n';
-                let end = if at_line_end && pos > start && b[pos - 1] == b'\r' {
-                    pos - 1
-                } else {
-                    pos
-                };
                 let k = *self.slot.get(n)?;
-                if k != usize::MAX {
-                    let v = number(&b[start..end])?;
-                    out[k].push(v);
-                }
                 n += 1;
-                pos += 1;
-                if at_line_end {
+                // one pass: a wanted cell is parsed where it starts and must
+                // end at its separator; an unwanted one is skipped
+                let end = if k == usize::MAX {
+                    memchr::memchr2(b',', b'\n', &b[pos..]).map_or(len, |i| pos + i)
+                } else {
+                    let (v, end) = number_at(b, pos)?;
+                    out[k].push(v);
+                    end
+                };
+                pos = end + 1;
+                if end == len || b[end] == b'\n' {
                     break;
                 }
             }
@@ -167,22 +160,76 @@ impl Rows {
     }
 }
 
-/// A cell's finite number (surrounding white space allowed), parsed as
-/// `str::parse::<f64>` does (the Eisel–Lemire algorithm, `fast-float2`);
-/// `None` for anything else.
+/// Whether `c` is white space a cell may carry around its number (what
+/// `<[u8]>::trim_ascii` takes off, but the line feed, which ends the line).
 #[inline]
+fn blank(c: u8) -> bool {
+    matches!(c, b' ' | b'\t' | b'\r' | b'\x0c')
+}
+
+/// The finite number of the cell that starts at `start` in `b`, parsed as
+/// `str::parse::<f64>` parses the trimmed cell (the Eisel–Lemire algorithm,
+/// `fast-float2`, which reads `inf`/`nan` spellings and a leading `+` as it
+/// does and refuses the rest), and the index of the byte that ends the cell
+/// (`,`, `\n` or `b.len()`); `None` when the trimmed cell is anything but a
+/// finite number.
+#[inline]
+fn number_at(b: &[u8], start: usize) -> Option<(f64, usize)> {
+    let mut i = start;
+    while i < b.len() && blank(b[i]) {
+        i += 1;
+    }
+    let (v, n): (f64, usize) = fast_float2::parse_partial(&b[i..]).ok()?;
+    let mut end = i + n;
+    while end < b.len() && blank(b[end]) {
+        end += 1;
+    }
+    if end < b.len() && b[end] != b',' && b[end] != b'\n' {
+        return None;
+    }
+    v.is_finite().then_some((v, end))
+}
+
+/// [`number_at`] on one whole cell.
+#[cfg(test)]
 fn number(cell: &[u8]) -> Option<f64> {
-    let cell = cell.trim_ascii();
-    // only what the standard library's parser also takes: fast-float2 reads
-    // `inf`/`nan` spellings and a leading `+` as it does, and refuses the rest
-    let v: f64 = fast_float2::parse(cell).ok()?;
-    v.is_finite().then_some(v)
+    match number_at(cell, 0) {
+        Some((v, end)) if end == cell.len() => Some(v),
+        _ => None,
+    }
 }
 
 /// Appends `v` as the shortest decimal text that parses back to `v`.
 #[inline]
 pub fn push_f64(out: &mut Vec<u8>, buf: &mut zmij::Buffer, v: f64) {
     out.extend_from_slice(buf.format(v).as_bytes());
+}
+
+/// The longest text zmij writes for an `f64`.
+const MAX_CELL: usize = 24;
+
+/// Puts `s` (at most [`MAX_CELL`] bytes) into `row` at `at` with two
+/// overlapping fixed-size copies (no `memcpy` call for a few bytes);
+/// returns the end. `row` must have room for [`MAX_CELL`] bytes at `at`.
+#[inline(always)]
+fn put_short(row: &mut [u8], at: usize, s: &[u8]) -> usize {
+    let n = s.len();
+    let d = &mut row[at..at + MAX_CELL];
+    if n >= 16 {
+        d[..16].copy_from_slice(&s[..16]);
+        d[n - 16..n].copy_from_slice(&s[n - 16..]);
+    } else if n >= 8 {
+        d[..8].copy_from_slice(&s[..8]);
+        d[n - 8..n].copy_from_slice(&s[n - 8..]);
+    } else if n >= 4 {
+        d[..4].copy_from_slice(&s[..4]);
+        d[n - 4..n].copy_from_slice(&s[n - 4..]);
+    } else {
+        for (d, s) in d.iter_mut().zip(s) {
+            *d = *s;
+        }
+    }
+    at + n
 }
 
 /// The columns of a run in the measured-data format: `time`, then every
@@ -199,16 +246,22 @@ pub fn run_columns(run: &hydrocyl_system::run::Run) -> (Vec<&str>, Vec<&[f64]>) 
 
 /// Appends rows `rows` of `columns` as CSV lines (shortest round-trip text).
 fn write_rows(columns: &[&[f64]], rows: std::ops::Range<usize>, out: &mut Vec<u8>) {
-    out.reserve(rows.len() * columns.len() * 22);
     let mut buf = zmij::Buffer::new();
+    // a row is put together in `row`, then appended with one copy
+    let mut row = vec![0u8; columns.len() * (MAX_CELL + 1) + 1];
+    out.reserve(rows.len() * columns.len() * 20);
     for k in rows {
-        for (j, c) in columns.iter().enumerate() {
-            if j > 0 {
-                out.push(b',');
-            }
-            push_f64(out, &mut buf, c[k]);
+        let mut at = 0;
+        for c in columns {
+            at = put_short(&mut row, at, buf.format(c[k]).as_bytes());
+            row[at] = b',';
+            at += 1;
         }
-        out.push(b'\n');
+        // the last separator becomes the line end
+        if at > 0 {
+            row[at - 1] = b'\n';
+        }
+        out.extend_from_slice(&row[..at]);
     }
 }
 

@@ -122,7 +122,8 @@ impl Outputs {
         self.files.push(Pending {
             path: path.to_path_buf(),
             tmp,
-            writer: Some(BufWriter::with_capacity(1 << 20, f)),
+            // small: a block of rows larger than this goes straight to the file
+            writer: Some(BufWriter::with_capacity(1 << 16, f)),
         });
         Ok(OutputId(self.files.len() - 1))
     }

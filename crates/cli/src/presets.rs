@@ -57,7 +57,13 @@ pub fn all() -> Vec<(&'static str, String, String)> {
 
 /// The preset names, comma-separated (for `--rig`'s help).
 pub fn names() -> String {
-    all().iter().map(|p| p.0).collect::<Vec<_>>().join(", ")
+    // names only: reading every preset here would cost each start-up
+    rig::PRESETS
+        .iter()
+        .map(|p| p.name)
+        .chain(bench::PRESETS.iter().copied())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Runs `hydrocyl presets`.

@@ -31,8 +31,8 @@
 //!
 //! Every input is checked and the output's temporary file created before the
 //! run ([`crate::output`]); the run is streamed in blocks
-//! ([`hydrocyl_system::run::run_streaming`]), each written as it is
-//! computed, and the temporary is renamed into place at the end, so a failed
+//! ([`hydrocyl_system::run::run_streaming`]), each formatted and written by
+//! a second thread while the solve computes the next ([`Writer`]), and the temporary is renamed into place at the end, so a failed
 //! or interrupted run leaves no file (`--fsync` also flushes it to the disk
 //! first; without it the operating system writes it back when it likes, as
 //! for any ordinary file).
@@ -40,10 +40,9 @@
 use crate::command::{read_command, CommandUnit};
 use crate::command_stream;
 use crate::error::CliError;
-use crate::output::Outputs;
+use crate::output::{OutputId, Outputs};
 use crate::progress::Progress;
 use hydrocyl_identify::bench::{self, FrictionBench};
-use hydrocyl_identify::plaincsv::{run_columns, write_columns_in_parts, write_rows_in_parts};
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{self as runner, Run, RunOptions, Solver};
 use hydrocyl_system::signal::{Signal, StreamedTable};
@@ -117,27 +116,100 @@ pub struct Args {
 }
 
 /// Output times per block of a streamed run: the memory a run needs grows
-/// with this, not with the record.
-const BLOCK: usize = 1 << 16;
+/// with this, not with the record. Blocks this small let the writer thread
+/// format and write one block while the solve computes the next (the last
+/// block's formatting is all that is left when the solve ends).
+const BLOCK: usize = 1 << 10;
 
-/// A block of a run as CSV text in the measured-data format (shortest
-/// round-trip numbers, [`hydrocyl_identify::plaincsv::write_columns`]), the
-/// header with the first block, in consecutive parts formatted in parallel
-/// on the machine's cores.
-pub fn to_csv(run: &Run, command: CommandUnit, first: bool) -> Vec<Vec<u8>> {
-    let (_, columns) = run_columns(run);
-    // threads pay for themselves from a few thousand rows on
-    let parts = if run.time.len() < 4096 {
-        1
-    } else {
-        std::thread::available_parallelism().map_or(1, |n| n.get().min(8))
-    };
-    if first {
-        let names = column_headers(run, command);
-        let names: Vec<&str> = names.iter().map(String::as_str).collect();
-        write_columns_in_parts(&names, &columns, parts)
-    } else {
-        write_rows_in_parts(&columns, parts)
+/// Samples of the command window of a streamed command file.
+const WINDOW: usize = 1 << 18;
+
+/// Blocks queued for the writer thread at most (bounds the memory when the
+/// disk is slower than the solve).
+const QUEUE: usize = 16;
+
+/// One block of a run's output for the writer thread: its columns (time,
+/// then the channels) one after the other, `rows` each.
+struct Block {
+    values: Vec<f64>,
+    rows: usize,
+}
+
+/// The writer thread of `hydrocyl simulate`: it formats the blocks the solve
+/// sends (the header first) and writes them to the output, so that the text
+/// of one block is made on the second core while the solve computes the
+/// next. Blocks' memory goes back to the solve for reuse (no fresh pages
+/// per block).
+struct Writer {
+    send: Option<std::sync::mpsc::SyncSender<Block>>,
+    recycled: std::sync::mpsc::Receiver<Block>,
+    thread: Option<std::thread::JoinHandle<(Outputs, Result<(), CliError>)>>,
+}
+
+impl Writer {
+    /// Starts the thread on `outputs` (file `id`), which it hands back at
+    /// [`Writer::finish`]; `header` is written first.
+    fn start(mut outputs: Outputs, id: OutputId, header: Vec<u8>) -> Self {
+        let (send, recv) = std::sync::mpsc::sync_channel::<Block>(QUEUE);
+        let (back, recycled) = std::sync::mpsc::channel::<Block>();
+        let thread = std::thread::spawn(move || {
+            let mut text = header;
+            let mut result = Ok(());
+            for block in recv {
+                if result.is_ok() {
+                    let columns: Vec<&[f64]> = block.values.chunks_exact(block.rows).collect();
+                    hydrocyl_identify::plaincsv::append_rows(&columns, &mut text);
+                    result = outputs.write(id, &text);
+                    text.clear();
+                }
+                // the solve may be gone already: then the block is just freed
+                let _ = back.send(block);
+            }
+            if result.is_ok() && !text.is_empty() {
+                result = outputs.write(id, &text);
+            }
+            (outputs, result)
+        });
+        Writer {
+            send: Some(send),
+            recycled,
+            thread: Some(thread),
+        }
+    }
+
+    /// Queues `run`'s rows; an error when the thread has stopped (a failed
+    /// write, which [`Writer::finish`] reports).
+    fn push(&mut self, run: &Run) -> Result<(), CliError> {
+        let rows = run.time.len();
+        let mut block = self.recycled.try_recv().unwrap_or(Block {
+            values: Vec::new(),
+            rows: 0,
+        });
+        block.values.clear();
+        block.values.reserve((run.channels.len() + 1) * rows);
+        block.values.extend_from_slice(&run.time);
+        for c in &run.channels {
+            block.values.extend_from_slice(&c.values);
+        }
+        block.rows = rows;
+        let stopped = || CliError::Input("the output writer stopped".into());
+        let send = self.send.as_ref().ok_or_else(stopped)?;
+        send.send(block).map_err(|_| stopped())
+    }
+
+    /// Waits for the thread to write every block; the outputs back, or its
+    /// first error.
+    fn finish(mut self) -> Result<Outputs, CliError> {
+        drop(self.send.take());
+        let thread = self
+            .thread
+            .take()
+            .ok_or_else(|| CliError::Input("no writer".into()))?;
+        match thread.join() {
+            Ok((outputs, Ok(()))) => Ok(outputs),
+            Ok((_, Err(e))) => Err(e),
+            Err(_) => Err(CliError::Input("the output writer failed".into())),
+        }
     }
 }
 
@@ -234,13 +306,23 @@ const ABSURD_PRESSURE_PA: f64 = 10.0 * rig::ABSOLUTE_VACUUM_GAUGE_PA;
 /// non-finite value, a chamber pressure far below vacuum) and names the fix.
 fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result<(), CliError> {
     let bad = run.channels.iter().find_map(|c| {
-        c.values.iter().enumerate().find_map(|(k, &v)| {
-            let absurd = !v.is_finite()
-                || (c.unit == "Pa"
-                    && matches!(c.name.as_str(), "p1" | "p2")
-                    && v < ABSURD_PRESSURE_PA);
-            absurd.then(|| format!("{} = {v:e} {} at t = {} s", c.name, c.unit, run.time[k]))
-        })
+        let chamber = c.unit == "Pa" && matches!(c.name.as_str(), "p1" | "p2");
+        let floor = if chamber {
+            ABSURD_PRESSURE_PA
+        } else {
+            f64::NEG_INFINITY
+        };
+        // one comparison per value: NaN and ±∞ fail the first test
+        let ok = |v: f64| v.is_finite() && v >= floor;
+        if c.values.iter().all(|&v| ok(v)) {
+            return None;
+        }
+        let k = c.values.iter().position(|&v| !ok(v))?;
+        let v = c.values[k];
+        Some(format!(
+            "{} = {v:e} {} at t = {} s",
+            c.name, c.unit, run.time[k]
+        ))
     });
     let Some(what) = bad else { return Ok(()) };
     let fix = if solver == Solver::Rk4 {
@@ -343,6 +425,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let mut outputs = Outputs::new(&inputs);
     let id = outputs.file("--out", &out)?;
+    let mut outputs = Some(outputs);
     let unit = command_unit(&checked);
     let opts = RunOptions {
         solver,
@@ -363,7 +446,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             if unit == CommandUnit::Normalised && !args.quiet {
                 warn_clamped(&cmd_path, scan.outside, scan.peak);
             }
-            let table = StreamedTable::new(4 * BLOCK);
+            let table = StreamedTable::new(WINDOW);
             table.set_range(scan.min, scan.max);
             let signal = Signal::Streamed(table.clone());
             (
@@ -405,12 +488,21 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut failed: Option<CliError> = None;
     let mut done = 0usize;
     let mut min_p = f64::INFINITY;
+    let mut writer: Option<Writer> = None;
     let mut sink = |block: &Run| -> Result<(), String> {
         let r = check_solution(block, solver, args.rk4_step).and_then(|()| {
-            for p in to_csv(block, unit, done == 0) {
-                outputs.write(id, &p)?;
+            if writer.is_none() {
+                let mut header = column_headers(block, unit).join(",").into_bytes();
+                header.push(b'\n');
+                let o = outputs
+                    .take()
+                    .ok_or_else(|| CliError::Input("no output".into()))?;
+                writer = Some(Writer::start(o, id, header));
             }
-            Ok(())
+            match writer.as_mut() {
+                Some(w) => w.push(block),
+                None => Ok(()),
+            }
         });
         done += block.time.len();
         min_p = min_p.min(block.min_chamber_pressure());
@@ -428,11 +520,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
     };
     bar.finish();
-    let run = match (streamed, failed) {
-        (_, Some(e)) => return Err(e),
-        (Err(e), None) => return Err(solver_hint(rig::RigError::Sim(e.to_string()))),
-        (Ok(r), None) => r,
+    // the writer's error (a failed write) first: the solve's is its echo
+    let written = writer.map(Writer::finish).transpose();
+    let run = match (streamed, failed, written) {
+        (_, _, Err(e)) | (_, Some(e), _) => return Err(e),
+        (Err(e), None, _) => return Err(solver_hint(rig::RigError::Sim(e.to_string()))),
+        (Ok(r), None, Ok(w)) => {
+            if let Some(o) = w {
+                outputs = Some(o);
+            }
+            r
+        }
     };
+    let outputs = outputs.ok_or_else(|| CliError::Input("no output".into()))?;
     outputs.commit(args.fsync)?;
     if args.quiet {
         return Ok(());

@@ -265,6 +265,13 @@ fn write_rows(columns: &[&[f64]], rows: std::ops::Range<usize>, out: &mut Vec<u8
     }
 }
 
+/// Appends every row of `columns` (all of the same length) to `out` as CSV
+/// lines, as [`write_columns`] writes them after its header.
+pub fn append_rows(columns: &[&[f64]], out: &mut Vec<u8>) {
+    let rows = columns.first().map_or(0, |c| c.len());
+    write_rows(columns, 0..rows, out);
+}
+
 /// CSV text of a table: the header `names` (comma-separated), then one row
 /// per entry of `columns[0]`, each value as its shortest round-trip text.
 /// All columns must have the same length.

@@ -4,7 +4,9 @@
 //! the previous per-row implementation, and the whole `hydrocyl simulate`
 //! process. Every ratio is against a reference run in the same run.
 
-use hydrocyl_identify::plaincsv::{run_columns, write_columns, PlainCsv};
+use hydrocyl_identify::plaincsv::{
+    run_columns, write_columns, write_columns_in_parts, PlainCsv, Rows,
+};
 use hydrocyl_integrators::Method;
 use hydrocyl_studies::chapter7::{Chapter7Test, Load, Shape};
 use hydrocyl_system::run::{nrmse, Run, RunOptions, Solver};
@@ -264,13 +266,23 @@ fn median_ns(mut f: impl FnMut() -> usize) -> f64 {
 }
 
 /// CSV per row: the plain-CSV path against the previous implementation
-/// (the `csv` crate's records with `str::parse`; `format!("{:?}")` per cell).
+/// (the `csv` crate's records with `str::parse`; `format!("{:?}")` per cell,
+/// one thread), on one thread and on every core (`PlainCsv::columns` and
+/// `write_columns_in_parts`, what `hydrocyl` uses), with the floor of each:
+/// the number conversions alone on the same values.
 fn csv_per_row() -> Result<(), String> {
     let case = square_case(10.0)?;
     let run = case.run(Solver::Dp45, 1e-5)?;
     let (names, columns) = run_columns(&run);
     let rows = run.time.len() as f64;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
     let write_new = median_ns(|| write_columns(&names, &columns).len()) / rows;
+    let write_par = median_ns(|| {
+        write_columns_in_parts(&names, &columns, cores)
+            .iter()
+            .map(Vec::len)
+            .sum()
+    }) / rows;
     let write_old = median_ns(|| {
         let mut s = names.join(",");
         s.push('\n');
@@ -285,11 +297,20 @@ fn csv_per_row() -> Result<(), String> {
     }) / rows;
     let text = String::from_utf8(write_columns(&names, &columns)).map_err(|e| e.to_string())?;
     let wanted: Vec<usize> = (0..names.len()).collect();
-    let read_new = median_ns(|| {
+    // `columns` reads a long text on every core; `one` is the same on one
+    let one = |text: &str, wanted: &[usize]| {
+        let p = PlainCsv::new(text)?;
+        let rows = Rows::new(p.width(), wanted)?;
+        let mut out = vec![Vec::new(); wanted.len()];
+        rows.parse(p.body().as_bytes(), &mut out)?;
+        Some(out)
+    };
+    let read_par = median_ns(|| {
         PlainCsv::new(&text)
             .and_then(|p| p.columns(&wanted))
             .map_or(0, |c| c.len())
     }) / rows;
+    let read_new = median_ns(|| one(&text, &wanted).map_or(0, |c| c.len())) / rows;
     let read_old = median_ns(|| {
         let mut rdr = csv_reader(&text);
         let mut cols = vec![Vec::new(); wanted.len()];
@@ -306,11 +327,12 @@ fn csv_per_row() -> Result<(), String> {
     let cmd = String::from_utf8(write_columns(&["time", "command"], &[time_s, value]))
         .map_err(|e| e.to_string())?;
     let cmd_rows = time_s.len() as f64;
-    let cmd_new = median_ns(|| {
+    let cmd_par = median_ns(|| {
         PlainCsv::new(&cmd)
             .and_then(|p| p.columns(&[0, 1]))
             .map_or(0, |c| c.len())
     }) / cmd_rows;
+    let cmd_new = median_ns(|| one(&cmd, &[0, 1]).map_or(0, |c| c.len())) / cmd_rows;
     let cmd_old = median_ns(|| {
         let mut rdr = csv_reader(&cmd);
         let (mut t, mut u) = (Vec::new(), Vec::new());
@@ -320,15 +342,48 @@ fn csv_per_row() -> Result<(), String> {
         }
         t.len() + u.len()
     }) / cmd_rows;
+    // the floors: the number conversions alone on the same values and cells
+    // (no splitting, no columns, no copying)
+    let write_floor = median_ns(|| {
+        let mut buf = zmij::Buffer::new();
+        columns
+            .iter()
+            .flat_map(|c| c.iter())
+            .map(|&v| buf.format(v).len())
+            .sum()
+    }) / rows;
+    let floor_of = |text: &str| {
+        let cells: Vec<&[u8]> = text
+            .lines()
+            .skip(1)
+            .flat_map(|l| l.split(','))
+            .map(str::as_bytes)
+            .collect();
+        median_ns(|| {
+            cells
+                .iter()
+                .map(|c| fast_float2::parse::<f64, _>(c).map_or(0, |v: f64| v.is_finite() as usize))
+                .sum()
+        })
+    };
+    let read_floor = floor_of(&text) / rows;
+    let cmd_floor = floor_of(&cmd) / cmd_rows;
     println!(
-        "CSV, 1 kHz command file (time, command): read {cmd_new:.0} ns/row (previous {cmd_old:.0}, {:.1}x faster); goal >= 10x",
-        cmd_old / cmd_new
+        "CSV, 1 kHz command file (time, command), read: one thread {cmd_new:.0} ns/row (previous {cmd_old:.0}, {:.1}x faster; fast-float2 alone {cmd_floor:.0}), {cores} threads {cmd_par:.0} ns/row ({:.1}x); goal >= 10x",
+        cmd_old / cmd_new,
+        cmd_old / cmd_par
     );
     println!(
-        "CSV, {} columns: write {write_new:.0} ns/row (previous {write_old:.0}, {:.1}x faster); read {read_new:.0} ns/row (previous {read_old:.0}, {:.1}x faster); goal >= 10x",
+        "CSV, {} columns, write: one thread {write_new:.0} ns/row (previous {write_old:.0}, {:.1}x faster; zmij alone {write_floor:.0}), {cores} threads {write_par:.0} ns/row ({:.1}x); goal >= 10x",
         names.len(),
         write_old / write_new,
-        read_old / read_new
+        write_old / write_par
+    );
+    println!(
+        "CSV, {} columns, read: one thread {read_new:.0} ns/row (previous {read_old:.0}, {:.1}x faster; fast-float2 alone {read_floor:.0}), {cores} threads {read_par:.0} ns/row ({:.1}x); goal >= 10x",
+        names.len(),
+        read_old / read_new,
+        read_old / read_par
     );
     Ok(())
 }

@@ -18,6 +18,10 @@
 //! the same `f64`). [`Rows`] reads data lines in pieces, for a file read a
 //! buffer at a time.
 
+/// Bodies at least this long are read on every core ([`PlainCsv::columns`]):
+/// below it, starting the threads costs more than they save.
+const PARALLEL_BYTES: usize = 1 << 16;
+
 /// A CSV text without quoting, split into its header and its data lines.
 #[derive(Clone, Debug)]
 pub struct PlainCsv<'a> {
@@ -65,14 +69,60 @@ impl<'a> PlainCsv<'a> {
     /// output vector, in the order given) from every data row. `None` when a
     /// row has a number of cells other than the header's, a blank line
     /// precedes more data, or a wanted cell is not a finite number.
+    ///
+    /// A long body is read in consecutive pieces (whole lines each), one per
+    /// core, and the pieces' columns joined: the values are the same.
     pub fn columns(&self, wanted: &[usize]) -> Option<Vec<Vec<f64>>> {
         let rows = Rows::new(self.width(), wanted)?;
-        let rows_hint = self.body.len() / (8 * rows.width).max(1) + 1;
-        let mut out: Vec<Vec<f64>> = wanted
-            .iter()
-            .map(|_| Vec::with_capacity(rows_hint))
-            .collect();
-        rows.parse(self.body.as_bytes(), &mut out)?;
+        let body = self.body.as_bytes();
+        let threads = if body.len() < PARALLEL_BYTES {
+            1
+        } else {
+            std::thread::available_parallelism().map_or(1, |n| n.get().min(8))
+        };
+        let read = |piece: &[u8]| -> Option<(Body, Vec<Vec<f64>>)> {
+            let hint = piece.len() / (8 * rows.width).max(1) + 1;
+            let mut out: Vec<Vec<f64>> = wanted.iter().map(|_| Vec::with_capacity(hint)).collect();
+            Some((rows.parse(piece, &mut out)?, out))
+        };
+        if threads == 1 {
+            return read(body).map(|(_, out)| out);
+        }
+        // cut after the line end at or after each share of the bytes
+        let mut cuts = vec![0];
+        for i in 1..threads {
+            let from = (i * body.len() / threads).max(cuts[cuts.len() - 1]);
+            let cut = memchr::memchr(b'\n', &body[from..]).map_or(body.len(), |j| from + j + 1);
+            cuts.push(cut);
+        }
+        cuts.push(body.len());
+        let pieces: Vec<&[u8]> = cuts.windows(2).map(|w| &body[w[0]..w[1]]).collect();
+        let parts: Vec<Option<(Body, Vec<Vec<f64>>)>> = std::thread::scope(|s| {
+            let handles: Vec<_> = pieces[1..]
+                .iter()
+                .map(|&p| s.spawn(move || read(p)))
+                .collect();
+            std::iter::once(read(pieces[0]))
+                .chain(handles.into_iter().map(|h| h.join().ok().flatten()))
+                .collect()
+        });
+        let mut out: Vec<Vec<f64>> = wanted.iter().map(|_| Vec::new()).collect();
+        let mut blank_end = false;
+        for (piece, part) in pieces.iter().zip(parts) {
+            // after blank lines only blank lines may follow (as in `parse`)
+            if blank_end && !piece.iter().all(|&c| c == b'\n' || c == b'\r') {
+                return None;
+            }
+            let (end, cols) = part?;
+            blank_end |= end == Body::BlankEnd;
+            for (o, c) in out.iter_mut().zip(cols) {
+                if o.is_empty() {
+                    *o = c;
+                } else {
+                    o.extend_from_slice(&c);
+                }
+            }
+        }
         Some(out)
     }
 
@@ -420,6 +470,44 @@ mod tests {
             c[1].iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
             b.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
         );
+    }
+
+    /// A body long enough to be read in pieces reads as it does whole:
+    /// every value, the blank end, and blank lines inside refused wherever
+    /// the cut falls.
+    #[test]
+    fn pieces_read_as_the_whole() {
+        let mut text = String::from("time,u,x\n");
+        let mut k = 0u64;
+        while text.len() < 3 * PARALLEL_BYTES {
+            text.push_str(&format!("{},{},{}\n", k as f64 * 1e-3, (k as f64).sin(), k));
+            k += 1;
+        }
+        let p = PlainCsv::new(&text).unwrap();
+        let rows = Rows::new(3, &[1, 0]).unwrap();
+        let mut whole = vec![Vec::new(), Vec::new()];
+        assert_eq!(
+            rows.parse(p.body().as_bytes(), &mut whole),
+            Some(Body::Rows)
+        );
+        assert_eq!(p.columns(&[1, 0]).unwrap(), whole);
+        assert_eq!(whole[1].len() as u64, k);
+        let ended = format!("{text}\n\r\n\n");
+        assert_eq!(
+            PlainCsv::new(&ended).unwrap().columns(&[1, 0]).unwrap(),
+            whole
+        );
+        for at in [0.1, 0.45, 0.5, 0.55, 0.9] {
+            let mut i = (text.len() as f64 * at) as usize;
+            while text.as_bytes()[i] != b'\n' {
+                i += 1;
+            }
+            let holed = format!("{}\n{}", &text[..=i], &text[i + 1..]);
+            assert!(
+                PlainCsv::new(&holed).unwrap().columns(&[0]).is_none(),
+                "blank line at {at}"
+            );
+        }
     }
 
     proptest! {

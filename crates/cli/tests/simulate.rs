@@ -590,3 +590,42 @@ fn netlist_errors_name_the_path_and_line() {
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(!out.exists());
 }
+
+/// The output written block by block by the writer thread (several blocks
+/// here) is, byte for byte, the in-process run of the same command written
+/// in one piece.
+#[test]
+fn the_written_rows_are_the_in_process_run_byte_for_byte() {
+    use hydrocyl_identify::plaincsv::{run_columns, write_columns};
+    use hydrocyl_system::{rig, run::RunOptions, signal::Signal};
+    let dir = tempfile::tempdir().unwrap();
+    let rows = square(3500, 1e-3);
+    let cmd = write_command(dir.path(), "cmd.csv", &rows);
+    let out = dir.path().join("out.csv");
+    let st = hydrocyl()
+        .args(["simulate", "--rig", "leaney-moog", "--command"])
+        .arg(&cmd)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let written = std::fs::read_to_string(&out).unwrap();
+    let (t, u): (Vec<f64>, Vec<f64>) = rows.iter().copied().unzip();
+    let run = rig::simulate(
+        &rig::load("leaney-moog").unwrap(),
+        Signal::table(t.clone(), u).unwrap(),
+        &t,
+        &RunOptions::default(),
+    )
+    .unwrap();
+    let (names, columns) = run_columns(&run);
+    let whole = String::from_utf8(write_columns(&names, &columns)).unwrap();
+    let body = |s: &str| s.split_once('\n').map(|(_, b)| b.to_string()).unwrap();
+    assert_eq!(written.lines().count(), rows.len() + 1);
+    assert!(body(&written) == body(&whole), "the rows differ");
+}

@@ -185,6 +185,9 @@ fn valve_diagnose_time() -> Result<(), String> {
 
 /// Runs the benchmarks; returns `false` only when a benchmark could not run
 /// (a benchmark has no pass/fail threshold).
+/// A section of the bench: prints its rows, or says why it could not run.
+pub type Section = fn() -> Result<(), String>;
+
 /// `only`: run only the sections whose name contains it; `keep`: the
 /// folder where the whole-process row writes and keeps its command files.
 pub fn run(only: Option<&str>, keep: Option<&std::path::Path>) -> bool {
@@ -197,7 +200,7 @@ pub fn run(only: Option<&str>, keep: Option<&std::path::Path>) -> bool {
         xfactor_analytical_vs_brent();
     }
     let mut ok = true;
-    let sections: [(&str, fn() -> Result<(), String>); 2] = [
+    let sections: [(&str, Section); 2] = [
         ("valve rig", valve_rig_real_time),
         ("diagnose", valve_diagnose_time),
     ];

@@ -534,18 +534,24 @@ fn whole_process(keep: Option<&Path>) -> Result<(), String> {
 /// could not run. `keep`: see [`whole_process`].
 pub fn run(wanted: &dyn Fn(&str) -> bool, keep: Option<&Path>) -> bool {
     let mut ok = true;
-    let sections: [(&str, &dyn Fn() -> Result<(), String>); 5] = [
-        ("csv", &csv_per_row),
-        ("cost per step", &cost_per_step),
-        ("work-precision", &work_precision),
-        ("hybrid solver choice", &hybrid_solver_choice),
-        ("whole process", &|| whole_process(keep)),
+    let sections: [(&str, crate::bench::Section); 4] = [
+        ("csv", csv_per_row),
+        ("cost per step", cost_per_step),
+        ("work-precision", work_precision),
+        ("hybrid solver choice", hybrid_solver_choice),
     ];
-    for (name, f) in sections {
-        if !wanted(name) {
-            continue;
-        }
-        if let Err(e) = f() {
+    // lazily, in this order: each section prints as it runs
+    let process = wanted("whole process")
+        .then_some("whole process")
+        .into_iter()
+        .map(|name| (name, whole_process(keep)));
+    let ran = sections
+        .into_iter()
+        .filter(|(name, _)| wanted(name))
+        .map(|(name, f)| (name, f()))
+        .chain(process);
+    for (name, r) in ran {
+        if let Err(e) = r {
             eprintln!("cargo xtask bench: {name}: {e}");
             ok = false;
         }

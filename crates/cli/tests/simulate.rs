@@ -18,6 +18,24 @@ fn write_command(dir: &Path, name: &str, rows: &[(f64, f64)]) -> PathBuf {
     p
 }
 
+/// `hydrocyl simulate --rig leaney-moog` on `cmd` into `out`, which must
+/// succeed.
+fn simulate_leaney_moog(cmd: &Path, out: &Path) -> std::process::Output {
+    let st = hydrocyl()
+        .args(["simulate", "--rig", "leaney-moog", "--command"])
+        .arg(cmd)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    st
+}
+
 fn square(n: usize, dt: f64) -> Vec<(f64, f64)> {
     (0..n)
         .map(|k| {
@@ -51,18 +69,7 @@ fn writes_the_measured_data_format_at_the_command_times() {
     rows.push((2.0013, 0.1));
     let cmd = write_command(dir.path(), "cmd.csv", &rows);
     let out = dir.path().join("out.csv");
-    let st = hydrocyl()
-        .args(["simulate", "--rig", "leaney-moog", "--command"])
-        .arg(&cmd)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+    let st = simulate_leaney_moog(&cmd, &out);
     let header = std::fs::read_to_string(&out).unwrap();
     assert!(
         header.starts_with("time [s],command [-],position [m],velocity [m/s],p1 [Pa],p2 [Pa],"),
@@ -602,18 +609,7 @@ fn the_written_rows_are_the_in_process_run_byte_for_byte() {
     let rows = square(3500, 1e-3);
     let cmd = write_command(dir.path(), "cmd.csv", &rows);
     let out = dir.path().join("out.csv");
-    let st = hydrocyl()
-        .args(["simulate", "--rig", "leaney-moog", "--command"])
-        .arg(&cmd)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+    simulate_leaney_moog(&cmd, &out);
     let written = std::fs::read_to_string(&out).unwrap();
     let (t, u): (Vec<f64>, Vec<f64>) = rows.iter().copied().unzip();
     let run = rig::simulate(

@@ -83,7 +83,7 @@ pub fn run() -> bool {
         println!(
             "with Table 5-8's seal gain K the hybrid drive's steady-extension force reserve falls to \
              {r:.2} N at {:.1} mm/s ({fold}; hydrocyl_studies::chapter7), so a transient \
-             locks it; `valve`/`hybrid` run Table 5-8 with K bounded to 5.03 bar and K H a on \
+             locks it; `valve`/`hybrid` run Table 5-8 with K bounded to 2.72 bar extending, 5.03 bar retracting and K H a on \
              (hydrocyl_friction::seal; docs/energy.md), `valve-k0`/`hybrid-k0` with K = 0, `hybrid-h0` without K H a",
             1e3 * v
         );

@@ -12,6 +12,14 @@ use std::sync::OnceLock;
 
 const CLOSURE: f64 = 1e-3;
 
+/// `hybrid ±100 mm/s square 0 kg` and `valve` at the same scenario, as
+/// `cargo xtask energy` measures them with the presets' per-direction seal
+/// bound [%]: the one base scenario where hydrocyl's hybrid is behind
+/// (`chapter8::HYBRID_NOT_AHEAD`; Table 8-2: 14.60 vs 8.59 %).
+const HYBRID_PCT: f64 = 5.13;
+/// See [`HYBRID_PCT`].
+const VALVE_PCT: f64 = 5.50;
+
 /// A short plan for tests: the run starts at rest and the ledger covers the
 /// whole of one period (start-up included), so the runs stay short.
 fn short() -> Plan {

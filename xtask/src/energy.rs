@@ -8,8 +8,7 @@
 //! bar of where the energy went, and reports its wall time.
 
 use hydrocyl_studies::chapter8::{
-    HYBRID_NOT_AHEAD,
-    run_scenario, scenarios_for, Drive, FrictionCase, Outcome, Plan, Scenario,
+    run_scenario, scenarios_for, Drive, FrictionCase, Outcome, Plan, Scenario, HYBRID_NOT_AHEAD,
 };
 use plotters::prelude::*;
 use rayon::prelude::*;
@@ -269,7 +268,11 @@ fn checks(outs: &[&Outcome]) -> bool {
                     sc.label(),
                     pct(h.efficiency),
                     pct(v.efficiency),
-                    if sc.hybrid_not_ahead() { "below (HYBRID_NOT_AHEAD)" } else { "above" }
+                    if sc.hybrid_not_ahead() {
+                        "below (HYBRID_NOT_AHEAD)"
+                    } else {
+                        "above"
+                    }
                 );
                 ok = false;
             }

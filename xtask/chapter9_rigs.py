@@ -11,8 +11,8 @@ needle file against the optimiser)."""
 import copy
 import json
 base = json.load(open('fixtures/rigs/wang-hybrid.json'))
-NEEDLE_50 = 3.7147199231635e-06
-NEEDLE_SOL_50 = 2.9286218367126874e-06
+NEEDLE_50 = 2.808624803859787e-06
+NEEDLE_SOL_50 = 1.6589642083026653e-06
 # proportional law through the 50 mm/s optimum: g = (A/v) K/A1, (A/v) K/A2
 SERVO_GP = NEEDLE_SOL_50/0.05*1.07e-05/0.0008042
 SERVO_GN = NEEDLE_SOL_50/0.05*1.07e-05/0.00055

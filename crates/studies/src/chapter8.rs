@@ -62,7 +62,23 @@ pub struct Scenario {
     pub load_kg: f64,
 }
 
+/// The base scenarios `(speed mm/s, wave, load kg)` in which hydrocyl's
+/// hybrid drive does **not** beat the valve drive, against Tables 8-2/8-3
+/// (where it is ahead in all eight). With the seal term bounded per direction
+/// (docs/hybrid.md item 8) the hybrid's extending seal friction stays at the
+/// 2.72 bar Table 5-3 shows, so at ±100 mm/s square without load its output
+/// falls below the valve drive's, whose 8–17 bar chambers keep the bound's
+/// full `K Δp_max² v` (docs/energy.md, "Where hydrocyl differs").
+pub const HYBRID_NOT_AHEAD: [(f64, Wave, f64); 1] = [(100.0, Wave::Square, 0.0)];
+
 impl Scenario {
+    /// `true` for a base scenario listed in [`HYBRID_NOT_AHEAD`].
+    pub fn hybrid_not_ahead(&self) -> bool {
+        HYBRID_NOT_AHEAD
+            .iter()
+            .any(|&(v, w, kg)| v == self.speed_mm_s && w == self.wave && kg == self.load_kg)
+    }
+
     /// A label such as `hybrid ±50 mm/s sine 20 kg`.
     pub fn label(&self) -> String {
         format!(

@@ -53,7 +53,7 @@ pub struct SteadyState {
 /// quantity could not be found, e.g. no reversal in the trace).
 #[derive(Clone, Copy, Debug, Default, Serialize)]
 pub struct Phenomena {
-    /// Stall (|v| < 1 mm/s) at the reversals from extending to retracting \[s\].
+    /// Stall at the reversals from extending to retracting ([`super::stall`]) \[s\].
     pub stall_to_retract: f64,
     /// Stall at the reversals from retracting to extending \[s\].
     pub stall_to_extend: f64,
@@ -326,7 +326,6 @@ fn reversals(tr: &Trace, t_from: f64) -> Vec<(usize, f64)> {
 
 fn phenomena(test: &Chapter7Test, rig: &WangHybrid, tr: &Trace) -> Phenomena {
     let period = 1.0 / test.frequency;
-    let thr = 1.0e-3;
     let v = &tr.velocity;
     let (a1, a2) = (rig.cylinder.area_1.si(), rig.cylinder.area_2.si());
     let ideal: Vec<f64> = tr
@@ -355,23 +354,9 @@ fn phenomena(test: &Chapter7Test, rig: &WangHybrid, tr: &Trace) -> Phenomena {
     let half = (0.5 * period / test.sample_interval).round() as usize;
     for &(k, dir) in &revs {
         let end = (k + half).min(n - 1);
-        // the low-speed interval around the reversal
-        let mut s = k;
-        if v[k].abs() < thr {
-            while s > 0 && v[s - 1].abs() < thr {
-                s -= 1;
-            }
-        } else {
-            while s < end && v[s].abs() >= thr {
-                s += 1;
-            }
-        }
-        let mut e = s;
-        while e < end && v[e] * dir < thr {
-            e += 1;
-        }
-        if s < end && e < end {
-            let d = tr.t[e] - tr.t[s];
+        // the stall (super::stall: total time with |v| < 1 mm/s until half
+        // the target speed in the new direction)
+        if let Some(d) = super::stall::stall_at(&tr.t, v, k, dir, 0.5 * test.speed, end) {
             if dir > 0.0 {
                 st_e.push(d);
             } else {

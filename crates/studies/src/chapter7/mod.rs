@@ -4,8 +4,9 @@
 //! measurement of each phenomenon the thesis reports (section 7.1–7.3):
 //!
 //! * the stall at each reversal ([`Phenomena::stall_to_retract`],
-//!   [`Phenomena::stall_to_extend`]): the length of the interval with
-//!   `|v| < 1 mm/s` around the command's reversal;
+//!   [`Phenomena::stall_to_extend`]): the total time with `|v| < 1 mm/s`
+//!   from the command's reversal until half the target speed in the new
+//!   direction ([`stall`] says why this measure);
 //! * slower response when retracting ([`Phenomena::t90_extend`],
 //!   [`Phenomena::t90_retract`]): time from the reversal to 90 % of the target
 //!   speed in the new direction;
@@ -46,6 +47,7 @@
 
 mod fold;
 mod measure;
+pub mod stall;
 
 pub use fold::{
     extend_fold_speed, extend_force_reserve, extend_pressure_roots, extend_reserve_minimum,

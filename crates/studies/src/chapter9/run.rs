@@ -18,9 +18,6 @@ use hydrocyl_system::simulation::Simulation;
 use serde::Serialize;
 use serde_json::Value;
 
-/// Below this speed the piston counts as stopped \[m/s\] (chapter 7's 1 mm/s).
-pub const STOPPED: f64 = 1e-3;
-
 /// Output sample interval \[s\].
 pub const SAMPLE_S: f64 = 1e-3;
 
@@ -184,21 +181,9 @@ fn measure(out: &Run, case: &Case, k0: usize, k1: usize) -> Result<Measured, Rig
     for r in 0..4 {
         let k = k0 + r * n_half;
         let dir = if r % 2 == 0 { 1.0 } else { -1.0 };
-        let (mut s, end) = (k, (k + n_half).min(k1));
-        if v[k].abs() < STOPPED {
-            while s > 0 && v[s - 1].abs() < STOPPED {
-                s -= 1;
-            }
-        } else {
-            while s < end && v[s].abs() >= STOPPED {
-                s += 1;
-            }
-        }
-        let mut e = s;
-        while e < end && v[e] * dir < STOPPED {
-            e += 1;
-        }
-        let d = out.time[e] - out.time[s];
+        let end = (k + n_half).min(k1);
+        let d = crate::chapter7::stall::stall_at(&out.time, v, k, dir, 0.5 * case.speed(), end)
+            .unwrap_or(f64::NAN);
         if dir < 0.0 {
             stalls.0.push(d);
         } else {

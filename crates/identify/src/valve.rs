@@ -248,9 +248,9 @@ pub fn diagnose_rig_traced(
         });
     }
     let mut rig0 = with_initial(declared, &p);
-    simulate(&rig0, &p)
+    let sims_declared = simulate(&rig0, &p)
         .map_err(|e| DiagnoseError::Rig(format!("declared model does not simulate: {e}")))?;
-    let nrmse_declared = channel_nrmse(&rig0, &p);
+    let nrmse_declared = nrmse_of(&p, &sims_declared);
     let mut warnings: Vec<String> = data_problems
         .iter()
         .map(|p| format!("{} left out of the fit: {}", p.channel, p.message))
@@ -279,7 +279,7 @@ pub fn diagnose_rig_traced(
     clock.lap("checks, smoothing and initial-state fit");
     let sims_before = simulate(&rig0, &p).unwrap_or_default();
     let nrmse_before = nrmse_of(&p, &sims_before);
-    let rss_before = rss(&rig0, &p, opts.holdout, Part::All);
+    let rss_before = rss_of(&p, &sims_before, opts.holdout);
     let candidates: Vec<EffectId> = opts
         .candidates
         .clone()
@@ -418,7 +418,10 @@ pub fn diagnose_rig_traced(
         });
         let queued: Vec<&(EffectId, Model)> = order.iter().map(|&i| &jobs[i]).collect();
         let mut done: Vec<Option<(Model, EffectReport, f64)>> = jobs.iter().map(|_| None).collect();
-        for (i, r) in order.into_iter().zip(trace_parallel(&queued, &|j| trace_one(j))) {
+        for (i, r) in order
+            .into_iter()
+            .zip(trace_parallel(&queued, &|j| trace_one(j)))
+        {
             done[i] = Some(r);
         }
         let mut traced: Vec<Option<(EffectId, Model, EffectReport, f64)>> = done
@@ -582,7 +585,7 @@ pub fn diagnose_rig_traced(
     clock.lap("backward step");
     let sims_after = simulate(&model, &p).unwrap_or_default();
     let nrmse_after = nrmse_of(&p, &sims_after);
-    let rss_after = rss(&model, &p, opts.holdout, Part::All);
+    let rss_after = rss_of(&p, &sims_after, opts.holdout);
     let mut noise_floor = BTreeMap::new();
     let mut noise_ss = 0.0;
     for (((ch, m), r), w) in p.meas.iter().zip(&p.ranges).zip(&p.weights) {

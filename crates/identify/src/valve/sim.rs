@@ -351,7 +351,19 @@ fn weighted(p: &Prepared, sims: &[Vec<f64>], holdout: f64, part: Part, out: &mut
     }
 }
 
-/// The NRMSE per channel ([`channel_nrmse`]) and the held-out part's
+/// The weighted sum of squares on the whole record of simulated channels
+/// `sims` ([`rss`] on `Part::All` without simulating again; infinite where
+/// the simulation failed and `sims` is empty).
+pub(super) fn rss_of(p: &Prepared, sims: &[Vec<f64>], holdout: f64) -> f64 {
+    if sims.len() < p.meas.len() {
+        return f64::INFINITY;
+    }
+    let mut r = Vec::new();
+    weighted(p, sims, holdout, Part::All, &mut r);
+    sum_sq(&r)
+}
+
+/// The NRMSE per channel ([`nrmse_of`]) and the held-out part's
 /// weighted sum of squares ([`rss`] on `Part::Held`), from one simulation.
 pub(super) fn nrmse_and_held(
     rig: &Model,
@@ -402,10 +414,6 @@ pub(super) fn held_sum_sq(r: &[f64], p: &Prepared, holdout: f64) -> f64 {
         .flat_map(|block| &block[cut.min(block.len())..])
         .map(|v| v * v)
         .sum()
-}
-
-pub(super) fn channel_nrmse(rig: &Model, p: &Prepared) -> BTreeMap<String, f64> {
-    simulate(rig, p).map_or_else(|_| BTreeMap::new(), |sims| nrmse_of(p, &sims))
 }
 
 /// NRMSE per measured channel of the simulated series `sims`.

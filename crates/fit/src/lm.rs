@@ -20,6 +20,17 @@ pub trait Residuals {
     fn jacobian(&self, _p: &[f64], _jac: &mut [f64]) -> bool {
         false
     }
+
+    /// Writes the residuals at each of `points` into the matching entry of
+    /// `out` (each as long as the residual vector). The finite-difference
+    /// Jacobian asks for all its points in one call; the default evaluates
+    /// them in turn, and a model that can evaluate several points at once
+    /// (on several cores) overrides it.
+    fn residuals_at(&self, points: &[Vec<f64>], out: &mut [Vec<f64>]) {
+        for (p, r) in points.iter().zip(out.iter_mut()) {
+            self.residuals(p, r);
+        }
+    }
 }
 
 impl<F: Fn(&[f64], &mut [f64])> Residuals for F {
@@ -192,33 +203,45 @@ impl<R: Residuals> Problem<R> {
         if self.model.jacobian(p, buf) {
             return DMatrix::from_row_slice(n, m, buf);
         }
-        let mut jac = DMatrix::zeros(n, m);
-        let mut pp = p.to_vec();
-        let mut rp = DVector::zeros(n);
-        let mut rm = DVector::zeros(n);
+        // Central differences where both sides are within the bounds, else
+        // one-sided; every point first, then the columns.
+        let mut points = Vec::with_capacity(2 * m);
+        let mut plan = Vec::with_capacity(m);
         for j in 0..m {
             let h = self.options.fd_step * p[j].abs().max(1e-3 * self.options.fd_step.sqrt());
-            let (lo, hi) = (self.lower[j], self.upper[j]);
-            let up_ok = p[j] + h <= hi;
-            let down_ok = p[j] - h >= lo;
-            if up_ok && down_ok {
-                pp[j] = p[j] + h;
-                self.model.residuals(&pp, rp.as_mut_slice());
-                pp[j] = p[j] - h;
-                self.model.residuals(&pp, rm.as_mut_slice());
-                jac.set_column(j, &((&rp - &rm) / (2.0 * h)));
-            } else if up_ok {
-                pp[j] = p[j] + h;
-                self.model.residuals(&pp, rp.as_mut_slice());
-                jac.set_column(j, &((&rp - r) / h));
-            } else {
-                pp[j] = p[j] - h;
-                self.model.residuals(&pp, rm.as_mut_slice());
-                jac.set_column(j, &((r - &rm) / h));
+            let up_ok = p[j] + h <= self.upper[j];
+            let down_ok = p[j] - h >= self.lower[j];
+            let mut at = |x: f64| {
+                let mut pp = p.to_vec();
+                pp[j] = x;
+                points.push(pp);
+            };
+            if up_ok {
+                at(p[j] + h);
             }
-            pp[j] = p[j];
-            *evaluations += if up_ok && down_ok { 2 } else { 1 };
+            if !up_ok || down_ok {
+                at(p[j] - h);
+            }
+            plan.push((h, up_ok, down_ok));
         }
+        let mut out = vec![vec![0.0; n]; points.len()];
+        self.model.residuals_at(&points, &mut out);
+        let out: Vec<DVector<f64>> = out.into_iter().map(DVector::from_vec).collect();
+        let mut jac = DMatrix::zeros(n, m);
+        let mut k = 0;
+        for (j, (h, up_ok, down_ok)) in plan.into_iter().enumerate() {
+            if up_ok && down_ok {
+                jac.set_column(j, &((&out[k] - &out[k + 1]) / (2.0 * h)));
+                k += 2;
+            } else if up_ok {
+                jac.set_column(j, &((&out[k] - r) / h));
+                k += 1;
+            } else {
+                jac.set_column(j, &((r - &out[k]) / h));
+                k += 1;
+            }
+        }
+        *evaluations += k;
         jac
     }
 

@@ -12,8 +12,10 @@
 //! channel block and the largest used.
 
 use std::cell::RefCell;
+use std::sync::Mutex;
 
-use hydrocyl_fit::{FitError, Options, Problem};
+use hydrocyl_fit::{FitError, Options, Problem, Residuals};
+use rayon::prelude::*;
 use thiserror::Error;
 
 /// Options of a fit.
@@ -92,6 +94,92 @@ pub fn fit<F>(
 where
     F: FnMut(&[f64], &mut Vec<f64>) -> Result<(), String>,
 {
+    check_setup(x0, lower, upper, typical)?;
+    let cell = RefCell::new((resid, Vec::new()));
+    let m = {
+        let mut c = cell.borrow_mut();
+        let (f, buf) = &mut *c;
+        f(x0, buf).map_err(LmError::Start)?;
+        buf.len()
+    };
+    let model = |u: &[f64], r: &mut [f64]| {
+        let mut c = cell.borrow_mut();
+        let (f, buf) = &mut *c;
+        match f(&unscaled(u, typical), buf) {
+            Ok(()) if buf.len() == r.len() => r.copy_from_slice(buf),
+            _ => r.iter_mut().for_each(|v| *v = f64::NAN),
+        }
+    };
+    solve(model, m, x0, lower, upper, typical, opts)
+}
+
+/// [`fit`] for a residual that can be evaluated at several points at once:
+/// the finite-difference Jacobian's points are evaluated on the available
+/// cores (rayon's pool). The iteration, and so the result, is [`fit`]'s;
+/// the residual at the start is evaluated once (where [`fit`] evaluates it
+/// twice, once to learn the residual's length).
+pub fn fit_parallel<F>(
+    resid: F,
+    x0: &[f64],
+    lower: &[f64],
+    upper: &[f64],
+    typical: &[f64],
+    opts: &LmOptions,
+) -> Result<LmResult, LmError>
+where
+    F: Fn(&[f64], &mut Vec<f64>) -> Result<(), String> + Sync,
+{
+    check_setup(x0, lower, upper, typical)?;
+    let u0 = scaled(x0, typical);
+    let mut r0 = Vec::new();
+    resid(&unscaled(&u0, typical), &mut r0).map_err(LmError::Start)?;
+    let model = Parallel {
+        resid,
+        typical,
+        start: Mutex::new(Some((u0, r0.clone()))),
+    };
+    solve(model, r0.len(), x0, lower, upper, typical, opts)
+}
+
+/// The residual of [`fit_parallel`], in scaled parameters.
+struct Parallel<'a, F> {
+    resid: F,
+    typical: &'a [f64],
+    /// The residual at the start, until the solver asks for it.
+    start: Mutex<Option<(Vec<f64>, Vec<f64>)>>,
+}
+
+impl<F> Residuals for Parallel<'_, F>
+where
+    F: Fn(&[f64], &mut Vec<f64>) -> Result<(), String> + Sync,
+{
+    fn residuals(&self, u: &[f64], r: &mut [f64]) {
+        if let Ok(mut start) = self.start.lock() {
+            if start.as_ref().is_some_and(|(u0, _)| u0 == u) {
+                if let Some((_, r0)) = start.take() {
+                    if r0.len() == r.len() {
+                        r.copy_from_slice(&r0);
+                        return;
+                    }
+                }
+            }
+        }
+        let mut buf = Vec::new();
+        match (self.resid)(&unscaled(u, self.typical), &mut buf) {
+            Ok(()) if buf.len() == r.len() => r.copy_from_slice(&buf),
+            _ => r.iter_mut().for_each(|v| *v = f64::NAN),
+        }
+    }
+
+    fn residuals_at(&self, points: &[Vec<f64>], out: &mut [Vec<f64>]) {
+        points
+            .par_iter()
+            .zip(out.par_iter_mut())
+            .for_each(|(u, r)| self.residuals(u, r));
+    }
+}
+
+fn check_setup(x0: &[f64], lower: &[f64], upper: &[f64], typical: &[f64]) -> Result<(), LmError> {
     let p = x0.len();
     if lower.len() != p || upper.len() != p || typical.len() != p {
         return Err(LmError::Setup("bounds and scales must match x0".into()));
@@ -101,27 +189,35 @@ where
             "typical scale of parameter {j} must be > 0"
         )));
     }
-    let cell = RefCell::new((resid, Vec::new()));
-    let m = {
-        let mut c = cell.borrow_mut();
-        let (f, buf) = &mut *c;
-        f(x0, buf).map_err(LmError::Start)?;
-        buf.len()
-    };
-    let to_x = |u: &[f64]| -> Vec<f64> { u.iter().zip(typical).map(|(a, s)| a * s).collect() };
-    let scaled = |v: &[f64]| -> Vec<f64> { v.iter().zip(typical).map(|(a, s)| a / s).collect() };
-    let model = |u: &[f64], r: &mut [f64]| {
-        let mut c = cell.borrow_mut();
-        let (f, buf) = &mut *c;
-        match f(&to_x(u), buf) {
-            Ok(()) if buf.len() == r.len() => r.copy_from_slice(buf),
-            _ => r.iter_mut().for_each(|v| *v = f64::NAN),
-        }
-    };
+    Ok(())
+}
+
+/// Parameters divided by their typical sizes (what the solver works in).
+fn scaled(x: &[f64], typical: &[f64]) -> Vec<f64> {
+    x.iter().zip(typical).map(|(a, s)| a / s).collect()
+}
+
+/// Scaled parameters back in their units.
+fn unscaled(u: &[f64], typical: &[f64]) -> Vec<f64> {
+    u.iter().zip(typical).map(|(a, s)| a * s).collect()
+}
+
+/// The solve and its report, for a residual `model` in scaled parameters
+/// with `m` residuals.
+fn solve<M: Residuals>(
+    model: M,
+    m: usize,
+    x0: &[f64],
+    lower: &[f64],
+    upper: &[f64],
+    typical: &[f64],
+    opts: &LmOptions,
+) -> Result<LmResult, LmError> {
+    let p = x0.len();
     let names: Vec<String> = (0..p).map(|j| format!("x{j}")).collect();
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
     let report = Problem::new(model, m, &names)
-        .bounds(&scaled(lower), &scaled(upper))
+        .bounds(&scaled(lower, typical), &scaled(upper, typical))
         .options(Options {
             max_evaluations: opts.max_evaluations,
             ftol: opts.ftol,
@@ -130,7 +226,7 @@ where
             fd_step: opts.fd_step,
             ..Options::default()
         })
-        .solve(&scaled(x0))?;
+        .solve(&scaled(x0, typical))?;
     let nb = opts.blocks.max(1);
     let len = report.residuals.len() / nb;
     let widen = (0..nb)
@@ -150,7 +246,7 @@ where
         })
         .collect();
     Ok(LmResult {
-        x: to_x(&report.values()),
+        x: unscaled(&report.values(), typical),
         ci95,
         rss: report.ssr,
         m,

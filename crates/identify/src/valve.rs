@@ -248,9 +248,9 @@ pub fn diagnose_rig_traced(
         });
     }
     let mut rig0 = with_initial(declared, &p);
-    simulate(&rig0, &p)
+    let sims_declared = simulate(&rig0, &p)
         .map_err(|e| DiagnoseError::Rig(format!("declared model does not simulate: {e}")))?;
-    let nrmse_declared = channel_nrmse(&rig0, &p);
+    let nrmse_declared = nrmse_of(&p, &sims_declared);
     let mut warnings: Vec<String> = data_problems
         .iter()
         .map(|p| format!("{} left out of the fit: {}", p.channel, p.message))
@@ -279,7 +279,7 @@ pub fn diagnose_rig_traced(
     clock.lap("checks, smoothing and initial-state fit");
     let sims_before = simulate(&rig0, &p).unwrap_or_default();
     let nrmse_before = nrmse_of(&p, &sims_before);
-    let rss_before = rss(&rig0, &p, opts.holdout, Part::All);
+    let rss_before = rss_of(&p, &sims_before, opts.holdout);
     let candidates: Vec<EffectId> = opts
         .candidates
         .clone()
@@ -308,8 +308,8 @@ pub fn diagnose_rig_traced(
         let mut r0 = Vec::new();
         residual(&model, &pt, opts.holdout, Part::All, &mut r0)
             .map_err(|e| DiagnoseError::Rig(e.to_string()))?;
-        let rss0: f64 = r0.iter().map(|v| v * v).sum();
-        let rss0_held = rss(&model, &pt, opts.holdout, Part::Held);
+        let rss0 = sum_sq(&r0);
+        let rss0_held = held_sum_sq(&r0, &pt, opts.holdout);
         let rho = lm::lag1_autocorrelation(&r0).clamp(0.0, 0.999);
         let neff = (r0.len() as f64 * (1.0 - rho) / (1.0 + rho)).max(2.0);
         let mut todo: Vec<EffectId> = candidates
@@ -345,6 +345,8 @@ pub fn diagnose_rig_traced(
             .iter()
             .flat_map(|&id| trace_starts(&model, id).into_iter().map(move |r| (id, r)))
             .collect();
+        // The first step's simulations every candidate shares.
+        let first = FirstStep::new(&model, &free, &pt, opts.holdout, Part::Train);
         let trace_one = |job: &(EffectId, Model)| -> (Model, EffectReport, f64) {
             let id = job.0;
             let params: ParamList = id.params().iter().map(|q| (id, q.name)).collect();
@@ -353,10 +355,19 @@ pub fn diagnose_rig_traced(
             // in for this one can give way.
             let joint: ParamList = free.iter().chain(params.iter()).copied().collect();
             let mut trial = job.1.clone();
-            let res = gauss_newton_trace(&mut trial, &joint, &pt, opts.holdout, Part::Train);
-            let rss_train = rss(&trial, &pt, opts.holdout, Part::Train);
-            let rss1 = rss(&trial, &pt, opts.holdout, Part::All);
-            let rss1_held = rss(&trial, &pt, opts.holdout, Part::Held);
+            let res = gauss_newton_trace(
+                &mut trial,
+                &joint,
+                &pt,
+                opts.holdout,
+                Part::Train,
+                first.as_ref(),
+            );
+            let rss_train = match &res {
+                Ok(r) => sum_sq(r),
+                Err(_) => rss(&trial, &pt, opts.holdout, Part::Train),
+            };
+            let (rss1, rss1_held) = rss_all_held(&trial, &pt, opts.holdout);
             // A trace whose simulation fails scores nothing (finite numbers
             // only reach the report) and says why below.
             let sim_failed = !(rss1.is_finite() && rss1_held.is_finite() && rss_train.is_finite());
@@ -398,12 +409,26 @@ pub fn diagnose_rig_traced(
         // (results taken in catalog order, so the outcome does not depend on
         // the number of threads). Of a candidate's starts, the one ending
         // lowest on the training part is kept.
-        let mut traced: Vec<Option<(EffectId, Model, EffectReport, f64)>> =
-            trace_parallel(&jobs, &trace_one)
-                .into_iter()
-                .zip(&jobs)
-                .map(|((t, r, x), (id, _))| Some((*id, t, r, x)))
-                .collect();
+        // The slowest first (the friction-law edits, then by parameter
+        // count), so that no core is left alone with one at the end.
+        let mut order: Vec<usize> = (0..jobs.len()).collect();
+        order.sort_by_key(|&i| {
+            let id = jobs[i].0;
+            std::cmp::Reverse((model::is_law_edit(id), id.params().len()))
+        });
+        let queued: Vec<&(EffectId, Model)> = order.iter().map(|&i| &jobs[i]).collect();
+        let mut done: Vec<Option<(Model, EffectReport, f64)>> = jobs.iter().map(|_| None).collect();
+        for (i, r) in order
+            .into_iter()
+            .zip(trace_parallel(&queued, &|j| trace_one(j)))
+        {
+            done[i] = Some(r);
+        }
+        let mut traced: Vec<Option<(EffectId, Model, EffectReport, f64)>> = done
+            .into_iter()
+            .zip(&jobs)
+            .map(|(d, (id, _))| d.map(|(t, r, x)| (*id, t, r, x)))
+            .collect();
         let mut chosen: Vec<(EffectId, Model, EffectReport)> = Vec::new();
         for &id in &todo {
             let mut pick: Option<(Model, EffectReport, f64)> = None;
@@ -429,7 +454,7 @@ pub fn diagnose_rig_traced(
             last.insert(id, rep);
         }
         eligible.sort_by(|a, b| b.2.explained_share.total_cmp(&a.2.explained_share));
-        if let Some(pr) = delay_probe(&model, &pt, opts.holdout) {
+        if let Some(pr) = delay_probe(&model, &pt, opts.holdout, rss0) {
             let top = eligible.first().map(|(id, _, r)| (*id, r.explained_share));
             if pr.explained_share >= opts.min_share
                 && top.is_none_or(|(_, share)| pr.explained_share > share + opts.min_share)
@@ -450,10 +475,16 @@ pub fn diagnose_rig_traced(
         // The acceptance rule (`accept`): refit each candidate in turn with
         // the effects already added; the first that earns its place is added.
         clock.lap("tracing");
+        // (simulated only where a candidate is to be refitted)
+        let (nrmse, held) = if eligible.is_empty() {
+            (BTreeMap::new(), f64::INFINITY)
+        } else {
+            nrmse_and_held(&model, &p, opts.holdout)
+        };
         let base = accept::Baseline {
-            model: &model,
             declared,
-            nrmse: channel_nrmse(&model, &p),
+            nrmse,
+            held,
             floors: floors.clone(),
             p: &p,
             holdout: opts.holdout,
@@ -554,7 +585,7 @@ pub fn diagnose_rig_traced(
     clock.lap("backward step");
     let sims_after = simulate(&model, &p).unwrap_or_default();
     let nrmse_after = nrmse_of(&p, &sims_after);
-    let rss_after = rss(&model, &p, opts.holdout, Part::All);
+    let rss_after = rss_of(&p, &sims_after, opts.holdout);
     let mut noise_floor = BTreeMap::new();
     let mut noise_ss = 0.0;
     for (((ch, m), r), w) in p.meas.iter().zip(&p.ranges).zip(&p.weights) {

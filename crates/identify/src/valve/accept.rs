@@ -17,7 +17,7 @@ use std::collections::BTreeMap;
 
 use super::Model;
 
-use super::{channel_nrmse, get, mean_coulomb, negligible, rss, ParamList, Part, Prepared};
+use super::{get, mean_coulomb, negligible, nrmse_and_held, ParamList, Prepared};
 use crate::catalog::EffectId;
 use crate::lm::LmResult;
 
@@ -54,12 +54,12 @@ fn size(id: EffectId, rig: &Model, declared: &Model) -> (&'static str, f64) {
 /// What the rule compares a candidate with: the model before it, its
 /// channels' NRMSE and their noise floors.
 pub(super) struct Baseline<'a> {
-    /// The model before the candidate.
-    pub model: &'a Model,
     /// The declared rig (neutral values, negligible sizes).
     pub declared: &'a Model,
     /// NRMSE per channel of `model`.
     pub nrmse: BTreeMap<String, f64>,
+    /// The held-out part's weighted sum of squares of `model`.
+    pub held: f64,
     /// Noise floor per compared channel (NRMSE of the sensor noise, at least
     /// 1e-4: the weights' floor).
     pub floors: BTreeMap<String, f64>,
@@ -109,7 +109,7 @@ pub(super) fn verdict(
     if negligible(id, refit, base.declared) {
         return Err("fitted size negligible (indistinguishable from the declared rig)".into());
     }
-    let after = channel_nrmse(refit, base.p);
+    let (after, h1) = nrmse_and_held(refit, base.p, base.holdout);
     for (ch, before) in &base.nrmse {
         let (Some(a), Some(floor)) = (after.get(ch), base.floors.get(ch)) else {
             continue;
@@ -120,10 +120,7 @@ pub(super) fn verdict(
             ));
         }
     }
-    let (h0, h1) = (
-        rss(base.model, base.p, base.holdout, Part::Held),
-        rss(refit, base.p, base.holdout, Part::Held),
-    );
+    let h0 = base.held;
     if h1.partial_cmp(&h0) != Some(std::cmp::Ordering::Less) {
         return Err(format!(
             "the held-out part does not improve (weighted SS {h0:.4e} -> {h1:.4e})"

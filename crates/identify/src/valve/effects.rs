@@ -311,7 +311,7 @@ pub(super) fn typical(id: EffectId, name: &str, rig: &Model) -> f64 {
         (EffectId::SupplyDroop, _) => 1e9,
         (EffectId::SensorLag, _) => 5e-3,
         // 10 N at half the supply (or the seal's Δp bound) across the piston and 10 mm/s
-        (EffectId::PressureViscous, _) => 10.0 / (seal_dp(rig).powi(2) * 0.01).max(1e-300),
+        (EffectId::PressureViscous, _) => 10.0 / (rig.seal_dp().powi(2) * 0.01).max(1e-300),
         // K H = 10 % of the moving mass
         (EffectId::AccelerationFriction, _) => 0.1 * rig.mass() / k_pressure(rig).max(1e-300),
     }
@@ -340,7 +340,7 @@ pub(super) fn negligible(id: EffectId, rig: &Model, declared: &Model) -> bool {
         // a lag under 0.1 ms is below any record's resolution here
         EffectId::SensorLag => v("tau") < 1e-4,
         // under 1 N at half the supply across the piston and 10 mm/s
-        EffectId::PressureViscous => v("K") * seal_dp(rig).powi(2) * 0.01 < 1.0,
+        EffectId::PressureViscous => v("K") * rig.seal_dp().powi(2) * 0.01 < 1.0,
         // an added mass K H under 1 % of the moving mass
         EffectId::AccelerationFriction => k_pressure(rig) * v("H") < 0.01 * rig.mass(),
         // friction terms under 5 % of the declared Coulomb level
@@ -394,21 +394,6 @@ pub(super) fn bounds(id: EffectId, name: &str, rig: &Model) -> (f64, f64) {
             .iter()
             .find(|p| p.name == name)
             .map_or((f64::NEG_INFINITY, f64::INFINITY), |p| (p.lower, p.upper)),
-    }
-}
-
-/// The pressure difference the seal terms are sized at: half the supply,
-/// or the friction component's bound `seal.dp_max` where it is lower \[Pa\].
-fn seal_dp(rig: &Model) -> f64 {
-    let half = 0.5 * rig.supply();
-    match rig
-        .roles
-        .friction
-        .as_deref()
-        .and_then(|f| rig.param(f, "seal.dp_max"))
-    {
-        Some(b) if b > 0.0 => half.min(b),
-        _ => half,
     }
 }
 

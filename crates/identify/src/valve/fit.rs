@@ -3,6 +3,7 @@
 //! runner and the out-of-catalog delay probe.
 
 use super::*;
+use rayon::prelude::*;
 pub(super) type ParamList = Vec<(EffectId, &'static str)>;
 
 /// Fits `params` of `rig` in place on `part`, together with the initial
@@ -45,9 +46,9 @@ pub(super) fn fit(
     hi.push(vi + 0.2);
     typ.push(1e-2);
     let k = params.len();
-    let mut work = rig.clone();
-    let res = lm::fit(
+    let res = lm::fit_parallel(
         |x, r| {
+            let mut work = rig.clone();
             for ((id, n), v) in params.iter().zip(x) {
                 set(&mut work, *id, n, *v);
             }
@@ -74,45 +75,148 @@ pub(super) fn fit(
     Ok(res)
 }
 
+/// One column of a trace's finite-difference Jacobian: an effect parameter
+/// or one of the two nuisance parameters (initial position and velocity).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Column {
+    /// Catalog parameter `name` of effect `id`.
+    Param(EffectId, &'static str),
+    /// The initial piston position.
+    X0,
+    /// The initial piston velocity.
+    V0,
+}
+
+/// The columns of a trace of `params`, in the order of its Jacobian.
+fn columns(params: &ParamList) -> Vec<Column> {
+    params
+        .iter()
+        .map(|&(id, n)| Column::Param(id, n))
+        .chain([Column::X0, Column::V0])
+        .collect()
+}
+
+/// `rig` with column `c` stepped by its finite-difference step, and the step:
+/// 10 % of a parameter's typical size, 10 µm of initial position (away from
+/// a stop the piston may start on), 0.1 mm/s of initial velocity.
+fn perturbed(rig: &Model, c: Column) -> (Model, f64) {
+    let mut t = rig.clone();
+    let h = match c {
+        Column::Param(id, n) => {
+            let h = 0.1 * typical(id, n, rig);
+            set(&mut t, id, n, get(rig, id, n).unwrap_or(0.0) + h);
+            h
+        }
+        Column::X0 => {
+            let h = if t.x0() + 1e-5 > 0.5 * rig.stroke() {
+                -1e-5
+            } else {
+                1e-5
+            };
+            t.set_x0(t.x0() + h);
+            h
+        }
+        Column::V0 => {
+            t.set_v0(t.v0() + 1e-4);
+            1e-4
+        }
+    };
+    (t, h)
+}
+
+/// The part of a trace's first Gauss–Newton step that every candidate of a
+/// round shares: the residual of the round's model on the traced part and
+/// its finite-difference columns for the effects already added and the two
+/// nuisance parameters. A candidate that starts from this model (every one
+/// but the friction-law starts of `trace_starts`) reuses them and simulates
+/// only its own parameters' columns; the numbers are the ones it would have
+/// computed itself.
+pub(super) struct FirstStep {
+    /// The round's model.
+    model: Model,
+    /// Its residual on the traced part.
+    r0: Vec<f64>,
+    /// The columns computed, with their values.
+    cols: Vec<(Column, Vec<f64>)>,
+}
+
+impl FirstStep {
+    /// Simulates the shared part of the first step of tracing with `free`
+    /// (the effects already added) on `model`, on the available cores.
+    /// `None` when the model does not simulate (each trace then fails on
+    /// its own, saying why); a column that does not simulate is left out.
+    pub(super) fn new(
+        model: &Model,
+        free: &ParamList,
+        p: &Prepared,
+        holdout: f64,
+        part: Part,
+    ) -> Option<Self> {
+        let mut r0 = Vec::new();
+        residual(model, p, holdout, part, &mut r0).ok()?;
+        let cols: Vec<(Column, Vec<f64>)> = columns(free)
+            .par_iter()
+            .filter_map(|&c| {
+                let (t, h) = perturbed(model, c);
+                let mut r1 = Vec::new();
+                residual(&t, p, holdout, part, &mut r1).ok()?;
+                Some((c, r1.iter().zip(&r0).map(|(a, b)| (a - b) / h).collect()))
+            })
+            .collect();
+        Some(Self {
+            model: model.clone(),
+            r0,
+            cols,
+        })
+    }
+
+    /// Whether a trace starting from `rig` may use these simulations.
+    fn applies_to(&self, rig: &Model) -> bool {
+        rig.lag == self.model.lag && rig.net == self.model.net
+    }
+}
+
 /// Traces a candidate cheaply: up to three backtracking Gauss–Newton steps on `part` from the
 /// current values, with a finite-difference Jacobian (step 10 % of each
 /// parameter's typical size) and the initial position and velocity as nuisance columns,
 /// then clamped to the bounds. A handful of simulations per candidate instead
 /// of a full Levenberg–Marquardt fit; the effect that is added is refitted
 /// properly afterwards.
+///
+/// The first step takes what `first` has of it (see [`FirstStep`]); each
+/// later step starts from the residual its backtracking accepted. Returns
+/// the residual on `part` at the point reached.
 pub(super) fn gauss_newton_trace(
     rig: &mut Model,
     params: &ParamList,
     p: &Prepared,
     holdout: f64,
     part: Part,
-) -> Result<(), String> {
-    let k = params.len() + 2;
-    for _ in 0..3 {
-        let mut r0 = Vec::new();
-        residual(rig, p, holdout, part, &mut r0)?;
+    first: Option<&FirstStep>,
+) -> Result<Vec<f64>, String> {
+    let cols = columns(params);
+    let k = cols.len();
+    let first = first.filter(|f| f.applies_to(rig));
+    let mut r0 = match first {
+        Some(f) => f.r0.clone(),
+        None => {
+            let mut r0 = Vec::new();
+            residual(rig, p, holdout, part, &mut r0)?;
+            r0
+        }
+    };
+    for step in 0..3 {
         let m = r0.len();
         let mut jac = nalgebra::DMatrix::<f64>::zeros(m, k);
-        for j in 0..k {
-            let mut t = rig.clone();
-            let h = if j < params.len() {
-                let (id, n) = params[j];
-                let h = 0.1 * typical(id, n, rig);
-                set(&mut t, id, n, get(rig, id, n).unwrap_or(0.0) + h);
-                h
-            } else if j == params.len() {
-                // step away from a stop the piston may start on
-                let h = if t.x0() + 1e-5 > 0.5 * rig.stroke() {
-                    -1e-5
-                } else {
-                    1e-5
-                };
-                t.set_x0(t.x0() + h);
-                h
-            } else {
-                t.set_v0(t.v0() + 1e-4);
-                1e-4
-            };
+        for (j, c) in cols.iter().enumerate() {
+            let shared = first
+                .filter(|_| step == 0)
+                .and_then(|f| f.cols.iter().find(|(fc, _)| fc == c));
+            if let Some((_, col)) = shared {
+                jac.set_column(j, &nalgebra::DVector::from_column_slice(col));
+                continue;
+            }
+            let (t, h) = perturbed(rig, *c);
             let mut r1 = Vec::new();
             residual(&t, p, holdout, part, &mut r1)?;
             for i in 0..m {
@@ -142,17 +246,23 @@ pub(super) fn gauss_newton_trace(
             let half = 0.5 * rig.stroke();
             t.set_x0((t.x0() + alpha * delta[k - 2]).clamp(-half, half));
             t.set_v0(t.v0() + alpha * delta[k - 1]);
-            if rss(&t, p, holdout, part) < rss0 {
-                accepted = Some(t);
+            let mut r1 = Vec::new();
+            if residual(&t, p, holdout, part, &mut r1).is_ok()
+                && r1.iter().map(|v| v * v).sum::<f64>() < rss0
+            {
+                accepted = Some((t, r1));
                 break;
             }
         }
         match accepted {
-            Some(t) => *rig = t,
+            Some((t, r1)) => {
+                *rig = t;
+                r0 = r1;
+            }
             None => break,
         }
     }
-    Ok(())
+    Ok(r0)
 }
 
 /// Runs `f` on every item, spread over the available cores (at most one
@@ -203,39 +313,28 @@ pub(super) fn trace_parallel<I: Sync, T: Send>(
 }
 
 /// Out-of-catalog probe: the command reaching the rig late by τ (a
-/// transport delay), τ on a grid up to 60 ms, initial position refitted.
-pub(super) fn delay_probe(rig: &Model, p: &Prepared, holdout: f64) -> Option<Probe> {
+/// transport delay), τ on a grid up to 60 ms, scored against `rss0`, the
+/// weighted sum of squares of `rig` on the whole record.
+pub(super) fn delay_probe(rig: &Model, p: &Prepared, holdout: f64, rss0: f64) -> Option<Probe> {
     if p.closed {
         // the input is the reference, not the command the valve receives
         return None;
     }
-    let rss0 = rss(rig, p, holdout, Part::All);
-    let mut best = (0.0, rss0);
-    for tau in [0.002, 0.005, 0.01, 0.015, 0.02, 0.03, 0.045, 0.06] {
-        let mut q = Prepared {
-            rtol: p.rtol,
-            input: p
-                .t
-                .iter()
+    const TAUS: [f64; 8] = [0.002, 0.005, 0.01, 0.015, 0.02, 0.03, 0.045, 0.06];
+    let shifted = |tau: &f64| {
+        let mut q = p.clone();
+        q.input =
+            p.t.iter()
                 .map(|&t| crate::data::interp_linear(&p.t, &p.input, t - tau))
-                .collect(),
-            closed: p.closed,
-            command0: p.command0,
-            t: p.t.clone(),
-            meas: p.meas.clone(),
-            ranges: p.ranges.clone(),
-            weights: p.weights.clone(),
-            x0: p.x0,
-            v0: p.v0,
-            p10: p.p10,
-            p20: p.p20,
-            restarts: p.restarts.clone(),
-            count: p.count.clone(),
-        };
+                .collect();
         q.input[0] = p.input[0];
-        let r = rss(rig, &q, holdout, Part::All);
+        rss(rig, &q, holdout, Part::All)
+    };
+    let scores = trace_parallel(&TAUS, &shifted);
+    let mut best = (0.0, rss0);
+    for (tau, r) in TAUS.iter().zip(scores) {
         if r < best.1 {
-            best = (tau, r);
+            best = (*tau, r);
         }
     }
     (best.0 > 0.0).then(|| Probe {

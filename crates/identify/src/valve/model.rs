@@ -25,23 +25,45 @@ use serde_json::{Map, Value};
 use crate::catalog::EffectId;
 
 /// One place an effect parameter is written: parameter `param` of every
-/// component of type `ty`. A `scale` target holds the catalog value times
-/// the declared value (a flow gain kw = 1.05 on a pump: its gain 5 % up).
+/// component of type `ty`, as its [`Scale`] says.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Target {
     /// Component type.
     pub ty: &'static str,
     /// Parameter path within the component.
     pub param: &'static str,
-    /// Relative (a factor on the declared value) rather than absolute.
-    pub scale: bool,
+    /// How the catalog value becomes the component's value.
+    pub scale: Scale,
+}
+
+/// How a catalog value is written to the components a [`Target`] reaches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scale {
+    /// The catalog value itself.
+    Absolute,
+    /// The catalog value times the component's declared value (a flow gain
+    /// kw = 1.05 on a pump: its gain 5 % up).
+    Factor,
+    /// The catalog value is the effect's first component's (the one it is
+    /// read from); every component keeps its declared ratio to that one (a
+    /// bulk modulus: a line declared with a stiffer oil than the cylinder's
+    /// stays that much stiffer).
+    Ratio,
 }
 
 const fn t(ty: &'static str, param: &'static str) -> Target {
     Target {
         ty,
         param,
-        scale: false,
+        scale: Scale::Absolute,
+    }
+}
+
+const fn ratio(ty: &'static str, param: &'static str) -> Target {
+    Target {
+        ty,
+        param,
+        scale: Scale::Ratio,
     }
 }
 
@@ -95,7 +117,7 @@ pub fn targets(id: EffectId, name: &str) -> Vec<Target> {
             Target {
                 ty: "pump_identified",
                 param: "gain",
-                scale: true,
+                scale: Scale::Factor,
             },
         ],
         (E::ValveDeadBand, "xd") => vec![t("four_way_valve", "dead_band")],
@@ -112,11 +134,12 @@ pub fn targets(id: EffectId, name: &str) -> Vec<Target> {
             t("cylinder", "external_leakage_2"),
             t("generalised_cylinder", "external_leakage_2"),
         ],
-        // the oil's: the chambers' and every line volume's
+        // the oil's: the chambers' and every line volume's, each scaled
+        // with the cylinder's (B is the cylinder's)
         (E::BulkModulus, "B") => vec![
-            t("cylinder", "bulk_modulus"),
-            t("generalised_cylinder", "bulk_modulus"),
-            t("volume", "bulk_modulus"),
+            ratio("cylinder", "bulk_modulus"),
+            ratio("generalised_cylinder", "bulk_modulus"),
+            ratio("volume", "bulk_modulus"),
         ],
         (E::ExternalForce, "F0") => vec![t("mass", "external_force")],
         (E::PressureViscous, "K") => SEAL_K.to_vec(),
@@ -297,6 +320,19 @@ impl Model {
                 None => Err("needs a friction component (the rig has none)".into()),
             };
         }
+        // the effects sized by the pressure the circuit holds
+        match id {
+            EffectId::PressureViscous if self.seal_dp() <= 0.0 => {
+                return Err(format!(
+                    "the seal term K (p1 − p2)² v has no pressure to be sized at: {} and the friction has no `seal.dp_max`",
+                    NO_PRESSURE
+                ));
+            }
+            EffectId::SupplyDroop if self.supply() <= 0.0 => {
+                return Err(format!("no supply to droop: {NO_PRESSURE}"));
+            }
+            _ => {}
+        }
         for q in id.params() {
             let tg = targets(id, q.name);
             if !tg.iter().any(|tg| !self.reached(tg).is_empty()) {
@@ -341,32 +377,49 @@ impl Model {
             .and_then(|f| type_of(&self.net, f))
     }
 
+    /// The first component an effect parameter's targets reach, with its
+    /// target (the component the parameter is read from).
+    fn first_reached(&self, id: EffectId, name: &str) -> Option<(Target, String)> {
+        targets(id, name)
+            .into_iter()
+            .find_map(|tg| self.reached(&tg).into_iter().next().map(|c| (tg, c)))
+    }
+
     /// Reads a parameter target: the first component it reaches.
     pub(super) fn read_target(&self, id: EffectId, name: &str) -> Option<f64> {
-        targets(id, name).iter().find_map(|tg| {
-            self.reached(tg).first().and_then(|c| {
-                let v = read(&self.net, c, tg.param).or_else(|| default_of(tg))?;
-                if tg.scale {
-                    let d = read(&self.roles.declared, c, tg.param)?;
-                    Some(v / d)
-                } else {
-                    Some(v)
-                }
-            })
-        })
+        let (tg, c) = self.first_reached(id, name)?;
+        let v = read(&self.net, &c, tg.param).or_else(|| default_of(&tg))?;
+        match tg.scale {
+            Scale::Factor => Some(v / read(&self.roles.declared, &c, tg.param)?),
+            Scale::Absolute | Scale::Ratio => Some(v),
+        }
     }
 
     /// Writes a parameter target on every component it reaches.
     pub(super) fn write_target(&mut self, id: EffectId, name: &str, x: f64) {
+        let declared = |c: &str, tg: &Target| {
+            read(&self.roles.declared, c, tg.param).or_else(|| default_of(tg))
+        };
+        // a `Ratio` target's reference: the first component's declared value
+        let reference = self
+            .first_reached(id, name)
+            .and_then(|(tg, c)| declared(&c, &tg))
+            .filter(|r| *r != 0.0 && r.is_finite());
+        let mut writes = Vec::new();
         for tg in &targets(id, name) {
             for c in self.reached(tg) {
-                let v = if tg.scale {
-                    read(&self.roles.declared, &c, tg.param).unwrap_or(1.0) * x
-                } else {
-                    x
+                let v = match (tg.scale, reference) {
+                    (Scale::Absolute, _) | (Scale::Ratio, None) => x,
+                    (Scale::Factor, _) => {
+                        read(&self.roles.declared, &c, tg.param).unwrap_or(1.0) * x
+                    }
+                    (Scale::Ratio, Some(r)) => declared(&c, tg).map_or(x, |d| x * (d / r)),
                 };
-                write(&mut self.net, &c, tg.param, Value::from(v));
+                writes.push((c, tg.param, v));
             }
+        }
+        for (c, param, v) in writes {
+            write(&mut self.net, &c, param, Value::from(v));
         }
     }
 
@@ -450,7 +503,31 @@ impl Model {
             .into_iter()
             .fold(0.0, f64::max)
     }
+
+    /// The pressure difference the seal term `pressure_viscous` is sized at \[Pa\]: half the supply
+    /// ([`Model::supply`]), or the friction component's bound `seal.dp_max`
+    /// where that is lower; the bound alone where the circuit holds no
+    /// pressure above tank; 0 (the effect does not apply) where neither is
+    /// there.
+    pub fn seal_dp(&self) -> f64 {
+        let half = 0.5 * self.supply();
+        let bound = self
+            .roles
+            .friction
+            .as_deref()
+            .and_then(|f| self.param(f, "seal.dp_max"))
+            .filter(|b| *b > 0.0);
+        match bound {
+            Some(b) if half > 0.0 => half.min(b),
+            Some(b) => b,
+            None => half.max(0.0),
+        }
+    }
 }
+
+/// Why a circuit has no supply pressure (the reason of the effects sized by it).
+const NO_PRESSURE: &str =
+    "the circuit holds no pressure above tank (no pressure source above the lowest one, no relief valve)";
 
 impl Model {
     /// The model of a `valve-cylinder` rig value: its netlist, with the

@@ -202,7 +202,9 @@ pub(super) fn simulate(rig: &Model, p: &Prepared) -> Result<Vec<Vec<f64>>, Strin
 /// The circuit is assembled once. At a stop restart (`stops`) the next
 /// segment starts from the last state of the one before with the piston
 /// put on the stop at rest: every other state — spool, chambers, lines,
-/// pump, bristles, the controller's integral — carries on.
+/// pump, bristles, the controller's integral — carries on. A rig whose load
+/// has no position and velocity states (`<load>.x`, `<load>.v`) cannot be
+/// restarted on a stop: an error, where the record has a restart.
 pub(super) fn simulate_prefix(
     rig: &Model,
     p: &Prepared,
@@ -235,6 +237,16 @@ pub(super) fn simulate_prefix(
         .iter()
         .filter(|r| r.index > 0 && r.index + 1 < n)
         .peekable();
+    let on_stop = match (kx, kv) {
+        (Some(kx), Some(kv)) => Some((kx, kv)),
+        _ => None,
+    };
+    if let (Some(r), None) = (cuts.peek(), on_stop) {
+        return Err(format!(
+            "the record rests on a stop (restart at t = {} s), but the load `{load}` has no states `{load}.x` and `{load}.v` to put the piston there",
+            t[r.index]
+        ));
+    }
     let mut a = 0;
     loop {
         let next = cuts.next();
@@ -250,7 +262,7 @@ pub(super) fn simulate_prefix(
         }
         let Some(r) = next else { break };
         let mut x = run.state(run.time.len() - 1).to_vec();
-        if let (Some(kx), Some(kv)) = (kx, kv) {
+        if let Some((kx, kv)) = on_stop {
             x[kx] = r.position;
             x[kv] = 0.0;
         }
@@ -314,6 +326,15 @@ pub(super) fn residual(
     } else {
         simulate(rig, p)?
     };
+    weighted(p, &sims, holdout, part, out);
+    Ok(())
+}
+
+/// The weighted residual of simulated channels `sims` on `part`, channel
+/// after channel (channels of weight 0 left out).
+fn weighted(p: &Prepared, sims: &[Vec<f64>], holdout: f64, part: Part, out: &mut Vec<f64>) {
+    let n = p.t.len();
+    let cut = ((1.0 - holdout) * n as f64) as usize;
     let range = match part {
         Part::All => 0..n,
         Part::Train => 0..cut,
@@ -328,7 +349,35 @@ pub(super) fn residual(
             out.push((s[i] - m[i]) * w);
         }
     }
-    Ok(())
+}
+
+/// The weighted sum of squares on the whole record of simulated channels
+/// `sims` ([`rss`] on `Part::All` without simulating again; infinite where
+/// the simulation failed and `sims` is empty).
+pub(super) fn rss_of(p: &Prepared, sims: &[Vec<f64>], holdout: f64) -> f64 {
+    if sims.len() < p.meas.len() {
+        return f64::INFINITY;
+    }
+    let mut r = Vec::new();
+    weighted(p, sims, holdout, Part::All, &mut r);
+    sum_sq(&r)
+}
+
+/// The NRMSE per channel ([`nrmse_of`]) and the held-out part's
+/// weighted sum of squares ([`rss`] on `Part::Held`), from one simulation.
+pub(super) fn nrmse_and_held(
+    rig: &Model,
+    p: &Prepared,
+    holdout: f64,
+) -> (BTreeMap<String, f64>, f64) {
+    match simulate(rig, p) {
+        Ok(sims) => {
+            let mut r = Vec::new();
+            weighted(p, &sims, holdout, Part::Held, &mut r);
+            (nrmse_of(p, &sims), sum_sq(&r))
+        }
+        Err(_) => (BTreeMap::new(), f64::INFINITY),
+    }
 }
 
 pub(super) fn rss(rig: &Model, p: &Prepared, holdout: f64, part: Part) -> f64 {
@@ -339,8 +388,32 @@ pub(super) fn rss(rig: &Model, p: &Prepared, holdout: f64, part: Part) -> f64 {
     }
 }
 
-pub(super) fn channel_nrmse(rig: &Model, p: &Prepared) -> BTreeMap<String, f64> {
-    simulate(rig, p).map_or_else(|_| BTreeMap::new(), |sims| nrmse_of(p, &sims))
+/// The sums of squares of the weighted residual on the whole record and on
+/// its held-out part, from one simulation (the same numbers as [`rss`] on
+/// `Part::All` and `Part::Held`).
+pub(super) fn rss_all_held(rig: &Model, p: &Prepared, holdout: f64) -> (f64, f64) {
+    let mut r = Vec::new();
+    if residual(rig, p, holdout, Part::All, &mut r).is_err() {
+        return (f64::INFINITY, f64::INFINITY);
+    }
+    (sum_sq(&r), held_sum_sq(&r, p, holdout))
+}
+
+/// The sum of squares of a residual.
+pub(super) fn sum_sq(r: &[f64]) -> f64 {
+    r.iter().map(|v| v * v).sum()
+}
+
+/// The sum of squares of the held-out part of a whole-record residual
+/// (`residual` on `Part::All`: one block of the record's length per
+/// compared channel), in the order `residual` on `Part::Held` sums it.
+pub(super) fn held_sum_sq(r: &[f64], p: &Prepared, holdout: f64) -> f64 {
+    let n = p.t.len();
+    let cut = ((1.0 - holdout) * n as f64) as usize;
+    r.chunks(n.max(1))
+        .flat_map(|block| &block[cut.min(block.len())..])
+        .map(|v| v * v)
+        .sum()
 }
 
 /// NRMSE per measured channel of the simulated series `sims`.
@@ -357,6 +430,49 @@ mod tests {
     use super::*;
     use crate::data::Record;
     use std::collections::BTreeMap;
+
+    /// A record that rests on a stop needs the load's position and velocity
+    /// states to restart the simulation there: a rig whose load role has
+    /// none is an error naming them, not a restart that leaves the piston
+    /// where the last segment ended.
+    #[test]
+    fn a_restart_on_a_stop_needs_the_loads_states() {
+        let v = hydrocyl_system::rig::preset("leaney-moog").unwrap();
+        let m = Model::new(&v).unwrap();
+        let t: Vec<f64> = (0..200).map(|k| k as f64 * 1e-3).collect();
+        let half = 0.5 * m.stroke();
+        let p = Prepared {
+            rtol: 1e-6,
+            input: vec![0.0; t.len()],
+            closed: false,
+            command0: Some(0.0),
+            meas: vec![(Signal::Position, vec![0.0; t.len()])],
+            ranges: vec![1.0],
+            weights: vec![1.0],
+            x0: None,
+            v0: None,
+            p10: None,
+            p20: None,
+            restarts: vec![stops::Restart {
+                index: 100,
+                position: half,
+            }],
+            count: Default::default(),
+            t,
+        };
+        assert!(simulate(&m, &p).is_ok(), "the mass has x and v");
+        let mut roles = (*m.roles).clone();
+        roles.load = roles.cylinder.clone();
+        let no_states = Model {
+            roles: std::sync::Arc::new(roles),
+            ..m
+        };
+        let e = simulate(&no_states, &p).unwrap_err();
+        assert!(
+            e.contains("has no states `cylinder.x` and `cylinder.v`"),
+            "{e}"
+        );
+    }
 
     /// A PI-controlled piston driven onto its extending stop (reference
     /// beyond it) rests there while the integral winds up to the output

@@ -5,6 +5,7 @@
 mod checks;
 mod closed_loop;
 mod hybrid;
+mod model;
 mod planted;
 mod valve;
 

@@ -152,6 +152,13 @@ pub struct Stats {
     pub stiff_steps: usize,
     /// Switches between the explicit and the stiff method ([`Method::Auto`]).
     pub switches: usize,
+    /// Accepted steps taken by the low-order explicit pair, Bogacki–Shampine
+    /// 3(2) ([`Method::Auto`] where the step is held at `Options::h_max`
+    /// far inside the tolerance).
+    pub low_order_steps: usize,
+    /// Switches between Dormand–Prince 5(4) and Bogacki–Shampine 3(2)
+    /// ([`Method::Auto`]).
+    pub order_switches: usize,
 }
 
 impl Stats {

@@ -97,10 +97,31 @@ pub(crate) trait Stepper {
     /// A stepper that changes its method between steps (the automatic
     /// choice) returns, once, after deciding to: the step-size controller of
     /// the method now in use and the largest step to continue with. Asked
-    /// before every step.
-    fn switch(&mut self) -> Option<(Controller, f64)> {
+    /// before every attempt.
+    fn switch(&mut self) -> Option<Switch> {
         None
     }
+
+    /// Told after each accepted step of an adaptive method, before
+    /// [`Stepper::accept`]: its normed error and whether the step the
+    /// controller proposes next is held at `Options::h_max`.
+    fn observe(&mut self, _err: f64, _held_at_h_max: bool) {}
+
+    /// Told after each step rejected for its error.
+    fn rejected(&mut self) {}
+}
+
+/// A change of method decided by a switching stepper ([`Stepper::switch`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Switch {
+    /// The step-size controller of the method now in use.
+    pub(crate) controller: Controller,
+    /// The largest step to continue with \[s\].
+    pub(crate) h_cap: f64,
+    /// Between the explicit and the stiff method (counted in
+    /// [`Stats::switches`]); otherwise between two explicit pairs (counted
+    /// in [`Stats::order_switches`]).
+    pub(crate) stiff: bool,
 }
 
 /// How a step attempt went.
@@ -422,17 +443,19 @@ fn emit_t_eval<St: Stepper>(
     h: f64,
     t_to: f64,
     x_to: &[f64],
-    buf: &mut [f64],
     sol: &mut Solution,
 ) {
+    let n = x_to.len();
     while *next_out < t_eval.len() && t_eval[*next_out] <= t_to {
         let tk = t_eval[*next_out];
         if tk == t_to {
             sol.x.extend_from_slice(x_to);
         } else {
+            // interpolated straight into the output (no copy through a buffer)
             let theta = ((tk - t_step) / h).clamp(0.0, 1.0);
-            stepper.dense(theta, buf);
-            sol.x.extend_from_slice(buf);
+            let at = sol.x.len();
+            sol.x.resize(at + n, 0.0);
+            stepper.dense(theta, &mut sol.x[at..]);
         }
         sol.t.push(tk);
         *next_out += 1;
@@ -526,10 +549,14 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                 max: opts.max_steps,
             });
         }
-        if let Some((c, h_cap)) = stepper.switch() {
-            ctrl = ControlState::new(c);
-            stats.switches += 1;
-            h = h.min(h_cap);
+        if let Some(sw) = stepper.switch() {
+            ctrl = ControlState::new(sw.controller);
+            if sw.stiff {
+                stats.switches += 1;
+            } else {
+                stats.order_switches += 1;
+            }
+            h = h.min(sw.h_cap);
         }
         if fresh {
             stepper.restart();
@@ -623,13 +650,13 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
         if err_norm.is_nan() || err_norm > 1.0 {
             stats.rejected += 1;
             h = ctrl.rejected(h, err_norm);
+            stepper.rejected();
             continue;
         }
         singular_retries = 0;
 
         // Accepted.
         stats.steps += 1;
-        stepper.accept(&*sys, t, &x, h, &x_new, &mut stats);
         let t_new = match (last, breakpoint) {
             (true, _) => t_end,
             (false, Some((bp, _))) => bp,
@@ -642,6 +669,10 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
             // step to take next: no smaller than the one wanted before it
             (true, Some((_, wanted))) => ctrl.accepted(h, err_norm).max(wanted),
         };
+        if adaptive {
+            stepper.observe(err_norm, h_next >= opts.h_max);
+        }
+        stepper.accept(&*sys, t, &x, h, &x_new, &mut stats);
 
         // Event detection over [t, t_new].
         let mut event_at: Option<f64> = None;
@@ -701,7 +732,6 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                         h,
                         t_new,
                         &x_new,
-                        &mut buf,
                         &mut sol,
                     );
                 } else {
@@ -734,7 +764,6 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                         h,
                         t_ev,
                         &x_ev,
-                        &mut buf,
                         &mut sol,
                     );
                 } else {
@@ -806,3 +835,4 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
     sol.stats = stats;
     Ok(sol)
 }
+

@@ -144,6 +144,7 @@
 
 mod api;
 mod auto;
+mod bs3;
 
 pub use api::*;
 mod dopri;

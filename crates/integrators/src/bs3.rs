@@ -13,6 +13,7 @@
 
 use crate::api::{OdeSystem, Stats};
 use crate::driver::{Attempt, Stepper};
+use crate::rk4::cubic_hermite;
 
 const A32: f64 = 3.0 / 4.0;
 const B1: f64 = 2.0 / 9.0;
@@ -31,11 +32,12 @@ pub(crate) struct BogackiShampine {
     y: Vec<f64>,
     /// `k[0]` holds `f(t, x)` for the next attempt (FSAL).
     k1_valid: bool,
-    /// Hermite data of the last accepted step: x, x_new, h f(x), h f(x_new).
+    /// Hermite data of the last accepted step: x, f(x), x_new, f(x_new), h.
     hx0: Vec<f64>,
-    hx1: Vec<f64>,
     hf0: Vec<f64>,
+    hx1: Vec<f64>,
     hf1: Vec<f64>,
+    hh: f64,
 }
 
 impl BogackiShampine {
@@ -45,9 +47,10 @@ impl BogackiShampine {
             y: vec![0.0; n],
             k1_valid: false,
             hx0: vec![0.0; n],
-            hx1: vec![0.0; n],
             hf0: vec![0.0; n],
+            hx1: vec![0.0; n],
             hf1: vec![0.0; n],
+            hh: 0.0,
         }
     }
 
@@ -118,27 +121,21 @@ impl Stepper for BogackiShampine {
         x_new: &[f64],
         _stats: &mut Stats,
     ) {
-        let n = x.len();
-        for i in 0..n {
-            self.hx0[i] = x[i];
-            self.hx1[i] = x_new[i];
-            self.hf0[i] = h * self.k[0][i];
-            self.hf1[i] = h * self.k[3][i];
-        }
+        self.hx0.copy_from_slice(x);
+        self.hf0.copy_from_slice(&self.k[0]);
+        self.hx1.copy_from_slice(x_new);
+        self.hf1.copy_from_slice(&self.k[3]);
+        self.hh = h;
         // FSAL: f(t + h, x_new) is the first stage of the next step.
         self.k.swap(0, 3);
     }
 
     fn dense(&self, theta: f64, out: &mut [f64]) {
-        let s = theta;
-        let s2 = s * s;
-        let s3 = s2 * s;
-        let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
-        let h10 = s3 - 2.0 * s2 + s;
-        let h01 = 1.0 - h00;
-        let h11 = s3 - s2;
-        for i in 0..out.len() {
-            out[i] = h00 * self.hx0[i] + h10 * self.hf0[i] + h01 * self.hx1[i] + h11 * self.hf1[i];
-        }
+        cubic_hermite(
+            theta,
+            self.hh,
+            [&self.hx0, &self.hf0, &self.hx1, &self.hf1],
+            out,
+        );
     }
 }

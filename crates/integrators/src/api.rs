@@ -89,8 +89,11 @@ pub enum Method {
     /// Automatic choice: Dormand–Prince 5(4) while the problem is not stiff,
     /// Rodas4 while it is, switched by the stiffness the run shows (DP45's
     /// step held by its stability region; the Jacobian's spectral radius
-    /// against the Rosenbrock step). [`Stats::stiff_steps`] and
-    /// [`Stats::switches`] say what it chose.
+    /// against the Rosenbrock step); Bogacki–Shampine 3(2) where the
+    /// explicit step is held at `Options::h_max` far inside the tolerance.
+    /// [`Stats::stiff_steps`], [`Stats::switches`],
+    /// [`Stats::low_order_steps`] and [`Stats::order_switches`] say what it
+    /// chose.
     Auto,
 }
 
@@ -152,12 +155,34 @@ pub struct Stats {
     pub stiff_steps: usize,
     /// Switches between the explicit and the stiff method ([`Method::Auto`]).
     pub switches: usize,
+    /// Accepted steps taken by the low-order explicit pair, Bogacki–Shampine
+    /// 3(2) ([`Method::Auto`] where the step is held at `Options::h_max`
+    /// far inside the tolerance).
+    pub low_order_steps: usize,
+    /// Switches between Dormand–Prince 5(4) and Bogacki–Shampine 3(2)
+    /// ([`Method::Auto`]).
+    pub order_switches: usize,
 }
 
 impl Stats {
     /// What the solve used: `explicit`, `stiff`, or `explicit+stiff` with
-    /// the number of switches and the stiff share of the steps.
+    /// the number of switches and the stiff share of the steps; the share
+    /// of the steps taken by the low-order explicit pair after it, when
+    /// there were any.
     pub fn choice(&self) -> String {
+        let base = self.stiff_choice();
+        if self.low_order_steps == 0 {
+            base
+        } else {
+            format!(
+                "{base}; {:.0} % of the steps Bogacki–Shampine 3(2) ({} switches)",
+                100.0 * self.low_order_steps as f64 / self.steps.max(1) as f64,
+                self.order_switches
+            )
+        }
+    }
+
+    fn stiff_choice(&self) -> String {
         if self.stiff_steps == 0 {
             "explicit".into()
         } else if self.stiff_steps == self.steps && self.switches == 0 {

@@ -26,8 +26,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::api::{OdeSystem, Stats};
+use crate::bs3::BogackiShampine;
 use crate::dopri::DormandPrince;
-use crate::driver::{Attempt, Controller, Stepper};
+use crate::driver::{Attempt, Controller, Stepper, Switch};
 use crate::rodas::Rodas4;
 
 /// `h ρ` above which a DP45 step counts as held by stability.
@@ -42,23 +43,36 @@ const BACK_HRHO: f64 = 2.0;
 pub(crate) const BACK_STEPS: usize = 25;
 /// Power iterations for the spectral radius.
 const POWER_ITERATIONS: usize = 12;
+/// DP45 normed error at or below which a step held at `h_max` counts as
+/// far inside the tolerance (a third-order step of the same size would be
+/// too).
+const LOW_ERR: f64 = 1e-2;
+/// Consecutive such DP45 steps that switch to Bogacki–Shampine 3(2).
+pub(crate) const LOW_STEPS: usize = 3;
 
 /// The controller of each method (the ones [`crate::solve`] uses for them).
 pub(crate) const DP_CONTROLLER: Controller = Controller::Pi { q: 5.0, beta: 0.04 };
 /// The controller of Rodas4.
 pub(crate) const RODAS_CONTROLLER: Controller = Controller::Predictive { q: 4.0 };
+/// The controller of Bogacki–Shampine 3(2).
+pub(crate) const BS_CONTROLLER: Controller = Controller::Pi { q: 3.0, beta: 0.04 };
 
 /// Which method takes the next step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Mode {
     Explicit,
     Stiff,
+    /// Bogacki–Shampine 3(2) while the step is held at `h_max`.
+    Low,
 }
 
 /// The switching stepper.
 pub(crate) struct Auto {
     dp: DormandPrince,
     rodas: Rodas4,
+    bs: BogackiShampine,
+    /// Consecutive DP45 steps held at `h_max` far inside the tolerance.
+    capped: usize,
     mode: Mode,
     /// Active (non-quadrature) states.
     na: usize,
@@ -87,6 +101,8 @@ impl Auto {
         Self {
             dp: DormandPrince::new(n),
             rodas: Rodas4::new(n, quadratures),
+            bs: BogackiShampine::new(n),
+            capped: 0,
             mode: Mode::Explicit,
             na,
             weight: vec![1.0; n],
@@ -193,20 +209,47 @@ impl Auto {
     /// The switch decided after the last accepted step, taken now: the
     /// controller of the method that takes the next step and the largest
     /// step it should start with.
-    pub(crate) fn take_switch(&mut self) -> Option<(Controller, f64)> {
+    pub(crate) fn take_switch(&mut self) -> Option<Switch> {
         let to = self.pending.take()?;
+        let from = self.mode;
         self.mode = to;
         self.held = 0;
         self.calm = 0;
         self.easy = 0;
-        Some(match to {
-            Mode::Stiff => {
+        self.capped = 0;
+        Some(match (from, to) {
+            (_, Mode::Stiff) => {
                 self.rodas.restart();
-                (RODAS_CONTROLLER, f64::INFINITY)
+                Switch {
+                    controller: RODAS_CONTROLLER,
+                    h_cap: f64::INFINITY,
+                    stiff: true,
+                }
             }
-            Mode::Explicit => {
+            (Mode::Stiff, Mode::Explicit) => {
                 self.dp.restart();
-                (DP_CONTROLLER, self.h_stable)
+                Switch {
+                    controller: DP_CONTROLLER,
+                    h_cap: self.h_stable,
+                    stiff: true,
+                }
+            }
+            (_, Mode::Low) => {
+                // the explicit pairs share the first stage
+                self.bs.set_f_start(self.dp.f_start());
+                Switch {
+                    controller: BS_CONTROLLER,
+                    h_cap: f64::INFINITY,
+                    stiff: false,
+                }
+            }
+            (_, Mode::Explicit) => {
+                self.dp.set_f_start(self.bs.f_start());
+                Switch {
+                    controller: DP_CONTROLLER,
+                    h_cap: f64::INFINITY,
+                    stiff: false,
+                }
             }
         })
     }
@@ -220,6 +263,7 @@ impl Stepper for Auto {
     fn restart(&mut self) {
         self.dp.restart();
         self.rodas.restart();
+        self.bs.restart();
     }
 
     fn attempt<S: OdeSystem + ?Sized>(
@@ -235,6 +279,7 @@ impl Stepper for Auto {
         match self.mode {
             Mode::Explicit => self.dp.attempt(sys, t, x, h, x_new, err, stats),
             Mode::Stiff => self.rodas.attempt(sys, t, x, h, x_new, err, stats),
+            Mode::Low => self.bs.attempt(sys, t, x, h, x_new, err, stats),
         }
     }
 
@@ -242,6 +287,7 @@ impl Stepper for Auto {
         match self.mode {
             Mode::Explicit => self.dp.f_start(),
             Mode::Stiff => self.rodas.f_start(),
+            Mode::Low => self.bs.f_start(),
         }
     }
 
@@ -249,6 +295,7 @@ impl Stepper for Auto {
         match self.mode {
             Mode::Explicit => self.dp.nonfinite_hint(),
             Mode::Stiff => self.rodas.nonfinite_hint(),
+            Mode::Low => self.bs.nonfinite_hint(),
         }
     }
 
@@ -277,6 +324,34 @@ impl Stepper for Auto {
                 self.check_stiff(h, x);
                 self.rodas.accept(sys, t, x, h, x_new, stats);
             }
+            Mode::Low => {
+                stats.low_order_steps += 1;
+                self.bs.accept(sys, t, x, h, x_new, stats);
+            }
+        }
+    }
+
+    fn observe(&mut self, err: f64, held_at_h_max: bool) {
+        match self.mode {
+            Mode::Explicit => {
+                if held_at_h_max && err <= LOW_ERR {
+                    self.capped += 1;
+                    if self.capped >= LOW_STEPS && self.pending.is_none() {
+                        self.pending = Some(Mode::Low);
+                    }
+                } else {
+                    self.capped = 0;
+                }
+            }
+            // the step is no longer held at h_max: accuracy sets it again
+            Mode::Low if !held_at_h_max => self.pending = Some(Mode::Explicit),
+            _ => {}
+        }
+    }
+
+    fn rejected(&mut self) {
+        if self.mode == Mode::Low {
+            self.pending = Some(Mode::Explicit);
         }
     }
 
@@ -284,10 +359,11 @@ impl Stepper for Auto {
         match self.mode {
             Mode::Explicit => self.dp.dense(theta, out),
             Mode::Stiff => self.rodas.dense(theta, out),
+            Mode::Low => self.bs.dense(theta, out),
         }
     }
 
-    fn switch(&mut self) -> Option<(Controller, f64)> {
+    fn switch(&mut self) -> Option<Switch> {
         self.take_switch()
     }
 }

@@ -67,6 +67,13 @@ impl DormandPrince {
 }
 
 impl DormandPrince {
+    /// Takes `f(t, x)` of the step about to start from another stepper
+    /// (the first stage it would otherwise compute).
+    pub(crate) fn set_f_start(&mut self, f: &[f64]) {
+        self.k[0].copy_from_slice(f);
+        self.k1_valid = true;
+    }
+
     /// `‖f(y₇) − f(y₆)‖ / ‖y₇ − y₆‖` of the last attempted step, over the
     /// first `w.len()` states weighted by `w`: both stages sit at `t + h`, so
     /// the ratio estimates the Jacobian's dominant eigenvalue magnitude

@@ -5,6 +5,7 @@
 use crate::api::{
     Crossing, EventAction, EventRecord, OdeSystem, Options, Solution, SolveError, Stats,
 };
+use crate::checks::check_inputs;
 use crate::events::{locate_root, Bracket};
 use std::borrow::Cow;
 
@@ -12,6 +13,11 @@ use std::borrow::Cow;
 /// streamed solve ([`crate::solve_streaming`]) hands the outputs written so
 /// far to its caller and takes more output times.
 pub(crate) trait Between<S: ?Sized> {
+    /// `true` when [`Between::between`] never changes the system, so that
+    /// what the system said of the times ahead (its next breakpoint) holds
+    /// until an event.
+    const LEAVES_SYSTEM: bool = false;
+
     /// Called before the output at `t0`, before every step from `t`, and
     /// once after the last step. `times[*next..]` are the output times not
     /// yet written; `sol` holds the outputs written since the last call.
@@ -29,6 +35,8 @@ pub(crate) trait Between<S: ?Sized> {
 pub(crate) struct Nothing;
 
 impl<S: ?Sized> Between<S> for Nothing {
+    const LEAVES_SYSTEM: bool = true;
+
     #[inline(always)]
     fn between(
         &mut self,
@@ -97,10 +105,31 @@ pub(crate) trait Stepper {
     /// A stepper that changes its method between steps (the automatic
     /// choice) returns, once, after deciding to: the step-size controller of
     /// the method now in use and the largest step to continue with. Asked
-    /// before every step.
-    fn switch(&mut self) -> Option<(Controller, f64)> {
+    /// before every attempt.
+    fn switch(&mut self) -> Option<Switch> {
         None
     }
+
+    /// Told after each accepted step of an adaptive method, before
+    /// [`Stepper::accept`]: its normed error and whether the step the
+    /// controller proposes next is held at `Options::h_max`.
+    fn observe(&mut self, _err: f64, _held_at_h_max: bool) {}
+
+    /// Told after each step rejected for its error.
+    fn rejected(&mut self) {}
+}
+
+/// A change of method decided by a switching stepper ([`Stepper::switch`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Switch {
+    /// The step-size controller of the method now in use.
+    pub(crate) controller: Controller,
+    /// The largest step to continue with \[s\].
+    pub(crate) h_cap: f64,
+    /// Between the explicit and the stiff method (counted in
+    /// [`Stats::switches`]); otherwise between two explicit pairs (counted
+    /// in [`Stats::order_switches`]).
+    pub(crate) stiff: bool,
 }
 
 /// How a step attempt went.
@@ -227,113 +256,6 @@ pub(crate) fn error_norm(err: &[f64], x: &[f64], x_new: &[f64], atol: &[f64], rt
     (sum / n as f64).sqrt()
 }
 
-/// Per-state absolute tolerances, expanded from `Options::atol`.
-fn expand_atol(opts: &Options, n: usize) -> Result<Vec<f64>, SolveError> {
-    let atol = match opts.atol.len() {
-        1 => vec![opts.atol[0]; n],
-        m if m == n => opts.atol.clone(),
-        m => {
-            return Err(SolveError::InvalidInput(format!(
-                "Options::atol has {m} entries; expected 1 or the system dimension {n}"
-            )))
-        }
-    };
-    for (i, &a) in atol.iter().enumerate() {
-        if !(a.is_finite() && a >= 0.0) {
-            return Err(SolveError::InvalidInput(format!(
-                "Options::atol[{i}] = {a} must be finite and >= 0"
-            )));
-        }
-        if a == 0.0 && opts.rtol == 0.0 {
-            return Err(SolveError::InvalidInput(format!(
-                "Options::atol[{i}] and Options::rtol are both zero: no error scale for state {i}"
-            )));
-        }
-    }
-    Ok(atol)
-}
-
-/// Checks the solver inputs; returns the expanded absolute tolerances.
-fn check_inputs(
-    n: usize,
-    t0: f64,
-    x0: &[f64],
-    t_end: f64,
-    opts: &Options,
-    fixed_step: bool,
-) -> Result<Vec<f64>, SolveError> {
-    let bad = |s: String| Err(SolveError::InvalidInput(s));
-    if n == 0 {
-        return bad("the system has no states (dim() = 0)".into());
-    }
-    if x0.len() != n {
-        return bad(format!(
-            "x0 has {} entries but the system has {n} states",
-            x0.len()
-        ));
-    }
-    if let Some(i) = x0.iter().position(|v| !v.is_finite()) {
-        return bad(format!("x0[{i}] = {} is not finite", x0[i]));
-    }
-    if !t0.is_finite() || !t_end.is_finite() {
-        return bad(format!("t0 = {t0} and t_end = {t_end} must be finite"));
-    }
-    if t_end < t0 {
-        return bad(format!(
-            "t_end = {t_end} s is before t0 = {t0} s (only forward integration is supported)"
-        ));
-    }
-    if !(opts.rtol.is_finite() && opts.rtol >= 0.0) {
-        return bad(format!(
-            "Options::rtol = {} must be finite and >= 0",
-            opts.rtol
-        ));
-    }
-    let atol = expand_atol(opts, n)?;
-    if let Some(h0) = opts.h0 {
-        if !(h0.is_finite() && h0 > 0.0) {
-            return bad(format!("Options::h0 = {h0} must be finite and > 0"));
-        }
-    } else if fixed_step {
-        return bad("RK4 is a fixed-step method: set Options::h0 to the step size".into());
-    }
-    if opts.h_max.is_nan() || opts.h_max <= 0.0 {
-        return bad(format!("Options::h_max = {} must be > 0", opts.h_max));
-    }
-    if !(opts.h_min.is_finite() && opts.h_min >= 0.0 && opts.h_min <= opts.h_max) {
-        return bad(format!(
-            "Options::h_min = {} must be finite, >= 0 and <= h_max = {}",
-            opts.h_min, opts.h_max
-        ));
-    }
-    if opts.max_steps == 0 {
-        return bad("Options::max_steps must be at least 1".into());
-    }
-    if !(opts.event_tol.is_finite() && opts.event_tol > 0.0) {
-        return bad(format!(
-            "Options::event_tol = {} must be finite and > 0",
-            opts.event_tol
-        ));
-    }
-    if let Some(te) = &opts.t_eval {
-        for (k, &tk) in te.iter().enumerate() {
-            if !tk.is_finite() || tk < t0 || tk > t_end {
-                return bad(format!(
-                    "Options::t_eval[{k}] = {tk} is not within [t0, t_end] = [{t0}, {t_end}]"
-                ));
-            }
-            if k > 0 && tk < te[k - 1] {
-                return bad(format!(
-                    "Options::t_eval is not sorted: t_eval[{k}] = {tk} < t_eval[{}] = {}",
-                    k - 1,
-                    te[k - 1]
-                ));
-            }
-        }
-    }
-    Ok(atol)
-}
-
 /// Hairer's starting-step heuristic (Hairer, Nørsett & Wanner I, §II.4):
 /// a step such that an explicit Euler step has a local error of about the
 /// tolerance, refined with one extra right-hand-side evaluation.
@@ -422,17 +344,19 @@ fn emit_t_eval<St: Stepper>(
     h: f64,
     t_to: f64,
     x_to: &[f64],
-    buf: &mut [f64],
     sol: &mut Solution,
 ) {
+    let n = x_to.len();
     while *next_out < t_eval.len() && t_eval[*next_out] <= t_to {
         let tk = t_eval[*next_out];
         if tk == t_to {
             sol.x.extend_from_slice(x_to);
         } else {
+            // interpolated straight into the output (no copy through a buffer)
             let theta = ((tk - t_step) / h).clamp(0.0, 1.0);
-            stepper.dense(theta, buf);
-            sol.x.extend_from_slice(buf);
+            let at = sol.x.len();
+            sol.x.resize(at + n, 0.0);
+            stepper.dense(theta, &mut sol.x[at..]);
         }
         sol.t.push(tk);
         *next_out += 1;
@@ -513,6 +437,10 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
     let mut fresh = true; // a fresh step-size estimate is needed
     let mut h = opts.h0.unwrap_or(0.0);
     let mut singular_retries = 0usize;
+    // The system's next breakpoint after `bp_from`: while nothing changes
+    // the system (no event, no streamed input) it is still the next one
+    // after any time before it, and is asked again only once passed.
+    let (mut bp_from, mut bp_next) = (f64::INFINITY, f64::INFINITY);
 
     // Times closer than this to t_end count as t_end.
     let t_close = |t: f64| 4.0 * f64::EPSILON * t.abs().max(t_end.abs()).max(1e-300);
@@ -526,10 +454,14 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                 max: opts.max_steps,
             });
         }
-        if let Some((c, h_cap)) = stepper.switch() {
-            ctrl = ControlState::new(c);
-            stats.switches += 1;
-            h = h.min(h_cap);
+        if let Some(sw) = stepper.switch() {
+            ctrl = ControlState::new(sw.controller);
+            if sw.stiff {
+                stats.switches += 1;
+            } else {
+                stats.order_switches += 1;
+            }
+            h = h.min(sw.h_cap);
         }
         if fresh {
             stepper.restart();
@@ -579,7 +511,10 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
             h = remaining;
             last = true;
         } else if adaptive {
-            let bp = sys.next_breakpoint(t);
+            if !(B::LEAVES_SYSTEM && bp_from <= t && t < bp_next) {
+                (bp_from, bp_next) = (t, sys.next_breakpoint(t));
+            }
+            let bp = bp_next;
             if bp - t <= h * stretch && t_end - bp > t_close(bp) && bp - t > t_close(t) {
                 breakpoint = Some((bp, h));
                 h = bp - t;
@@ -623,13 +558,13 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
         if err_norm.is_nan() || err_norm > 1.0 {
             stats.rejected += 1;
             h = ctrl.rejected(h, err_norm);
+            stepper.rejected();
             continue;
         }
         singular_retries = 0;
 
         // Accepted.
         stats.steps += 1;
-        stepper.accept(&*sys, t, &x, h, &x_new, &mut stats);
         let t_new = match (last, breakpoint) {
             (true, _) => t_end,
             (false, Some((bp, _))) => bp,
@@ -642,6 +577,10 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
             // step to take next: no smaller than the one wanted before it
             (true, Some((_, wanted))) => ctrl.accepted(h, err_norm).max(wanted),
         };
+        if adaptive {
+            stepper.observe(err_norm, h_next >= opts.h_max);
+        }
+        stepper.accept(&*sys, t, &x, h, &x_new, &mut stats);
 
         // Event detection over [t, t_new].
         let mut event_at: Option<f64> = None;
@@ -701,7 +640,6 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                         h,
                         t_new,
                         &x_new,
-                        &mut buf,
                         &mut sol,
                     );
                 } else {
@@ -734,7 +672,6 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                         h,
                         t_ev,
                         &x_ev,
-                        &mut buf,
                         &mut sol,
                     );
                 } else {
@@ -791,6 +728,8 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                     ev.armed[i] = g != 0.0 && !(ev.triggered[i] && g.abs() <= ev.bracket_mag[i]);
                 }
                 fresh = true;
+                // the handler may have changed the system's inputs
+                bp_from = f64::INFINITY;
             }
         }
     }

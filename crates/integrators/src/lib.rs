@@ -23,8 +23,14 @@
 //!   `h ‖f(y₇) − f(y₆)‖ / ‖y₇ − y₆‖ > 3.25` for 15 steps) switches to
 //!   Rodas4; a Rosenbrock step at which DP45 would be stable (power-iteration
 //!   spectral radius of the Jacobian, `h ρ(J) ≤ 2` for 25 steps) switches
-//!   back. [`Stats::stiff_steps`] and [`Stats::switches`] report the choice;
-//!   a run that never switches is the DP45 run exactly;
+//!   back. Where DP45's step is held at `Options::h_max` with a normed
+//!   error ≤ 1e-2 for 3 steps (a drive at rest between command edges), it
+//!   takes Bogacki–Shampine 3(2) (`ode23`'s pair: 3 right-hand sides a step
+//!   instead of 6) until that pair's controller wants a step below `h_max`
+//!   or rejects one, then DP45 again. [`Stats::stiff_steps`],
+//!   [`Stats::switches`], [`Stats::low_order_steps`] and
+//!   [`Stats::order_switches`] report the choice; a run that never switches
+//!   is the DP45 run exactly;
 //!
 //! and **event location**: the model declares switching functions
 //! ([`OdeSystem::events`]); the solver finds each sign change to
@@ -59,7 +65,7 @@
 //!
 //! ## Step-size control
 //!
-//! * DP45: proportional–integral controller (Hairer, Nørsett & Wanner I,
+//! * DP45 (and Bogacki–Shampine 3(2), with `q = 3`): proportional–integral controller (Hairer, Nørsett & Wanner I,
 //!   §II.4; Gustafsson 1991): `h_new = h · 0.9 · ‖e‖^(−α) · ‖e_prev‖^(β)`
 //!   with `β = 0.04`, `α = 1/5 − 0.75 β`.
 //! * Rodas4: Gustafsson's predictive controller (Hairer & Wanner II, §IV.8),
@@ -144,6 +150,8 @@
 
 mod api;
 mod auto;
+mod bs3;
+mod checks;
 
 pub use api::*;
 mod dopri;

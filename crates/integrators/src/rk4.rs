@@ -105,18 +105,26 @@ impl Stepper for Rk4 {
     }
 
     fn dense(&self, theta: f64, out: &mut [f64]) {
-        let (s, h) = (theta, self.hh);
-        let s2 = s * s;
-        let s3 = s2 * s;
-        let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
-        let h10 = s3 - 2.0 * s2 + s;
-        let h01 = -2.0 * s3 + 3.0 * s2;
-        let h11 = s3 - s2;
-        for i in 0..out.len() {
-            out[i] = h00 * self.hx0[i]
-                + h10 * h * self.hf0[i]
-                + h01 * self.hx1[i]
-                + h11 * h * self.hf1[i];
-        }
+        cubic_hermite(
+            theta,
+            self.hh,
+            [&self.hx0, &self.hf0, &self.hx1, &self.hf1],
+            out,
+        );
+    }
+}
+
+/// The cubic Hermite interpolant at `θ ∈ [0, 1]` of a step of size `h` from
+/// its end values and end derivatives `[x0, f0, x1, f1]` (third order).
+pub(crate) fn cubic_hermite(theta: f64, h: f64, [x0, f0, x1, f1]: [&[f64]; 4], out: &mut [f64]) {
+    let s = theta;
+    let s2 = s * s;
+    let s3 = s2 * s;
+    let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
+    let h10 = s3 - 2.0 * s2 + s;
+    let h01 = -2.0 * s3 + 3.0 * s2;
+    let h11 = s3 - s2;
+    for i in 0..out.len() {
+        out[i] = h00 * x0[i] + h10 * h * f0[i] + h01 * x1[i] + h11 * h * f1[i];
     }
 }

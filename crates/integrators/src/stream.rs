@@ -185,50 +185,32 @@ pub(crate) fn dispatch<S: OdeSystem + ?Sized, B: Between<S>>(
     between: &mut B,
 ) -> Result<Solution, SolveError> {
     let n = sys.dim();
+    // the arms differ in the stepper (a type each), its controller and the
+    // order of the starting-step estimate only
+    macro_rules! run {
+        ($stepper:expr, $controller:expr, $order:expr) => {
+            driver::run_with(
+                $stepper,
+                $controller,
+                $order,
+                sys,
+                t0,
+                x0,
+                t_end,
+                opts,
+                between,
+            )
+        };
+    }
+    let quadratures = sys.n_quadratures().min(n);
     match method {
-        Method::DormandPrince45 => driver::run_with(
-            dopri::DormandPrince::new(n),
-            auto::DP_CONTROLLER,
-            5.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            opts,
-            between,
-        ),
-        Method::Rosenbrock => driver::run_with(
-            rodas::Rodas4::new(n, sys.n_quadratures().min(n)),
+        Method::DormandPrince45 => run!(dopri::DormandPrince::new(n), auto::DP_CONTROLLER, 5.0),
+        Method::Rosenbrock => run!(
+            rodas::Rodas4::new(n, quadratures),
             auto::RODAS_CONTROLLER,
-            4.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            opts,
-            between,
+            4.0
         ),
-        Method::Auto => driver::run_with(
-            auto::Auto::new(n, sys.n_quadratures().min(n)),
-            auto::DP_CONTROLLER,
-            5.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            opts,
-            between,
-        ),
-        Method::Rk4 => driver::run_with(
-            rk4::Rk4::new(n),
-            Controller::Pi { q: 5.0, beta: 0.0 },
-            4.0,
-            sys,
-            t0,
-            x0,
-            t_end,
-            opts,
-            between,
-        ),
+        Method::Auto => run!(auto::Auto::new(n, quadratures), auto::DP_CONTROLLER, 5.0),
+        Method::Rk4 => run!(rk4::Rk4::new(n), Controller::Pi { q: 5.0, beta: 0.0 }, 4.0),
     }
 }

@@ -122,3 +122,87 @@ fn fading_stiffness_switches_back_to_the_explicit_method() {
         auto.stats.choice()
     );
 }
+
+/// `dx/dt = −k (x − u(t))` with `u` ramping from 0 to 1 over
+/// `[t_on, t_on + 1 ms]` (its corners declared as breakpoints): a first-order
+/// lag that sits at rest, follows a fast edge, and settles again — the
+/// shape of a drive's square-wave response.
+struct Lag {
+    k: f64,
+    t_on: f64,
+}
+
+impl Lag {
+    fn u(&self, t: f64) -> f64 {
+        ((t - self.t_on) / 1e-3).clamp(0.0, 1.0)
+    }
+}
+
+impl OdeSystem for Lag {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
+        dx[0] = -self.k * (x[0] - self.u(t));
+    }
+    fn next_breakpoint(&self, t: f64) -> f64 {
+        [self.t_on, self.t_on + 1e-3]
+            .into_iter()
+            .find(|&b| b > t)
+            .unwrap_or(f64::INFINITY)
+    }
+}
+
+#[test]
+fn steps_held_at_h_max_far_inside_the_tolerance_go_third_order_and_come_back_for_the_edge() {
+    let t_eval: Vec<f64> = (0..=1000).map(|k| k as f64 * 0.01).collect();
+    let opts = |rtol: f64| Options {
+        rtol,
+        atol: vec![rtol],
+        h_max: 0.01,
+        t_eval: Some(t_eval.clone()),
+        ..Options::default()
+    };
+    let mut sys = Lag { k: 50.0, t_on: 5.0 };
+    let reference = solve(
+        Method::DormandPrince45,
+        &mut sys,
+        0.0,
+        &[1.0],
+        10.0,
+        &opts(1e-12),
+    )
+    .unwrap();
+    let dp = solve(
+        Method::DormandPrince45,
+        &mut sys,
+        0.0,
+        &[1.0],
+        10.0,
+        &opts(1e-6),
+    )
+    .unwrap();
+    let auto = solve(Method::Auto, &mut sys, 0.0, &[1.0], 10.0, &opts(1e-6)).unwrap();
+    let max_err = |x: &[f64]| {
+        x.iter()
+            .zip(&reference.x)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    };
+    // to the third-order pair in the rest before the edge and after it, and
+    // back to DP45 for the edge
+    assert!(auto.stats.order_switches >= 3, "{:?}", auto.stats);
+    assert!(auto.stats.low_order_steps > 700, "{:?}", auto.stats);
+    assert_eq!(auto.stats.switches, 0);
+    assert_eq!(auto.stats.stiff_steps, 0);
+    // half the right-hand sides where the step is held at h_max
+    assert!(
+        (auto.stats.rhs_evals as f64) < 0.65 * dp.stats.rhs_evals as f64,
+        "auto {:?} dp45 {:?}",
+        auto.stats,
+        dp.stats
+    );
+    // and as accurate: within the tolerance's reach of the reference
+    let (e_auto, e_dp) = (max_err(&auto.x), max_err(&dp.x));
+    assert!(e_auto < 1e-5, "auto max error {e_auto:e} (dp45 {e_dp:e})");
+}

@@ -134,3 +134,43 @@ fn adaptive_error_falls_with_tolerance() {
         }
     }
 }
+
+#[test]
+fn auto_held_at_h_max_is_third_order_bogacki_shampine() {
+    // a constant step with no error to speak of: after LOW_STEPS = 3 DP45
+    // steps the automatic choice takes Bogacki–Shampine 3(2)
+    let osc = HarmonicOscillator { omega: 2.0 };
+    let t_end = 3.0;
+    let exact = osc.exact(t_end, [1.0, 0.5]);
+    let (mut hs, mut errs) = (Vec::new(), Vec::new());
+    for n in [40, 80, 160, 320] {
+        let h = t_end / n as f64;
+        let mut sys = osc;
+        let sol = solve(
+            Method::Auto,
+            &mut sys,
+            0.0,
+            &[1.0, 0.5],
+            t_end,
+            &fixed_step(h),
+        )
+        .unwrap();
+        assert_eq!(sol.stats.steps, n);
+        assert_eq!(sol.stats.low_order_steps, n - 3, "{:?}", sol.stats);
+        assert_eq!(sol.stats.order_switches, 1);
+        let err = sol
+            .last()
+            .unwrap()
+            .iter()
+            .zip(&exact)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        hs.push(h);
+        errs.push(err);
+    }
+    let p = loglog_slope(&hs, &errs);
+    assert!(
+        (p - 3.0).abs() < 0.2,
+        "Bogacki–Shampine observed order {p} ({errs:?})"
+    );
+}

@@ -138,7 +138,10 @@ pub fn record(
     seed: u64,
 ) -> Record {
     let m = motion(n, dt);
-    let mut force = truth.simulate(&m);
+    let inputs = crate::bench::BenchInputs::of(&m).expect("the motion is a valid table");
+    let mut force = truth
+        .simulate(&m, &inputs)
+        .expect("the bench's netlist simulates the generated motion");
     let x = m.x.clone();
     match foreign {
         Foreign::None => {}

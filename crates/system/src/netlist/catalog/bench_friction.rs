@@ -242,7 +242,7 @@ fn law_of(i: &super::super::registry::Instance) -> BenchLaw {
 pub const TYPES: &[ComponentType] = &[
     ComponentType {
         name: "friction_bench",
-        summary: "the friction bench's law: g(v) tanh(v/v_t) with Stribeck g (or LuGre σ0 z + σ1 ż) + b v + K (p1 − p2)² v + K H a + (dFc/2)|tanh(v/v_t)| + F0 (eqs 5.1, 5.4, 5.12)",
+        summary: "the friction bench's law: g(v) tanh(v/v_t) with Stribeck g (or LuGre σ0 z + σ1 ż) + b v + K (p1 − p2)² v + K H a + (dFc/2) abs(tanh(v/v_t)) + F0 (eqs 5.1, 5.4, 5.12)",
         ports: &[
             port("rod", MECH, Role::Reads, false, "the rod (body) it acts on"),
             port("A", HYD, Role::Reads, true, "cap-side chamber (pressure term)"),

@@ -138,10 +138,7 @@ pub fn record(
     seed: u64,
 ) -> Record {
     let m = motion(n, dt);
-    let inputs = crate::bench::BenchInputs::of(&m).expect("the motion is a valid table");
-    let mut force = truth
-        .simulate(&m, &inputs)
-        .expect("the bench's netlist simulates the generated motion");
+    let mut force = truth.simulate(&m);
     let x = m.x.clone();
     match foreign {
         Foreign::None => {}

@@ -346,10 +346,9 @@ impl FrictionBench {
     }
 }
 
+mod inverse;
 mod model;
 mod presets;
-#[cfg(test)]
-mod reference;
 mod signals;
 
 pub use model::{run_options, BenchInputs};

@@ -57,14 +57,18 @@ impl FrictionBench {
     /// Simulates the bench on one record: the predicted load-cell force at
     /// every sample. The bristle state starts from the value that explains
     /// the first five samples' force (limited to the steady range).
-    pub fn simulate(&self, s: &BenchSignals, inputs: &BenchInputs) -> Result<Vec<f64>, String> {
+    pub fn simulate_netlist(
+        &self,
+        s: &BenchSignals,
+        inputs: &BenchInputs,
+    ) -> Result<Vec<f64>, String> {
         self.run(s, inputs, false)
     }
 
     /// Simulates the bench with the bristle deflection starting at zero (at
     /// rest) instead of from the measured force: what `hydrocyl simulate`
     /// does for a record that has no force to start from.
-    pub fn simulate_from_rest(
+    pub fn simulate_netlist_from_rest(
         &self,
         s: &BenchSignals,
         inputs: &BenchInputs,
@@ -139,8 +143,8 @@ mod tests {
 
     /// Every friction-bench fixture, migrated to its netlist and run through
     /// `Simulation`, predicts the load-cell force of the bench's inverse
-    /// model (the hand-written model this replaced, kept as the test's
-    /// reference) to 1e-9 of the force's range, on its own record; and
+    /// model ([`super::super::inverse`]) to 1e-9 of the force's range, on
+    /// its own record; and
     /// again with every catalog effect switched on (LuGre's bristle aside,
     /// which the netlist integrates as an ODE: checked to 1e-3, the old
     /// model's own per-sample discretisation).
@@ -178,8 +182,8 @@ mod tests {
                 all.set(&super::super::ParamRef::Effect(id, p.into()), v);
             }
             for (r, tol) in [(&rig, 1e-9), (&all, 1e-9)] {
-                let new = r.simulate(&s, &inputs).unwrap();
-                let old = super::super::reference::simulate(r, &s, false);
+                let new = r.simulate_netlist(&s, &inputs).unwrap();
+                let old = r.simulate(&s);
                 let scale = old.iter().fold(0.0f64, |m, f| m.max(f.abs()));
                 let worst = new
                     .iter()
@@ -196,8 +200,8 @@ mod tests {
                         v,
                     );
                 }
-                let new = lugre.simulate(&s, &inputs).unwrap();
-                let old = super::super::reference::simulate(&lugre, &s, false);
+                let new = lugre.simulate_netlist(&s, &inputs).unwrap();
+                let old = lugre.simulate(&s);
                 let scale = old.iter().fold(0.0f64, |m, f| m.max(f.abs()));
                 let rms = (new
                     .iter()

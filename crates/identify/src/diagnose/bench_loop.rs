@@ -3,7 +3,6 @@
 //! probes (delay, spring).
 
 use super::*;
-use crate::bench::BenchInputs;
 
 /// Which samples a residual uses.
 #[derive(Clone, Copy, PartialEq)]
@@ -15,8 +14,6 @@ pub(super) enum Part {
 
 pub(super) struct Bench<'a> {
     sigs: &'a [BenchSignals],
-    /// Each record's inputs to the bench netlist, built once.
-    inputs: &'a [BenchInputs],
     holdout: f64,
 }
 
@@ -31,29 +28,20 @@ impl Bench<'_> {
         }
     }
 
-    /// The simulated load-cell force of every record, concatenated.
-    fn simulate(&self, rig: &FrictionBench) -> Result<Vec<Vec<f64>>, String> {
-        self.sigs
-            .iter()
-            .zip(self.inputs)
-            .map(|(s, i)| rig.simulate(s, i))
-            .collect()
-    }
-
-    fn residual(&self, rig: &FrictionBench, part: Part, out: &mut Vec<f64>) -> Result<(), String> {
+    fn residual(&self, rig: &FrictionBench, part: Part, out: &mut Vec<f64>) {
         out.clear();
-        for (s, sim) in self.sigs.iter().zip(self.simulate(rig)?) {
+        for s in self.sigs {
+            let sim = rig.simulate(s);
             for i in self.range(s, part) {
                 out.push(s.force[i] - sim[i]);
             }
         }
-        Ok(())
     }
 
-    fn rss(&self, rig: &FrictionBench, part: Part) -> Result<f64, String> {
+    fn rss(&self, rig: &FrictionBench, part: Part) -> f64 {
         let mut r = Vec::new();
-        self.residual(rig, part, &mut r)?;
-        Ok(r.iter().map(|v| v * v).sum())
+        self.residual(rig, part, &mut r);
+        r.iter().map(|v| v * v).sum()
     }
 
     /// Fits `params` of `rig` in place on `part`; returns the LM result.
@@ -81,7 +69,8 @@ impl Bench<'_> {
                 for (p, v) in params.iter().zip(x) {
                     work.set(p, *v);
                 }
-                self.residual(&work, part, r)
+                self.residual(&work, part, r);
+                Ok(())
             },
             &x0,
             &lo,
@@ -122,7 +111,7 @@ pub(super) fn initial_guess(
     id: EffectId,
     rig: &FrictionBench,
     b: &Bench<'_>,
-) -> Result<BTreeMap<String, f64>, String> {
+) -> BTreeMap<String, f64> {
     let mut g = BTreeMap::new();
     let sg = rig.force_sign;
     let vt = rig.friction.smoothing_velocity;
@@ -138,7 +127,7 @@ pub(super) fn initial_guess(
         }
     };
     let mut r = Vec::new();
-    b.residual(rig, Part::Train, &mut r)?;
+    b.residual(rig, Part::Train, &mut r);
     let (mut num, mut den) = (0.0, 0.0);
     let mut j = 0;
     for s in b.sigs {
@@ -192,15 +181,14 @@ pub(super) fn initial_guess(
         }
         _ => {}
     }
-    Ok(g)
+    g
 }
 
 /// Out-of-catalog probes on the current model: a time shift of the measured
 /// force (transport delay, up to ±40 samples) and a force proportional to
 /// the position (a spring the catalog lacks).
-pub(super) fn probes(rig: &FrictionBench, b: &Bench<'_>) -> Result<Vec<Probe>, String> {
-    let sigs = b.sigs;
-    let sims = b.simulate(rig)?;
+pub(super) fn probes(rig: &FrictionBench, sigs: &[BenchSignals]) -> Vec<Probe> {
+    let sims: Vec<Vec<f64>> = sigs.iter().map(|s| rig.simulate(s)).collect();
     let rss0: f64 = sigs
         .iter()
         .zip(&sims)
@@ -249,7 +237,7 @@ pub(super) fn probes(rig: &FrictionBench, b: &Bench<'_>) -> Result<Vec<Probe>, S
         value: k,
         explained_share: num * k / rss0,
     });
-    Ok(out)
+    out
 }
 
 /// Runs the loop on a friction bench.
@@ -290,31 +278,19 @@ pub fn diagnose_bench(
         smoother.get_or_insert(info);
         sigs.push(s);
     }
-    let inputs = sigs
-        .iter()
-        .map(BenchInputs::of)
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| DiagnoseError::Rig(e))?;
     let b = Bench {
         sigs: &sigs,
-        inputs: &inputs,
         holdout: opts.holdout,
     };
-    let sim_err = |what: &str| {
-        let what = what.to_string();
-        move |reason: String| DiagnoseError::Fit { what, reason }
-    };
     let measured: Vec<f64> = sigs.iter().flat_map(|s| s.force.iter().copied()).collect();
-    let channel = |rig: &FrictionBench| -> Result<BTreeMap<String, f64>, DiagnoseError> {
-        let sim: Vec<f64> = b
-            .simulate(rig)
-            .map_err(sim_err("simulation"))?
-            .concat();
+    let sim_all =
+        |rig: &FrictionBench| -> Vec<f64> { sigs.iter().flat_map(|s| rig.simulate(s)).collect() };
+    let channel = |rig: &FrictionBench| -> BTreeMap<String, f64> {
         let mut m = BTreeMap::new();
-        m.insert("force".to_string(), nrmse(&measured, &sim));
-        Ok(m)
+        m.insert("force".to_string(), nrmse(&measured, &sim_all(rig)));
+        m
     };
-    let nrmse_declared = channel(rig)?;
+    let nrmse_declared = channel(rig);
     // Declared refit.
     let mut model = rig.clone();
     let refit: Vec<ParamRef> = rig
@@ -332,8 +308,8 @@ pub fn diagnose_bench(
             })?;
     }
     let before = model.clone();
-    let nrmse_before = channel(&model)?;
-    let rss_before = b.rss(&model, Part::All).map_err(sim_err("simulation"))?;
+    let nrmse_before = channel(&model);
+    let rss_before = b.rss(&model, Part::All);
     let candidates: Vec<EffectId> = opts
         .candidates
         .clone()
@@ -354,10 +330,9 @@ pub fn diagnose_bench(
     for round in 0..opts.max_effects {
         progress("tracing", round + 1, total_steps);
         let mut r0 = Vec::new();
-        b.residual(&model, Part::All, &mut r0)
-            .map_err(sim_err("simulation"))?;
+        b.residual(&model, Part::All, &mut r0);
         let rss0: f64 = r0.iter().map(|v| v * v).sum();
-        let rss0_held = b.rss(&model, Part::Held).map_err(sim_err("simulation"))?;
+        let rss0_held = b.rss(&model, Part::Held);
         let neff = n_eff(&r0);
         let mut best: Option<(EffectId, FrictionBench, EffectReport)> = None;
         for &id in &candidates {
@@ -382,7 +357,7 @@ pub fn diagnose_bench(
                 continue;
             }
             let mut trial = model.clone();
-            let guess = initial_guess(id, &model, &b).map_err(sim_err(id.id()))?;
+            let guess = initial_guess(id, &model, &b);
             let params: Vec<ParamRef> = id
                 .params()
                 .iter()
@@ -394,8 +369,8 @@ pub fn diagnose_bench(
                 trial.set(p, v.clamp(lo, hi));
             }
             let fit = b.fit(&mut trial, &params, Part::Train);
-            let rss1 = b.rss(&trial, Part::All).map_err(sim_err(id.id()))?;
-            let rss1_held = b.rss(&trial, Part::Held).map_err(sim_err(id.id()))?;
+            let rss1 = b.rss(&trial, Part::All);
+            let rss1_held = b.rss(&trial, Part::Held);
             let share = 1.0 - rss1 / rss0.max(1e-300);
             let held = 1.0 - rss1_held / rss0_held.max(1e-300);
             let k = params.len() as f64;
@@ -429,7 +404,7 @@ pub fn diagnose_bench(
         let probe = if rig.steady_state {
             Vec::new()
         } else {
-            probes(&model, &b).map_err(sim_err("probes"))?
+            probes(&model, &sigs)
         }
         .into_iter()
         .max_by(|a, b| a.explained_share.total_cmp(&b.explained_share));
@@ -513,8 +488,8 @@ pub fn diagnose_bench(
         }
     }
     progress("report", total_steps, total_steps);
-    let nrmse_after = channel(&model)?;
-    let rss_after = b.rss(&model, Part::All).map_err(sim_err("simulation"))?;
+    let nrmse_after = channel(&model);
+    let rss_after = b.rss(&model, Part::All);
     // The floor: load-cell noise plus the pressure sensors' noise carried
     // into the prediction by the areas (the balance is linear in both).
     let noise_ss: f64 = sigs
@@ -538,14 +513,9 @@ pub fn diagnose_bench(
         "force".to_string(),
         (noise_ss / measured.len() as f64).sqrt() / range,
     );
-    let (sims_before, sims_after) = (
-        b.simulate(&before).map_err(sim_err("simulation"))?,
-        b.simulate(&model).map_err(sim_err("simulation"))?,
-    );
     let traces = sigs
         .iter()
-        .zip(sims_before.into_iter().zip(sims_after))
-        .map(|(s, (sim_before, sim_after))| {
+        .map(|s| {
             // Show friction (the force minus the pressure force), not the
             // pressure-dominated load-cell force.
             let pf: Vec<f64> = (0..s.t.len())
@@ -559,8 +529,8 @@ pub fn diagnose_bench(
                 velocity: s.v.clone(),
                 channel: "friction".into(),
                 measured: minus(s.force.clone()),
-                before: minus(sim_before),
-                after: minus(sim_after),
+                before: minus(before.simulate(s)),
+                after: minus(model.simulate(s)),
                 regressor: first_added.map(|id| {
                     let vt = model.friction.smoothing_velocity;
                     let k = model.get(&ParamRef::Effect(EffectId::PressureViscous, "K".into()));

@@ -165,7 +165,11 @@ pub fn column_headers(run: &Run, command: CommandUnit) -> Vec<String> {
 
 /// `hydrocyl simulate` on a friction bench: the `--command` file carries the
 /// imposed motion (see [`crate::bench_sim`]).
-fn run_bench(args: &Args, bench: &FrictionBench, value: &serde_json::Value) -> Result<(), CliError> {
+fn run_bench(
+    args: &Args,
+    bench: &FrictionBench,
+    value: &serde_json::Value,
+) -> Result<(), CliError> {
     if args.print_rig {
         let shown = hydrocyl_system::netlist::expanded(value)
             .map_err(|e| CliError::Input(e.to_string()))?;

@@ -112,7 +112,12 @@ impl FrictionBench {
         }
     }
 
-    fn run(&self, s: &BenchSignals, inputs: &BenchInputs, at_rest: bool) -> Result<Vec<f64>, String> {
+    fn run(
+        &self,
+        s: &BenchSignals,
+        inputs: &BenchInputs,
+        at_rest: bool,
+    ) -> Result<Vec<f64>, String> {
         let mut v = self.netlist()?;
         if !at_rest && self.has(EffectId::LugreDynamics) {
             v["components"][net::FRICTION]["initial"] =
@@ -210,7 +215,10 @@ mod tests {
                     .sum::<f64>()
                     / new.len() as f64)
                     .sqrt();
-                assert!(rms <= 1e-3 * scale, "{stem} LuGre: rms {rms} N of {scale} N");
+                assert!(
+                    rms <= 1e-3 * scale,
+                    "{stem} LuGre: rms {rms} N of {scale} N"
+                );
             }
             seen += 1;
         }

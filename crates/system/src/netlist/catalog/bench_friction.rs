@@ -206,18 +206,90 @@ impl Component for SignalPressureSource {
 }
 
 const LAW: &[ParamSpec] = &[
-    param("coulomb", "N", Required, Range::NON_NEGATIVE, "Coulomb level Fc"),
-    param("smoothing_velocity", "m/s", Required, Range::POSITIVE, "smoothing velocity v_t of the tanh"),
-    param("viscous", "N s/m", Value(0.0), Range::NON_NEGATIVE, "viscous coefficient b"),
-    param("stiction", "N", Absent, Range::NON_NEGATIVE, "stiction level Fs of the Stribeck curve; absent = no hump (catalog `stribeck`)"),
-    param("stribeck_velocity", "m/s", Value(0.01), Range::POSITIVE, "Stribeck velocity vs"),
-    param("stribeck_exponent", "-", Value(1.0), Range::POSITIVE, "Stribeck exponent α"),
-    param("asymmetry", "N", Value(0.0), Range::ANY, "dFc: extending level Fc + dFc/2, retracting Fc − dFc/2 (catalog `coulomb_asymmetry`)"),
-    param("external_force", "N", Value(0.0), Range::ANY, "constant force F0 against + motion (catalog `external_force`)"),
-    param("sigma0", "N/m", Value(0.0), Range::NON_NEGATIVE, "bristle stiffness σ0 (LuGre, eq 5.1); 0 = the static curve"),
-    param("sigma1", "N s/m", Value(0.0), Range::NON_NEGATIVE, "bristle damping σ1"),
-    param("seal.k_pressure", "m^3 s/N", Value(0.0), Range::NON_NEGATIVE, "additive seal term K (p1 − p2)² v (eq 5.4); needs ports A and B"),
-    param("seal.h_acceleration", "N^2 s/m^4", Value(0.0), Range::ANY, "additive acceleration term K H a (eq 5.12), with K above"),
+    param(
+        "coulomb",
+        "N",
+        Required,
+        Range::NON_NEGATIVE,
+        "Coulomb level Fc",
+    ),
+    param(
+        "smoothing_velocity",
+        "m/s",
+        Required,
+        Range::POSITIVE,
+        "smoothing velocity v_t of the tanh",
+    ),
+    param(
+        "viscous",
+        "N s/m",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "viscous coefficient b",
+    ),
+    param(
+        "stiction",
+        "N",
+        Absent,
+        Range::NON_NEGATIVE,
+        "stiction level Fs of the Stribeck curve; absent = no hump (catalog `stribeck`)",
+    ),
+    param(
+        "stribeck_velocity",
+        "m/s",
+        Value(0.01),
+        Range::POSITIVE,
+        "Stribeck velocity vs",
+    ),
+    param(
+        "stribeck_exponent",
+        "-",
+        Value(1.0),
+        Range::POSITIVE,
+        "Stribeck exponent α",
+    ),
+    param(
+        "asymmetry",
+        "N",
+        Value(0.0),
+        Range::ANY,
+        "dFc: extending level Fc + dFc/2, retracting Fc − dFc/2 (catalog `coulomb_asymmetry`)",
+    ),
+    param(
+        "external_force",
+        "N",
+        Value(0.0),
+        Range::ANY,
+        "constant force F0 against + motion (catalog `external_force`)",
+    ),
+    param(
+        "sigma0",
+        "N/m",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "bristle stiffness σ0 (LuGre, eq 5.1); 0 = the static curve",
+    ),
+    param(
+        "sigma1",
+        "N s/m",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "bristle damping σ1",
+    ),
+    param(
+        "seal.k_pressure",
+        "m^3 s/N",
+        Value(0.0),
+        Range::NON_NEGATIVE,
+        "additive seal term K (p1 − p2)² v (eq 5.4); needs ports A and B",
+    ),
+    param(
+        "seal.h_acceleration",
+        "N^2 s/m^4",
+        Value(0.0),
+        Range::ANY,
+        "additive acceleration term K H a (eq 5.12), with K above",
+    ),
 ];
 
 /// The bench law of an instance of `friction_bench`.
@@ -345,11 +417,7 @@ mod tests {
     fn run(v: &Value, t: &[f64], sig: [Signal; 4]) -> crate::run::Run {
         let s = schematic(v).unwrap();
         let names = ["drive", "acc", "p1", "p2"];
-        let inputs: Vec<_> = names
-            .iter()
-            .map(|n| n.to_string())
-            .zip(sig)
-            .collect();
+        let inputs: Vec<_> = names.iter().map(|n| n.to_string()).zip(sig).collect();
         let mut opts = RunOptions::dp45();
         opts.rtol = 1e-10;
         let mut sim = Simulation::of_circuit(assemble_inputs(&s, &inputs).unwrap()).options(opts);
@@ -370,7 +438,9 @@ mod tests {
         }));
         let t: Vec<f64> = (0..=400).map(|k| k as f64 * 1e-3).collect();
         let vel = |t: f64| 0.03 * (7.0 * t).sin();
-        let table = |f: &dyn Fn(f64) -> f64| Signal::table(t.clone(), t.iter().map(|&t| f(t)).collect()).unwrap();
+        let table = |f: &dyn Fn(f64) -> f64| {
+            Signal::table(t.clone(), t.iter().map(|&t| f(t)).collect()).unwrap()
+        };
         let acc = |t: f64| 0.5 * (3.0 * t).cos();
         let p1 = |t: f64| 4e5 + 1e5 * t;
         let p2 = |t: f64| 1e5 - 2e4 * t;
@@ -380,9 +450,9 @@ mod tests {
             let (v, a, p1, p2) = (vel(tk), acc(tk), p1(tk), p2(tk));
             let th = (v / 1e-3).tanh();
             let g = 20.0 + 15.0 * (-(v / 5e-3).abs().powf(1.5)).exp();
-            let ff = g * th + 300.0 * v + 2e-9 * (p1 - p2).powi(2) * v + 2e-9 * 3e7 * a
-                + 2.0 * th.abs()
-                - 7.0;
+            let ff =
+                g * th + 300.0 * v + 2e-9 * (p1 - p2).powi(2) * v + 2e-9 * 3e7 * a + 2.0 * th.abs()
+                    - 7.0;
             let expect = -(2.0 * a + ff - p1 * 1e-3 + p2 * 5e-4);
             assert!(
                 (f[k] - expect).abs() < 1e-9 * expect.abs().max(1.0),
@@ -443,6 +513,9 @@ mod tests {
             })
             .unwrap_err()
             .to_string();
-        assert!(e.contains("components.friction") && e.contains("`A` and `B`"), "{e}");
+        assert!(
+            e.contains("components.friction") && e.contains("`A` and `B`"),
+            "{e}"
+        );
     }
 }

@@ -100,7 +100,11 @@ pub fn to_netlist(v: &Value) -> Result<Value, RigError> {
         if p.range.contains(x) {
             Ok(())
         } else {
-            Err(out_of_range(path, x, &format!("must be {} [{}]", p.range.describe(), p.unit)))
+            Err(out_of_range(
+                path,
+                x,
+                &format!("must be {} [{}]", p.range.describe(), p.unit),
+            ))
         }
     };
     check("friction.coulomb", "coulomb", f.friction.coulomb)?;
@@ -131,7 +135,10 @@ pub fn to_netlist(v: &Value) -> Result<Value, RigError> {
                 ),
             });
         }
-        if let Some(k) = params.keys().find(|k| !of_effect.iter().any(|(_, p, _)| p == k)) {
+        if let Some(k) = params
+            .keys()
+            .find(|k| !of_effect.iter().any(|(_, p, _)| p == k))
+        {
             return Err(RigError::Invalid {
                 path: format!("{here}.{k}"),
                 why: format!("unknown parameter of `{id}`"),
@@ -245,7 +252,11 @@ mod tests {
         let ff = g * th + 300.0 * v + 1e-9 * (p1 - p2).powi(2) * v + 1e-9 * 2e7 * a + 1.5 * th;
         let expect = -(2.0 * a + ff + 5.0 - p1 * 1e-3 + p2 * 4e-4);
         let f = r.channel("force").unwrap();
-        assert!((f[1] - expect).abs() < 1e-9 * expect.abs(), "{} vs {expect}", f[1]);
+        assert!(
+            (f[1] - expect).abs() < 1e-9 * expect.abs(),
+            "{} vs {expect}",
+            f[1]
+        );
     }
 
     #[test]
@@ -254,9 +265,21 @@ mod tests {
             ("/mass", json!(-1.0), "mass"),
             ("/force_sign", json!(0.5), "force_sign"),
             ("/friction/coulomb", json!("lots"), "friction.coulomb"),
-            ("/friction/effects/stribeck/vs", json!(-0.1), "friction.effects.stribeck.vs"),
-            ("/friction/effects/viscous/c", json!(1.0), "friction.effects.viscous.c"),
-            ("/friction/effects/internal_leakage", json!({"Cl": 1e-12}), "friction.effects.internal_leakage"),
+            (
+                "/friction/effects/stribeck/vs",
+                json!(-0.1),
+                "friction.effects.stribeck.vs",
+            ),
+            (
+                "/friction/effects/viscous/c",
+                json!(1.0),
+                "friction.effects.viscous.c",
+            ),
+            (
+                "/friction/effects/internal_leakage",
+                json!({"Cl": 1e-12}),
+                "friction.effects.internal_leakage",
+            ),
         ];
         for (ptr, bad, path) in cases {
             let mut v = file();
@@ -272,6 +295,9 @@ mod tests {
             .unwrap()
             .remove("vs");
         let e = to_netlist(&v).unwrap_err().to_string();
-        assert!(e.contains("friction.effects.stribeck") && e.contains("`vs` missing"), "{e}");
+        assert!(
+            e.contains("friction.effects.stribeck") && e.contains("`vs` missing"),
+            "{e}"
+        );
     }
 }

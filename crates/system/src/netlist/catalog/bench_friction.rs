@@ -425,8 +425,8 @@ mod tests {
     }
 
     /// Every static term at once against its closed form: the load cell
-    /// reads `s (m a + g(v) tanh(v/v_t) + b v + K (p1−p2)² v + K H a
-    /// + (dFc/2)|tanh| + F0 − p1 A1 + p2 A2)` with the imposed acceleration
+    /// reads `s (m a + g(v) tanh(v/v_t) + b v + K (p1−p2)² v + K H a +
+    /// (dFc/2)|tanh| + F0 − p1 A1 + p2 A2)` with the imposed acceleration
     /// (not the velocity's slope) and the signals' pressures.
     #[test]
     fn static_law_through_the_bench_is_the_closed_form() {

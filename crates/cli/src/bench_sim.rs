@@ -6,12 +6,44 @@
 //! pressures; the output adds the predicted load-cell `force`:
 //! `time, position, velocity, p1, p2, force` (SI). Velocity and acceleration
 //! come from the same smoother `diagnose` uses; the bristle starts from the
-//! record's measured force when it has one, else at rest.
+//! record's measured force when it has one, else at rest. The bench runs as
+//! its netlist through the one run path (`FrictionBench::simulate_netlist`:
+//! the record's velocity, acceleration and pressures are the netlist's inputs).
 
 use crate::error::CliError;
-use hydrocyl_identify::bench::{bench_signals, FrictionBench};
+use hydrocyl_identify::bench::{self, bench_signals, BenchInputs, FrictionBench};
 use hydrocyl_identify::data::{Record, Signal};
 use std::path::Path;
+
+/// A `friction-bench` rig file read for the CLI, or `None` for any other
+/// `--rig`: the bench (identification fields from the file, the circuit
+/// from its netlist after `sets`) and its netlist (what `--print-rig`
+/// shows; `--set` takes its `<component>.<parameter>` paths). Errors name
+/// the JSON path.
+pub fn load(
+    spec: &str,
+    sets: &[String],
+) -> Result<Option<(FrictionBench, serde_json::Value)>, CliError> {
+    use hydrocyl_system::rig;
+    if rig::preset(spec).is_some() {
+        return Ok(None);
+    }
+    let Some(file) = std::fs::read_to_string(spec)
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .filter(|v| v.get("kind").and_then(|k| k.as_str()) == Some(bench::KIND))
+    else {
+        return Ok(None);
+    };
+    let err = |e: rig::RigError| CliError::Input(e.to_string());
+    let mut net = rig::load(spec).map_err(err)?;
+    for s in sets {
+        rig::apply_set(&mut net, s).map_err(err)?;
+    }
+    let bench = FrictionBench::from_file_and_netlist(&file, &net)
+        .map_err(|e| CliError::Input(format!("{spec}: {e}")))?;
+    Ok(Some((bench, net)))
+}
 
 /// Simulates `bench` on the motion in `input`; returns the output CSV text.
 pub fn simulate(bench: &FrictionBench, input: &Path) -> Result<String, CliError> {
@@ -29,11 +61,13 @@ pub fn simulate(bench: &FrictionBench, input: &Path) -> Result<String, CliError>
     }
     let (s, _) = bench_signals(&rec, None, bench.steady_state)
         .map_err(|e| CliError::Input(e.to_string()))?;
+    let inputs = BenchInputs::of(&s).map_err(CliError::Input)?;
     let force = if measured_force {
-        bench.simulate(&s)
+        bench.simulate_netlist(&s, &inputs)
     } else {
-        bench.simulate_from_rest(&s)
-    };
+        bench.simulate_netlist_from_rest(&s, &inputs)
+    }
+    .map_err(|e| CliError::Input(format!("{}: {e}", input.display())))?;
     if let Some(i) = force.iter().position(|f| !f.is_finite()) {
         return Err(CliError::Input(format!(
             "{}: the bench model gave a non-finite force at row {} (t = {} s)",

@@ -92,12 +92,13 @@ fn load_rig(spec: &str) -> Result<Rig, CliError> {
             crate::presets::names()
         )));
     }
+    // a friction-bench file: its identification fields and its netlist
+    if let Some((b, _)) = crate::bench_sim::load(spec, &[])? {
+        return Ok(Rig::Bench(b));
+    }
     // duplicate keys refused, errors with the JSON path and line
     let v = hydrocyl_system::rig::load(spec).map_err(|e| CliError::Input(e.to_string()))?;
     match v.get("kind").and_then(|k| k.as_str()).unwrap_or("") {
-        k if k == bench::KIND => FrictionBench::from_json(&v.to_string())
-            .map(Rig::Bench)
-            .map_err(|e| CliError::Input(format!("{spec}: {e}"))),
         // an older rig kind (`valve-cylinder`) is read as its netlist (rig::load)
         k if k == hydrocyl_system::netlist::KIND => net_rig(&v)
             .map(|r| Rig::Net(Box::new(r)))

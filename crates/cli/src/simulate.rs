@@ -42,7 +42,7 @@ use crate::command_stream;
 use crate::error::CliError;
 use crate::output::{OutputId, Outputs};
 use crate::progress::Progress;
-use hydrocyl_identify::bench::{self, FrictionBench};
+use hydrocyl_identify::bench::FrictionBench;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{self as runner, Run, RunOptions, Solver};
 use hydrocyl_system::signal::{Signal, StreamedTable};
@@ -237,11 +237,15 @@ pub fn column_headers(run: &Run, command: CommandUnit) -> Vec<String> {
 
 /// `hydrocyl simulate` on a friction bench: the `--command` file carries the
 /// imposed motion (see [`crate::bench_sim`]).
-fn run_bench(args: &Args, value: &serde_json::Value) -> Result<(), CliError> {
-    let bench = FrictionBench::from_json(&value.to_string())
-        .map_err(|e| CliError::Input(format!("rig {}: {e}", args.rig)))?;
+fn run_bench(
+    args: &Args,
+    bench: &FrictionBench,
+    value: &serde_json::Value,
+) -> Result<(), CliError> {
     if args.print_rig {
-        let text = serde_json::to_string_pretty(value)
+        let shown = hydrocyl_system::netlist::expanded(value)
+            .map_err(|e| CliError::Input(e.to_string()))?;
+        let text = serde_json::to_string_pretty(&shown)
             .map_err(|e| CliError::Input(format!("rig: {e}")))?;
         println!("{text}");
         return Ok(());
@@ -251,7 +255,7 @@ fn run_bench(args: &Args, value: &serde_json::Value) -> Result<(), CliError> {
     };
     let mut outputs = Outputs::new(&[("--command", input.as_path())]);
     let id = outputs.file("--out", out)?;
-    let text = crate::bench_sim::simulate(&bench, input)?;
+    let text = crate::bench_sim::simulate(bench, input)?;
     outputs.write(id, text.as_bytes())?;
     outputs.commit(args.fsync)?;
     eprintln!(
@@ -374,14 +378,14 @@ fn solver_hint(e: rig::RigError) -> CliError {
 /// Runs `hydrocyl simulate`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let rig_err = |e: rig::RigError| CliError::Input(e.to_string());
+    if let Some((bench, net)) = crate::bench_sim::load(&args.rig, &args.set)? {
+        return run_bench(&args, &bench, &net);
+    }
     let mut value = rig::load(&args.rig).map_err(rig_err)?;
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(rig_err)?;
     }
     let kind = value.get("kind").and_then(|k| k.as_str());
-    if kind == Some(bench::KIND) {
-        return run_bench(&args, &value);
-    }
     let checked = crate::rigfile::check(&value, &args.rig)?;
     check_initial_pressures(&checked)?;
     if args.print_rig {

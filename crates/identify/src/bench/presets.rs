@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use super::{BenchFriction, FrictionBench, KIND};
 use crate::catalog::EffectId;
 use crate::data::{ColumnMap, Signal};
+use hydrocyl_system::netlist::migrate::bench as net;
 
 /// Names of the built-in friction-bench presets: netlist files in
 /// `fixtures/rigs/` listed in `hydrocyl_system::rig::PRESETS`.
@@ -112,7 +113,14 @@ impl FrictionBench {
             _ => return Err("components: a friction bench has at most one `piston`".into()),
         };
         if let Some(extra) = s.instances.iter().find(|i| {
-            !["imposed_motion", "piston", "pressure_source"].contains(&i.ty.name)
+            ![
+                "imposed_motion",
+                "piston",
+                "pressure_source",
+                "signal_pressure_source",
+                "command_input",
+            ]
+            .contains(&i.ty.name)
                 && !std::ptr::eq(*i, law)
         }) {
             return Err(format!(
@@ -170,9 +178,32 @@ impl FrictionBench {
                 on(EffectId::Viscous, &[("b", law.get("extending.sigma2"))]);
                 (fc, smoothing_velocity)
             }
+            "friction_bench" => {
+                // an effect is on when the file gives any of its parameters
+                let raw = &v["components"][law.name.as_str()];
+                let given = |t: &str| t.split('.').try_fold(raw, |o, k| o.get(k)).is_some();
+                let mut ids: Vec<&str> = net::EFFECT_PARAMS.iter().map(|(e, _, _)| *e).collect();
+                ids.dedup();
+                for id in ids {
+                    let params: Vec<(&str, &str)> = net::EFFECT_PARAMS
+                        .iter()
+                        .filter(|(e, _, _)| *e == id)
+                        .map(|(_, p, target)| (*p, *target))
+                        .collect();
+                    if let (Some(eid), true) = (
+                        EffectId::from_id(id),
+                        params.iter().any(|(_, t)| given(t)),
+                    ) {
+                        let vals: Vec<(&str, f64)> =
+                            params.iter().map(|(p, t)| (*p, law.get(t))).collect();
+                        on(eid, &vals);
+                    }
+                }
+                (law.get("coulomb"), law.get("smoothing_velocity"))
+            }
             other => {
                 return Err(format!(
-                    "components.{}.type: `{other}` has no friction-bench view (friction_coulomb_viscous or friction_lugre)",
+                    "components.{}.type: `{other}` has no friction-bench view (friction_coulomb_viscous, friction_lugre or friction_bench)",
                     law.name
                 ))
             }
@@ -209,6 +240,36 @@ impl FrictionBench {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every `friction-bench` fixture read back from its migrated netlist is
+    /// the file's declaration, field for field (so diagnose fits the same
+    /// model from the same start whichever way the file is read), and a
+    /// `--set` on the netlist reaches the bench.
+    #[test]
+    fn bench_files_read_back_from_their_netlists() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/measured");
+        let mut seen = 0;
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            let text = std::fs::read_to_string(&path).unwrap_or_default();
+            let Ok(file) = serde_json::from_str::<serde_json::Value>(&text) else {
+                continue;
+            };
+            if file.get("kind").and_then(|k| k.as_str()) != Some(KIND) {
+                continue;
+            }
+            let declared = FrictionBench::from_json(&text).unwrap();
+            let mut net = hydrocyl_system::rig::load(path.to_str().unwrap()).unwrap();
+            assert_eq!(net["kind"], "netlist");
+            let back = FrictionBench::from_file_and_netlist(&file, &net).unwrap();
+            assert_eq!(back, declared, "{}", path.display());
+            hydrocyl_system::rig::apply_set(&mut net, "friction.viscous=123").unwrap();
+            let set = FrictionBench::from_file_and_netlist(&file, &net).unwrap();
+            assert_eq!(set.friction.effects[&EffectId::Viscous]["b"], 123.0);
+            seen += 1;
+        }
+        assert!(seen >= 12, "{seen}");
+    }
 
     /// The presets' identification view is the declaration the bench had
     /// before its circuit became a netlist, field for field (so `diagnose`

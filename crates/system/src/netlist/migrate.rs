@@ -8,20 +8,24 @@
 //!   steady state at rest ([`super::steady`]) after any `--set`.
 //! * `hybrid-pump` ([`WangHybrid`]): [`WangHybrid::to_netlist`], the hybrid
 //!   circuit of `fixtures/rigs/wang-hybrid.json` with the file's values.
+//! * `friction-bench` ([`bench::to_netlist`]): the bench's drive, measured
+//!   pressures, piston and `friction_bench` law; its identification fields
+//!   (catalog refits, column map) stay with `hydrocyl-identify`, which reads
+//!   them from the file.
 //!
 //! The typed rigs stay the identification and study views of their
-//! circuits (`ValveRig::from_netlist`, `WangHybrid::from_netlist`); the
-//! `friction-bench` kind is identification's own declaration format (its
-//! catalog effects, column map and refit list) and is read by
-//! `hydrocyl-identify`.
+//! circuits (`ValveRig::from_netlist`, `WangHybrid::from_netlist`,
+//! identify's `FrictionBench::from_netlist`).
 
 use crate::hybrid::{self, WangHybrid};
 use crate::rig::RigError;
 use crate::valve_rig::{self, ValveRig};
 use serde_json::Value;
 
+pub mod bench;
+
 /// The rig kinds that [`migrate`] converts.
-pub const MIGRATED_KINDS: [&str; 2] = [valve_rig::KIND, hybrid::KIND];
+pub const MIGRATED_KINDS: [&str; 3] = [valve_rig::KIND, hybrid::KIND, bench::KIND];
 
 /// Deserialises an older rig kind, naming the JSON path of a type error.
 pub(crate) fn typed<T: serde::de::DeserializeOwned>(v: &Value) -> Result<T, RigError> {
@@ -71,6 +75,7 @@ pub fn migrate(v: &Value) -> Result<Option<Value>, RigError> {
             }
             Ok(Some(n))
         }
+        Some(bench::KIND) => bench::to_netlist(v).map(Some),
         _ => Ok(None),
     }
 }

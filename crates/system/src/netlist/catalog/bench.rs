@@ -11,7 +11,7 @@
 //! a bench whose drive imposes the motion it is the well-posed simulation.
 
 use super::super::registry::{param, ComponentType, Default::*, Range, Role, StateSpec};
-use super::{built, port, HYD, MECH};
+use super::{built, port, HYD, MECH, SIG};
 use crate::circuit::{
     BuildError, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe, Wire, Wires,
 };
@@ -35,15 +35,28 @@ pub struct ImposedMotion {
     /// Initial position \[m\].
     pub initial_position: f64,
     hint: Cell<usize>,
+    /// The signal giving the imposed acceleration \[m·s⁻²\], when port
+    /// `acceleration` is connected (else the velocity's slope).
+    acceleration_name: Option<String>,
+    acceleration: Option<Wire<f64>>,
     rod: MechanicalNode,
     force: Wire<Force>,
 }
 
 impl ImposedMotion {
+    /// The imposed acceleration at `t` \[m·s⁻²\]: the `acceleration`
+    /// signal's, or the velocity's slope.
+    fn acceleration_at(&self, t: f64, w: &Wires) -> f64 {
+        match self.acceleration {
+            Some(a) => w.get(a),
+            None => self.velocity.slope_hinted(t, &self.hint),
+        }
+    }
+
     /// The drive force on the rod in + direction (not the load cell's sign)
     /// at `t`, with every other component evaluated \[N\].
     fn drive_force(&self, t: f64, w: &Wires) -> f64 {
-        let a = self.velocity.slope_hinted(t, &self.hint);
+        let a = self.acceleration_at(t, w);
         (self.mass + w.get(self.rod.added_mass).si()) * a - w.get(self.rod.force).si()
     }
 }
@@ -54,6 +67,7 @@ impl Component for ImposedMotion {
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.rod = net.own_mechanical(&self.rod_name)?;
+        self.acceleration = self.acceleration_name.as_deref().map(|n| net.signal(n));
         self.force = net.private("force");
         Ok(())
     }
@@ -86,7 +100,7 @@ impl Component for ImposedMotion {
     }
     fn power(&self, t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         let v = self.velocity.value_hinted(t, &self.hint);
-        let a = self.velocity.slope_hinted(t, &self.hint);
+        let a = self.acceleration_at(t, w);
         // the drive's work on the rod comes from outside the circuit; the
         // moving mass (with the friction's added mass) stores m v a
         p.source = self.drive_force(t, w) * v;
@@ -159,7 +173,10 @@ pub const TYPES: &[ComponentType] = &[
     ComponentType {
         name: "imposed_motion",
         summary: "a bench drive: the rod's velocity is the run's command [m/s], the load-cell force is s((m + Σc) a − ΣF) (eq 5.9 solved for the drive force)",
-        ports: &[port("rod", MECH, Role::Owns, false, "the rod it moves")],
+        ports: &[
+            port("rod", MECH, Role::Owns, false, "the rod it moves"),
+            port("acceleration", SIG, Role::Reads, true, "the imposed acceleration [m/s^2] (a measured record's; else the velocity's slope)"),
+        ],
         params: &[
             param("mass", "kg", Value(0.0), Range::NON_NEGATIVE, "moving mass between the load cell and the rod"),
             param("force_sign", "-", Value(1.0), Range { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false }, "+1 when a positive load-cell force pushes the rod in + direction, −1 otherwise"),
@@ -186,6 +203,8 @@ pub const TYPES: &[ComponentType] = &[
                 force_sign: s,
                 initial_position: i.initial("position").unwrap_or(0.0),
                 hint: Cell::new(0),
+                acceleration_name: i.connected("acceleration").then(|| i.node("acceleration").to_string()),
+                acceleration: None,
                 rod: MechanicalNode::UNBOUND,
                 force: Wire::UNBOUND,
             })

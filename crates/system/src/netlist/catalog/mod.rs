@@ -5,6 +5,7 @@ use crate::circuit::Component;
 use std::sync::LazyLock;
 
 mod bench;
+mod bench_friction;
 mod control;
 mod friction;
 mod hybrid;
@@ -73,6 +74,7 @@ static ALL: LazyLock<Vec<ComponentType>> = LazyLock::new(|| {
         hybrid::TYPES,
         control::TYPES,
         bench::TYPES,
+        bench_friction::TYPES,
         switched::TYPES,
     ]
     .concat()

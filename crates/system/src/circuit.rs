@@ -10,6 +10,9 @@ use thiserror::Error;
 
 use crate::series::{SeriesGroup, Step};
 
+mod jacobian;
+pub use jacobian::Tangents;
+
 pub use crate::binding::{Causality, Netlist};
 pub use crate::wires::{Acc, AnyWire, HydraulicNode, MechanicalNode, ReadWire, Wire, Wires};
 
@@ -173,6 +176,32 @@ pub trait Component {
     /// Time derivatives of its states (all accumulators are complete here).
     fn derivatives(&self, _t: f64, _x: &[f64], _w: &Wires, _dx: &mut [f64]) {}
 
+    /// Whether this component gives the analytic Jacobian's tangents (the
+    /// four `*_tangents` methods below; see [`Tangents`]). `false` (the
+    /// default) makes the whole circuit fall back to finite differences, so
+    /// a component without them keeps working.
+    fn has_tangents(&self) -> bool {
+        false
+    }
+
+    /// The gradient rows of the efforts [`publish`](Component::publish)
+    /// sets, with respect to its own states ([`Tangents::state`]).
+    fn publish_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, _d: &mut Tangents) {}
+
+    /// The gradient rows of what [`evaluate`](Component::evaluate) writes:
+    /// its local partials chained onto the rows of the wires it reads
+    /// ([`Tangents::chain`]) and onto its own states ([`Tangents::state`]),
+    /// for the branch (mode, regime) the evaluation at `w` took.
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, _d: &mut Tangents) {}
+
+    /// The rows of `∂ẋ/∂x` of its states ([`Tangents::rate_chain`],
+    /// [`Tangents::rate_state`]); every wire's row is complete here.
+    fn derivative_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, _d: &mut Tangents) {}
+
+    /// The rows of its quadratures' integrands ([`Tangents::quadrature_chain`],
+    /// [`Tangents::quadrature_state`]).
+    fn quadrature_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, _d: &mut Tangents) {}
+
     /// Whether [`evaluate`](Component::evaluate) must run after every other
     /// component's, to read complete accumulators (an imposed-motion source
     /// reporting the force it takes to impose its motion). Nothing may read
@@ -262,6 +291,9 @@ pub struct Circuit {
     n_quad: usize,
     wire_names: Vec<String>,
     probe_names: Option<Vec<Option<String>>>,
+    /// Every component has tangents and the analytic Jacobian is wanted.
+    analytic: bool,
+    tangents: RefCell<Tangents>,
 }
 
 impl std::fmt::Debug for Circuit {
@@ -329,6 +361,7 @@ impl Circuit {
         offsets.push(s);
         ev_offsets.push(e);
         q_offsets.push(q);
+        let analytic = comps.iter().all(|c| c.has_tangents());
         Ok(Self {
             comps,
             offsets,
@@ -348,6 +381,8 @@ impl Circuit {
             n_quad: q,
             wire_names: net.names,
             probe_names: None,
+            analytic,
+            tangents: RefCell::new(Tangents::default()),
         })
     }
 
@@ -648,6 +683,12 @@ impl OdeSystem for Circuit {
                 dx[k + 3] = p.load;
             }
         }
+    }
+
+    /// The analytic Jacobian (see [`Tangents`]) where every component has
+    /// one and the ledger is off; finite differences otherwise.
+    fn jacobian(&self, t: f64, x: &[f64], jac: &mut [f64]) -> bool {
+        self.analytic_jacobian(t, x, jac)
     }
 
     fn next_breakpoint(&self, t: f64) -> f64 {

@@ -71,6 +71,9 @@ impl Component for AlgebraicNode {
     fn name(&self) -> &str {
         &self.name
     }
+    fn has_tangents(&self) -> bool {
+        true
+    }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.node = net.solve_hydraulic(&self.node_name)?;
         Ok(())
@@ -116,6 +119,11 @@ pub(crate) struct SeriesGroup {
 }
 
 impl SeriesGroup {
+    /// Every wire a member may write (the node's pressure among them).
+    pub(crate) fn writes(&self) -> &[usize] {
+        &self.writes
+    }
+
     /// Forgets the last solution and slope (a run from a given state solves
     /// the same way whatever ran before).
     pub(crate) fn forget(&self) {

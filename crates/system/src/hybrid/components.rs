@@ -7,7 +7,8 @@
 //! diagnostics); the valves give the slopes the node's Newton solve uses.
 
 use crate::circuit::{
-    BuildError, Causality, Component, HydraulicNode, Netlist, PowerTerms, Probe, Wire, Wires,
+    BuildError, Causality, Component, HydraulicNode, Netlist, PowerTerms, Probe, Tangents, Wire,
+    Wires,
 };
 use hydrocyl_integrators::{Crossing, EventAction};
 use hydrocyl_ports::{Position, Pressure, Voltage, VolumeFlow};
@@ -67,6 +68,27 @@ impl PumpComponent {
 impl Component for PumpComponent {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn publish_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.state(self.flow, 0, 1.0);
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.state(self.a.inflow, 0, 1.0);
+        d.state(self.b.inflow, 0, -1.0);
+    }
+    fn derivative_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        let j = self.pump.jacobian();
+        for (k, jk) in j.iter().enumerate() {
+            d.rate_state(k / 2, k % 2, *jk);
+        }
+        let wn = self.pump.natural_frequency;
+        d.rate_chain(1, wn * wn * self.pump.gain, self.u);
+    }
+    fn quadrature_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.quadrature_state(0, 0, 1.0);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         IdentifiedPump::new(
@@ -186,6 +208,19 @@ impl Component for ReliefComponent {
     fn name(&self) -> &str {
         &self.name
     }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        // the regime the pressures select (closed, cracking, open)
+        let g = self
+            .valve
+            .conductance(w.get(self.i.pressure), w.get(self.o.pressure));
+        d.resistive(self.i, self.o, g, Some(self.flow));
+    }
+    fn quadrature_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.quadrature_chain(0, 1.0, self.flow);
+    }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         ReliefValve::new(self.valve.cracking, self.valve.kv, self.valve.full_open).map_err(
             |e| BuildError::Component {
@@ -295,6 +330,19 @@ impl CheckComponent {
 impl Component for CheckComponent {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        // the regime the pressures select (closed, cracking, open)
+        let g = self
+            .valve
+            .conductance(w.get(self.i.pressure), w.get(self.o.pressure));
+        d.resistive(self.i, self.o, g, Some(self.flow));
+    }
+    fn quadrature_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.quadrature_chain(0, 1.0, self.flow);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         CheckValve::new(
@@ -472,6 +520,42 @@ impl Component for PilotValve {
     fn name(&self) -> &str {
         &self.name
     }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        let (pp1, pp2) = (w.get(self.pp1.pressure), w.get(self.pp2.pressure));
+        // the spool travel and the opening move with pp1 − pp2
+        let ds = self.four_way.spool_travel_slope(pp1, pp2);
+        d.chain(self.spool, ds, self.pp1.pressure);
+        d.chain(self.spool, -ds, self.pp2.pressure);
+        let y = self.opening(w);
+        let k = self.four_way.return_coefficient(y);
+        if k <= 0.0 {
+            return;
+        }
+        // Q = k(y) ssr(p_x − p_T) leaves the open chamber x and enters T
+        let (open, q) = if y > 0.0 {
+            (self.b, self.flow_b)
+        } else {
+            (self.a, self.flow_a)
+        };
+        let xt = self.four_way.dp_transition.si();
+        let dp = (w.get(open.pressure) - w.get(self.t.pressure)).si();
+        let dk = self.four_way.k_t * y.signum() * self.four_way.opening_slope(pp1, pp2);
+        let c_pilot = dk * signed_sqrt_regularised(dp, xt);
+        let g = k * signed_sqrt_regularised_derivative(dp, xt);
+        d.chain(q, c_pilot, self.pp1.pressure);
+        d.chain(q, -c_pilot, self.pp2.pressure);
+        d.chain(q, g, open.pressure);
+        d.chain(q, -g, self.t.pressure);
+        d.chain(open.inflow, -1.0, q);
+        d.chain(self.t.inflow, 1.0, q);
+    }
+    fn quadrature_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.quadrature_chain(0, 1.0, self.flow_a);
+        d.quadrature_chain(1, 1.0, self.flow_b);
+    }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.four_way
             .validate()
@@ -612,6 +696,15 @@ impl NeedleComponent {
 impl Component for NeedleComponent {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        let g = self
+            .needle
+            .conductance(w.get(self.i.pressure), w.get(self.o.pressure));
+        d.resistive(self.i, self.o, g, None);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         NeedleValve::new(

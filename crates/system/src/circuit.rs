@@ -294,6 +294,16 @@ pub struct Circuit {
     /// Every component has tangents and the analytic Jacobian is wanted.
     analytic: bool,
     tangents: RefCell<Tangents>,
+    /// The point of the last [`Circuit::fill`], while no mode changed since.
+    filled: RefCell<FillKey>,
+}
+
+/// Where the wire table was last evaluated (see [`Circuit::filled_at`]).
+#[derive(Debug, Default)]
+struct FillKey {
+    valid: bool,
+    t: f64,
+    x: Vec<f64>,
 }
 
 impl std::fmt::Debug for Circuit {
@@ -383,6 +393,7 @@ impl Circuit {
             probe_names: None,
             analytic,
             tangents: RefCell::new(Tangents::default()),
+            filled: RefCell::new(FillKey::default()),
         })
     }
 
@@ -595,10 +606,30 @@ impl Circuit {
         for (i, c) in self.comps.iter_mut().enumerate() {
             c.reset(t, &x[self.offsets[i]..self.offsets[i + 1]], &w);
         }
+        // the components' modes may have changed: the table is stale
+        self.filled.borrow_mut().valid = false;
+    }
+
+    /// Whether the wire table holds the evaluation at exactly `(t, x)` with
+    /// the components' modes as they are now (the stiff solver asks for the
+    /// Jacobian right after `f(t, x)`; its tangent pass reuses that table).
+    fn filled_at(&self, t: f64, x: &[f64]) -> bool {
+        let k = self.filled.borrow();
+        k.valid
+            && k.t.to_bits() == t.to_bits()
+            && k.x.len() == x.len()
+            && k.x.iter().zip(x).all(|(a, b)| a.to_bits() == b.to_bits())
     }
 
     /// Publish + evaluate: every wire is current for `(t, x)`.
     fn fill(&self, t: f64, x: &[f64]) {
+        {
+            let mut k = self.filled.borrow_mut();
+            k.valid = true;
+            k.t = t;
+            k.x.clear();
+            k.x.extend_from_slice(x);
+        }
         let mut w = self.wires.borrow_mut();
         for &a in &self.accumulators {
             w.zero(a);
@@ -730,6 +761,8 @@ impl OdeSystem for Circuit {
         for (i, c) in self.comps.iter_mut().enumerate() {
             c.after_event(t, &mut x[self.offsets[i]..self.offsets[i + 1]], &w);
         }
+        // modes and states changed after the last evaluation
+        self.filled.borrow_mut().valid = false;
         action
     }
 }

@@ -166,7 +166,9 @@ impl Circuit {
         if !self.has_jacobian() {
             return false;
         }
-        self.fill(t, x);
+        if !self.filled_at(t, x) {
+            self.fill(t, x);
+        }
         let w = self.wires.borrow();
         let mut tg = self.tangents.borrow_mut();
         let (n, dim) = (self.n_states, hydrocyl_integrators::OdeSystem::dim(self));

@@ -123,6 +123,11 @@ impl Probe {
 /// 3. [`derivatives`](Component::derivatives) on every stateful component.
 ///
 /// Each component sees only its own slice of the state vector.
+///
+/// For the stiff solver's Jacobian a component may also give its tangents
+/// ([`has_tangents`](Component::has_tangents) and the `*_tangents` methods,
+/// mirroring the three calls above; see [`Tangents`]); a circuit with one
+/// component without them falls back to finite differences.
 pub trait Component {
     /// Instance name (unique in a circuit), used in errors and reports.
     fn name(&self) -> &str;

@@ -90,10 +90,15 @@ impl Tangents {
     /// `∂ẋ_k += c · ∂source` for the component's own state `k`.
     #[inline]
     pub fn rate_chain(&mut self, k: usize, c: f64, source: impl Into<AnyWire>) {
+        self.rates_chain(self.offset + k, c, source.into());
+    }
+
+    /// `rates[r] += c · ∂source`.
+    fn rates_chain(&mut self, r: usize, c: f64, source: AnyWire) {
         if c == 0.0 {
             return;
         }
-        let (r, s, m) = (self.offset + k, source.into().0, self.width);
+        let (s, m) = (source.0, self.width);
         Self::add_row(
             &mut self.rates[r * m..(r + 1) * m],
             c,
@@ -110,15 +115,7 @@ impl Tangents {
     /// `∂q_k += c · ∂source` for the component's own quadrature `k`.
     #[inline]
     pub fn quadrature_chain(&mut self, k: usize, c: f64, source: impl Into<AnyWire>) {
-        if c == 0.0 {
-            return;
-        }
-        let (r, s, m) = (self.q_offset + k, source.into().0, self.width);
-        Self::add_row(
-            &mut self.rates[r * m..(r + 1) * m],
-            c,
-            &self.rows[s * m..(s + 1) * m],
-        );
+        self.rates_chain(self.q_offset + k, c, source.into());
     }
 
     /// A resistive two-port: a flow `q` with `∂q/∂p_from = g` and

@@ -5,12 +5,12 @@
 //!
 //! 1. [`Component::publish_tangents`]: the rows of the efforts a component
 //!    sets from its own states (`∂p/∂x_k = 1` for a volume's pressure);
-//! 2. [`Component::evaluate_tangents`] in dependency order: the component's
+//! 2. [`Component::evaluate_tangents`](crate::Component::evaluate_tangents) in dependency order: the component's
 //!    local partials (an orifice's `∂Q/∂p_a`, a friction law's `∂F/∂v`)
 //!    chained onto the rows of the wires it reads, added into the rows of the
 //!    wires it writes;
 //! 3. [`Component::derivative_tangents`]: the rows of `∂ẋ/∂x` (and
-//!    [`Component::quadrature_tangents`] for the quadratures).
+//!    [`Component::quadrature_tangents`](crate::Component::quadrature_tangents) for the quadratures).
 //!
 //! An algebraic node's pressure ([`crate::series`]) is implicit: its members
 //! run with the node pressure's row set to a unit vector in an extra column,
@@ -19,7 +19,7 @@
 //! has its extra column folded into the state columns with it.
 //!
 //! A circuit has an analytic Jacobian when every component says it has
-//! ([`Component::has_tangents`]); otherwise, and while the energy ledger is
+//! ([`Component::has_tangents`](crate::Component::has_tangents)); otherwise, and while the energy ledger is
 //! on, the stiff solver differences the right-hand side as before. At a
 //! non-smooth point (a valve's cracking pressure, a stick/slip switch) each
 //! component gives the one-sided derivative of the branch its evaluation
@@ -144,7 +144,7 @@ impl Tangents {
 
 impl Circuit {
     /// Whether the circuit gives the stiff solver an analytic Jacobian:
-    /// every component has tangents ([`Component::has_tangents`]) and the
+    /// every component has tangents ([`Component::has_tangents`](crate::Component::has_tangents)) and the
     /// energy ledger is off.
     pub fn has_jacobian(&self) -> bool {
         self.analytic && !self.ledger

@@ -93,6 +93,9 @@ impl<M: FrictionModel> FrictionModel for WithSealTerms<M> {
         self.inner.acceleration_coefficient(input)
             + Mass::new(self.terms.k_pressure * self.terms.h_acceleration)
     }
+    fn acceleration_coefficient_slope(&self, input: &FrictionInput) -> f64 {
+        self.inner.acceleration_coefficient_slope(input)
+    }
     fn state_derivative(&self, input: &FrictionInput, state: &[f64], dstate: &mut [f64]) {
         self.inner.state_derivative(input, state, dstate)
     }

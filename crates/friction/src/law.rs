@@ -97,6 +97,9 @@ impl FrictionModel for FrictionLaw {
     fn jacobian(&self, input: &FrictionInput, state: &[f64]) -> FrictionJacobian {
         each!(self, m => m.jacobian(input, state))
     }
+    fn acceleration_coefficient_slope(&self, input: &FrictionInput) -> f64 {
+        each!(self, m => m.acceleration_coefficient_slope(input))
+    }
     fn stored_energy(&self, state: &[f64]) -> Energy {
         each!(self, m => m.stored_energy(state))
     }

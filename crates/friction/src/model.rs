@@ -112,6 +112,14 @@ pub trait FrictionModel {
         Mass::ZERO
     }
 
+    /// `∂c/∂v` of [`acceleration_coefficient`](FrictionModel::acceleration_coefficient)
+    /// \[kg·s·m⁻¹\], for the analytic Jacobian: zero (the default) for a
+    /// constant coefficient; a model whose coefficient moves with the
+    /// velocity overrides it.
+    fn acceleration_coefficient_slope(&self, _input: &FrictionInput) -> f64 {
+        0.0
+    }
+
     /// Time derivative of the internal states.
     fn state_derivative(&self, _input: &FrictionInput, _state: &[f64], _dstate: &mut [f64]) {}
 

@@ -255,6 +255,15 @@ impl FrictionModel for Wang {
         Mass::new(mean + half_jump * v / (v * v + a * a).sqrt())
     }
 
+    /// `d/dv [c̄ + (Δc/2) v/√(v² + a²)] = (Δc/2) a²/(v² + a²)^{3/2}`.
+    fn acceleration_coefficient_slope(&self, input: &FrictionInput) -> f64 {
+        let (_, half_jump) = self.added_mass_levels();
+        let v = input.velocity.si();
+        let a = ACCELERATION_BLEND_VELOCITY;
+        let r2 = v * v + a * a;
+        half_jump * a * a / (r2 * r2.sqrt())
+    }
+
     fn state_derivative(&self, input: &FrictionInput, state: &[f64], dstate: &mut [f64]) {
         let v = input.velocity.si();
         let s = self.set_for(v, input.acceleration.si());

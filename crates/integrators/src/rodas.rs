@@ -175,6 +175,10 @@ impl Rodas4 {
         sys.rhs(t, x, &mut self.f0);
         stats.rhs_evals += 1;
         self.lin_bad = first_nonfinite(&self.f0);
+        // the model's Jacobian right after f(t, x), so that a model can reuse
+        // that evaluation for it (the circuit's tangent pass does)
+        stats.jac_evals += 1;
+        let analytic = sys.jacobian(t, x, &mut self.jac);
         // ∂f/∂t by a forward difference.
         let t_plus = t + sqrt_eps * t.abs().max(h);
         let dt = t_plus - t;
@@ -184,8 +188,7 @@ impl Rodas4 {
         for i in 0..n {
             self.ft[i] = (self.fy[i] - self.f0[i]) / dt;
         }
-        stats.jac_evals += 1;
-        if !sys.jacobian(t, x, &mut self.jac) {
+        if !analytic {
             self.y.copy_from_slice(x);
             // quadrature columns are zero: nothing depends on a quadrature
             for j in 0..n {

@@ -1,7 +1,8 @@
 //! Criterion bench of the `wang-hybrid` rig: simulated seconds per wall
 //! second for the chapter-7 square-wave test (±50 mm/s, 0.2 Hz, no added
 //! load, one 5 s period, Rosenbrock, rtol 1e-6), output every 1 ms, with
-//! and without the mass-balance quadratures. The goal is 500× real time.
+//! and without the mass-balance quadratures, and with the finite-difference
+//! Jacobian in place of the circuit's analytic one. The goal is 500× real time.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use hydrocyl_studies::chapter7::{Chapter7Test, Load, Shape};
@@ -17,20 +18,22 @@ fn square_period(c: &mut Criterion) {
     // simulated ms per wall second, i.e. 1000 x the real-time factor
     g.throughput(Throughput::Elements(5000));
     g.sample_size(10);
-    for quadratures in [false, true] {
+    // the circuit's analytic Jacobian (issue 13 item 9), and the same run
+    // with the finite-difference Jacobian it replaced, as an in-run reference
+    for (name, quadratures, analytic) in [
+        ("plain", false, true),
+        ("with mass balance", true, true),
+        ("plain, finite-difference Jacobian", false, false),
+    ] {
         let opts = RunOptions {
             solver: Solver::Rosenbrock,
             quadratures,
             ..RunOptions::default()
         };
-        let name = if quadratures {
-            "with mass balance"
-        } else {
-            "plain"
-        };
         g.bench_function(name, |b| {
             b.iter(|| {
                 let mut circ = rig.build(test.command(&rig)).expect("rig");
+                circ.set_analytic_jacobian(analytic);
                 let x0 = circ.initial_state();
                 circ.reset(0.0, &x0);
                 black_box(run(&mut circ, &x0, &t, &opts).expect("run").stats.steps)

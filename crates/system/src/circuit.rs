@@ -10,6 +10,9 @@ use thiserror::Error;
 
 use crate::series::{SeriesGroup, Step};
 
+mod jacobian;
+pub use jacobian::Tangents;
+
 pub use crate::binding::{Causality, Netlist};
 pub use crate::wires::{Acc, AnyWire, HydraulicNode, MechanicalNode, ReadWire, Wire, Wires};
 
@@ -120,6 +123,11 @@ impl Probe {
 /// 3. [`derivatives`](Component::derivatives) on every stateful component.
 ///
 /// Each component sees only its own slice of the state vector.
+///
+/// For the stiff solver's Jacobian a component may also give its tangents
+/// ([`has_tangents`](Component::has_tangents) and the `*_tangents` methods,
+/// mirroring the three calls above; see [`Tangents`]); a circuit with one
+/// component without them falls back to finite differences.
 pub trait Component {
     /// Instance name (unique in a circuit), used in errors and reports.
     fn name(&self) -> &str;
@@ -172,6 +180,32 @@ pub trait Component {
 
     /// Time derivatives of its states (all accumulators are complete here).
     fn derivatives(&self, _t: f64, _x: &[f64], _w: &Wires, _dx: &mut [f64]) {}
+
+    /// Whether this component gives the analytic Jacobian's tangents (the
+    /// four `*_tangents` methods below; see [`Tangents`]). `false` (the
+    /// default) makes the whole circuit fall back to finite differences, so
+    /// a component without them keeps working.
+    fn has_tangents(&self) -> bool {
+        false
+    }
+
+    /// The gradient rows of the efforts [`publish`](Component::publish)
+    /// sets, with respect to its own states ([`Tangents::state`]).
+    fn publish_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, _d: &mut Tangents) {}
+
+    /// The gradient rows of what [`evaluate`](Component::evaluate) writes:
+    /// its local partials chained onto the rows of the wires it reads
+    /// ([`Tangents::chain`]) and onto its own states ([`Tangents::state`]),
+    /// for the branch (mode, regime) the evaluation at `w` took.
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, _d: &mut Tangents) {}
+
+    /// The rows of `∂ẋ/∂x` of its states ([`Tangents::rate_chain`],
+    /// [`Tangents::rate_state`]); every wire's row is complete here.
+    fn derivative_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, _d: &mut Tangents) {}
+
+    /// The rows of its quadratures' integrands ([`Tangents::quadrature_chain`],
+    /// [`Tangents::quadrature_state`]).
+    fn quadrature_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, _d: &mut Tangents) {}
 
     /// Whether [`evaluate`](Component::evaluate) must run after every other
     /// component's, to read complete accumulators (an imposed-motion source
@@ -262,6 +296,19 @@ pub struct Circuit {
     n_quad: usize,
     wire_names: Vec<String>,
     probe_names: Option<Vec<Option<String>>>,
+    /// Every component has tangents and the analytic Jacobian is wanted.
+    analytic: bool,
+    tangents: RefCell<Tangents>,
+    /// The point of the last [`Circuit::fill`], while no mode changed since.
+    filled: RefCell<FillKey>,
+}
+
+/// Where the wire table was last evaluated (see [`Circuit::filled_at`]).
+#[derive(Debug, Default)]
+struct FillKey {
+    valid: bool,
+    t: f64,
+    x: Vec<f64>,
 }
 
 impl std::fmt::Debug for Circuit {
@@ -329,6 +376,7 @@ impl Circuit {
         offsets.push(s);
         ev_offsets.push(e);
         q_offsets.push(q);
+        let analytic = comps.iter().all(|c| c.has_tangents());
         Ok(Self {
             comps,
             offsets,
@@ -348,6 +396,9 @@ impl Circuit {
             n_quad: q,
             wire_names: net.names,
             probe_names: None,
+            analytic,
+            tangents: RefCell::new(Tangents::default()),
+            filled: RefCell::new(FillKey::default()),
         })
     }
 
@@ -560,10 +611,30 @@ impl Circuit {
         for (i, c) in self.comps.iter_mut().enumerate() {
             c.reset(t, &x[self.offsets[i]..self.offsets[i + 1]], &w);
         }
+        // the components' modes may have changed: the table is stale
+        self.filled.borrow_mut().valid = false;
+    }
+
+    /// Whether the wire table holds the evaluation at exactly `(t, x)` with
+    /// the components' modes as they are now (the stiff solver asks for the
+    /// Jacobian right after `f(t, x)`; its tangent pass reuses that table).
+    fn filled_at(&self, t: f64, x: &[f64]) -> bool {
+        let k = self.filled.borrow();
+        k.valid
+            && k.t.to_bits() == t.to_bits()
+            && k.x.len() == x.len()
+            && k.x.iter().zip(x).all(|(a, b)| a.to_bits() == b.to_bits())
     }
 
     /// Publish + evaluate: every wire is current for `(t, x)`.
     fn fill(&self, t: f64, x: &[f64]) {
+        {
+            let mut k = self.filled.borrow_mut();
+            k.valid = true;
+            k.t = t;
+            k.x.clear();
+            k.x.extend_from_slice(x);
+        }
         let mut w = self.wires.borrow_mut();
         for &a in &self.accumulators {
             w.zero(a);
@@ -650,6 +721,12 @@ impl OdeSystem for Circuit {
         }
     }
 
+    /// The analytic Jacobian (see [`Tangents`]) where every component has
+    /// one and the ledger is off; finite differences otherwise.
+    fn jacobian(&self, t: f64, x: &[f64], jac: &mut [f64]) -> bool {
+        self.analytic_jacobian(t, x, jac)
+    }
+
     fn next_breakpoint(&self, t: f64) -> f64 {
         self.comps
             .iter()
@@ -689,6 +766,8 @@ impl OdeSystem for Circuit {
         for (i, c) in self.comps.iter_mut().enumerate() {
             c.after_event(t, &mut x[self.offsets[i]..self.offsets[i + 1]], &w);
         }
+        // modes and states changed after the last evaluation
+        self.filled.borrow_mut().valid = false;
         action
     }
 }

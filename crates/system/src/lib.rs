@@ -142,5 +142,5 @@ mod wires;
 
 pub use circuit::{
     Acc, AnyWire, BuildError, Causality, Circuit, Component, HydraulicNode, MechanicalNode,
-    Netlist, PowerTerms, Probe, ReadWire, Wire, Wires,
+    Netlist, PowerTerms, Probe, ReadWire, Tangents, Wire, Wires,
 };

@@ -71,6 +71,9 @@ impl Component for AlgebraicNode {
     fn name(&self) -> &str {
         &self.name
     }
+    fn has_tangents(&self) -> bool {
+        true
+    }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.node = net.solve_hydraulic(&self.node_name)?;
         Ok(())
@@ -116,6 +119,11 @@ pub(crate) struct SeriesGroup {
 }
 
 impl SeriesGroup {
+    /// Every wire a member may write (the node's pressure among them).
+    pub(crate) fn writes(&self) -> &[usize] {
+        &self.writes
+    }
+
     /// Forgets the last solution and slope (a run from a given state solves
     /// the same way whatever ran before).
     pub(crate) fn forget(&self) {
@@ -210,7 +218,10 @@ impl SeriesGroup {
 /// step takes `warm` (the slope at the previous solve's root) when it is a
 /// usable (negative) number: near the root the secant is as good as the
 /// analytic slope, and a warm-started solve then costs the residual
-/// evaluations alone. Returns the root and the slope there.
+/// evaluations alone. A first step that would end the solve on the warm
+/// slope is checked again on the members' slope at that point (a stale,
+/// steeper warm slope would otherwise accept an unconverged residual).
+/// Returns the root and the slope there.
 fn newton(
     f: &mut impl FnMut(f64, &mut Wires) -> f64,
     slope: &impl Fn(&Wires) -> Option<f64>,
@@ -223,10 +234,12 @@ fn newton(
     let mut p = p0;
     let mut last_step = f64::INFINITY;
     let mut prev: Option<(f64, f64)> = None;
+    let mut last_slope = warm;
     for k in 0..NEWTON_ITERATIONS {
         let r = f(p, w);
         if r == 0.0 {
-            return Some((p, prev.map_or(warm, |(_, s)| s)));
+            // the slope of the step that got here (not the last residual)
+            return Some((p, last_slope));
         }
         // the inflow falls with p: a positive residual puts the root above p
         if r > 0.0 {
@@ -238,17 +251,36 @@ fn newton(
             let s = (r - rp) / (p - pp);
             (s < 0.0 && s.is_finite()).then_some(s)
         });
-        let s = match secant {
+        let warm_step = secant.is_none() && k == 0 && warm < 0.0 && warm.is_finite();
+        let mut s = match secant {
             Some(s) => s,
-            None if k == 0 && warm < 0.0 && warm.is_finite() => warm,
+            None if warm_step => warm,
             None => slope(w)?,
         };
-        let step = if s < 0.0 { -r / s } else { f64::NAN };
+        let mut step = if s < 0.0 { -r / s } else { f64::NAN };
+        let mut confirmed = true;
+        if warm_step && step.abs() <= tol {
+            // the warm slope is the last solve's: a stale, steeper one would
+            // shrink the step and accept a residual that is not converged, so
+            // convergence is confirmed on the members' slope here (without
+            // one, the step is taken and the secant decides)
+            confirmed = match slope(w) {
+                Some(fresh) => {
+                    s = fresh;
+                    step = if s < 0.0 { -r / s } else { f64::NAN };
+                    true
+                }
+                None => false,
+            };
+        }
         // converged, or at the rounding floor (a step that stopped shrinking)
-        if step.abs() <= tol || (step.abs() <= 1e3 * tol && step.abs() >= 0.5 * last_step) {
+        if confirmed
+            && (step.abs() <= tol || (step.abs() <= 1e3 * tol && step.abs() >= 0.5 * last_step))
+        {
             return Some((p, s));
         }
         last_step = step.abs();
+        last_slope = s;
         prev = Some((p, r));
         let next = p + step;
         p = if next > a && next < b {
@@ -531,6 +563,27 @@ mod tests {
         let e = Circuit::build(parts).unwrap_err();
         assert!(matches!(e, BuildError::NoOwner { .. }), "{e}");
         assert!(e.to_string().contains("`M`"), "{e}");
+    }
+
+    #[test]
+    fn a_stale_warm_slope_does_not_accept_an_unconverged_root() {
+        // root at 1, slope −1e-3; the last solve's slope was 1e6 times
+        // steeper: its step from 1 + 1e-9 looks converged, the true one not
+        let mut f = |p: f64, _: &mut Wires| -1e-3 * (p - 1.0);
+        let slope = |_: &Wires| Some(-1e-3);
+        let mut w = Wires::default();
+        let tol = 1e-12;
+        let (p, s) = newton(&mut f, &slope, &mut w, 1.0 + 1e-9, (0.0, 2.0), tol, -1e3).unwrap();
+        assert!((p - 1.0).abs() <= tol, "{p}");
+        assert!((s + 1e-3).abs() < 1e-9, "{s}");
+        // a usable warm slope still converges in one residual when it is right
+        let mut calls = 0;
+        let mut g = |p: f64, _: &mut Wires| {
+            calls += 1;
+            -1e-3 * (p - 1.0)
+        };
+        let (p, _) = newton(&mut g, &slope, &mut w, 1.0 + 1e-13, (0.0, 2.0), tol, -1e-3).unwrap();
+        assert!((p - 1.0).abs() <= tol && calls == 1, "{p} {calls}");
     }
 
     #[test]

@@ -167,6 +167,34 @@ impl PilotFourWay {
         Position::new(s * d.signum())
     }
 
+    /// `∂s/∂(pp1 − pp2)` of [`PilotFourWay::spool_travel`] \[m·Pa⁻¹\]:
+    /// `1/spring_rate` while the spool moves, zero on the overlap and at the
+    /// end of its stroke (the one-sided slope of the branch it is on).
+    #[inline]
+    pub fn spool_travel_slope(&self, pp1: Pressure, pp2: Pressure) -> f64 {
+        let u = (pp1 - pp2).si().abs() / self.spring_rate - self.overlap.si();
+        if u > 0.0 && u < self.stroke.si() {
+            1.0 / self.spring_rate
+        } else {
+            0.0
+        }
+    }
+
+    /// `∂y/∂(pp1 − pp2)` of [`PilotFourWay::opening`] \[Pa⁻¹\]: the hole's
+    /// chord `2√(2rh − h²)` at travel `h` over the full segment area, times
+    /// [`PilotFourWay::spool_travel_slope`].
+    #[inline]
+    pub fn opening_slope(&self, pp1: Pressure, pp2: Pressure) -> f64 {
+        let ds = self.spool_travel_slope(pp1, pp2);
+        if ds == 0.0 {
+            return 0.0;
+        }
+        let h = self.spool_travel(pp1, pp2).si().abs();
+        let r = self.hole_radius.si();
+        let chord = 2.0 * (2.0 * r * h - h * h).max(0.0).sqrt();
+        chord / segment_area(self.stroke.si(), r) * ds
+    }
+
     /// Open fraction of the ports in `[0, 1]` at spool travel `s` (sign ignored).
     #[inline]
     pub fn open_fraction(&self, s: Position) -> f64 {

@@ -1,7 +1,7 @@
 //! A position controller: P or PI on the piston position, its output (the
 //! valve command) clipped to limits.
 
-use crate::circuit::{BuildError, Causality, Component, Netlist, Probe, Wire, Wires};
+use crate::circuit::{BuildError, Causality, Component, Netlist, Probe, Tangents, Wire, Wires};
 use crate::wires::MechanicalNode;
 
 /// The controller's law: `u = clip(Kp (e + I/Ti) + u0, lo, hi)` with the error
@@ -106,6 +106,31 @@ impl PositionController {
 impl Component for PositionController {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
+        let i = x.first().copied().unwrap_or(0.0);
+        let raw = self.law.raw(self.error(w), i);
+        // flat where the output is clipped
+        if raw <= self.law.output_min || raw >= self.law.output_max {
+            return;
+        }
+        let k = self.law.gain;
+        d.chain(self.out, k, self.reference);
+        d.chain(self.out, -k, self.rod.position);
+        if self.has_integral() {
+            d.state(self.out, 0, k / self.law.integral_time);
+        }
+    }
+    fn derivative_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
+        let e = self.error(w);
+        // the anti-windup branch `integral_rate` takes
+        if self.law.integral_rate(e, x[0]) == e {
+            d.rate_chain(0, 1.0, self.reference);
+            d.rate_chain(0, -1.0, self.rod.position);
+        }
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         let l = self.law;

@@ -2,7 +2,7 @@
 
 use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe,
-    Wire, Wires,
+    Tangents, Wire, Wires,
 };
 use hydrocyl_actuator::Cylinder;
 use hydrocyl_integrators::{Crossing, EventAction};
@@ -93,6 +93,57 @@ impl TwoChamberCylinder {
 impl Component for TwoChamberCylinder {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn publish_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.state(self.a.pressure, 0, 1.0);
+        d.state(self.b.pressure, 1, 1.0);
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        let (a1, a2) = (self.cylinder.area_1.si(), self.cylinder.area_2.si());
+        let ae = self.cylinder.effective_area().si();
+        d.state(self.rod.force, 0, a1);
+        d.state(self.rod.force, 1, -a2);
+        d.state(self.p_le, 0, a1 / ae);
+        d.state(self.p_le, 1, -a2 / ae);
+    }
+    fn derivative_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
+        // dp1/dt = B/V1 (Q1 − Cl (p1 − p2) − Ce1 p1 − A1 v), V1 = A1 (L1 + x);
+        // dp2/dt = B/V2 (A2 v + Cl (p1 − p2) − Ce2 p2 + Q2_in), V2 = A2 (L2 − x)
+        let c = &self.cylinder;
+        let (a1, a2, b) = (c.area_1.si(), c.area_2.si(), c.bulk_modulus.si());
+        let (cl, ce1, ce2) = (
+            c.internal_leakage,
+            c.external_leakage_1,
+            c.external_leakage_2,
+        );
+        let (v1, v2) = c.volumes(w.get(self.rod.position));
+        let (v1, v2) = (v1.si(), v2.si());
+        let (d1, d2) = self.rates(x, w);
+        let (k1, k2) = (b / v1, b / v2);
+        d.rate_chain(0, k1, self.a.inflow);
+        d.rate_state(0, 0, -k1 * (cl + ce1));
+        d.rate_state(0, 1, k1 * cl);
+        d.rate_chain(0, -k1 * a1, self.rod.velocity);
+        d.rate_chain(0, -d1 / v1 * a1, self.rod.position);
+        d.rate_chain(1, k2, self.b.inflow);
+        d.rate_state(1, 0, k2 * cl);
+        d.rate_state(1, 1, -k2 * (cl + ce2));
+        d.rate_chain(1, k2 * a2, self.rod.velocity);
+        d.rate_chain(1, d2 / v2 * a2, self.rod.position);
+    }
+    fn quadrature_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
+        let v = w.get(self.rod.velocity).si();
+        let b = self.cylinder.bulk_modulus.si();
+        let (a1, a2) = (self.cylinder.area_1.si(), self.cylinder.area_2.si());
+        d.quadrature_chain(0, 1.0, self.a.inflow);
+        d.quadrature_chain(1, 1.0, self.b.inflow);
+        d.quadrature_state(2, 0, a1 * v / b);
+        d.quadrature_chain(2, x[0] * a1 / b, self.rod.velocity);
+        d.quadrature_state(3, 1, a2 * v / b);
+        d.quadrature_chain(3, x[1] * a2 / b, self.rod.velocity);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.cylinder

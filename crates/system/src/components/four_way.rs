@@ -1,7 +1,7 @@
 //! The servovalve's four-way metering (eqs 2.8, 2.9, 3.2).
 
 use crate::circuit::{
-    BuildError, Component, HydraulicNode, Netlist, PowerTerms, Probe, Wire, Wires,
+    BuildError, Component, HydraulicNode, Netlist, PowerTerms, Probe, Tangents, Wire, Wires,
 };
 use hydrocyl_ports::{Position, Pressure};
 use hydrocyl_valves::servovalve::Metering;
@@ -80,9 +80,91 @@ impl FourWayValve {
     }
 }
 
+impl FourWayValve {
+    /// The tangents of [`FourWayValve::evaluate`]: the four metering edges'
+    /// conductances and area gradients chained onto the spool and port
+    /// pressures, the drooped supply by the implicit function theorem on
+    /// `ps + R_s Q_P(ps) = p_P`.
+    fn flow_tangents(&self, w: &Wires, d: &mut Tangents) {
+        let m = &self.metering;
+        let o = &m.orifice;
+        let xs = w.get(self.spool).si();
+        // d(effective travel)/d(spool): the dead band is flat
+        let dxe = if self.dead_band > 0.0 && xs.abs() <= self.dead_band {
+            0.0
+        } else {
+            1.0
+        };
+        let x = xs.signum() * (xs.abs() - self.dead_band).max(0.0) + m.null_bias.si();
+        let x = if self.dead_band > 0.0 {
+            x
+        } else {
+            xs + m.null_bias.si()
+        };
+        let (wg, u0) = (m.area_gradient(), m.underlap.si());
+        let areas = m.areas(Position::new(x - m.null_bias.si()));
+        // ∂A/∂x of each pair of edges (zero where an edge is shut)
+        let da1 = if u0 + x > 0.0 { wg * dxe } else { 0.0 };
+        let da2 = if u0 - x > 0.0 { -wg * dxe } else { 0.0 };
+        let pr = |n: &HydraulicNode| w.get(n.pressure);
+        let (ps, pt, pa, pb) = (w.get(self.ps), pr(&self.t), pr(&self.a), pr(&self.b));
+        let unit = hydrocyl_ports::Area::new(1.0);
+        // conductance and ∂Q/∂A of an edge
+        let edge = |area, up, down| (o.conductance(area, up, down), o.flow(unit, up, down).si());
+        let (g1, c1) = edge(areas.av1, ps, pa);
+        let (g2, c2) = edge(areas.av2, pa, pt);
+        let (g3, c3) = edge(areas.av1, pb, pt);
+        let (g4, c4) = edge(areas.av2, ps, pb);
+        // the supply pressure the edges see
+        let rs = self.supply_resistance;
+        let qx_p = c1 * da1 + c4 * da2;
+        if rs == 0.0 {
+            d.chain(self.ps, 1.0, self.p.pressure);
+        } else {
+            let den = 1.0 + rs * (g1 + g4);
+            d.chain(self.ps, 1.0 / den, self.p.pressure);
+            d.chain(self.ps, rs * g1 / den, self.a.pressure);
+            d.chain(self.ps, rs * g4 / den, self.b.pressure);
+            d.chain(self.ps, -rs * qx_p / den, self.spool);
+        }
+        // (accumulator, sign, [∂/∂ps, ∂/∂pa, ∂/∂pb, ∂/∂pt, ∂/∂x])
+        let rows = [
+            (
+                self.a.inflow,
+                1.0,
+                [g1, -g1 - g2, 0.0, g2, c1 * da1 - c2 * da2],
+            ),
+            (
+                self.b.inflow,
+                -1.0,
+                [-g4, 0.0, g3 + g4, -g3, c3 * da1 - c4 * da2],
+            ),
+            (self.p.inflow, -1.0, [g1 + g4, -g1, -g4, 0.0, qx_p]),
+            (
+                self.t.inflow,
+                1.0,
+                [0.0, g2, g3, -g2 - g3, c2 * da2 + c3 * da1],
+            ),
+        ];
+        for (acc, sign, [dps, dpa, dpb, dpt, dx]) in rows {
+            d.chain(acc, sign * dps, self.ps);
+            d.chain(acc, sign * dpa, self.a.pressure);
+            d.chain(acc, sign * dpb, self.b.pressure);
+            d.chain(acc, sign * dpt, self.t.pressure);
+            d.chain(acc, sign * dx, self.spool);
+        }
+    }
+}
+
 impl Component for FourWayValve {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        self.flow_tangents(w, d);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.metering

@@ -1,7 +1,7 @@
 //! A friction law acting on a rod.
 
 use crate::circuit::{
-    BuildError, Component, MechanicalNode, Netlist, PowerTerms, Probe, Wire, Wires,
+    BuildError, Component, MechanicalNode, Netlist, PowerTerms, Probe, Tangents, Wire, Wires,
 };
 use hydrocyl_friction::{FrictionInput, FrictionMode, FrictionModel};
 use hydrocyl_integrators::{Crossing, EventAction};
@@ -77,6 +77,36 @@ impl Friction {
 impl Component for Friction {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        // the friction Jacobian has one internal state at most
+        self.model.n_states() <= 1
+    }
+    fn evaluate_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
+        if self.mode == FrictionMode::Stick {
+            return; // the mass holds: the force is the drive's, dv/dt = 0
+        }
+        let input = self.input(w);
+        let j = self.model.jacobian(&input, x);
+        d.chain(self.force, j.df_dv, self.rod.velocity);
+        if let (Some(p1), Some(p2)) = (self.p1, self.p2) {
+            d.chain(self.force, j.df_dp1, p1);
+            d.chain(self.force, j.df_dp2, p2);
+        }
+        if !x.is_empty() {
+            d.state(self.force, 0, j.df_dz);
+        }
+        d.chain(self.rod.force, -1.0, self.force);
+        d.chain(
+            self.rod.added_mass,
+            self.model.acceleration_coefficient_slope(&input),
+            self.rod.velocity,
+        );
+    }
+    fn derivative_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
+        let j = self.model.jacobian(&self.input(w), x);
+        d.rate_state(0, 0, j.dzdot_dz);
+        d.rate_chain(0, j.dzdot_dv, self.rod.velocity);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.model.validate().map_err(|e| BuildError::Component {

@@ -1,6 +1,8 @@
 //! The moving mass with stroke-end stops (eq 2.27).
 
-use crate::circuit::{BuildError, Component, MechanicalNode, Netlist, PowerTerms, Probe, Wires};
+use crate::circuit::{
+    BuildError, Component, MechanicalNode, Netlist, PowerTerms, Probe, Tangents, Wires,
+};
 use hydrocyl_actuator::StrokeEnds;
 use hydrocyl_integrators::{Crossing, EventAction};
 use hydrocyl_ports::{Force, MechanicalPort, Position, Velocity};
@@ -66,6 +68,24 @@ impl Mass {
 impl Component for Mass {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn publish_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.state(self.rod.position, 0, 1.0);
+        d.state(self.rod.velocity, 1, 1.0);
+    }
+    fn derivative_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        // the branch `derivatives` takes: held, free, or resting at a stop
+        if w.get(self.rod.hold) > 0.0 {
+            d.rate_state(0, 1, 1.0);
+        } else if self.mode == StopMode::Free {
+            d.rate_state(0, 1, 1.0);
+            let m = self.mass + w.get(self.rod.added_mass).si();
+            d.rate_chain(1, 1.0 / m, self.rod.force);
+            d.rate_chain(1, -self.net_force(w) / (m * m), self.rod.added_mass);
+        }
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         if !(self.mass > 0.0 && self.mass.is_finite()) {

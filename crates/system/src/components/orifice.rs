@@ -1,6 +1,8 @@
 //! A fixed sharp-edged orifice between two nodes.
 
-use crate::circuit::{BuildError, Component, HydraulicNode, Netlist, PowerTerms, Wire, Wires};
+use crate::circuit::{
+    BuildError, Component, HydraulicNode, Netlist, PowerTerms, Tangents, Wire, Wires,
+};
 use hydrocyl_ports::{Pressure, VolumeFlow};
 use hydrocyl_valves::orifice::Orifice;
 
@@ -40,6 +42,15 @@ impl FixedOrifice {
 impl Component for FixedOrifice {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        let g = self
+            .orifice
+            .conductance(self.area, w.get(self.a.pressure), w.get(self.b.pressure));
+        d.resistive(self.a, self.b, g, None);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.a = net.hydraulic(&self.a_name);

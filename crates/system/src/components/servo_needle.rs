@@ -15,7 +15,9 @@
 //! modelled). Switching functions: `u = 0` and the opening reaching `A_max`
 //! (the law's kinks), and the reverse check's cracking.
 
-use crate::circuit::{BuildError, Causality, Component, Netlist, PowerTerms, Probe, Wire};
+use crate::circuit::{
+    BuildError, Causality, Component, Netlist, PowerTerms, Probe, Tangents, Wire,
+};
 use crate::wires::HydraulicNode;
 use crate::Wires;
 use hydrocyl_integrators::{Crossing, EventAction};
@@ -112,6 +114,31 @@ impl ServoNeedle {
 impl Component for ServoNeedle {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        let v = self.valve(w);
+        let (pi, po) = (w.get(self.i.pressure), w.get(self.o.pressure));
+        d.resistive(self.i, self.o, v.conductance(pi, po), None);
+        // the opening law's slope on the branch the command is on
+        let u = w.get(self.command);
+        let da = if self.law.raw(u) > self.law.area_max {
+            0.0
+        } else if u > 0.0 {
+            self.law.gain_positive
+        } else if u < 0.0 {
+            -self.law.gain_negative
+        } else {
+            0.0
+        };
+        // the metered flow is linear in the area
+        let unit = Area::new(1.0);
+        let dq = da * v.effective_factor * v.orifice.flow(unit, pi, po).si();
+        d.chain(self.opening, da, self.command);
+        d.chain(self.i.inflow, -dq, self.command);
+        d.chain(self.o.inflow, dq, self.command);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         let bad = |message: String| BuildError::Component {

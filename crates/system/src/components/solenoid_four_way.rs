@@ -17,7 +17,9 @@
 //! at `u = ±u_d` ends a step at every change of target. Power is dissipated
 //! only in the four orifices (the massless spool stores none).
 
-use crate::circuit::{BuildError, Causality, Component, Netlist, PowerTerms, Probe, Wire};
+use crate::circuit::{
+    BuildError, Causality, Component, Netlist, PowerTerms, Probe, Tangents, Wire,
+};
 use crate::wires::HydraulicNode;
 use crate::Wires;
 use hydrocyl_integrators::{Crossing, EventAction};
@@ -129,6 +131,41 @@ impl SolenoidFourWay {
 impl Component for SolenoidFourWay {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn publish_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.state(self.spool, 0, 1.0);
+    }
+    fn evaluate_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
+        let p = self.pressures(w);
+        let s = x[0];
+        let o = &self.law.orifice;
+        let (ap, at) = (self.law.area_supply, self.law.area_return);
+        // (area per unit opening, ∂opening/∂s, from, to) of P1→A, B→T, P2→B, A→T
+        let (df, dr) = (f64::from(s > 0.0), -f64::from(s < 0.0));
+        let (f, r) = (s.max(0.0), (-s).max(0.0));
+        let edges = [
+            (ap, f, df, 0, 2),
+            (at, f, df, 3, 4),
+            (ap, r, dr, 1, 3),
+            (at, r, dr, 2, 4),
+        ];
+        let unit = Area::new(1.0);
+        for (area, open, dopen, from, to) in edges {
+            let (up, down) = (self.ports[from], self.ports[to]);
+            let g = o.conductance(area * open, p[from], p[to]);
+            d.resistive(up, down, g, None);
+            // the edge's flow is linear in its area
+            let dq = area.si() * dopen * o.flow(unit, p[from], p[to]).si();
+            d.state(up.inflow, 0, -dq);
+            d.state(down.inflow, 0, dq);
+        }
+    }
+    fn derivative_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        // the target is piecewise constant in the command (events at ±threshold)
+        d.rate_state(0, 0, -1.0 / self.law.time_constant);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         let bad = |message: String| BuildError::Component {

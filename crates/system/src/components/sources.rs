@@ -37,6 +37,9 @@ impl Component for PressureSource {
     fn name(&self) -> &str {
         &self.name
     }
+    fn has_tangents(&self) -> bool {
+        true
+    }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.node = net.own_hydraulic(&self.node_name, Causality::Stored)?;
         Ok(())
@@ -131,6 +134,9 @@ impl CommandInput {
 impl Component for CommandInput {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.out = net.own_signal(&self.output_name, Causality::Stored)?;

@@ -1,8 +1,8 @@
 //! The servovalve spool dynamics (eqs 2.2, 2.3/3.1).
 
-use crate::circuit::{BuildError, Causality, Component, Netlist, Probe, Wire, Wires};
+use crate::circuit::{BuildError, Causality, Component, Netlist, Probe, Tangents, Wire, Wires};
 use hydrocyl_ports::Position;
-use hydrocyl_valves::servovalve::Spool;
+use hydrocyl_valves::servovalve::{Spool, SpoolDynamics};
 
 /// The servovalve spool: normalised command in, spool position out
 /// (first- or second-order dynamics with saturation, eqs 2.2, 2.3/3.1).
@@ -37,6 +37,36 @@ impl ServoSpool {
 impl Component for ServoSpool {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn publish_tangents(&self, _t: f64, x: &[f64], _w: &Wires, d: &mut Tangents) {
+        // the position is clamped to the stroke: flat outside it
+        if x[0].abs() <= self.spool.stroke.si() {
+            d.state(self.out, 0, 1.0);
+        }
+    }
+    fn derivative_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        let xm = self.spool.stroke.si();
+        let u = w.get(self.input);
+        // demand = clamp(u x_m, ±x_m)
+        let dd = if (u * xm).abs() <= xm { xm } else { 0.0 };
+        match self.spool.dynamics {
+            SpoolDynamics::First { time_constant_s } => {
+                d.rate_chain(0, dd / time_constant_s, self.input);
+                d.rate_state(0, 0, -1.0 / time_constant_s);
+            }
+            SpoolDynamics::Second {
+                natural_frequency_rad_per_s: wn,
+                damping_ratio: z,
+            } => {
+                d.rate_state(0, 1, 1.0);
+                d.rate_chain(1, wn * wn * dd, self.input);
+                d.rate_state(1, 0, -wn * wn);
+                d.rate_state(1, 1, -2.0 * z * wn);
+            }
+        }
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.spool.validate().map_err(|e| BuildError::Component {

@@ -1,7 +1,7 @@
 //! A constant hydraulic volume (a capacitive node owner).
 
 use crate::circuit::{
-    BuildError, Causality, Component, HydraulicNode, Netlist, PowerTerms, Probe, Wires,
+    BuildError, Causality, Component, HydraulicNode, Netlist, PowerTerms, Probe, Tangents, Wires,
 };
 use hydrocyl_ports::{HydraulicPort, Pressure};
 
@@ -46,6 +46,15 @@ impl Volume {
 impl Component for Volume {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn publish_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.state(self.node.pressure, 0, 1.0);
+    }
+    fn derivative_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.rate_chain(0, self.bulk_modulus / self.volume, self.node.inflow);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         if !(self.volume > 0.0

@@ -7,7 +7,8 @@
 //! diagnostics); the valves give the slopes the node's Newton solve uses.
 
 use crate::circuit::{
-    BuildError, Causality, Component, HydraulicNode, Netlist, PowerTerms, Probe, Wire, Wires,
+    BuildError, Causality, Component, HydraulicNode, Netlist, PowerTerms, Probe, Tangents, Wire,
+    Wires,
 };
 use hydrocyl_integrators::{Crossing, EventAction};
 use hydrocyl_ports::{Position, Pressure, Voltage, VolumeFlow};
@@ -67,6 +68,27 @@ impl PumpComponent {
 impl Component for PumpComponent {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn publish_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.state(self.flow, 0, 1.0);
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.state(self.a.inflow, 0, 1.0);
+        d.state(self.b.inflow, 0, -1.0);
+    }
+    fn derivative_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        let j = self.pump.jacobian();
+        for (k, jk) in j.iter().enumerate() {
+            d.rate_state(k / 2, k % 2, *jk);
+        }
+        let wn = self.pump.natural_frequency;
+        d.rate_chain(1, wn * wn * self.pump.gain, self.u);
+    }
+    fn quadrature_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.quadrature_state(0, 0, 1.0);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         IdentifiedPump::new(
@@ -186,6 +208,19 @@ impl Component for ReliefComponent {
     fn name(&self) -> &str {
         &self.name
     }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        // the regime the pressures select (closed, cracking, open)
+        let g = self
+            .valve
+            .conductance(w.get(self.i.pressure), w.get(self.o.pressure));
+        d.resistive(self.i, self.o, g, Some(self.flow));
+    }
+    fn quadrature_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.quadrature_chain(0, 1.0, self.flow);
+    }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         ReliefValve::new(self.valve.cracking, self.valve.kv, self.valve.full_open).map_err(
             |e| BuildError::Component {
@@ -295,6 +330,19 @@ impl CheckComponent {
 impl Component for CheckComponent {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        // the regime the pressures select (closed, cracking, open)
+        let g = self
+            .valve
+            .conductance(w.get(self.i.pressure), w.get(self.o.pressure));
+        d.resistive(self.i, self.o, g, Some(self.flow));
+    }
+    fn quadrature_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.quadrature_chain(0, 1.0, self.flow);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         CheckValve::new(
@@ -472,6 +520,42 @@ impl Component for PilotValve {
     fn name(&self) -> &str {
         &self.name
     }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        let (pp1, pp2) = (w.get(self.pp1.pressure), w.get(self.pp2.pressure));
+        // the spool travel and the opening move with pp1 − pp2
+        let ds = self.four_way.spool_travel_slope(pp1, pp2);
+        d.chain(self.spool, ds, self.pp1.pressure);
+        d.chain(self.spool, -ds, self.pp2.pressure);
+        let y = self.opening(w);
+        let k = self.four_way.return_coefficient(y);
+        if k <= 0.0 {
+            return;
+        }
+        // Q = k(y) ssr(p_x − p_T) leaves the open chamber x and enters T
+        let (open, q) = if y > 0.0 {
+            (self.b, self.flow_b)
+        } else {
+            (self.a, self.flow_a)
+        };
+        let xt = self.four_way.dp_transition.si();
+        let dp = (w.get(open.pressure) - w.get(self.t.pressure)).si();
+        let dk = self.four_way.k_t * y.signum() * self.four_way.opening_slope(pp1, pp2);
+        let c_pilot = dk * signed_sqrt_regularised(dp, xt);
+        let g = k * signed_sqrt_regularised_derivative(dp, xt);
+        d.chain(q, c_pilot, self.pp1.pressure);
+        d.chain(q, -c_pilot, self.pp2.pressure);
+        d.chain(q, g, open.pressure);
+        d.chain(q, -g, self.t.pressure);
+        d.chain(open.inflow, -1.0, q);
+        d.chain(self.t.inflow, 1.0, q);
+    }
+    fn quadrature_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.quadrature_chain(0, 1.0, self.flow_a);
+        d.quadrature_chain(1, 1.0, self.flow_b);
+    }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.four_way
             .validate()
@@ -613,6 +697,15 @@ impl Component for NeedleComponent {
     fn name(&self) -> &str {
         &self.name
     }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        let g = self
+            .needle
+            .conductance(w.get(self.i.pressure), w.get(self.o.pressure));
+        d.resistive(self.i, self.o, g, None);
+    }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         NeedleValve::new(
             self.needle.area,
@@ -682,96 +775,4 @@ impl Component for NeedleComponent {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::components::PressureSource;
-    use crate::series::AlgebraicNode;
-    use crate::Circuit;
-    use hydrocyl_valves::pilot_valve::series_coefficient;
-
-    /// chamber ══[ pilot valve ]══ T (solved) ══[ needle ]══ tank, pilot fully shifted
-    fn series(p_chamber: f64) -> Circuit {
-        let src = |n: &str, node: &str, p: f64| -> Box<dyn Component> {
-            Box::new(PressureSource::new(n, node, Pressure::new(p), None))
-        };
-        Circuit::build(vec![
-            src("l1", "l1", 30.0e5),
-            src("l2", "l2", 0.0),
-            src("a", "a", 0.0),
-            src("b", "b", p_chamber),
-            src("tank", "tank", 0.0),
-            Box::new(PilotValve::new(
-                "pilot",
-                PilotFourWay::dddc(),
-                PilotNodes {
-                    pilot_1: "l1",
-                    pilot_2: "l2",
-                    a: "a",
-                    b: "b",
-                    t: "t",
-                },
-            )),
-            Box::new(NeedleComponent::new(
-                "needle",
-                NeedleValve::nccc(),
-                "t",
-                "tank",
-            )),
-            Box::new(AlgebraicNode::new("t_port", "t", Some("p_t"))),
-        ])
-        .unwrap()
-    }
-
-    #[test]
-    fn forward_series_flow_matches_the_series_coefficient() {
-        let c = series(5.0e5);
-        let w = c.wires_at(0.0, &[]);
-        let pt = w.get(c.find_wire("hyd:t:p").unwrap());
-        let fw = PilotFourWay::dddc();
-        let y = fw.opening(Pressure::new(30.0e5), Pressure::ZERO);
-        let (k_fw, k_n) = (fw.return_coefficient(y), NeedleValve::nccc().coefficient());
-        // two square-root orifices in series: Q = k √Δp with 1/k² = 1/k1² + 1/k2²
-        let q = series_coefficient(k_fw, k_n) * 5.0e5_f64.sqrt();
-        let q_needle = NeedleValve::nccc()
-            .flow(Pressure::new(pt), Pressure::ZERO)
-            .si();
-        assert!((q_needle - q).abs() < 1e-10 * q, "{q_needle} {q}");
-        // the flows into the T node balance: what reaches the tank left chamber B
-        let q_tank = w.get(c.find_wire("hyd:tank:q").unwrap());
-        let q_b = -w.get(c.find_wire("hyd:b:q").unwrap());
-        assert!((q_tank - q_b).abs() < 1e-12 * q, "{q_tank} {q_b}");
-        let d = c.diagnostics();
-        let solves = d.iter().find(|(k, _)| k == "t_port.solves").unwrap().1;
-        assert!(solves >= 1.0);
-    }
-
-    #[test]
-    fn reverse_flow_through_the_open_check_balances_at_the_node() {
-        let c = series(-0.9e5);
-        let w = c.wires_at(0.0, &[]);
-        let pt = w.get(c.find_wire("hyd:t:p").unwrap());
-        assert!(pt > -0.9e5 && pt < 0.0, "{pt}");
-        let n = NeedleValve::nccc();
-        let q = n.flow(Pressure::new(pt), Pressure::ZERO).si();
-        // the reverse check opened: more backflow than the needle alone would pass
-        assert!(q < n.metered_flow(Pressure::new(pt), Pressure::ZERO).si());
-        let q_b = w.get(c.find_wire("hyd:b:q").unwrap());
-        assert!((q_b + q).abs() < 1e-9 * q.abs(), "{q_b} {q}");
-    }
-
-    #[test]
-    fn an_algebraic_node_needs_two_resistive_neighbours() {
-        let e = Circuit::build(vec![
-            Box::new(PressureSource::new("tank", "tank", Pressure::ZERO, None)),
-            Box::new(NeedleComponent::new(
-                "needle",
-                NeedleValve::nccc(),
-                "t",
-                "tank",
-            )),
-            Box::new(AlgebraicNode::new("t_port", "t", None)),
-        ])
-        .unwrap_err();
-        assert!(e.to_string().contains("at least two"), "{e}");
-    }
-}
+mod tests;

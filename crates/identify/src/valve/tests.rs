@@ -1,0 +1,158 @@
+use super::model::{targets, Model, FRICTION_TYPES};
+use super::{get, is_on, lag_samples, set};
+use crate::catalog::EffectId;
+use hydrocyl_friction::{FrictionInput, FrictionLaw, FrictionModel};
+use hydrocyl_ports::Velocity;
+use hydrocyl_system::netlist::registry;
+use hydrocyl_system::valve_rig::ValveRig;
+
+fn on(r: &ValveRig, id: EffectId) -> bool {
+    is_on(&Model::from_valve_rig(r).unwrap(), id)
+}
+
+fn force(law: &FrictionLaw, v: f64) -> f64 {
+    law.force(&FrictionInput::at_velocity(Velocity::new(v)), &[])
+        .si()
+}
+
+/// Every target of the catalog names a parameter its component type has.
+#[test]
+fn every_target_is_a_registry_parameter() {
+    for id in EffectId::ALL {
+        for q in id.params() {
+            for tg in targets(id, q.name) {
+                let ty = registry::lookup(tg.ty).unwrap_or_else(|| panic!("{}", tg.ty));
+                assert!(ty.param(tg.param).is_some(), "{}.{}", tg.ty, tg.param);
+            }
+        }
+    }
+    for ty in FRICTION_TYPES {
+        assert!(registry::lookup(ty).is_some(), "{ty}");
+    }
+}
+
+/// Which effects apply is read from the components: the valve rig has
+/// all of them; the hybrid rig (pump, no servovalve, Wang's law) the
+/// cylinder's, the load's, the pump's and the seal terms, and the
+/// others name the component type they need.
+#[test]
+fn the_effects_that_apply_follow_the_components() {
+    let valve = Model::new(&hydrocyl_system::rig::preset("leaney-moog").unwrap()).unwrap();
+    for id in EffectId::ALL {
+        assert!(valve.applies(id).is_ok(), "{id:?}: {:?}", valve.applies(id));
+    }
+    let hybrid = Model::new(&hydrocyl_system::rig::preset("wang-hybrid").unwrap()).unwrap();
+    let yes = [
+        EffectId::InternalLeakage,
+        EffectId::ExternalLeakage,
+        EffectId::BulkModulus,
+        EffectId::ExternalForce,
+        EffectId::PressureViscous,
+        EffectId::AccelerationFriction,
+        EffectId::FlowGainError,
+        EffectId::SensorLag,
+    ];
+    for id in EffectId::ALL {
+        let ok = hybrid.applies(id);
+        assert_eq!(ok.is_ok(), yes.contains(&id), "{id:?}: {ok:?}");
+    }
+    let why = hybrid.applies(EffectId::ValveNullBias).unwrap_err();
+    assert!(why.contains("four_way_valve"), "{why}");
+    // the bulk modulus reaches the chambers and both lines
+    assert_eq!(
+        hybrid.paths_of(EffectId::BulkModulus),
+        [
+            "cylinder.bulk_modulus",
+            "line_1.bulk_modulus",
+            "line_2.bulk_modulus"
+        ]
+    );
+    // the pump's gain is scaled by kw
+    let mut h = hybrid.clone();
+    assert_eq!(get(&h, EffectId::FlowGainError, "kw"), Some(1.0));
+    set(&mut h, EffectId::FlowGainError, "kw", 1.1);
+    let g = h.param("pump", "gain").unwrap();
+    assert!((g / 1.07e-5 - 1.1).abs() < 1e-12, "{g}");
+    assert!(is_on(&h, EffectId::FlowGainError));
+}
+
+#[test]
+fn friction_effects_map_onto_a_stribeck_law() {
+    let rig = ValveRig::leaney_moog();
+    let cv = rig.friction;
+    let vs = [-0.2, -0.01, -1e-3, -1e-5, 0.0, 1e-5, 1e-3, 0.01, 0.2];
+    // off: both effects read 0; setting them to 0 rewrites the
+    // coulomb-viscous law as the equivalent Stribeck law, exactly
+    let mut r = rig.clone();
+    assert!(!on(&r, EffectId::CoulombAsymmetry) && !on(&r, EffectId::Stribeck));
+    set(&mut r, EffectId::CoulombAsymmetry, "dFc", 0.0);
+    set(&mut r, EffectId::Stribeck, "Fs", 0.0);
+    assert!(
+        matches!(r.friction, FrictionLaw::Stribeck(_)),
+        "{:?}",
+        r.friction
+    );
+    for v in vs {
+        assert!(
+            (force(&cv, v) - force(&r.friction, v)).abs() < 1e-12,
+            "v {v}"
+        );
+    }
+    // asymmetry: extending Fc + dFc/2, retracting Fc − dFc/2, read back
+    set(&mut r, EffectId::CoulombAsymmetry, "dFc", 40.0);
+    assert_eq!(get(&r, EffectId::CoulombAsymmetry, "dFc"), Some(40.0));
+    let b = 500.0;
+    assert!((force(&r.friction, 0.2) - (70.0 + b * 0.2)).abs() < 1e-9);
+    assert!((force(&r.friction, -0.2) - (-30.0 - b * 0.2)).abs() < 1e-9);
+    // a hump on top keeps the asymmetry: g(0+) = Fs + dFc/2
+    set(&mut r, EffectId::Stribeck, "Fs", 150.0);
+    assert!(on(&r, EffectId::Stribeck));
+    assert_eq!(get(&r, EffectId::Stribeck, "Fs"), Some(150.0));
+    // (vs = 10 mm/s and α = 1 from the conversion, v_t = 1 mm/s)
+    for v in [5e-3, -5e-3] {
+        let level = if v > 0.0 { 70.0 } else { 30.0 };
+        let g = level + 100.0 * (-(v / 0.01f64).abs()).exp();
+        let want = (v / 1e-3f64).tanh() * g + b * v;
+        assert!((force(&r.friction, v) - want).abs() < 1e-9, "v {v}");
+    }
+    // and the hump switches off again at Fs = 0
+    set(&mut r, EffectId::Stribeck, "Fs", 0.0);
+    assert!(!on(&r, EffectId::Stribeck));
+    assert!((force(&r.friction, 0.2) - (70.0 + b * 0.2)).abs() < 1e-9);
+    // bristles in (the curves and σ2 kept), and out again
+    set(&mut r, EffectId::LugreDynamics, "sigma0", 2e5);
+    set(&mut r, EffectId::LugreDynamics, "sigma1", 600.0);
+    match &r.friction {
+        FrictionLaw::LuGre(l) => {
+            assert_eq!((l.sigma0, l.sigma1), (2e5, 600.0));
+            assert_eq!(l.extending.curve.coulomb.si(), 70.0);
+            assert_eq!(l.retracting.sigma2, b);
+        }
+        other => panic!("expected a LuGre law, got {other:?}"),
+    }
+    assert_eq!(get(&r, EffectId::CoulombAsymmetry, "dFc"), Some(40.0));
+    set(&mut r, EffectId::LugreDynamics, "sigma0", 0.0);
+    assert!(!on(&r, EffectId::LugreDynamics));
+    assert!((force(&r.friction, 0.2) - (70.0 + b * 0.2)).abs() < 1e-9);
+}
+
+#[test]
+fn lag_of_samples_is_exact_for_a_ramp_and_identity_at_zero() {
+    // uneven steps; u = 2 + 3 t, y(0) = u(0): y = u - 3 τ (1 - exp(-t/τ))
+    let t = [0.0, 0.001, 0.0025, 0.003, 0.01, 0.0101, 0.05];
+    let u: Vec<f64> = t.iter().map(|t| 2.0 + 3.0 * t).collect();
+    let tau = 0.004;
+    let y = lag_samples(&t, &u, tau);
+    for (k, &tk) in t.iter().enumerate() {
+        let want = u[k] - 3.0 * tau * (1.0 - (-tk / tau).exp());
+        assert!((y[k] - want).abs() < 1e-14, "t {tk}: {} vs {want}", y[k]);
+    }
+    assert_eq!(lag_samples(&t, &u, 0.0), u);
+    // a step held after the first sample settles to the new value
+    let t: Vec<f64> = (0..200).map(|k| k as f64 * 1e-3).collect();
+    let mut u = vec![1.0; 200];
+    u[0] = 0.0;
+    let y = lag_samples(&t, &u, 0.01);
+    assert!(y[1] > 0.0 && y[1] < 1.0 && (y[199] - 1.0).abs() < 1e-6);
+    assert!(lag_samples(&[], &[], 0.01).is_empty());
+}

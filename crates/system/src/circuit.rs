@@ -739,7 +739,11 @@ impl OdeSystem for Circuit {
     }
 
     fn events(&self, t: f64, x: &[f64], g: &mut [f64]) {
-        self.fill(t, x);
+        // after an accepted step the last stage has just filled the table at
+        // exactly (t, x) (first same as last): no second evaluation
+        if !self.filled_at(t, x) {
+            self.fill(t, x);
+        }
         let w = self.wires.borrow();
         for (i, c) in self.comps.iter().enumerate() {
             c.events(

@@ -63,12 +63,13 @@
 //!   (the energy ledger), `quadratures`, `probes` (output columns) and
 //!   `diagnostics` (counters). Placeholders for wire fields before `bind`:
 //!   [`Wire::UNBOUND`], [`HydraulicNode::UNBOUND`], [`MechanicalNode::UNBOUND`]. No
-//!   change to the assembler is needed.
-//! * **A new rig kind** (e.g. the hybrid pump-controlled rig): a module that
-//!   builds its `Vec<Box<dyn Component>>` and calls [`Circuit::build`], a
-//!   serde struct for its JSON file, and one entry in [`rig::RIG_KINDS`] (and
-//!   [`rig::PRESETS`] for a preset). `hydrocyl simulate` and `--set` then
-//!   work for it unchanged.
+//!   change to the assembler is needed. For the stiff solver's analytic
+//!   Jacobian it may also give its tangents (`has_tangents` and the
+//!   `*_tangents` twins of its calls, see [`Tangents`]); without them the
+//!   circuit falls back to finite differences.
+//! * **A new circuit or rig**: a netlist JSON file of registered component
+//!   types (and an entry in [`rig::PRESETS`] for a preset). `hydrocyl
+//!   simulate`, `--set` and `--print-rig` then work for it unchanged.
 //! * **Swapping a component**: the `leaney-moog` rig swaps the spool order
 //!   (`valve.dynamics`), the actuator formulation (`cylinder.formulation`:
 //!   [`components::FourWayValve`] + [`components::TwoChamberCylinder`] or

@@ -304,8 +304,9 @@ fn median_ns(mut f: impl FnMut() -> usize) -> f64 {
 
 /// CSV per row: the plain-CSV path against the previous implementation
 /// (the `csv` crate's records with `str::parse`; `format!("{:?}")` per cell,
-/// one thread), on one thread and on every core (`PlainCsv::columns` and
-/// `write_columns_in_parts`, what `hydrocyl` uses), with the floor of each:
+/// one thread), on one thread and on every core (`PlainCsv::columns`, which
+/// `hydrocyl` reads with; `write_columns_in_parts`, a library call: the CLI
+/// formats on one writer thread beside the solve), with the floor of each:
 /// the number conversions alone on the same values.
 fn csv_per_row() -> Result<(), String> {
     let case = square_case(10.0)?;

@@ -18,22 +18,29 @@ fn write_command(dir: &Path, name: &str, rows: &[(f64, f64)]) -> PathBuf {
     p
 }
 
-/// `hydrocyl simulate --rig leaney-moog` on `cmd` into `out`, which must
-/// succeed.
-fn simulate_leaney_moog(cmd: &Path, out: &Path) -> std::process::Output {
+/// `hydrocyl simulate --rig <rig>` on `cmd` into `out` with `extra`
+/// arguments, which must succeed.
+fn simulate_ok(rig: &str, cmd: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
     let st = hydrocyl()
-        .args(["simulate", "--rig", "leaney-moog", "--command"])
+        .args(["simulate", "--rig", rig, "--command"])
         .arg(cmd)
         .arg("--out")
         .arg(out)
+        .args(extra)
         .output()
         .unwrap();
     assert!(
         st.status.success(),
-        "{}",
+        "{extra:?}: {}",
         String::from_utf8_lossy(&st.stderr)
     );
     st
+}
+
+/// `hydrocyl simulate --rig leaney-moog` on `cmd` into `out`, which must
+/// succeed.
+fn simulate_leaney_moog(cmd: &Path, out: &Path) -> std::process::Output {
+    simulate_ok("leaney-moog", cmd, out, &[])
 }
 
 fn square(n: usize, dt: f64) -> Vec<(f64, f64)> {
@@ -107,19 +114,7 @@ fn overrides_and_solvers_change_the_run() {
     let cmd = write_command(dir.path(), "cmd.csv", &square(200, 0.005));
     let run_on = |rig: &str, extra: &[&str], name: &str| {
         let out = dir.path().join(name);
-        let st = hydrocyl()
-            .args(["simulate", "--rig", rig, "--command"])
-            .arg(&cmd)
-            .arg("--out")
-            .arg(&out)
-            .args(extra)
-            .output()
-            .unwrap();
-        assert!(
-            st.status.success(),
-            "{extra:?}: {}",
-            String::from_utf8_lossy(&st.stderr)
-        );
+        simulate_ok(rig, &cmd, &out, extra);
         read_csv(&out).1
     };
     let run = |extra: &[&str], name: &str| run_on("leaney-moog", extra, name);

@@ -249,12 +249,6 @@ fn number(cell: &[u8]) -> Option<f64> {
     }
 }
 
-/// Appends `v` as the shortest decimal text that parses back to `v`.
-#[inline]
-pub fn push_f64(out: &mut Vec<u8>, buf: &mut zmij::Buffer, v: f64) {
-    out.extend_from_slice(buf.format(v).as_bytes());
-}
-
 /// The longest text zmij writes for an `f64`.
 const MAX_CELL: usize = 24;
 
@@ -337,16 +331,6 @@ pub fn write_columns(names: &[&str], columns: &[&[f64]]) -> Vec<u8> {
 pub fn write_columns_in_parts(names: &[&str], columns: &[&[f64]], parts: usize) -> Vec<Vec<u8>> {
     let mut head = names.join(",").into_bytes();
     head.push(b'\n');
-    rows_in_parts(head, columns, parts)
-}
-
-/// [`write_columns_in_parts`] without the header: the rows of a table's
-/// later block, for a writer that streams a table block by block.
-pub fn write_rows_in_parts(columns: &[&[f64]], parts: usize) -> Vec<Vec<u8>> {
-    rows_in_parts(Vec::new(), columns, parts)
-}
-
-fn rows_in_parts(head: Vec<u8>, columns: &[&[f64]], parts: usize) -> Vec<Vec<u8>> {
     let rows = columns.first().map_or(0, |c| c.len());
     let parts = parts.clamp(1, rows.max(1));
     let bounds: Vec<usize> = (0..=parts).map(|i| i * rows / parts).collect();

@@ -44,7 +44,7 @@ use crate::output::{OutputId, Outputs};
 use crate::progress::Progress;
 use hydrocyl_identify::bench::FrictionBench;
 use hydrocyl_system::rig;
-use hydrocyl_system::run::{self as runner, Run, RunOptions, Solver};
+use hydrocyl_system::run::{self as runner, ProbeReader, Run, RunOptions, Solver};
 use hydrocyl_system::signal::{Signal, StreamedTable};
 use std::path::{Path, PathBuf};
 
@@ -128,47 +128,105 @@ const WINDOW: usize = 1 << 18;
 /// disk is slower than the solve).
 const QUEUE: usize = 16;
 
-/// One block of a run's output for the writer thread: its columns (time,
-/// then the channels) one after the other, `rows` each.
+/// One block of a run's output for the writer thread: its times and either
+/// its channels (one column after the other, `time.len()` each) or, when the
+/// writer reads the probes itself ([`OnWriter`]), its full states
+/// (row-major).
+#[derive(Default)]
 struct Block {
+    time: Vec<f64>,
     values: Vec<f64>,
-    rows: usize,
 }
+
+/// The probes read on the writer thread: a second circuit of the rig, made
+/// there by `make` (a circuit stays on the thread that built it), and what
+/// the solve's sink would otherwise do with each block (the header, the
+/// solution check).
+struct OnWriter {
+    make: Box<dyn FnOnce() -> Result<ProbeReader, CliError> + Send>,
+    unit: CommandUnit,
+    solver: Solver,
+    rk4_step: f64,
+}
+
+/// What the writer thread hands back: the outputs, its first error, and the
+/// lowest sampled chamber pressure of the blocks whose probes it read.
+type Written = (Outputs, Result<(), CliError>, f64);
 
 /// The writer thread of `hydrocyl simulate`: it formats the blocks the solve
 /// sends (the header first) and writes them to the output, so that the text
 /// of one block is made on the second core while the solve computes the
-/// next. Blocks' memory goes back to the solve for reuse (no fresh pages
-/// per block).
+/// next; with [`OnWriter`] it also reads the blocks' probes, so that the
+/// solve's core only solves. Blocks' memory goes back to the solve for reuse
+/// (the memory stays that of [`QUEUE`] blocks, whatever the record's length).
 struct Writer {
     send: Option<std::sync::mpsc::SyncSender<Block>>,
     recycled: std::sync::mpsc::Receiver<Block>,
-    thread: Option<std::thread::JoinHandle<(Outputs, Result<(), CliError>)>>,
+    thread: Option<std::thread::JoinHandle<Written>>,
 }
 
 impl Writer {
     /// Starts the thread on `outputs` (file `id`), which it hands back at
-    /// [`Writer::finish`]; `header` is written first.
-    fn start(mut outputs: Outputs, id: OutputId, header: Vec<u8>) -> Self {
+    /// [`Writer::finish`]. Blocks of channels (`probes` `None`) are written
+    /// after `header`; blocks of states have their probes read by `probes`,
+    /// the header made from the first.
+    fn start(
+        mut outputs: Outputs,
+        id: OutputId,
+        header: Vec<u8>,
+        probes: Option<OnWriter>,
+    ) -> Self {
         let (send, recv) = std::sync::mpsc::sync_channel::<Block>(QUEUE);
         let (back, recycled) = std::sync::mpsc::channel::<Block>();
         let thread = std::thread::spawn(move || {
             let mut text = header;
+            let mut min_p = f64::INFINITY;
+            let (mut reader, on) = match probes {
+                Some(on) => match (on.make)() {
+                    Ok(r) => (Some(r), Some((on.unit, on.solver, on.rk4_step))),
+                    Err(e) => return (outputs, Err(e), min_p),
+                },
+                None => (None, None),
+            };
+            let mut run = Run::default();
+            let mut headed = reader.is_none();
             let mut result = Ok(());
             for block in recv {
+                let columns: Vec<&[f64]> = match (reader.as_mut(), on) {
+                    (Some(r), Some((unit, solver, rk4_step))) => {
+                        r.read(&block.time, &block.values, &mut run);
+                        result = check_solution(&run, solver, rk4_step);
+                        min_p = min_p.min(run.min_chamber_pressure());
+                        if !headed {
+                            headed = true;
+                            text = column_headers(&run, unit).join(",").into_bytes();
+                            text.push(b'\n');
+                        }
+                        std::iter::once(&run.time)
+                            .chain(run.channels.iter().map(|c| &c.values))
+                            .map(Vec::as_slice)
+                            .collect()
+                    }
+                    _ => std::iter::once(block.time.as_slice())
+                        .chain(block.values.chunks_exact(block.time.len().max(1)))
+                        .collect(),
+                };
                 if result.is_ok() {
-                    let columns: Vec<&[f64]> = block.values.chunks_exact(block.rows).collect();
                     hydrocyl_identify::plaincsv::append_rows(&columns, &mut text);
                     result = outputs.write(id, &text);
                     text.clear();
                 }
                 // the solve may be gone already: then the block is just freed
                 let _ = back.send(block);
+                if result.is_err() {
+                    // the solve's next block finds the thread gone and stops
+                    break;
+                }
             }
             if result.is_ok() && !text.is_empty() {
                 result = outputs.write(id, &text);
             }
-            (outputs, result)
+            (outputs, result, min_p)
         });
         Writer {
             send: Some(send),
@@ -177,37 +235,49 @@ impl Writer {
         }
     }
 
-    /// Queues `run`'s rows; an error when the thread has stopped (a failed
-    /// write, which [`Writer::finish`] reports).
-    fn push(&mut self, run: &Run) -> Result<(), CliError> {
-        let rows = run.time.len();
-        let mut block = self.recycled.try_recv().unwrap_or(Block {
-            values: Vec::new(),
-            rows: 0,
-        });
+    /// Queues a block filled by `fill` (in a recycled one); an error when
+    /// the thread has stopped (a failed write or a bad solution, which
+    /// [`Writer::finish`] reports).
+    fn push(&mut self, fill: impl FnOnce(&mut Block)) -> Result<(), CliError> {
+        let mut block = self.recycled.try_recv().unwrap_or_default();
+        block.time.clear();
         block.values.clear();
-        block.values.reserve((run.channels.len() + 1) * rows);
-        block.values.extend_from_slice(&run.time);
-        for c in &run.channels {
-            block.values.extend_from_slice(&c.values);
-        }
-        block.rows = rows;
+        fill(&mut block);
         let stopped = || CliError::Input("the output writer stopped".into());
         let send = self.send.as_ref().ok_or_else(stopped)?;
         send.send(block).map_err(|_| stopped())
     }
 
-    /// Waits for the thread to write every block; the outputs back, or its
-    /// first error.
-    fn finish(mut self) -> Result<Outputs, CliError> {
+    /// Queues `run`'s channels.
+    fn push_channels(&mut self, run: &Run) -> Result<(), CliError> {
+        self.push(|b| {
+            b.time.extend_from_slice(&run.time);
+            b.values.reserve(run.channels.len() * run.time.len());
+            for c in &run.channels {
+                b.values.extend_from_slice(&c.values);
+            }
+        })
+    }
+
+    /// Queues raw times and states, for the probes read on the thread.
+    fn push_states(&mut self, t: &[f64], x: &[f64]) -> Result<(), CliError> {
+        self.push(|b| {
+            b.time.extend_from_slice(t);
+            b.values.extend_from_slice(x);
+        })
+    }
+
+    /// Waits for the thread to write every block; the outputs back and the
+    /// lowest chamber pressure it read, or its first error.
+    fn finish(mut self) -> Result<(Outputs, f64), CliError> {
         drop(self.send.take());
         let thread = self
             .thread
             .take()
             .ok_or_else(|| CliError::Input("no writer".into()))?;
         match thread.join() {
-            Ok((outputs, Ok(()))) => Ok(outputs),
-            Ok((_, Err(e))) => Err(e),
+            Ok((outputs, Ok(()), min_p)) => Ok((outputs, min_p)),
+            Ok((_, Err(e), _)) => Err(e),
             Err(_) => Err(CliError::Input("the output writer failed".into())),
         }
     }
@@ -484,6 +554,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
             (rows, t0, t1, signal, Input::Table(times))
         }
     };
+    // a history-free circuit's probes are read on the writer thread, on a
+    // second circuit of the rig (the solve's thread then only solves)
+    let second = matches!(input, Input::Table(_)).then(|| signal.clone());
     let mut c = checked
         .circuit(signal)
         .map_err(|e| CliError::Input(e.to_string()))?;
@@ -493,45 +566,83 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut done = 0usize;
     let mut min_p = f64::INFINITY;
     let mut writer: Option<Writer> = None;
-    let mut sink = |block: &Run| -> Result<(), String> {
-        let r = check_solution(block, solver, args.rk4_step).and_then(|()| {
-            if writer.is_none() {
-                let mut header = column_headers(block, unit).join(",").into_bytes();
-                header.push(b'\n');
-                let o = outputs
-                    .take()
-                    .ok_or_else(|| CliError::Input("no output".into()))?;
-                writer = Some(Writer::start(o, id, header));
-            }
-            match writer.as_mut() {
-                Some(w) => w.push(block),
-                None => Ok(()),
-            }
-        });
-        done += block.time.len();
-        min_p = min_p.min(block.min_chamber_pressure());
-        bar.set("rows", done as u64, rows as u64);
-        r.map_err(|e| {
-            let m = e.to_string();
-            failed = Some(e);
-            m
-        })
+    let on_writer = match (second, &input) {
+        (Some(signal), Input::Table(times)) if c.history_free() => {
+            let (x0, t0, opts) = (x0.clone(), times[0], opts.clone());
+            let make = move || {
+                let c = checked
+                    .circuit(signal)
+                    .map_err(|e| CliError::Input(e.to_string()))?;
+                ProbeReader::new(c, &x0, t0, &opts).map_err(|e| CliError::Input(e.to_string()))
+            };
+            Some(OnWriter {
+                make: Box::new(make),
+                unit,
+                solver,
+                rk4_step: args.rk4_step,
+            })
+        }
+        _ => None,
     };
-    let streamed = match &mut input {
-        Input::Table(times) => runner::run_streaming(&mut c, &x0, times, &opts, BLOCK, &mut sink),
-        Input::Stream(table, chunks) => {
-            runner::run_command_stream(&mut c, &x0, table, chunks, t1, &opts, BLOCK, &mut sink)
+    let streamed = if let Some(on) = on_writer {
+        let Input::Table(times) = &input else {
+            return Err(CliError::Input("no command table".into()));
+        };
+        let o = outputs
+            .take()
+            .ok_or_else(|| CliError::Input("no output".into()))?;
+        let w = writer.insert(Writer::start(o, id, Vec::new(), Some(on)));
+        let mut sink = |t: &[f64], x: &[f64]| -> Result<(), String> {
+            done += t.len();
+            bar.set("rows", done as u64, rows as u64);
+            w.push_states(t, x).map_err(|e| e.to_string())
+        };
+        runner::run_streaming_states(&mut c, &x0, times, &opts, BLOCK, &mut sink)
+    } else {
+        let mut sink = |block: &Run| -> Result<(), String> {
+            let r = check_solution(block, solver, args.rk4_step).and_then(|()| {
+                if writer.is_none() {
+                    let mut header = column_headers(block, unit).join(",").into_bytes();
+                    header.push(b'\n');
+                    let o = outputs
+                        .take()
+                        .ok_or_else(|| CliError::Input("no output".into()))?;
+                    writer = Some(Writer::start(o, id, header, None));
+                }
+                match writer.as_mut() {
+                    Some(w) => w.push_channels(block),
+                    None => Ok(()),
+                }
+            });
+            done += block.time.len();
+            min_p = min_p.min(block.min_chamber_pressure());
+            bar.set("rows", done as u64, rows as u64);
+            r.map_err(|e| {
+                let m = e.to_string();
+                failed = Some(e);
+                m
+            })
+        };
+        match &mut input {
+            Input::Table(times) => {
+                runner::run_streaming(&mut c, &x0, times, &opts, BLOCK, &mut sink)
+            }
+            Input::Stream(table, chunks) => runner::run_command_stream(
+                &mut c, &x0, table, chunks, t1, &opts, BLOCK, &mut sink,
+            ),
         }
     };
     bar.finish();
-    // the writer's error (a failed write) first: the solve's is its echo
+    // the writer's error (a failed write, a bad solution) first: the
+    // solve's is its echo
     let written = writer.map(Writer::finish).transpose();
     let run = match (streamed, failed, written) {
         (_, _, Err(e)) | (_, Some(e), _) => return Err(e),
         (Err(e), None, _) => return Err(solver_hint(rig::RigError::Sim(e.to_string()))),
         (Ok(r), None, Ok(w)) => {
-            if let Some(o) = w {
+            if let Some((o, p)) = w {
                 outputs = Some(o);
+                min_p = min_p.min(p);
             }
             r
         }

@@ -289,15 +289,28 @@ pub fn run_columns(run: &hydrocyl_system::run::Run) -> (Vec<&str>, Vec<&[f64]>) 
 }
 
 /// Appends rows `rows` of `columns` as CSV lines (shortest round-trip text).
+/// A value equal (bit for bit) to the one above it in its column is not
+/// formatted again: its text is copied from the row above (a supply
+/// pressure, a held command).
 fn write_rows(columns: &[&[f64]], rows: std::ops::Range<usize>, out: &mut Vec<u8>) {
     let mut buf = zmij::Buffer::new();
     // a row is put together in `row`, then appended with one copy
     let mut row = vec![0u8; columns.len() * (MAX_CELL + 1) + 1];
+    // per column, the row above's value (bits) and its text's place in `out`
+    let mut above: Vec<(u64, usize, usize)> = vec![(0, 0, 0); columns.len()];
     out.reserve(rows.len() * columns.len() * 20);
     for k in rows {
+        let base = out.len();
         let mut at = 0;
-        for c in columns {
-            at = put_short(&mut row, at, buf.format(c[k]).as_bytes());
+        for (c, a) in columns.iter().zip(above.iter_mut()) {
+            let bits = c[k].to_bits();
+            let start = at;
+            at = if a.2 > 0 && a.0 == bits {
+                put_short(&mut row, at, &out[a.1..a.1 + a.2])
+            } else {
+                put_short(&mut row, at, buf.format(c[k]).as_bytes())
+            };
+            *a = (bits, base + start, at - start);
             row[at] = b',';
             at += 1;
         }
@@ -495,6 +508,34 @@ mod tests {
     }
 
     proptest! {
+        /// Every cell is the shortest round-trip text of its value, also
+        /// where a value repeats the one above it (its text copied) or
+        /// differs from it only in sign (0.0 below -0.0).
+        #[test]
+        fn repeated_values_are_written_as_each_alone(
+            cells in proptest::collection::vec(
+                (prop_oneof![Just(0.0), Just(-0.0), Just(7e6), -1e9f64..1e9], 0u8..3), 1..40),
+        ) {
+            // runs of a value in column a; b the same values from its end
+            let mut a = Vec::new();
+            for (v, times) in &cells {
+                for _ in 0..=*times {
+                    a.push(*v);
+                }
+            }
+            let b: Vec<f64> = a.iter().rev().copied().collect();
+            let text = String::from_utf8(write_columns(&["a", "b"], &[&a, &b])).unwrap();
+            let mut one = zmij::Buffer::new();
+            let mut expected = String::from("a,b\n");
+            for (x, y) in a.iter().zip(&b) {
+                expected.push_str(one.format(*x));
+                expected.push(',');
+                expected.push_str(one.format(*y));
+                expected.push('\n');
+            }
+            prop_assert_eq!(text, expected);
+        }
+
         /// Wherever the fast path answers, it answers what the full reader does.
         #[test]
         fn agrees_with_the_full_reader(

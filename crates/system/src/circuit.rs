@@ -241,6 +241,17 @@ pub trait Component {
         EventAction::Continue
     }
 
+    /// Whether [`on_event`](Component::on_event) or
+    /// [`after_event`](Component::after_event) can change what
+    /// [`publish`](Component::publish) and [`evaluate`](Component::evaluate)
+    /// compute at a given `(t, x)` (a mode: stick/slip, at a stop). `true`
+    /// for every component with events unless it says otherwise (one that
+    /// only counts its events, e.g. cavitation entries); see
+    /// [`Circuit::history_free`].
+    fn events_change_evaluation(&self) -> bool {
+        self.n_events() > 0
+    }
+
     /// Called on every component after any component handled an event, with
     /// the wires re-evaluated at the edited state: a chance to edit its own
     /// state in response (a mass sets v = 0 when a friction law starts to stick).
@@ -549,6 +560,17 @@ impl Circuit {
             d.push((format!("{n}.solve_fallbacks"), g.fallbacks.get() as f64));
         }
         d
+    }
+
+    /// Whether the wires at `(t, x)` are the same whatever was evaluated
+    /// before and whichever events were handled: no algebraic node (its
+    /// Newton solve starts from the last solution, which moves the last
+    /// bits) and no component whose events change its evaluation
+    /// ([`Component::events_change_evaluation`]). Then a second circuit built
+    /// and reset like this one reads the same probes at the same points, on
+    /// another thread ([`crate::run::ProbeReader`]).
+    pub fn history_free(&self) -> bool {
+        self.groups.is_empty() && !self.comps.iter().any(|c| c.events_change_evaluation())
     }
 
     /// Evaluates every wire at `(t, x)` and returns a copy of the table.

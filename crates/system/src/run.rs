@@ -9,6 +9,9 @@ use hydrocyl_integrators::{
 use std::time::{Duration, Instant};
 use thiserror::Error;
 
+mod probes;
+pub use probes::{ProbeReader, ProbeSet};
+
 /// Why a run failed.
 #[derive(Debug, Error)]
 pub enum SimError {
@@ -161,7 +164,7 @@ pub struct Channel {
 }
 
 /// The result of a run.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Run {
     /// Output times \[s\].
     pub time: Vec<f64>,
@@ -246,33 +249,10 @@ pub fn run(
     })?;
     let wall = start.elapsed();
     // probes → channels
-    let probes = if opts.channels {
-        circuit.probes()
-    } else {
-        Vec::new()
-    };
-    let mut channels: Vec<Channel> = probes
-        .iter()
-        .map(|p| Channel {
-            name: p.name.clone(),
-            unit: p.unit,
-            values: Vec::with_capacity(sol.t.len()),
-        })
-        .collect();
-    let wires: Vec<_> = probes.iter().map(|p| p.wire).collect();
-    let mut row = vec![0.0; wires.len()];
-    for k in (0..sol.t.len()).filter(|_| !wires.is_empty()) {
-        circuit.read_wires(sol.t[k], sol.state(k), &wires, &mut row);
-        for (c, v) in channels.iter_mut().zip(&row) {
-            c.values.push(*v);
-        }
+    let mut channels = Vec::new();
+    if opts.channels {
+        ProbeSet::of(circuit).read_channels(circuit, &sol.t, &sol.x, &mut channels);
     }
-    channels.sort_by_key(|c| {
-        ORDER
-            .iter()
-            .position(|o| *o == c.name)
-            .unwrap_or(ORDER.len())
-    });
     Ok(Run {
         time: sol.t,
         channels,
@@ -361,7 +341,37 @@ pub fn run_streaming(
         t_eval[t_eval.len() - 1],
         opts,
         block,
-        sink,
+        Output::Channels(sink),
+    )
+}
+
+/// [`run_streaming`] without the channels: `sink` receives each block's
+/// output times and full states (row-major, `x.len() / t.len()` each) as
+/// the integrator wrote them, and reads the probes itself where it likes,
+/// e.g. a [`ProbeReader`] on another thread (the solve's thread then only
+/// solves). The buffers are the solve's, reused block after block: copy
+/// what is kept.
+pub fn run_streaming_states(
+    circuit: &mut Circuit,
+    x0: &[f64],
+    t_eval: &[f64],
+    opts: &RunOptions,
+    block: usize,
+    sink: &mut dyn FnMut(&[f64], &[f64]) -> Result<(), String>,
+) -> Result<Run, SimError> {
+    check_times(t_eval)?;
+    let mut times = Times::Slice {
+        t: t_eval,
+        pushed: 0,
+    };
+    stream(
+        circuit,
+        x0,
+        &mut times,
+        t_eval[t_eval.len() - 1],
+        opts,
+        block,
+        Output::States(sink),
     )
 }
 
@@ -403,7 +413,15 @@ pub fn run_command_stream(
     times
         .refill(f64::NEG_INFINITY, f64::NEG_INFINITY)
         .map_err(SimError::Settings)?;
-    stream(circuit, x0, &mut times, t_end, opts, block, sink)
+    stream(
+        circuit,
+        x0,
+        &mut times,
+        t_end,
+        opts,
+        block,
+        Output::Channels(sink),
+    )
 }
 
 /// Output times must be at least two, finite and strictly increasing.
@@ -501,17 +519,24 @@ impl Times<'_> {
     }
 }
 
+/// Where a streamed run's blocks go.
+enum Output<'a> {
+    /// The channels read on the solving circuit, as a [`Run`].
+    Channels(&'a mut dyn FnMut(&Run) -> Result<(), String>),
+    /// The raw times and states.
+    States(&'a mut dyn FnMut(&[f64], &[f64]) -> Result<(), String>),
+}
+
 /// The [`Stream`] of [`run_streaming`] and [`run_command_stream`].
-struct Streamer<'a, 'b> {
+struct Streamer<'a, 'b, 's> {
     times: &'a mut Times<'b>,
     /// How far past the time reached the next step may go \[s\].
     ahead: f64,
     block: usize,
-    sink: &'a mut dyn FnMut(&Run) -> Result<(), String>,
-    wires: Vec<crate::circuit::AnyWire>,
-    names: Vec<(String, &'static str)>,
-    order: Vec<usize>,
-    row: Vec<f64>,
+    sink: Output<'s>,
+    probes: ProbeSet,
+    /// The block handed to a channel sink, its buffers reused.
+    out: Run,
     /// Time spent in `sink` (not the solve's).
     in_sink: Duration,
     /// The last output time pushed (∞ once all are).
@@ -519,7 +544,7 @@ struct Streamer<'a, 'b> {
     new_times: Vec<f64>,
 }
 
-impl Stream<Circuit> for Streamer<'_, '_> {
+impl Stream<Circuit> for Streamer<'_, '_, '_> {
     fn between_steps(
         &mut self,
         c: &mut Circuit,
@@ -581,45 +606,32 @@ impl Stream<Circuit> for Streamer<'_, '_> {
     }
 }
 
-impl Streamer<'_, '_> {
-    /// Turns the outputs written so far into a block of channels for the sink.
+impl Streamer<'_, '_, '_> {
+    /// Hands the outputs written so far to the sink: their channels read
+    /// on `c` (into the reused block), or the raw times and states.
     fn flush(&mut self, c: &mut Circuit, io: &mut StreamIo<'_, '_>) -> Result<(), String> {
-        let (wires, names, order, row) = (&self.wires, &self.names, &self.order, &mut self.row);
-        let block = io.take(|t, x| {
-            let dim = if t.is_empty() { 0 } else { x.len() / t.len() };
-            let mut channels: Vec<Channel> = names
-                .iter()
-                .map(|(name, unit)| Channel {
-                    name: name.clone(),
-                    unit,
-                    values: Vec::with_capacity(t.len()),
-                })
-                .collect();
-            for (k, &tk) in t.iter().enumerate() {
-                c.read_wires(tk, &x[k * dim..(k + 1) * dim], wires, row);
-                for (ch, v) in channels.iter_mut().zip(row.iter()) {
-                    ch.values.push(*v);
-                }
+        let (probes, out, sink, in_sink) = (
+            &mut self.probes,
+            &mut self.out,
+            &mut self.sink,
+            &mut self.in_sink,
+        );
+        io.take(|t, x| {
+            if t.is_empty() {
+                return Ok(());
             }
-            let mut sorted: Vec<Option<Channel>> = channels.into_iter().map(Some).collect();
-            let channels = order.iter().filter_map(|&i| sorted[i].take()).collect();
-            Run {
-                time: t.to_vec(),
-                channels,
-                states: x.to_vec(),
-                dim,
-                stats: Stats::default(),
-                diagnostics: Vec::new(),
-                wall: Duration::ZERO,
+            // the channels are read on the solve's time, the sink's is not
+            if let Output::Channels(_) = sink {
+                probes.read(c, t, x, out);
             }
-        });
-        if block.time.is_empty() {
-            return Ok(());
-        }
-        let start = Instant::now();
-        let r = (self.sink)(&block);
-        self.in_sink += start.elapsed();
-        r
+            let start = Instant::now();
+            let r = match sink {
+                Output::States(f) => f(t, x),
+                Output::Channels(f) => f(out),
+            };
+            *in_sink += start.elapsed();
+            r
+        })
     }
 }
 
@@ -631,7 +643,7 @@ fn stream(
     t_end: f64,
     opts: &RunOptions,
     block: usize,
-    sink: &mut dyn FnMut(&Run) -> Result<(), String>,
+    sink: Output<'_>,
 ) -> Result<Run, SimError> {
     let t0 = times
         .first()
@@ -643,14 +655,6 @@ fn stream(
     }
     check_options(opts)?;
     let x = initial(circuit, x0, t0, opts)?;
-    let probes = circuit.probes();
-    let mut order: Vec<usize> = (0..probes.len()).collect();
-    order.sort_by_key(|&i| {
-        ORDER
-            .iter()
-            .position(|o| *o == probes[i].name)
-            .unwrap_or(ORDER.len())
-    });
     let mut streamer = Streamer {
         times,
         ahead: opts.h_max.max(if opts.solver == Solver::Rk4 {
@@ -660,10 +664,8 @@ fn stream(
         }) * 1.05,
         block: block.max(2),
         sink,
-        wires: probes.iter().map(|p| p.wire).collect(),
-        names: probes.iter().map(|p| (p.name.clone(), p.unit)).collect(),
-        order,
-        row: vec![0.0; probes.len()],
+        probes: ProbeSet::of(circuit),
+        out: Run::default(),
         in_sink: Duration::ZERO,
         covered: f64::NEG_INFINITY,
         new_times: Vec::new(),

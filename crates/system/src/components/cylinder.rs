@@ -204,6 +204,10 @@ impl Component for TwoChamberCylinder {
     ) -> EventAction {
         Cavitation::count(&mut self.cav, which, dir)
     }
+    /// Its events only count cavitation entries.
+    fn events_change_evaluation(&self) -> bool {
+        false
+    }
     fn reset(&mut self, _t: f64, _x: &[f64], _w: &Wires) {
         self.cav = [Cavitation::default(); 2];
     }

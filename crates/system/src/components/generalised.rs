@@ -225,6 +225,10 @@ impl Component for GeneralisedCylinder {
     ) -> EventAction {
         Cavitation::count(&mut self.cav, which, dir)
     }
+    /// Its events only count cavitation entries.
+    fn events_change_evaluation(&self) -> bool {
+        false
+    }
     fn diagnostics(&self) -> Vec<(String, f64)> {
         vec![
             ("x_factor_evaluations".into(), self.x_calls.get() as f64),

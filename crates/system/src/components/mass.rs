@@ -242,6 +242,10 @@ impl Component for Mass {
         p.load = load.power().si();
         p.stored = 0.5 * self.mass * x[1] * x[1];
     }
+    /// The stop mode changes only the derivatives: the wires are the state's.
+    fn events_change_evaluation(&self) -> bool {
+        false
+    }
     fn probes(&self) -> Vec<Probe> {
         vec![
             Probe::of("position", self.rod.position),

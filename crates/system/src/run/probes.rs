@@ -1,0 +1,129 @@
+//! A circuit's probes read into a run's channels at its output points, on
+//! the solving circuit ([`ProbeSet`]) or on a second circuit of its own on
+//! another thread ([`ProbeReader`], fed by [`super::run_streaming_states`]).
+
+use super::{initial, Channel, Run, RunOptions, SimError, ORDER};
+use crate::circuit::{AnyWire, Circuit};
+
+/// The probes of a circuit as a run's channels, in the measured-data order
+/// (command, position, velocity, p1, p2, then the others in component
+/// order).
+#[derive(Clone, Debug)]
+pub struct ProbeSet {
+    wires: Vec<AnyWire>,
+    /// Name and unit of each channel, in channel order.
+    names: Vec<(String, &'static str)>,
+    /// The wire of each channel, in channel order.
+    order: Vec<usize>,
+    row: Vec<f64>,
+}
+
+impl ProbeSet {
+    /// The probes of `circuit`.
+    pub fn of(circuit: &Circuit) -> Self {
+        let probes = circuit.probes();
+        let mut order: Vec<usize> = (0..probes.len()).collect();
+        // stable: probes outside ORDER keep their component order
+        order.sort_by_key(|&i| {
+            ORDER
+                .iter()
+                .position(|o| *o == probes[i].name)
+                .unwrap_or(ORDER.len())
+        });
+        Self {
+            wires: probes.iter().map(|p| p.wire).collect(),
+            names: order
+                .iter()
+                .map(|&i| (probes[i].name.clone(), probes[i].unit))
+                .collect(),
+            order,
+            row: vec![0.0; probes.len()],
+        }
+    }
+
+    /// Reads the probes of `c` at the outputs `(t[k], x[k·dim..])` (`x`
+    /// row-major, `dim = x.len() / t.len()`) into `out`: its time, states
+    /// and channels are replaced, their buffers reused (no allocation once
+    /// `out` has held a block this large).
+    pub fn read(&mut self, c: &Circuit, t: &[f64], x: &[f64], out: &mut Run) {
+        out.time.clear();
+        out.time.extend_from_slice(t);
+        out.states.clear();
+        out.states.extend_from_slice(x);
+        out.dim = if t.is_empty() { 0 } else { x.len() / t.len() };
+        self.read_channels(c, t, x, &mut out.channels);
+    }
+
+    /// [`ProbeSet::read`] into the channels alone.
+    pub fn read_channels(&mut self, c: &Circuit, t: &[f64], x: &[f64], out: &mut Vec<Channel>) {
+        let dim = if t.is_empty() { 0 } else { x.len() / t.len() };
+        out.truncate(self.names.len());
+        for (j, (name, unit)) in self.names.iter().enumerate() {
+            if out.get(j).is_some_and(|ch| ch.name == *name) {
+                out[j].values.clear();
+                continue;
+            }
+            let ch = Channel {
+                name: name.clone(),
+                unit,
+                values: Vec::with_capacity(t.len()),
+            };
+            if j < out.len() {
+                out[j] = ch;
+            } else {
+                out.push(ch);
+            }
+        }
+        if self.wires.is_empty() {
+            return;
+        }
+        for (k, &tk) in t.iter().enumerate() {
+            c.read_wires(tk, &x[k * dim..(k + 1) * dim], &self.wires, &mut self.row);
+            for (ch, &i) in out.iter_mut().zip(&self.order) {
+                ch.values.push(self.row[i]);
+            }
+        }
+    }
+}
+
+/// A run's probes read on a circuit of their own: built like the solving
+/// circuit (the same rig, the same command) and set up from the same initial
+/// state, it reads the same channels, bit for bit, from the raw outputs of
+/// [`super::run_streaming_states`], so that the solve's thread does not
+/// evaluate the circuit once more per output row. Only for a circuit whose
+/// wires do not depend on what ran before ([`Circuit::history_free`]).
+pub struct ProbeReader {
+    circuit: Circuit,
+    probes: ProbeSet,
+}
+
+impl ProbeReader {
+    /// Sets `circuit` up as [`super::run_streaming_states`] sets up the
+    /// solving one (from `x0` at `t0`, with `opts`' quadratures and ledger).
+    ///
+    /// # Errors
+    /// [`SimError::Settings`] when the circuit is not
+    /// [`Circuit::history_free`] (its probes must be read on the solving
+    /// circuit) or `x0` does not fit it.
+    pub fn new(
+        mut circuit: Circuit,
+        x0: &[f64],
+        t0: f64,
+        opts: &RunOptions,
+    ) -> Result<Self, SimError> {
+        if !circuit.history_free() {
+            return Err(SimError::Settings(
+                "the circuit's wires depend on its history (an algebraic node or a mode): read its probes on the solving circuit".into(),
+            ));
+        }
+        initial(&mut circuit, x0, t0, opts)?;
+        let probes = ProbeSet::of(&circuit);
+        Ok(Self { circuit, probes })
+    }
+
+    /// Reads the channels at the outputs `(t, x)` into `out` (see
+    /// [`ProbeSet::read`]).
+    pub fn read(&mut self, t: &[f64], x: &[f64], out: &mut Run) {
+        self.probes.read(&self.circuit, t, x, out);
+    }
+}

@@ -113,13 +113,19 @@ pub struct Args {
     /// during the run instead of whole (tests set it low).
     #[arg(long, hide = true, default_value_t = 16 << 20)]
     stream_above: u64,
+    /// Where the writer thread reads the probes: the solve's thread reads a
+    /// block's itself (on a circuit of its own) while the writer is this
+    /// many blocks behind (tests set 0: always, or a large number: never).
+    #[arg(long, hide = true, default_value_t = 2)]
+    probes_behind: usize,
 }
 
 /// Output times per block of a streamed run: the memory a run needs grows
 /// with this, not with the record. Blocks this small let the writer thread
-/// format and write one block while the solve computes the next (the last
-/// block's formatting is all that is left when the solve ends).
-const BLOCK: usize = 1 << 10;
+/// read the probes of, format and write one block while the solve computes
+/// the next, and keep what is left when the solve ends (the blocks the
+/// writer is behind, at most `--probes-behind` and the last) short.
+const BLOCK: usize = 1 << 8;
 
 /// Samples of the command window of a streamed command file.
 const WINDOW: usize = 1 << 18;
@@ -136,6 +142,9 @@ const QUEUE: usize = 16;
 struct Block {
     time: Vec<f64>,
     values: Vec<f64>,
+    /// `values` are channels (with [`OnWriter`]: read on the solve's
+    /// thread while the writer was behind).
+    channels: bool,
 }
 
 /// The probes read on the writer thread: a second circuit of the rig, made
@@ -163,6 +172,8 @@ struct Writer {
     send: Option<std::sync::mpsc::SyncSender<Block>>,
     recycled: std::sync::mpsc::Receiver<Block>,
     thread: Option<std::thread::JoinHandle<Written>>,
+    /// Blocks sent and not yet written.
+    pending: std::sync::Arc<std::sync::atomic::AtomicUsize>,
 }
 
 impl Writer {
@@ -178,6 +189,8 @@ impl Writer {
     ) -> Self {
         let (send, recv) = std::sync::mpsc::sync_channel::<Block>(QUEUE);
         let (back, recycled) = std::sync::mpsc::channel::<Block>();
+        let pending = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+        let written = pending.clone();
         let thread = std::thread::spawn(move || {
             let mut text = header;
             let mut min_p = f64::INFINITY;
@@ -194,7 +207,16 @@ impl Writer {
             for block in recv {
                 let columns: Vec<&[f64]> = match (reader.as_mut(), on) {
                     (Some(r), Some((unit, solver, rk4_step))) => {
-                        r.read(&block.time, &block.values, &mut run);
+                        if block.channels {
+                            r.read(&[], &[], &mut run);
+                            run.time.extend_from_slice(&block.time);
+                            let n = block.time.len().max(1);
+                            for (c, v) in run.channels.iter_mut().zip(block.values.chunks_exact(n)) {
+                                c.values.extend_from_slice(v);
+                            }
+                        } else {
+                            r.read(&block.time, &block.values, &mut run);
+                        }
                         result = check_solution(&run, solver, rk4_step);
                         min_p = min_p.min(run.min_chamber_pressure());
                         if !headed {
@@ -218,6 +240,7 @@ impl Writer {
                 }
                 // the solve may be gone already: then the block is just freed
                 let _ = back.send(block);
+                written.fetch_sub(1, std::sync::atomic::Ordering::Relaxed);
                 if result.is_err() {
                     // the solve's next block finds the thread gone and stops
                     break;
@@ -232,7 +255,13 @@ impl Writer {
             send: Some(send),
             recycled,
             thread: Some(thread),
+            pending,
         }
+    }
+
+    /// Blocks sent and not yet written.
+    fn behind(&self) -> usize {
+        self.pending.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Queues a block filled by `fill` (in a recycled one); an error when
@@ -245,12 +274,15 @@ impl Writer {
         fill(&mut block);
         let stopped = || CliError::Input("the output writer stopped".into());
         let send = self.send.as_ref().ok_or_else(stopped)?;
+        self.pending
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         send.send(block).map_err(|_| stopped())
     }
 
     /// Queues `run`'s channels.
     fn push_channels(&mut self, run: &Run) -> Result<(), CliError> {
         self.push(|b| {
+            b.channels = true;
             b.time.extend_from_slice(&run.time);
             b.values.reserve(run.channels.len() * run.time.len());
             for c in &run.channels {
@@ -262,6 +294,7 @@ impl Writer {
     /// Queues raw times and states, for the probes read on the thread.
     fn push_states(&mut self, t: &[f64], x: &[f64]) -> Result<(), CliError> {
         self.push(|b| {
+            b.channels = false;
             b.time.extend_from_slice(t);
             b.values.extend_from_slice(x);
         })
@@ -569,22 +602,27 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let on_writer = match (second, &input) {
         (Some(signal), Input::Table(times)) if c.history_free() => {
             let (x0, t0, opts) = (x0.clone(), times[0], opts.clone());
+            let checked = std::sync::Arc::new(checked);
+            let own = (checked.clone(), signal.clone());
             let make = move || {
                 let c = checked
                     .circuit(signal)
                     .map_err(|e| CliError::Input(e.to_string()))?;
                 ProbeReader::new(c, &x0, t0, &opts).map_err(|e| CliError::Input(e.to_string()))
             };
-            Some(OnWriter {
-                make: Box::new(make),
-                unit,
-                solver,
-                rk4_step: args.rk4_step,
-            })
+            Some((
+                OnWriter {
+                    make: Box::new(make),
+                    unit,
+                    solver,
+                    rk4_step: args.rk4_step,
+                },
+                own,
+            ))
         }
         _ => None,
     };
-    let streamed = if let Some(on) = on_writer {
+    let streamed = if let Some((on, (rig, third))) = on_writer {
         let Input::Table(times) = &input else {
             return Err(CliError::Input("no command table".into()));
         };
@@ -592,10 +630,25 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .take()
             .ok_or_else(|| CliError::Input("no output".into()))?;
         let w = writer.insert(Writer::start(o, id, Vec::new(), Some(on)));
+        // the solve's own reader (a third circuit), made when first needed
+        let mut own: Option<ProbeReader> = None;
+        let mut block = Run::default();
+        let t0 = times[0];
         let mut sink = |t: &[f64], x: &[f64]| -> Result<(), String> {
             done += t.len();
             bar.set("rows", done as u64, rows as u64);
-            w.push_states(t, x).map_err(|e| e.to_string())
+            if w.behind() < args.probes_behind {
+                return w.push_states(t, x).map_err(|e| e.to_string());
+            }
+            let r = match own.as_mut() {
+                Some(r) => r,
+                None => {
+                    let c = rig.circuit(third.clone()).map_err(|e| e.to_string())?;
+                    own.insert(ProbeReader::new(c, &x0, t0, &opts).map_err(|e| e.to_string())?)
+                }
+            };
+            r.read(t, x, &mut block);
+            w.push_channels(&block).map_err(|e| e.to_string())
         };
         runner::run_streaming_states(&mut c, &x0, times, &opts, BLOCK, &mut sink)
     } else {

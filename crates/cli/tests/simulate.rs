@@ -595,7 +595,9 @@ fn netlist_errors_name_the_path_and_line() {
 
 /// The output written block by block by the writer thread (several blocks
 /// here) is, byte for byte, the in-process run of the same command written
-/// in one piece.
+/// in one piece, wherever its probes were read: on the writer thread (a
+/// second circuit), on the solve's thread (`--probes-behind 0`: a third
+/// circuit), or as the writer falls behind (the default).
 #[test]
 fn the_written_rows_are_the_in_process_run_byte_for_byte() {
     use hydrocyl_identify::plaincsv::{run_columns, write_columns};
@@ -603,9 +605,6 @@ fn the_written_rows_are_the_in_process_run_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
     let rows = square(3500, 1e-3);
     let cmd = write_command(dir.path(), "cmd.csv", &rows);
-    let out = dir.path().join("out.csv");
-    simulate_leaney_moog(&cmd, &out);
-    let written = std::fs::read_to_string(&out).unwrap();
     let (t, u): (Vec<f64>, Vec<f64>) = rows.iter().copied().unzip();
     let run = rig::simulate(
         &rig::load("leaney-moog").unwrap(),
@@ -617,6 +616,16 @@ fn the_written_rows_are_the_in_process_run_byte_for_byte() {
     let (names, columns) = run_columns(&run);
     let whole = String::from_utf8(write_columns(&names, &columns)).unwrap();
     let body = |s: &str| s.split_once('\n').map(|(_, b)| b.to_string()).unwrap();
-    assert_eq!(written.lines().count(), rows.len() + 1);
-    assert!(body(&written) == body(&whole), "the rows differ");
+    for extra in [&[][..], &["--probes-behind", "0"], &["--probes-behind", "1000"]] {
+        let out = dir.path().join("out.csv");
+        simulate_ok("leaney-moog", &cmd, &out, extra);
+        let written = std::fs::read_to_string(&out).unwrap();
+        assert_eq!(written.lines().count(), rows.len() + 1, "{extra:?}");
+        assert_eq!(
+            written.lines().next().unwrap().split(',').count(),
+            names.len(),
+            "{extra:?}"
+        );
+        assert!(body(&written) == body(&whole), "{extra:?}: the rows differ");
+    }
 }

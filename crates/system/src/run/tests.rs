@@ -129,3 +129,52 @@ fn streamed_runs_equal_the_whole_run() {
     assert_eq!(total.stats, whole.stats);
     assert!(!window.underrun());
 }
+
+/// A history-free circuit's probes read on a second circuit from the raw
+/// states of [`run_streaming_states`] are the whole run's channels, bit for
+/// bit; a circuit with a modal component (Karnopp friction's stick/slip) is
+/// not history-free and a [`ProbeReader`] refuses it.
+#[test]
+fn probes_read_on_a_second_circuit_are_the_runs() {
+    let value = rig::load("leaney-moog").unwrap();
+    let (t, u) = square(5.0);
+    let table = Signal::table(t.clone(), u).unwrap();
+    let opts = RunOptions::default();
+    let mut c = rig::circuit(&value, table.clone()).unwrap();
+    assert!(c.history_free());
+    let x0 = c.initial_state();
+    let whole = run(&mut c, &x0, &t, &opts).unwrap();
+
+    let second = rig::circuit(&value, table.clone()).unwrap();
+    let mut reader = ProbeReader::new(second, &x0, t[0], &opts).unwrap();
+    let mut blocks = Vec::new();
+    let mut c = rig::circuit(&value, table.clone()).unwrap();
+    let total = run_streaming_states(&mut c, &x0, &t, &opts, 300, &mut |t, x| {
+        let mut b = Run::default();
+        reader.read(t, x, &mut b);
+        blocks.push(b);
+        Ok(())
+    })
+    .unwrap();
+    assert!(blocks.len() >= 10, "{} blocks", blocks.len());
+    let (ts, ch) = joined(&blocks);
+    assert_eq!(ts, whole.time);
+    assert_eq!(ch.len(), whole.channels.len());
+    for (j, (a, b)) in ch.iter().zip(&whole.channels).enumerate() {
+        assert_eq!(blocks[0].channels[j].name, b.name);
+        assert_eq!(a, &b.values, "channel {}", b.name);
+    }
+    let states: Vec<f64> = blocks.iter().flat_map(|b| b.states.clone()).collect();
+    assert_eq!(states, whole.states);
+    assert_eq!(total.stats, whole.stats);
+
+    let mut modal = value.clone();
+    modal["components"]["friction"] = serde_json::json!({
+        "type": "friction_karnopp", "sigma2": 500.0,
+        "curve": {"coulomb": 50.0, "stiction": 60.0, "stribeck_velocity": 0.005,
+                  "stribeck_exponent": 2.0}
+    });
+    let c = rig::circuit(&modal, table).unwrap();
+    assert!(!c.history_free());
+    assert!(ProbeReader::new(c, &x0, t[0], &opts).is_err());
+}

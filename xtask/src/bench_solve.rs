@@ -9,7 +9,7 @@ use hydrocyl_identify::plaincsv::{
 };
 use hydrocyl_integrators::Method;
 use hydrocyl_studies::chapter7::{Chapter7Test, Load, Shape};
-use hydrocyl_system::run::{nrmse, Run, RunOptions, Solver};
+use hydrocyl_system::run::{nrmse, run_streaming_states, Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::valve_rig::ValveRig;
 use std::path::{Path, PathBuf};
@@ -199,43 +199,109 @@ fn first_touch_us() -> f64 {
 /// and 1000 s, DP45 at rtol 1e-5 on the 1 kHz square with 1 kHz output. Each
 /// length runs 1000 simulated seconds in all (1000 runs of 1 s, ..., one of
 /// 1000 s), so every row does the same work; the ratio to the 1 s cost says
-/// whether anything grows with the record. The page faults per step show
-/// the cost of first touching the output's memory, which a long record
-/// cannot reuse from an earlier run (the faults of the whole run, the
-/// channels built after the solve included; beside them, what they cost at
-/// most at this machine's [`first_touch_us`]).
+/// whether anything grows with the record. Two paths, each its own 1 s
+/// reference:
+/// - **streamed** (`run_streaming_states` in 256-row blocks, the path of
+///   `hydrocyl simulate`'s solve thread): the outputs go to a sink block by
+///   block in reused buffers (here one reused copy, as the CLI's writer
+///   queue), so the memory does not grow with the record; this is the row
+///   the goal (<= 1.10) is for;
+/// - **in memory** (`run`: every output state kept, 72 MB at 1000 s): the
+///   page faults per step show the kernel's first touch of that memory,
+///   which a long record cannot reuse from an earlier run (the faults of
+///   the whole run, the channels built after the solve included; beside
+///   them, what they cost at most at this machine's [`first_touch_us`]).
+///   They are inside the timed solve, as they are for a caller of `run`.
+///   The streamed rows count the faults of the solve alone.
 fn cost_per_step() -> Result<(), String> {
-    println!("valve rig cost per step, DP45 rtol 1e-5, 1 kHz command and output, 1000 s simulated per row:");
+    println!("valve rig cost per step, DP45 rtol 1e-5, 1 kHz command and output, 1000 s simulated per row (wall of the solve / attempted steps; the fastest of 3 rounds, the lengths interleaved):");
     let fault = first_touch_us();
-    let mut base = None;
-    for t_end in [1.0, 10.0, 100.0, 1000.0] {
-        let case = square_case(t_end)?;
-        let runs = (1000.0 / t_end) as usize;
-        case.run(Solver::Dp45, 1e-5)?; // warm-up
-        let (mut wall, mut steps) = (0.0, 0usize);
-        let f0 = minor_faults();
-        for _ in 0..runs {
-            let r = case.run(Solver::Dp45, 1e-5)?;
-            wall += r.wall.as_secs_f64();
-            steps += r.stats.steps + r.stats.rejected;
-        }
-        let faults = match (f0, minor_faults()) {
-            (Some(a), Some(b)) => {
-                let per_step = (b - a) as f64 / steps as f64;
-                format!(
-                    "{per_step:.3} (at most {:.3} µs/step at {fault:.2} µs each)",
-                    per_step * fault
-                )
-            }
-            _ => "?".into(),
+    let opts = RunOptions {
+        solver: Solver::Dp45,
+        rtol: 1e-5,
+        ..RunOptions::default()
+    };
+    let lengths = [1.0, 10.0, 100.0, 1000.0];
+    let cases = lengths
+        .iter()
+        .map(|&t| square_case(t))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut kept = Vec::new();
+    // one run: its solve's wall, attempted steps and page faults (streamed:
+    // the solve's alone, the circuit's copy of the command table is made
+    // before; in memory: the whole run's)
+    let mut one = |case: &SquareCase, streamed: bool| -> Result<(f64, usize, Option<u64>), String> {
+        let f0;
+        let r = if streamed {
+            let mut c = case
+                .rig
+                .circuit(case.command.clone())
+                .map_err(|e| e.to_string())?;
+            let x0 = c.initial_state();
+            f0 = minor_faults();
+            run_streaming_states(&mut c, &x0, &case.times, &opts, 256, &mut |t, x| {
+                kept.clear();
+                kept.extend_from_slice(t);
+                kept.extend_from_slice(x);
+                Ok(())
+            })
+            .map_err(|e| e.to_string())?
+        } else {
+            f0 = minor_faults();
+            case.run(Solver::Dp45, 1e-5)?
         };
-        let us = wall * 1e6 / steps as f64;
-        let b = *base.get_or_insert(us);
+        let faults = minor_faults().zip(f0).map(|(b, a)| b - a);
+        Ok((r.wall.as_secs_f64(), r.stats.steps + r.stats.rejected, faults))
+    };
+    for streamed in [true, false] {
         println!(
-            "  {t_end:>6.0} s x {runs:>4}: {:>8.1} ms, {steps:>7} steps, {us:.3} µs/step, / 1 s {:.2} (goal <= 1.10); page faults/step {faults}",
-            wall * 1e3,
-            us / b
+            "  {}",
+            if streamed {
+                "streamed (run_streaming_states, 256-row blocks in reused buffers: hydrocyl simulate's solve thread):"
+            } else {
+                "in memory (run: all outputs kept, the states grow with the record):"
+            }
         );
+        // per length: (fastest wall, steps, faults of that round)
+        let mut rows = vec![(f64::INFINITY, 0usize, Some(0u64)); lengths.len()];
+        for _ in 0..3 {
+            for (case, row) in cases.iter().zip(rows.iter_mut()) {
+                let t_end = case.times[case.times.len() - 1];
+                let runs = (1000.0 / t_end).round() as usize;
+                one(case, streamed)?; // warm-up
+                let (mut wall, mut steps, mut faulted) = (0.0, 0usize, Some(0u64));
+                for _ in 0..runs {
+                    let (w, n, f) = one(case, streamed)?;
+                    wall += w;
+                    steps += n;
+                    faulted = faulted.zip(f).map(|(a, b)| a + b);
+                }
+                if wall < row.0 {
+                    *row = (wall, steps, faulted);
+                }
+            }
+        }
+        let base = rows[0].0 / rows[0].1 as f64;
+        for (t_end, (wall, steps, faulted)) in lengths.iter().zip(rows) {
+            let runs = (1000.0 / t_end) as usize;
+            let faults = match faulted {
+                Some(n) => {
+                    let per_step = n as f64 / steps as f64;
+                    format!(
+                        "{per_step:.3} (at most {:.3} µs/step at {fault:.2} µs each)",
+                        per_step * fault
+                    )
+                }
+                None => "?".into(),
+            };
+            let us = wall * 1e6 / steps as f64;
+            println!(
+                "    {t_end:>6.0} s x {runs:>4}: {:>8.1} ms, {steps:>7} steps, {us:.3} µs/step, / 1 s {:.2}{}; page faults/step {faults}",
+                wall * 1e3,
+                us / (base * 1e6),
+                if streamed { " (goal <= 1.10)" } else { "" }
+            );
+        }
     }
     Ok(())
 }

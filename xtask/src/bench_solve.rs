@@ -230,29 +230,34 @@ fn cost_per_step() -> Result<(), String> {
     // one run: its solve's wall, attempted steps and page faults (streamed:
     // the solve's alone, the circuit's copy of the command table is made
     // before; in memory: the whole run's)
-    let mut one = |case: &SquareCase, streamed: bool| -> Result<(f64, usize, Option<u64>), String> {
-        let f0;
-        let r = if streamed {
-            let mut c = case
-                .rig
-                .circuit(case.command.clone())
-                .map_err(|e| e.to_string())?;
-            let x0 = c.initial_state();
-            f0 = minor_faults();
-            run_streaming_states(&mut c, &x0, &case.times, &opts, 256, &mut |t, x| {
-                kept.clear();
-                kept.extend_from_slice(t);
-                kept.extend_from_slice(x);
-                Ok(())
-            })
-            .map_err(|e| e.to_string())?
-        } else {
-            f0 = minor_faults();
-            case.run(Solver::Dp45, 1e-5)?
+    let mut one =
+        |case: &SquareCase, streamed: bool| -> Result<(f64, usize, Option<u64>), String> {
+            let f0;
+            let r = if streamed {
+                let mut c = case
+                    .rig
+                    .circuit(case.command.clone())
+                    .map_err(|e| e.to_string())?;
+                let x0 = c.initial_state();
+                f0 = minor_faults();
+                run_streaming_states(&mut c, &x0, &case.times, &opts, 256, &mut |t, x| {
+                    kept.clear();
+                    kept.extend_from_slice(t);
+                    kept.extend_from_slice(x);
+                    Ok(())
+                })
+                .map_err(|e| e.to_string())?
+            } else {
+                f0 = minor_faults();
+                case.run(Solver::Dp45, 1e-5)?
+            };
+            let faults = minor_faults().zip(f0).map(|(b, a)| b - a);
+            Ok((
+                r.wall.as_secs_f64(),
+                r.stats.steps + r.stats.rejected,
+                faults,
+            ))
         };
-        let faults = minor_faults().zip(f0).map(|(b, a)| b - a);
-        Ok((r.wall.as_secs_f64(), r.stats.steps + r.stats.rejected, faults))
-    };
     for streamed in [true, false] {
         println!(
             "  {}",
@@ -480,7 +485,11 @@ fn csv_per_row() -> Result<(), String> {
     // a value equal to the one above it is copied, not formatted again
     let repeats = columns
         .iter()
-        .map(|c| c.windows(2).filter(|w| w[0].to_bits() == w[1].to_bits()).count())
+        .map(|c| {
+            c.windows(2)
+                .filter(|w| w[0].to_bits() == w[1].to_bits())
+                .count()
+        })
         .sum::<usize>() as f64
         / (rows * columns.len() as f64);
     println!(

@@ -32,7 +32,10 @@
 //! Every input is checked and the output's temporary file created before the
 //! run ([`crate::output`]); the run is streamed in blocks
 //! ([`hydrocyl_system::run::run_streaming`]), each formatted and written by
-//! a second thread while the solve computes the next ([`Writer`]), and the temporary is renamed into place at the end, so a failed
+//! a second thread while the solve computes the next ([`Writer`]); a
+//! history-free rig's probes are read there too, on a second circuit
+//! ([`hydrocyl_system::run::run_streaming_states`],
+//! [`hydrocyl_system::run::ProbeReader`]), and the temporary is renamed into place at the end, so a failed
 //! or interrupted run leaves no file (`--fsync` also flushes it to the disk
 //! first; without it the operating system writes it back when it likes, as
 //! for any ordinary file).
@@ -211,7 +214,8 @@ impl Writer {
                             r.read(&[], &[], &mut run);
                             run.time.extend_from_slice(&block.time);
                             let n = block.time.len().max(1);
-                            for (c, v) in run.channels.iter_mut().zip(block.values.chunks_exact(n)) {
+                            for (c, v) in run.channels.iter_mut().zip(block.values.chunks_exact(n))
+                            {
                                 c.values.extend_from_slice(v);
                             }
                         } else {
@@ -680,9 +684,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
             Input::Table(times) => {
                 runner::run_streaming(&mut c, &x0, times, &opts, BLOCK, &mut sink)
             }
-            Input::Stream(table, chunks) => runner::run_command_stream(
-                &mut c, &x0, table, chunks, t1, &opts, BLOCK, &mut sink,
-            ),
+            Input::Stream(table, chunks) => {
+                runner::run_command_stream(&mut c, &x0, table, chunks, t1, &opts, BLOCK, &mut sink)
+            }
         }
     };
     bar.finish();

@@ -616,7 +616,11 @@ fn the_written_rows_are_the_in_process_run_byte_for_byte() {
     let (names, columns) = run_columns(&run);
     let whole = String::from_utf8(write_columns(&names, &columns)).unwrap();
     let body = |s: &str| s.split_once('\n').map(|(_, b)| b.to_string()).unwrap();
-    for extra in [&[][..], &["--probes-behind", "0"], &["--probes-behind", "1000"]] {
+    for extra in [
+        &[][..],
+        &["--probes-behind", "0"],
+        &["--probes-behind", "1000"],
+    ] {
         let out = dir.path().join("out.csv");
         simulate_ok("leaney-moog", &cmd, &out, extra);
         let written = std::fs::read_to_string(&out).unwrap();

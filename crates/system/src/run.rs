@@ -345,6 +345,10 @@ pub fn run_streaming(
     )
 }
 
+/// The sink of [`run_streaming_states`]: a block's output times and
+/// states (row-major); an `Err` stops the run.
+pub type StateSink<'a> = dyn FnMut(&[f64], &[f64]) -> Result<(), String> + 'a;
+
 /// [`run_streaming`] without the channels: `sink` receives each block's
 /// output times and full states (row-major, `x.len() / t.len()` each) as
 /// the integrator wrote them, and reads the probes itself where it likes,
@@ -357,7 +361,7 @@ pub fn run_streaming_states(
     t_eval: &[f64],
     opts: &RunOptions,
     block: usize,
-    sink: &mut dyn FnMut(&[f64], &[f64]) -> Result<(), String>,
+    sink: &mut StateSink<'_>,
 ) -> Result<Run, SimError> {
     check_times(t_eval)?;
     let mut times = Times::Slice {
@@ -524,7 +528,7 @@ enum Output<'a> {
     /// The channels read on the solving circuit, as a [`Run`].
     Channels(&'a mut dyn FnMut(&Run) -> Result<(), String>),
     /// The raw times and states.
-    States(&'a mut dyn FnMut(&[f64], &[f64]) -> Result<(), String>),
+    States(&'a mut StateSink<'a>),
 }
 
 /// The [`Stream`] of [`run_streaming`] and [`run_command_stream`].

@@ -329,20 +329,7 @@ pub fn run_streaming(
     block: usize,
     sink: &mut dyn FnMut(&Run) -> Result<(), String>,
 ) -> Result<Run, SimError> {
-    check_times(t_eval)?;
-    let mut times = Times::Slice {
-        t: t_eval,
-        pushed: 0,
-    };
-    stream(
-        circuit,
-        x0,
-        &mut times,
-        t_eval[t_eval.len() - 1],
-        opts,
-        block,
-        Output::Channels(sink),
-    )
+    stream_slice(circuit, x0, t_eval, opts, block, Output::Channels(sink))
 }
 
 /// The sink of [`run_streaming_states`]: a block's output times and
@@ -363,20 +350,25 @@ pub fn run_streaming_states(
     block: usize,
     sink: &mut StateSink<'_>,
 ) -> Result<Run, SimError> {
+    stream_slice(circuit, x0, t_eval, opts, block, Output::States(sink))
+}
+
+/// [`stream`] at the output times `t_eval`, all given.
+fn stream_slice(
+    circuit: &mut Circuit,
+    x0: &[f64],
+    t_eval: &[f64],
+    opts: &RunOptions,
+    block: usize,
+    out: Output<'_>,
+) -> Result<Run, SimError> {
     check_times(t_eval)?;
     let mut times = Times::Slice {
         t: t_eval,
         pushed: 0,
     };
-    stream(
-        circuit,
-        x0,
-        &mut times,
-        t_eval[t_eval.len() - 1],
-        opts,
-        block,
-        Output::States(sink),
-    )
+    let t_end = t_eval[t_eval.len() - 1];
+    stream(circuit, x0, &mut times, t_end, opts, block, out)
 }
 
 /// The samples of a command record, read while the run goes (a source for

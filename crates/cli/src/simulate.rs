@@ -130,6 +130,11 @@ pub struct Args {
 /// writer is behind, at most `--probes-behind` and the last) short.
 const BLOCK: usize = 1 << 8;
 
+/// The writer thread writes its text once it holds this many bytes (more
+/// than the output's buffer, [`crate::output`]: written past it, not copied
+/// into it).
+const WRITE_AT: usize = 1 << 17;
+
 /// Samples of the command window of a streamed command file.
 const WINDOW: usize = 1 << 18;
 
@@ -239,8 +244,12 @@ impl Writer {
                 };
                 if result.is_ok() {
                     hydrocyl_identify::plaincsv::append_rows(&columns, &mut text);
-                    result = outputs.write(id, &text);
-                    text.clear();
+                    // written in pieces larger than the file's buffer, which
+                    // then takes them without a copy
+                    if text.len() >= WRITE_AT {
+                        result = outputs.write(id, &text);
+                        text.clear();
+                    }
                 }
                 // the solve may be gone already: then the block is just freed
                 let _ = back.send(block);

@@ -308,8 +308,15 @@ impl Signal {
                 let Some(i) = interval_hinted(time_s, t, hint) else {
                     return value[value.len() - 1];
                 };
+                let dv = value[i + 1] - value[i];
+                if dv == 0.0 {
+                    // a held interval (most of a stepped command): the
+                    // formula below without its division, bit for bit
+                    // (`+ 0.0` turns a −0.0 sample into +0.0 as it does)
+                    return value[i] + 0.0;
+                }
                 let (t0, t1) = (time_s[i], time_s[i + 1]);
-                value[i] + (value[i + 1] - value[i]) * (t - t0) / (t1 - t0)
+                value[i] + dv * (t - t0) / (t1 - t0)
             }
         }
     }

@@ -94,9 +94,24 @@ impl Orifice {
     /// pressure difference reverses).
     #[inline]
     pub fn flow(&self, area: Area, p_up: Pressure, p_down: Pressure) -> VolumeFlow {
+        self.flow_with_coefficient(self.coefficient(), area, p_up, p_down)
+    }
+
+    /// [`Orifice::flow`] with its [`Orifice::coefficient`] given: a valve
+    /// with several edges of one orifice computes the coefficient (a
+    /// division and a square root) once for all of them. The same value,
+    /// bit for bit, when `coefficient` is `self.coefficient()`.
+    #[inline]
+    pub fn flow_with_coefficient(
+        &self,
+        coefficient: f64,
+        area: Area,
+        p_up: Pressure,
+        p_down: Pressure,
+    ) -> VolumeFlow {
         let dp = (p_up - p_down).si();
         VolumeFlow::new(
-            self.coefficient() * area.si() * signed_sqrt_regularised(dp, self.dp_transition.si()),
+            coefficient * area.si() * signed_sqrt_regularised(dp, self.dp_transition.si()),
         )
     }
 

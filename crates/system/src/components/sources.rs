@@ -104,6 +104,11 @@ pub fn kinks(signal: &Signal) -> Vec<f64> {
             }
             (1..time_s.len() - 1)
                 .filter(|&i| {
+                    // three equal samples: both slopes 0, no kink (the
+                    // divisions below would say so, at ten times the cost)
+                    if value[i - 1] == value[i] && value[i] == value[i + 1] {
+                        return false;
+                    }
                     let (d0, d1) = (time_s[i] - time_s[i - 1], time_s[i + 1] - time_s[i]);
                     let s0 = (value[i] - value[i - 1]) / d0;
                     let s1 = (value[i + 1] - value[i]) / d1;

@@ -639,8 +639,8 @@ impl Circuit {
         for &a in &self.accumulators {
             w.zero(a);
         }
-        for (i, c) in self.comps.iter().enumerate() {
-            c.publish(t, &x[self.offsets[i]..self.offsets[i + 1]], &mut w);
+        for (c, o) in self.comps.iter().zip(self.offsets.windows(2)) {
+            c.publish(t, &x[o[0]..o[1]], &mut w);
         }
         let xs = |i: usize| &x[self.offsets[i]..self.offsets[i + 1]];
         for step in &self.order {
@@ -685,8 +685,8 @@ impl OdeSystem for Circuit {
     fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
         self.fill(t, x);
         let w = self.wires.borrow();
-        for (i, c) in self.comps.iter().enumerate() {
-            let r = self.offsets[i]..self.offsets[i + 1];
+        for (c, o) in self.comps.iter().zip(self.offsets.windows(2)) {
+            let r = o[0]..o[1];
             // a component without states has no derivatives to write
             if !r.is_empty() {
                 c.derivatives(t, &x[r.clone()], &w, &mut dx[r]);

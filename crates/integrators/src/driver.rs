@@ -311,6 +311,7 @@ fn initial_step<S: OdeSystem + ?Sized>(
 }
 
 /// Sign of a switching-function value: -1, 0 or +1.
+#[inline]
 fn sgn(v: f64) -> i8 {
     if v > 0.0 {
         1

@@ -172,7 +172,11 @@ fn print_goal(rows: &[(Solver, f64, f64, f64)]) {
                 "{what} rtol {:.0e} {:.1e} {}",
                 r.1,
                 r.3,
-                if r.3 <= NRMSE_GOAL { "meets it" } else { "misses" }
+                if r.3 <= NRMSE_GOAL {
+                    "meets it"
+                } else {
+                    "misses"
+                }
             ),
             None => format!("no {what} rtol"),
         };

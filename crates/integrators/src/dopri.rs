@@ -176,7 +176,13 @@ impl Stepper for DormandPrince {
         let [k1, _k2, k3, k4, k5, k6, k7] = &self.k;
         let [r1, r2, r3, r4, r5] = &mut self.rcont;
         let (k1, k3, k4, k5, k6, k7) = (&k1[..n], &k3[..n], &k4[..n], &k5[..n], &k6[..n], &k7[..n]);
-        let (r1, r2, r3, r4, r5) = (&mut r1[..n], &mut r2[..n], &mut r3[..n], &mut r4[..n], &mut r5[..n]);
+        let (r1, r2, r3, r4, r5) = (
+            &mut r1[..n],
+            &mut r2[..n],
+            &mut r3[..n],
+            &mut r4[..n],
+            &mut r5[..n],
+        );
         let x_new = &x_new[..n];
         for i in 0..n {
             let dy = x_new[i] - x[i];

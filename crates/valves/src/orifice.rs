@@ -134,7 +134,12 @@ mod tests {
     fn flow_with_its_own_coefficient_is_flow_bit_for_bit() {
         let o = Orifice::new(0.625, Density::new(870.0));
         let a = Area::new(3.7e-6);
-        for (up, down) in [(7.0e6, 2.1e6), (1.0e5, 3.0e6), (2.0e5, 2.0e5 + 400.0), (0.0, 0.0)] {
+        for (up, down) in [
+            (7.0e6, 2.1e6),
+            (1.0e5, 3.0e6),
+            (2.0e5, 2.0e5 + 400.0),
+            (0.0, 0.0),
+        ] {
             let (up, down) = (Pressure::new(up), Pressure::new(down));
             let q = o.flow(a, up, down).si();
             let qc = o.flow_with_coefficient(o.coefficient(), a, up, down).si();

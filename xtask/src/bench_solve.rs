@@ -113,8 +113,8 @@ fn work_precision() -> Result<(), String> {
         head.push_str(&format!(" {:>9}", truncate(n, 9)));
     }
     println!("{head}");
-    // the fastest run of each solver at velocity NRMSE <= 1e-4
-    let mut goal: Vec<(Solver, f64, f64)> = Vec::new();
+    // every run's (solver, rtol, ms, velocity NRMSE), in table order
+    let mut rows: Vec<(Solver, f64, f64, f64)> = Vec::new();
     for solver in [Solver::Auto, Solver::Dp45, Solver::Rosenbrock] {
         for rtol in WORK_PRECISION_RTOLS {
             let reps = if rtol >= 1e-7 { 5 } else { 2 };
@@ -142,26 +142,56 @@ fn work_precision() -> Result<(), String> {
                 r.channel("velocity").unwrap_or(&[]),
                 reference.channel("velocity").unwrap_or(&[]),
             );
-            if v <= 1e-4 {
-                match goal.iter_mut().find(|g| g.0 == solver) {
-                    Some(g) if ms < g.1 => *g = (solver, ms, rtol),
-                    Some(_) => {}
-                    None => goal.push((solver, ms, rtol)),
-                }
-            }
+            rows.push((solver, rtol, ms, v));
         }
     }
-    for (solver, ms, rtol) in &goal {
+    print_goal(&rows);
+    Ok(())
+}
+
+/// The velocity NRMSE goal of the work-precision table.
+const NRMSE_GOAL: f64 = 1e-4;
+
+/// For each solver, the fastest run at velocity NRMSE ≤ [`NRMSE_GOAL`], with
+/// its margin (NRMSE / goal) and how its neighbouring tolerances in the table
+/// fare: a run that meets the goal between two that miss it met it by luck
+/// of the step sequence (the error at the valve's corners is not smooth in
+/// rtol), not by its tolerance.
+fn print_goal(rows: &[(Solver, f64, f64, f64)]) {
+    let mut any = false;
+    for solver in [Solver::Auto, Solver::Dp45, Solver::Rosenbrock] {
+        let runs: Vec<_> = rows.iter().filter(|r| r.0 == solver).collect();
+        let best = (0..runs.len())
+            .filter(|&i| runs[i].3 <= NRMSE_GOAL)
+            .min_by(|&a, &b| runs[a].2.total_cmp(&runs[b].2));
+        let Some(i) = best else { continue };
+        any = true;
+        let (_, rtol, ms, v) = *runs[i];
+        let side = |j: Option<usize>, what: &str| match j.and_then(|j| runs.get(j)) {
+            Some(r) => format!(
+                "{what} rtol {:.0e} {:.1e} {}",
+                r.1,
+                r.3,
+                if r.3 <= NRMSE_GOAL {
+                    "meets it"
+                } else {
+                    "misses"
+                }
+            ),
+            None => format!("no {what} rtol"),
+        };
         println!(
-            "  fastest {} run at velocity NRMSE <= 1e-4: {ms:.3} ms (rtol {rtol:.0e}; goal <= 1 ms; {})",
+            "  fastest {} run at velocity NRMSE <= 1e-4: {ms:.3} ms (rtol {rtol:.0e}, NRMSE {v:.2e} = {:.2} of the goal; {}, {}; goal <= 1 ms; {})",
             solver.name(),
+            v / NRMSE_GOAL,
+            side(i.checked_sub(1), "looser"),
+            side(Some(i + 1), "tighter"),
             profile()
         );
     }
-    if goal.is_empty() {
+    if !any {
         println!("  no run reached velocity NRMSE <= 1e-4");
     }
-    Ok(())
 }
 
 fn truncate(s: &str, n: usize) -> &str {

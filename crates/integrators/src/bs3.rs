@@ -83,7 +83,9 @@ impl Stepper for BogackiShampine {
     ) -> Attempt {
         let n = x.len();
         let [k1, k2, k3, k4] = &mut self.k;
-        let y = &mut self.y;
+        // every vector cut to n: the stage loops need no bounds checks
+        let (k1, k2, k3, k4) = (&mut k1[..n], &mut k2[..n], &mut k3[..n], &mut k4[..n]);
+        let (y, x_new, err) = (&mut self.y[..n], &mut x_new[..n], &mut err[..n]);
         if !self.k1_valid {
             sys.rhs(t, x, k1);
             stats.rhs_evals += 1;

@@ -117,7 +117,10 @@ impl Stepper for DormandPrince {
     ) -> Attempt {
         let n = x.len();
         let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
-        let y = &mut self.y;
+        // every vector cut to n: the stage loops need no bounds checks
+        let (k1, k2, k3, k4) = (&mut k1[..n], &mut k2[..n], &mut k3[..n], &mut k4[..n]);
+        let (k5, k6, k7) = (&mut k5[..n], &mut k6[..n], &mut k7[..n]);
+        let (y, x_new, err) = (&mut self.y[..n], &mut x_new[..n], &mut err[..n]);
         if !self.k1_valid {
             sys.rhs(t, x, k1);
             stats.rhs_evals += 1;
@@ -172,6 +175,15 @@ impl Stepper for DormandPrince {
         let n = x.len();
         let [k1, _k2, k3, k4, k5, k6, k7] = &self.k;
         let [r1, r2, r3, r4, r5] = &mut self.rcont;
+        let (k1, k3, k4, k5, k6, k7) = (&k1[..n], &k3[..n], &k4[..n], &k5[..n], &k6[..n], &k7[..n]);
+        let (r1, r2, r3, r4, r5) = (
+            &mut r1[..n],
+            &mut r2[..n],
+            &mut r3[..n],
+            &mut r4[..n],
+            &mut r5[..n],
+        );
+        let x_new = &x_new[..n];
         for i in 0..n {
             let dy = x_new[i] - x[i];
             let bspl = h * k1[i] - dy;
@@ -188,8 +200,10 @@ impl Stepper for DormandPrince {
 
     fn dense(&self, theta: f64, out: &mut [f64]) {
         let s1 = 1.0 - theta;
+        let n = out.len();
         let [r1, r2, r3, r4, r5] = &self.rcont;
-        for i in 0..out.len() {
+        let (r1, r2, r3, r4, r5) = (&r1[..n], &r2[..n], &r3[..n], &r4[..n], &r5[..n]);
+        for i in 0..n {
             out[i] = r1[i] + theta * (r2[i] + s1 * (r3[i] + theta * (r4[i] + s1 * r5[i])));
         }
     }

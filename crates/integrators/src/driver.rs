@@ -247,6 +247,7 @@ impl ControlState {
 /// `‖e‖ = sqrt( (1/n) Σ (e_i / (atol_i + rtol·max(|x_i|, |x̂_i|)))² )`.
 pub(crate) fn error_norm(err: &[f64], x: &[f64], x_new: &[f64], atol: &[f64], rtol: f64) -> f64 {
     let n = err.len();
+    let (x, x_new, atol) = (&x[..n], &x_new[..n], &atol[..n]);
     let mut sum = 0.0;
     for i in 0..n {
         let sc = (atol[i] + rtol * x[i].abs().max(x_new[i].abs())).max(f64::MIN_POSITIVE);
@@ -310,6 +311,7 @@ fn initial_step<S: OdeSystem + ?Sized>(
 }
 
 /// Sign of a switching-function value: -1, 0 or +1.
+#[inline]
 fn sgn(v: f64) -> i8 {
     if v > 0.0 {
         1

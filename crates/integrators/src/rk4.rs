@@ -124,7 +124,9 @@ pub(crate) fn cubic_hermite(theta: f64, h: f64, [x0, f0, x1, f1]: [&[f64]; 4], o
     let h10 = s3 - 2.0 * s2 + s;
     let h01 = -2.0 * s3 + 3.0 * s2;
     let h11 = s3 - s2;
-    for i in 0..out.len() {
+    let n = out.len();
+    let (x0, f0, x1, f1) = (&x0[..n], &f0[..n], &x1[..n], &f1[..n]);
+    for i in 0..n {
         out[i] = h00 * x0[i] + h10 * h * f0[i] + h01 * x1[i] + h11 * h * f1[i];
     }
 }

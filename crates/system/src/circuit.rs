@@ -661,8 +661,8 @@ impl Circuit {
         for &a in &self.accumulators {
             w.zero(a);
         }
-        for (i, c) in self.comps.iter().enumerate() {
-            c.publish(t, &x[self.offsets[i]..self.offsets[i + 1]], &mut w);
+        for (c, o) in self.comps.iter().zip(self.offsets.windows(2)) {
+            c.publish(t, &x[o[0]..o[1]], &mut w);
         }
         let xs = |i: usize| &x[self.offsets[i]..self.offsets[i + 1]];
         for step in &self.order {
@@ -707,8 +707,8 @@ impl OdeSystem for Circuit {
     fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
         self.fill(t, x);
         let w = self.wires.borrow();
-        for (i, c) in self.comps.iter().enumerate() {
-            let r = self.offsets[i]..self.offsets[i + 1];
+        for (c, o) in self.comps.iter().zip(self.offsets.windows(2)) {
+            let r = o[0]..o[1];
             // a component without states has no derivatives to write
             if !r.is_empty() {
                 c.derivatives(t, &x[r.clone()], &w, &mut dx[r]);
@@ -767,13 +767,12 @@ impl OdeSystem for Circuit {
             self.fill(t, x);
         }
         let w = self.wires.borrow();
-        for (i, c) in self.comps.iter().enumerate() {
-            c.events(
-                t,
-                &x[self.offsets[i]..self.offsets[i + 1]],
-                &w,
-                &mut g[self.ev_offsets[i]..self.ev_offsets[i + 1]],
-            );
+        let spans = self.offsets.windows(2).zip(self.ev_offsets.windows(2));
+        for (c, (o, e)) in self.comps.iter().zip(spans) {
+            // a component without event functions has nothing to write
+            if e[0] < e[1] {
+                c.events(t, &x[o[0]..o[1]], &w, &mut g[e[0]..e[1]]);
+            }
         }
     }
 

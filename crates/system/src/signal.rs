@@ -308,8 +308,15 @@ impl Signal {
                 let Some(i) = interval_hinted(time_s, t, hint) else {
                     return value[value.len() - 1];
                 };
+                let dv = value[i + 1] - value[i];
+                if dv == 0.0 {
+                    // a held interval (most of a stepped command): the
+                    // formula below without its division, bit for bit
+                    // (`+ 0.0` turns a −0.0 sample into +0.0 as it does)
+                    return value[i] + 0.0;
+                }
                 let (t0, t1) = (time_s[i], time_s[i + 1]);
-                value[i] + (value[i + 1] - value[i]) * (t - t0) / (t1 - t0)
+                value[i] + dv * (t - t0) / (t1 - t0)
             }
         }
     }
@@ -435,6 +442,23 @@ fn table_interval(time_s: &[f64], t: f64, from: usize) -> usize {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn a_held_table_interval_is_the_interpolation_bit_for_bit() {
+        // the shortcut on equal samples returns what the formula gives,
+        // signed zeros included
+        let time_s = vec![0.0, 1.0, 2.0, 3.0, 4.0];
+        let value = vec![-0.0, -0.0, 0.0, 2.5, 2.5];
+        let formula = |t: f64| {
+            let i = (t.floor() as usize).min(3);
+            let (t0, t1) = (time_s[i], time_s[i + 1]);
+            value[i] + (value[i + 1] - value[i]) * (t - t0) / (t1 - t0)
+        };
+        let s = Signal::table(time_s.clone(), value.clone()).unwrap();
+        for t in [0.25, 1.0, 1.5, 2.0, 2.75, 3.0, 3.5] {
+            assert_eq!(s.value(t).to_bits(), formula(t).to_bits(), "t = {t}");
+        }
+    }
 
     #[test]
     fn shapes() {

@@ -303,12 +303,14 @@ impl Metering {
     ) -> MeteringFlows {
         let a = self.areas(xs);
         let o = &self.orifice;
+        // the orifice coefficient once for the four edges
+        let c = o.coefficient();
         // away from null one pair of edges is shut: no square roots for it
         let flow = |area: Area, up, down| {
             if area.si() == 0.0 {
                 VolumeFlow::ZERO
             } else {
-                o.flow(area, up, down)
+                o.flow_with_coefficient(c, area, up, down)
             }
         };
         let q_p1 = flow(a.av1, pp, pa);

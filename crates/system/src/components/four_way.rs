@@ -60,7 +60,9 @@ impl FourWayValve {
     }
 
     /// The flows and the supply pressure the valve sees (drooped when
-    /// `supply_resistance > 0`).
+    /// `supply_resistance > 0`). Inlined: [`Component::evaluate`] drops the
+    /// dissipated power it does not read.
+    #[inline(always)]
     fn flows(&self, w: &Wires) -> (hydrocyl_valves::servovalve::MeteringFlows, Pressure) {
         let g = |n: &HydraulicNode| w.get(n.pressure);
         let xs = w.get(self.spool);

@@ -93,10 +93,12 @@ pub fn kinks(signal: &Signal) -> Vec<f64> {
     match signal {
         Signal::Ramp { t0_s, t1_s, .. } => vec![*t0_s, *t1_s],
         Signal::Table { time_s, value } if time_s.len() >= 3 => {
+            // the values are finite (checked when the table was made): plain
+            // comparisons give the range `f64::min`/`max` would
             let (lo, hi) = value
                 .iter()
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
-                    (l.min(v), h.max(v))
+                    (if v < l { v } else { l }, if v > h { v } else { h })
                 });
             let range = hi - lo;
             if range <= 0.0 {
@@ -104,6 +106,11 @@ pub fn kinks(signal: &Signal) -> Vec<f64> {
             }
             (1..time_s.len() - 1)
                 .filter(|&i| {
+                    // three equal samples: both slopes 0, no kink (the
+                    // divisions below would say so, at ten times the cost)
+                    if value[i - 1] == value[i] && value[i] == value[i + 1] {
+                        return false;
+                    }
                     let (d0, d1) = (time_s[i] - time_s[i - 1], time_s[i + 1] - time_s[i]);
                     let s0 = (value[i] - value[i - 1]) / d0;
                     let s1 = (value[i + 1] - value[i]) / d1;

@@ -309,16 +309,15 @@ impl FirstStep {
 /// The first step takes what `first` has of it (see [`FirstStep`]); each
 /// later step starts from the residual its backtracking accepted.
 ///
-/// Two shortcuts, both judged against `screen.rss`, the round model's sum
-/// of squares on `part`:
-/// - *screening*: where the first step's linearised sum of squares
-///   `rss₀ + gᵀδ` (δ the Gauss–Newton step, g = Jᵀr) removes less than
-///   `screen.share` of it, the trace stops before simulating the step and
-///   `rig` is left where it started ([`TraceEnd::Screened`]);
-/// - *linear end*: a full step whose simulated sum of squares is within
-///   [`LINEAR_END`] of itself of its linearised one ends the trace:
-///   the model was linear in the traced parameters over that step, so a
-///   further step would gain less than that.
+/// Screening: where the first step's linearised sum of squares
+/// `rss₀ + gᵀδ` (δ the Gauss–Newton step, g = Jᵀr) removes less than
+/// `screen.share` of `screen.rss`, the round model's sum of squares on
+/// `part`, the trace stops before simulating the step and `rig` is left
+/// where it started ([`TraceEnd::Screened`]). (Ending a trace early where
+/// a full step did what its linearisation predicted was tried and left
+/// out: two candidates that explain nearly the same share, a Coulomb
+/// asymmetry and a constant force on a record that never stops, then swap
+/// places.)
 ///
 /// The trace only ranks the candidates and starts the refit, whose polish
 /// does not depend on where it starts ([`refit_polished`]).
@@ -391,22 +390,15 @@ pub(super) fn gauss_newton_trace(
             t.set_x0((t.x0() + alpha * delta[k - 2]).clamp(-half, half));
             t.set_v0(t.v0() + alpha * delta[k - 1]);
             let mut r1 = Vec::new();
-            if residual(&t, p, holdout, part, &mut r1).is_ok() {
-                let rss1 = sum_sq(&r1);
-                if rss1 < rss0 {
-                    let linear_end = alpha == 1.0 && rss1 <= linear + LINEAR_END * rss1;
-                    accepted = Some((t, r1, linear_end));
-                    break;
-                }
+            if residual(&t, p, holdout, part, &mut r1).is_ok() && sum_sq(&r1) < rss0 {
+                accepted = Some((t, r1));
+                break;
             }
         }
         match accepted {
-            Some((t, r1, linear_end)) => {
+            Some((t, r1)) => {
                 *rig = t;
                 r0 = r1;
-                if linear_end {
-                    break;
-                }
             }
             None => break,
         }
@@ -422,12 +414,6 @@ pub(super) struct Screen {
     /// Screened out below this linearised share of `rss`.
     pub(super) share: f64,
 }
-
-/// A trace ends when a full step's sum of squares is within this share of
-/// itself of its linearised prediction (see [`gauss_newton_trace`]): a
-/// further step could gain about that share of what is left, far below
-/// what tells two candidates apart.
-const LINEAR_END: f64 = 1e-2;
 
 /// How a trace ended.
 #[derive(Clone, Debug)]

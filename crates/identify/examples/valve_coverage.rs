@@ -45,7 +45,7 @@ fn main() {
             };
             let (got, ci) = (e.params[name], e.ci95[name].unwrap_or(f64::NAN));
             let k = (got - truth).abs() / ci;
-            if !(k <= 1.0) {
+            if k.is_nan() || k > 1.0 {
                 misses.push(format!("seed {seed}: {k:.2}x"));
             }
         }

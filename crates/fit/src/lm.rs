@@ -79,8 +79,34 @@ pub struct Options {
     pub initial_lambda: f64,
     /// Relative finite-difference step (absolute where a parameter is zero).
     pub fd_step: f64,
+    /// The finite-difference step is `fd_step × max(|p|, fd_floor)`; `None`
+    /// takes `1e-3 √fd_step`. A parameter that wanders near zero (an
+    /// initial offset) gets a step of `fd_step × |p|` that is far too small
+    /// for a model with integration noise unless the floor is raised: its
+    /// Jacobian column is then the integrator's noise, and the iteration
+    /// wanders with it.
+    pub fd_floor: Option<f64>,
+    /// Forward differences only (one model evaluation per parameter instead
+    /// of two). Their O(h) error is smooth in the parameters, so it moves
+    /// the point where `Jᵀr = 0` by a small share of a standard error when
+    /// the residual at the minimum is noise; it halves a Jacobian's cost.
+    pub forward_differences: bool,
     /// Confidence level of the reported intervals (0.95 = 95 %).
     pub confidence_level: f64,
+    /// Converged when the undamped Gauss–Newton step of every free
+    /// parameter is below `step_se` × its standard error, both from the
+    /// Jacobian at the current point (0 = off). Unlike `ftol`, this says
+    /// how far the point is from the minimum in the units of the answer's
+    /// own uncertainty, so where the iteration started does not show in
+    /// where it stops (in a flat valley a damped step may lower the cost by
+    /// less than `ftol` while still several standard errors away).
+    pub step_se: f64,
+    /// Stop ([`Termination::NoReduction`]) after this many trial steps in a
+    /// row fail to lower the cost (0 = no limit: until λ overflows or the
+    /// step falls below `xtol`). With integration noise in the residual a
+    /// point near the minimum rejects every step the noise hides, and the
+    /// damping then shrinks the step over a dozen evaluations to nothing.
+    pub max_rejections: usize,
 }
 
 impl Default for Options {
@@ -92,7 +118,11 @@ impl Default for Options {
             gtol: 1e-10,
             initial_lambda: 1e-3,
             fd_step: 1e-7,
+            fd_floor: None,
+            forward_differences: false,
             confidence_level: 0.95,
+            step_se: 0.0,
+            max_rejections: 0,
         }
     }
 }
@@ -208,9 +238,13 @@ impl<R: Residuals> Problem<R> {
         let mut points = Vec::with_capacity(2 * m);
         let mut plan = Vec::with_capacity(m);
         for j in 0..m {
-            let h = self.options.fd_step * p[j].abs().max(1e-3 * self.options.fd_step.sqrt());
+            let floor = self
+                .options
+                .fd_floor
+                .unwrap_or(1e-3 * self.options.fd_step.sqrt());
+            let h = self.options.fd_step * p[j].abs().max(floor);
             let up_ok = p[j] + h <= self.upper[j];
-            let down_ok = p[j] - h >= self.lower[j];
+            let down_ok = p[j] - h >= self.lower[j] && !(self.options.forward_differences && up_ok);
             let mut at = |x: f64| {
                 let mut pp = p.to_vec();
                 pp[j] = x;
@@ -304,8 +338,16 @@ impl<R: Residuals> Problem<R> {
                 break;
             }
             let k = free.len();
+            if o.step_se > 0.0 && gauss_newton_within_se(&a, &g, &free, cost, n, o.step_se) {
+                termination = Termination::StandardError;
+                break;
+            }
             let max_diag = free.iter().map(|&j| a[(j, j)]).fold(0.0, f64::max);
             let floor = (max_diag * 1e-12).max(f64::MIN_POSITIVE);
+            let mut rejected = 0usize;
+            // a trial the bounds project onto the point rejected last is
+            // rejected again without evaluating it
+            let mut last_rejected: Option<Vec<f64>> = None;
             loop {
                 if evaluations >= o.max_evaluations {
                     return Err(FitError::NotConverged {
@@ -340,9 +382,14 @@ impl<R: Residuals> Problem<R> {
                     termination = Termination::Step;
                     break 'outer;
                 }
-                evaluations += 1;
-                let finite = self.eval(&trial, &mut r_new);
-                let cost_new = 0.5 * r_new.norm_squared();
+                let repeat = last_rejected.as_ref() == Some(&trial);
+                let (finite, cost_new) = if repeat {
+                    (false, f64::INFINITY)
+                } else {
+                    evaluations += 1;
+                    let finite = self.eval(&trial, &mut r_new);
+                    (finite, 0.5 * r_new.norm_squared())
+                };
                 let predicted = -(g.dot(&step) + 0.5 * step.dot(&(&a * &step)));
                 let rho = if finite && predicted > 0.0 {
                     (cost - cost_new) / predicted
@@ -364,9 +411,11 @@ impl<R: Residuals> Problem<R> {
                     }
                     break;
                 }
+                last_rejected = Some(trial);
+                rejected += 1;
                 lambda *= nu;
                 nu *= 2.0;
-                if lambda > 1e30 {
+                if lambda > 1e30 || (o.max_rejections > 0 && rejected >= o.max_rejections) {
                     termination = Termination::NoReduction;
                     break 'outer;
                 }
@@ -386,6 +435,36 @@ impl<R: Residuals> Problem<R> {
             termination,
         ))
     }
+}
+
+/// Whether the undamped Gauss–Newton step `−A⁻¹g` on the `free` parameters
+/// (`A = JᵀJ`, `g = Jᵀr`) is below `tol` standard errors in every one:
+/// `|d_j| ≤ tol √(s² (A⁻¹)_jj)` with `s² = 2 cost / (n − k)`. `false` where
+/// the free block is singular or there are no degrees of freedom left.
+fn gauss_newton_within_se(
+    a: &DMatrix<f64>,
+    g: &DVector<f64>,
+    free: &[usize],
+    cost: f64,
+    n: usize,
+    tol: f64,
+) -> bool {
+    let k = free.len();
+    if n <= k {
+        return false;
+    }
+    let sub = DMatrix::from_fn(k, k, |i, j| a[(free[i], free[j])]);
+    let rhs = DVector::from_fn(k, |i, _| -g[free[i]]);
+    let Some(chol) = sub.cholesky() else {
+        return false;
+    };
+    let d = chol.solve(&rhs);
+    let inv = chol.inverse();
+    let s2 = 2.0 * cost / (n - k) as f64;
+    (0..k).all(|i| {
+        let se = (s2 * inv[(i, i)]).sqrt();
+        se.is_finite() && d[i].abs() <= tol * se
+    })
 }
 
 fn check_finite(jac: &DMatrix<f64>, iteration: usize) -> Result<(), FitError> {

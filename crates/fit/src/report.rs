@@ -20,6 +20,9 @@ pub enum Termination {
     /// No trial step lowered the cost even at very large damping: the point is
     /// a minimum to machine precision.
     NoReduction,
+    /// The Gauss–Newton step fell below `step_se` standard errors in every
+    /// free parameter.
+    StandardError,
 }
 
 /// One fitted parameter.

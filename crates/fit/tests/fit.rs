@@ -1,6 +1,6 @@
 //! Integration tests of the bounded Levenberg–Marquardt fit.
 
-use hydrocyl_fit::{FitError, Options, Problem, WithJacobian};
+use hydrocyl_fit::{FitError, Options, Problem, Termination, WithJacobian};
 use proptest::prelude::*;
 
 /// Deterministic zero-mean pseudo-noise in [-1, 1].
@@ -231,5 +231,139 @@ fn determined_parameters_keep_intervals_when_others_are_not() {
     assert_eq!(fit.unidentifiable(), vec![2, 3]);
     let (lo, hi) = fit.parameters[1].interval.unwrap();
     assert!(lo < 2.0 && 2.0 < hi && hi - lo < 0.2, "[{lo}, {hi}]");
+    assert!(fit.parameters[0].interval.is_some());
+}
+
+/// `y = a exp(−b t)` with pseudo-noise: the residual of the tests below.
+fn decay(n: usize) -> impl Fn(&[f64], &mut [f64]) {
+    move |p: &[f64], r: &mut [f64]| {
+        for (i, ri) in r.iter_mut().enumerate().take(n) {
+            let t = i as f64 * 0.05;
+            let y = 2.0 * (-1.3 * t).exp() + 0.02 * noise(i);
+            *ri = y - p[0] * (-p[1] * t).exp();
+        }
+    }
+}
+
+#[test]
+fn the_standard_error_stop_ends_near_the_minimum_whatever_the_start() {
+    // Stopped when the Gauss–Newton step is below 0.05 standard errors,
+    // with the cost test off: from two starts, both ends are within 0.05
+    // standard errors of the fully converged fit.
+    let n = 120;
+    let full = Problem::new(decay(n), n, &["a", "b"])
+        .solve(&[1.0, 1.0])
+        .unwrap();
+    for start in [[1.0, 1.0], [4.0, 0.3]] {
+        let fit = Problem::new(decay(n), n, &["a", "b"])
+            .options(Options {
+                ftol: 0.0,
+                xtol: 0.0,
+                gtol: 0.0,
+                step_se: 0.05,
+                ..Options::default()
+            })
+            .solve(&start)
+            .unwrap();
+        assert_eq!(fit.termination, Termination::StandardError);
+        for (q, f) in fit.parameters.iter().zip(&full.parameters) {
+            let se = f.std_error.unwrap();
+            assert!((q.value - f.value).abs() < 0.05 * se, "{q:?} vs {f:?}");
+        }
+    }
+}
+
+#[test]
+fn forward_differences_take_one_evaluation_per_parameter() {
+    // A straight line: one Jacobian is exact either way; forward differences
+    // evaluate it at one point per parameter, central ones at two.
+    let n = 20;
+    let model = |p: &[f64], r: &mut [f64]| {
+        for (i, ri) in r.iter_mut().enumerate() {
+            *ri = (1.0 + 0.5 * i as f64 + 0.1 * noise(i)) - (p[0] + p[1] * i as f64);
+        }
+    };
+    let solve = |forward_differences| {
+        Problem::new(model, n, &["a", "b"])
+            .options(Options {
+                forward_differences,
+                ..Options::default()
+            })
+            .solve(&[0.0, 0.0])
+            .unwrap()
+    };
+    let (c, f) = (solve(false), solve(true));
+    for (a, b) in c.parameters.iter().zip(&f.parameters) {
+        assert!((a.value - b.value).abs() < 1e-6, "{a:?} vs {b:?}");
+    }
+    assert!(
+        f.evaluations < c.evaluations,
+        "{} vs {}",
+        f.evaluations,
+        c.evaluations
+    );
+    assert_eq!(
+        c.evaluations - f.evaluations,
+        2 * (c.iterations + 1),
+        "central {c:?}\nforward {f:?}"
+    );
+}
+
+#[test]
+fn the_difference_step_has_the_floor_it_is_given() {
+    // At p = 0 the step is fd_step × fd_floor.
+    let seen = std::sync::Mutex::new(Vec::new());
+    let model = |p: &[f64], r: &mut [f64]| {
+        seen.lock().unwrap().push(p[0]);
+        for (i, ri) in r.iter_mut().enumerate() {
+            *ri = p[0] - 0.1 * noise(i);
+        }
+    };
+    let _ = Problem::new(model, 5, &["a"])
+        .options(Options {
+            fd_step: 1e-3,
+            fd_floor: Some(10.0),
+            forward_differences: true,
+            ..Options::default()
+        })
+        .solve(&[0.0]);
+    let points = seen.lock().unwrap().clone();
+    assert!((points[1] - 1e-2).abs() < 1e-15, "{points:?}");
+}
+
+#[test]
+fn a_noisy_residual_stops_after_the_rejections_it_is_allowed() {
+    // A residual with a fine staircase (as an adaptive integrator's noise):
+    // near the minimum no step lowers the cost; with `max_rejections` 4 the
+    // fit ends after four rejected trials in a row, with its interval.
+    let n = 60;
+    let stair = |p: &[f64], r: &mut [f64]| {
+        for (i, ri) in r.iter_mut().enumerate() {
+            let q = (p[0] * 1e4).round() / 1e4 + 1e-5 * ((p[0] * 1e7).sin());
+            *ri = q - 0.3 - 0.05 * noise(i);
+        }
+    };
+    let solve = |max_rejections| {
+        Problem::new(stair, n, &["a"])
+            .options(Options {
+                fd_step: 1e-2,
+                ftol: 0.0,
+                xtol: 0.0,
+                gtol: 0.0,
+                max_rejections,
+                ..Options::default()
+            })
+            .solve(&[1.0])
+            .unwrap()
+    };
+    let (fit, unlimited) = (solve(4), solve(0));
+    assert_eq!(fit.termination, Termination::NoReduction);
+    assert!(
+        fit.evaluations + 10 < unlimited.evaluations,
+        "{} vs {}",
+        fit.evaluations,
+        unlimited.evaluations
+    );
+    assert!((fit.parameters[0].value - 0.3).abs() < 0.05, "{fit:?}");
     assert!(fit.parameters[0].interval.is_some());
 }

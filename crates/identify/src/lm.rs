@@ -32,6 +32,20 @@ pub struct LmOptions {
     /// The residual vector is this many equal-length blocks (channels); the
     /// interval is widened by the largest of the blocks' AR(1) factors.
     pub blocks: usize,
+    /// The step is `fd_step × max(|x|, fd_floor)` in scaled parameters;
+    /// `None` as `hydrocyl_fit::Options::fd_floor`. 1 makes it at least
+    /// `fd_step` of the parameter's typical size.
+    pub fd_floor: Option<f64>,
+    /// Forward differences only (see
+    /// `hydrocyl_fit::Options::forward_differences`).
+    pub forward_differences: bool,
+    /// Also converged when the Gauss–Newton step is below this many
+    /// standard errors in every free parameter (0 = off; see
+    /// `hydrocyl_fit::Options::step_se`).
+    pub step_se: f64,
+    /// Stop after this many rejected steps in a row (0 = no limit; see
+    /// `hydrocyl_fit::Options::max_rejections`).
+    pub max_rejections: usize,
 }
 
 impl Default for LmOptions {
@@ -41,6 +55,10 @@ impl Default for LmOptions {
             ftol: 1e-8,
             fd_step: 1e-7,
             blocks: 1,
+            fd_floor: None,
+            forward_differences: false,
+            step_se: 0.0,
+            max_rejections: 0,
         }
     }
 }
@@ -224,6 +242,10 @@ fn solve<M: Residuals>(
             xtol: 1e-10,
             gtol: 1e-8,
             fd_step: opts.fd_step,
+            step_se: opts.step_se,
+            fd_floor: opts.fd_floor,
+            forward_differences: opts.forward_differences,
+            max_rejections: opts.max_rejections,
             ..Options::default()
         })
         .solve(&scaled(x0, typical))?;

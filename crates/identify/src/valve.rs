@@ -109,6 +109,10 @@ pub fn set<R: Effects + ?Sized>(rig: &mut R, id: EffectId, name: &str, v: f64) {
     rig.set_effect(id, name, v);
 }
 
+/// A candidate whose first linearised trace step explains less than this
+/// share of `--min-share` is not traced further (see `gauss_newton_trace`).
+const SCREEN_SHARE: f64 = 1.0 / 3.0;
+
 /// Most candidates refitted in one round of the loop (the best by traced
 /// share first); each refit is a full Levenberg–Marquardt fit.
 const MAX_REFITS_PER_ROUND: usize = 3;
@@ -355,6 +359,10 @@ pub fn diagnose_rig_traced(
             // in for this one can give way.
             let joint: ParamList = free.iter().chain(params.iter()).copied().collect();
             let mut trial = job.1.clone();
+            let screen = Screen {
+                rss: first.as_ref().map_or(f64::INFINITY, |f| sum_sq(&f.r0)),
+                share: SCREEN_SHARE * opts.min_share,
+            };
             let res = gauss_newton_trace(
                 &mut trial,
                 &joint,
@@ -362,12 +370,26 @@ pub fn diagnose_rig_traced(
                 opts.holdout,
                 Part::Train,
                 first.as_ref(),
+                screen,
             );
+            let (res, screened) = match res {
+                Ok(TraceEnd::Traced(r)) => (Ok(r), None),
+                Ok(TraceEnd::Screened { r, share }) => (Ok(r), Some(share)),
+                Err(e) => (Err(e), None),
+            };
             let rss_train = match &res {
                 Ok(r) => sum_sq(r),
                 Err(_) => rss(&trial, &pt, opts.holdout, Part::Train),
             };
-            let (rss1, rss1_held) = rss_all_held(&trial, &pt, opts.holdout);
+            // A candidate screened out where the round model is its start
+            // scores what the round model scores (nothing to simulate).
+            let unchanged =
+                screened.is_some() && first.as_ref().is_some_and(|f| f.applies_to(&trial));
+            let (rss1, rss1_held) = if unchanged {
+                (rss0, rss0_held)
+            } else {
+                rss_all_held(&trial, &pt, opts.holdout)
+            };
             // A trace whose simulation fails scores nothing (finite numbers
             // only reach the report) and says why below.
             let sim_failed = !(rss1.is_finite() && rss1_held.is_finite() && rss_train.is_finite());
@@ -395,6 +417,12 @@ pub fn diagnose_rig_traced(
             };
             if let Err(e) = &res {
                 rep.reason = Some(format!("fit failed: {e}"));
+            } else if let Some(lin) = screened {
+                rep.reason = Some(format!(
+                    "screened out: a linearised Gauss–Newton step explains {:.2} % of the training part (< {:.1} %), not traced further",
+                    100.0 * lin,
+                    100.0 * screen.share
+                ));
             } else if sim_failed {
                 rep.reason = Some("the rig does not simulate at the traced values".into());
             } else if let Some(why) = opts.screen(share, held, dbic) {
@@ -505,7 +533,7 @@ pub fn diagnose_rig_traced(
                 .chain(id.params().iter().map(|q| (id, q.name)))
                 .collect();
             let mut refit = trial;
-            let verdict = match fit(&mut refit, &joint, &p, opts.holdout, Part::All) {
+            let verdict = match refit_polished(&mut refit, &joint, &p, opts.holdout) {
                 Ok(res) => accept::verdict(id, &joint, &res, &refit, &base).map(|()| res),
                 Err(e) => Err(format!("refit failed: {e}")),
             };
@@ -521,6 +549,8 @@ pub fn diagnose_rig_traced(
                 }
             }
         }
+        // (booked here: the next lap is the next round's tracing)
+        clock.lap("refits");
         let Some((id, refit, rep, joint, res)) = accepted else {
             break;
         };
@@ -560,7 +590,7 @@ pub fn diagnose_rig_traced(
         }
         if !free.is_empty() {
             let mut refit = model.clone();
-            let res = match fit(&mut refit, &free, &p, opts.holdout, Part::All) {
+            let res = match refit_polished(&mut refit, &free, &p, opts.holdout) {
                 Ok(r) => {
                     model = refit;
                     r

@@ -21,6 +21,125 @@ pub(super) fn fit(
     holdout: f64,
     part: Part,
 ) -> Result<lm::LmResult, lm::LmError> {
+    fit_with(rig, params, p, holdout, part, Stop::LOOSE)
+}
+
+/// Every valve-rig fit stops after this many rejected steps in a row: the
+/// integration noise then hides any further gain (see
+/// `hydrocyl_fit::Options::max_rejections`).
+const MAX_REJECTIONS: usize = 4;
+
+/// When a fit stops, and how its Jacobian is taken.
+#[derive(Clone, Copy, Debug)]
+struct Stop {
+    /// Relative cost reduction of an accepted step below which it stops.
+    ftol: f64,
+    /// Gauss–Newton step in standard errors below which it stops (0 = off).
+    step_se: f64,
+    /// Most residual evaluations.
+    evaluations: usize,
+    /// Forward differences (else central where the bounds allow).
+    forward: bool,
+    /// The least finite-difference step in typical sizes (`None`: the
+    /// solver's default floor, relative to the value).
+    fd_floor: Option<f64>,
+    /// Stop after this many rejected steps in a row (0 = no limit).
+    max_rejections: usize,
+}
+
+impl Stop {
+    /// The initial-state fit and the refit's first stage: forward
+    /// differences, stop where an accepted step gains less than 1e-6 of the
+    /// cost or the Gauss–Newton step is within half a standard error (about
+    /// as close as the integration noise at rtol 1e-6 lets it get).
+    const LOOSE: Stop = Stop {
+        ftol: 1e-6,
+        step_se: 0.5,
+        evaluations: 600,
+        forward: true,
+        fd_floor: Some(FD_FLOOR),
+        max_rejections: MAX_REJECTIONS,
+    };
+}
+
+/// Integration tolerance of the polish that ends every refit: at rtol
+/// 1e-8 the weighted sum of squares of the 12 s valve record wobbles by
+/// about 0.1 from one Cl to the next a millionth of a standard error away
+/// (the adaptive steps change), which hides its minimum within about half
+/// a standard error; at 1e-10 it is smooth to 0.01 there, and 1e-9 and
+/// 1e-10 agree.
+const POLISH_RTOL: f64 = 1e-9;
+
+/// The finite-difference step of every fitted parameter is at least
+/// `1e-3 × FD_FLOOR` of its typical size (10 µm of initial position, 0.1
+/// mm/s of initial velocity, as the traces' steps): a step relative to a
+/// value near zero measures the integrator's noise, not the model.
+const FD_FLOOR: f64 = 10.0;
+
+/// The polish stops when the Gauss–Newton step is below this many
+/// standard errors in every parameter.
+const POLISH_STEP_SE: f64 = 0.05;
+
+/// A refit: [`fit`] on the whole record, then a polish from where it
+/// stopped at [`POLISH_RTOL`] that stops only when the Gauss–Newton step is
+/// below [`POLISH_STEP_SE`] standard errors. Where the refit starts (the
+/// trace it comes from) then does not show in where it ends, and the
+/// intervals come from a Jacobian at that end.
+pub(super) fn refit_polished(
+    rig: &mut Model,
+    params: &ParamList,
+    p: &Prepared,
+    holdout: f64,
+) -> Result<lm::LmResult, lm::LmError> {
+    // first near the minimum, cheaply (as far as its integration noise lets it)
+    let coarse = Prepared {
+        rtol: 1e-6,
+        ..p.clone()
+    };
+    // The trace fitted the initial position and velocity on the training
+    // part, from the round model's (which the initial-state fit of a
+    // declared model that cannot follow the record may have bent far off):
+    // start from those or the smoother's, whichever is closer on the whole record.
+    if let (Some(x0), Some(v0)) = (p.x0, p.v0) {
+        let half = 0.5 * rig.stroke();
+        let mut smoothed = rig.clone();
+        smoothed.set_x0(x0.clamp(-half, half));
+        smoothed.set_v0(v0);
+        if rss(&smoothed, &coarse, holdout, Part::All) < rss(rig, &coarse, holdout, Part::All) {
+            *rig = smoothed;
+        }
+    }
+    fit_with(rig, params, &coarse, holdout, Part::All, Stop::LOOSE)?;
+    let q = Prepared {
+        rtol: POLISH_RTOL,
+        ..p.clone()
+    };
+    fit_with(
+        rig,
+        params,
+        &q,
+        holdout,
+        Part::All,
+        Stop {
+            ftol: 1e-12,
+            step_se: POLISH_STEP_SE,
+            evaluations: 200,
+            forward: false,
+            fd_floor: Some(FD_FLOOR),
+            max_rejections: MAX_REJECTIONS,
+        },
+    )
+}
+
+/// [`fit`] with its stopping rule `stop`.
+fn fit_with(
+    rig: &mut Model,
+    params: &ParamList,
+    p: &Prepared,
+    holdout: f64,
+    part: Part,
+    stop: Stop,
+) -> Result<lm::LmResult, lm::LmError> {
     let mut x0: Vec<f64> = params
         .iter()
         .map(|(id, n)| get(rig, *id, n).unwrap_or(0.0))
@@ -61,10 +180,14 @@ pub(super) fn fit(
         &hi,
         &typ,
         &LmOptions {
-            max_evaluations: 600,
-            ftol: 1e-6,
+            max_evaluations: stop.evaluations,
+            ftol: stop.ftol,
             fd_step: 1e-3,
+            fd_floor: stop.fd_floor,
+            forward_differences: stop.forward,
             blocks: p.weights.iter().filter(|w| **w > 0.0).count(),
+            step_se: stop.step_se,
+            max_rejections: stop.max_rejections,
         },
     )?;
     for ((id, n), v) in params.iter().zip(&res.x) {
@@ -135,7 +258,7 @@ pub(super) struct FirstStep {
     /// The round's model.
     model: Model,
     /// Its residual on the traced part.
-    r0: Vec<f64>,
+    pub(super) r0: Vec<f64>,
     /// The columns computed, with their values.
     cols: Vec<(Column, Vec<f64>)>,
 }
@@ -171,7 +294,7 @@ impl FirstStep {
     }
 
     /// Whether a trace starting from `rig` may use these simulations.
-    fn applies_to(&self, rig: &Model) -> bool {
+    pub(super) fn applies_to(&self, rig: &Model) -> bool {
         rig.lag == self.model.lag && rig.net == self.model.net
     }
 }
@@ -184,8 +307,20 @@ impl FirstStep {
 /// properly afterwards.
 ///
 /// The first step takes what `first` has of it (see [`FirstStep`]); each
-/// later step starts from the residual its backtracking accepted. Returns
-/// the residual on `part` at the point reached.
+/// later step starts from the residual its backtracking accepted.
+///
+/// Screening: where the first step's linearised sum of squares
+/// `rss₀ + gᵀδ` (δ the Gauss–Newton step, g = Jᵀr) removes less than
+/// `screen.share` of `screen.rss`, the round model's sum of squares on
+/// `part`, the trace stops before simulating the step and `rig` is left
+/// where it started ([`TraceEnd::Screened`]). (Ending a trace early where
+/// a full step did what its linearisation predicted was tried and left
+/// out: two candidates that explain nearly the same share, a Coulomb
+/// asymmetry and a constant force on a record that never stops, then swap
+/// places.)
+///
+/// The trace only ranks the candidates and starts the refit, whose polish
+/// does not depend on where it starts ([`refit_polished`]).
 pub(super) fn gauss_newton_trace(
     rig: &mut Model,
     params: &ParamList,
@@ -193,7 +328,8 @@ pub(super) fn gauss_newton_trace(
     holdout: f64,
     part: Part,
     first: Option<&FirstStep>,
-) -> Result<Vec<f64>, String> {
+    screen: Screen,
+) -> Result<TraceEnd, String> {
     let cols = columns(params);
     let k = cols.len();
     let first = first.filter(|f| f.applies_to(rig));
@@ -231,10 +367,17 @@ pub(super) fn gauss_newton_trace(
         let delta = a
             .cholesky()
             .ok_or("singular trace Jacobian")?
-            .solve(&(-rhs));
+            .solve(&(-&rhs));
+        let rss0: f64 = r0.iter().map(|v| v * v).sum();
+        let linear = rss0 + rhs.dot(&delta);
+        if step == 0 && 1.0 - linear / screen.rss.max(1e-300) < screen.share {
+            return Ok(TraceEnd::Screened {
+                r: r0,
+                share: 1.0 - linear / screen.rss.max(1e-300),
+            });
+        }
         // Backtrack: take the largest of 1, 1/2, 1/4, 1/8 of the step that
         // lowers the sum of squares (keep the point if none does).
-        let rss0: f64 = r0.iter().map(|v| v * v).sum();
         let mut accepted = None;
         for alpha in [1.0, 0.5, 0.25, 0.125] {
             let mut t = rig.clone();
@@ -247,9 +390,7 @@ pub(super) fn gauss_newton_trace(
             t.set_x0((t.x0() + alpha * delta[k - 2]).clamp(-half, half));
             t.set_v0(t.v0() + alpha * delta[k - 1]);
             let mut r1 = Vec::new();
-            if residual(&t, p, holdout, part, &mut r1).is_ok()
-                && r1.iter().map(|v| v * v).sum::<f64>() < rss0
-            {
+            if residual(&t, p, holdout, part, &mut r1).is_ok() && sum_sq(&r1) < rss0 {
                 accepted = Some((t, r1));
                 break;
             }
@@ -262,7 +403,32 @@ pub(super) fn gauss_newton_trace(
             None => break,
         }
     }
-    Ok(r0)
+    Ok(TraceEnd::Traced(r0))
+}
+
+/// What a trace's shortcuts are judged against (see [`gauss_newton_trace`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Screen {
+    /// The round model's sum of squares on the traced part.
+    pub(super) rss: f64,
+    /// Screened out below this linearised share of `rss`.
+    pub(super) share: f64,
+}
+
+/// How a trace ended.
+#[derive(Clone, Debug)]
+pub(super) enum TraceEnd {
+    /// Traced; the residual on the traced part at the point reached.
+    Traced(Vec<f64>),
+    /// Screened out by its first linearised step, which removes `share` of
+    /// the round's sum of squares; the model is where it started, `r` its
+    /// residual there.
+    Screened {
+        /// The residual at the start.
+        r: Vec<f64>,
+        /// The linearised share.
+        share: f64,
+    },
 }
 
 /// Runs `f` on every item, spread over the available cores (at most one

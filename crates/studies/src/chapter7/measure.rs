@@ -272,6 +272,8 @@ fn balances(
     };
     let b_line = rig.bulk_modulus;
     let v_line = rig.pump_line_volume;
+    // C(p) = ∫dp/B_eff (p/B without air): the content a unit volume gains
+    let air = rig.entrained_air;
     let pump = quad("pump", 0);
     let mut out = Vec::new();
     let mut push = |name: &str, inflow: f64, accounted: f64| {
@@ -282,16 +284,30 @@ fn balances(
             relative_error: (inflow - accounted).abs() / pumped,
         });
     };
-    // pump lines: V/B Δp
+    // pump lines: V ΔC(p) (V/B Δp without air)
+    let line = |name: &str| {
+        let (pa, pb) = (state(name, 0, first), state(name, 0, last));
+        if air.is_none() {
+            v_line / b_line * (pb - pa)
+        } else {
+            v_line * (air.compliance(b_line, pb) - air.compliance(b_line, pa))
+        }
+    };
     let in_1 = pump - quad("relief_1", 0) - quad("relief_3_line_1", 0) + quad("check_1", 0);
-    let acc_1 = v_line / b_line * (state("line_1", 0, last) - state("line_1", 0, first));
-    push("pump_line_1", in_1, acc_1);
+    push("pump_line_1", in_1, line("line_1"));
     let in_2 = -pump - quad("relief_2", 0) - quad("relief_3_line_2", 0) + quad("check_2", 0);
-    let acc_2 = v_line / b_line * (state("line_2", 0, last) - state("line_2", 0, first));
-    push("pump_line_2", in_2, acc_2);
-    // chambers: ∫q1 = A1 Δx + [V1 p1/B] − ∫p1 A1 v/B;  ∫q2 = [V2 p2/B] + ∫p2 A2 v/B − A2 Δx
+    push("pump_line_2", in_2, line("line_2"));
+    // chambers: ∫q1 = A1 Δx + [V1 C(p1)] − ∫C(p1) A1 v;  ∫q2 = [V2 C(p2)] + ∫C(p2) A2 v − A2 Δx
     let cyl = &rig.cylinder;
     let b = cyl.bulk_modulus.si();
+    // Δ(V C(p)) between the window's ends
+    let stored = |(va, pa): (f64, f64), (vb, pb): (f64, f64)| {
+        if air.is_none() {
+            (vb * pb - va * pa) / b
+        } else {
+            vb * air.compliance(b, pb) - va * air.compliance(b, pa)
+        }
+    };
     let (x_a, x_b) = (state("load", 0, first), state("load", 0, last));
     let vols = |xp: f64| cyl.volumes(hydrocyl_ports::Position::new(xp));
     let (v1a, v2a) = vols(x_a);
@@ -299,12 +315,12 @@ fn balances(
     let (p1a, p2a) = (state("cylinder", 0, first), state("cylinder", 1, first));
     let (p1b, p2b) = (state("cylinder", 0, last), state("cylinder", 1, last));
     let in_c1 = quad("relief_1", 0) - quad("pilot_valve", 0);
-    let acc_c1 =
-        cyl.area_1.si() * (x_b - x_a) + (v1b.si() * p1b - v1a.si() * p1a) / b - quad("cylinder", 2);
+    let acc_c1 = cyl.area_1.si() * (x_b - x_a) + stored((v1a.si(), p1a), (v1b.si(), p1b))
+        - quad("cylinder", 2);
     push("chamber_1", in_c1, acc_c1);
     let in_c2 = quad("relief_2", 0) - quad("pilot_valve", 1);
     let acc_c2 =
-        (v2b.si() * p2b - v2a.si() * p2a) / b + quad("cylinder", 3) - cyl.area_2.si() * (x_b - x_a);
+        stored((v2a.si(), p2a), (v2b.si(), p2b)) + quad("cylinder", 3) - cyl.area_2.si() * (x_b - x_a);
     push("chamber_2", in_c2, acc_c2);
     out
 }

@@ -12,7 +12,7 @@ use hydrocyl_system::hybrid::WangHybrid;
 fn main() {
     let args: Vec<f64> = std::env::args().skip(1).filter_map(|s| s.parse().ok()).collect();
     let alphas = if args.is_empty() { vec![0.0, 0.001, 0.005, 0.01] } else { args };
-    println!("shape  alpha   n    stall r/e ms   lag e/r ms   drift mm  fric e/r N   min p1/p2 bar  min line bar  balance");
+    println!("shape  alpha   n    stall r/e ms   charge r/e ms (travel mm)      lag e/r ms   drift mm  fric e/r N   min p1/p2 bar  min line bar  balance");
     for shape in [Shape::Square, Shape::Sine] {
         for &a in &alphas {
             for n in [1.0, 1.4] {
@@ -53,10 +53,14 @@ fn main() {
                     r.min_pressures.iter().filter(|(n, _)| n.contains(k)).map(|(_, p)| *p).fold(f64::INFINITY, f64::min) / 1e5
                 };
                 println!(
-                    "{:6} {a:6.4} {n:3.1}  {:5.2} / {:5.2}  {:5.1} / {:5.1}  {:+6.3}  {:5.0} / {:5.0}  {:6.3} / {:6.3}  {:6.3}  {:.1e}",
+                    "{:6} {a:6.4} {n:3.1}  {:5.2} / {:5.2}  {:5.1} / {:5.1} ({:.3} / {:.3})  {:5.1} / {:5.1}  {:+6.3}  {:5.0} / {:5.0}  {:6.3} / {:6.3}  {:6.3}  {:.1e}",
                     format!("{shape:?}"),
                     p.stall_to_retract * 1e3,
                     p.stall_to_extend * 1e3,
+                    p.charge_to_retract * 1e3,
+                    p.charge_to_extend * 1e3,
+                    p.charge_travel_retract * 1e3,
+                    p.charge_travel_extend * 1e3,
                     p.lag_extend * 1e3,
                     p.lag_retract * 1e3,
                     p.drift_per_period * 1e3,

@@ -57,6 +57,20 @@ pub struct Phenomena {
     pub stall_to_retract: f64,
     /// Stall at the reversals from retracting to extending \[s\].
     pub stall_to_extend: f64,
+    /// The pressure-charging interval of section 7.1 at the extend→retract
+    /// reversal: the time the pilot-operated four-way valve stays centred
+    /// (both chambers shut) between the command's reversal and half the
+    /// target speed in the new direction, while the pump charges the new
+    /// line to the pilot shift pressure \[s\]. See [`super::stall`]: the
+    /// piston is not held still during it, it rings on the shut chambers.
+    pub charge_to_retract: f64,
+    /// Same at the retract→extend reversal \[s\].
+    pub charge_to_extend: f64,
+    /// Range of the piston's position during the charging interval,
+    /// extend→retract \[m\] (what a position sensor sees of the ringing).
+    pub charge_travel_retract: f64,
+    /// Same at the retract→extend reversal \[m\].
+    pub charge_travel_extend: f64,
     /// Time from reversal to 90 % of the target speed, extending \[s\].
     pub t90_extend: f64,
     /// Same, retracting \[s\].
@@ -367,6 +381,7 @@ fn phenomena(test: &Chapter7Test, rig: &WangHybrid, tr: &Trace) -> Phenomena {
     let revs = reversals(tr, period);
     let (mut st_r, mut st_e, mut t9_e, mut t9_r) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let (mut lag_e, mut lag_r) = (Vec::new(), Vec::new());
+    let (mut ch_e, mut ch_r, mut tr_e, mut tr_r) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let half = (0.5 * period / test.sample_interval).round() as usize;
     for &(k, dir) in &revs {
         let end = (k + half).min(n - 1);
@@ -377,6 +392,27 @@ fn phenomena(test: &Chapter7Test, rig: &WangHybrid, tr: &Trace) -> Phenomena {
                 st_e.push(d);
             } else {
                 st_r.push(d);
+            }
+        }
+        // the charging interval: samples with the pilot spool centred before
+        // half the target speed in the new direction
+        let mut j = k;
+        while j < end && v[j] * dir < 0.5 * test.speed {
+            j += 1;
+        }
+        if j < end {
+            let centred: Vec<usize> = (k..j).filter(|&i| tr.spool[i].abs() <= 1e-12).collect();
+            let time = centred.len() as f64 * test.sample_interval;
+            let (lo, hi) = centred.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &i| {
+                (a.min(tr.position[i]), b.max(tr.position[i]))
+            });
+            let travel = if centred.is_empty() { 0.0 } else { hi - lo };
+            if dir > 0.0 {
+                ch_e.push(time);
+                tr_e.push(travel);
+            } else {
+                ch_r.push(time);
+                tr_r.push(travel);
             }
         }
         // time to 90 % of the target speed in the new direction, and the same for the
@@ -445,6 +481,10 @@ fn phenomena(test: &Chapter7Test, rig: &WangHybrid, tr: &Trace) -> Phenomena {
     Phenomena {
         stall_to_retract: mean(st_r.into_iter()),
         stall_to_extend: mean(st_e.into_iter()),
+        charge_to_retract: mean(ch_r.into_iter()),
+        charge_to_extend: mean(ch_e.into_iter()),
+        charge_travel_retract: mean(tr_r.into_iter()),
+        charge_travel_extend: mean(tr_e.into_iter()),
         t90_extend: mean(t9_e.into_iter()),
         t90_retract: mean(t9_r.into_iter()),
         lag_extend: mean(lag_e.into_iter()),

@@ -198,7 +198,6 @@ fn the_return_port_solve_is_cheap_on_the_rig() {
 fn the_valve_is_centred_for_the_line_charging_and_air_lengthens_it() {
     let mut test = Chapter7Test::new(Shape::Square, Load::None);
     test.initial_position = -0.06;
-    test.periods = 2;
     let run = |air: f64| {
         let mut rig = WangHybrid::preset();
         rig.entrained_air = hydrocyl_actuator::EntrainedAir::isothermal(air);

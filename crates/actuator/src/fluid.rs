@@ -198,8 +198,18 @@ impl EntrainedAir {
         let panels = ((u1 - u0).abs() / 0.5).ceil().max(1.0);
         let h = (u1 - u0) / panels;
         // 4-point Gauss–Legendre nodes and weights on [−1, 1]
-        const X: [f64; 4] = [-0.861_136_311_594_052_6, -0.339_981_043_584_856_3, 0.339_981_043_584_856_3, 0.861_136_311_594_052_6];
-        const W: [f64; 4] = [0.347_854_845_137_453_9, 0.652_145_154_862_546_1, 0.652_145_154_862_546_1, 0.347_854_845_137_453_9];
+        const X: [f64; 4] = [
+            -0.861_136_311_594_052_6,
+            -0.339_981_043_584_856_3,
+            0.339_981_043_584_856_3,
+            0.861_136_311_594_052_6,
+        ];
+        const W: [f64; 4] = [
+            0.347_854_845_137_453_9,
+            0.652_145_154_862_546_1,
+            0.652_145_154_862_546_1,
+            0.347_854_845_137_453_9,
+        ];
         let mut e = 0.0;
         for k in 0..panels as usize {
             let mid = u0 + (k as f64 + 0.5) * h;
@@ -242,7 +252,10 @@ mod tests {
             let slope = STANDARD_ATMOSPHERE / big * (B / big - 1.0) * (p / B).exp();
             for a in [1e-7, 1e-9, 1e-11] {
                 let got = (B / EntrainedAir::isothermal(a).bulk_modulus(B, p) - 1.0) / a;
-                assert!((got / slope - 1.0).abs() < 1e-3, "{p} {a}: {got} vs {slope}");
+                assert!(
+                    (got / slope - 1.0).abs() < 1e-3,
+                    "{p} {a}: {got} vs {slope}"
+                );
             }
         }
     }
@@ -286,7 +299,10 @@ mod tests {
             let h = 1e-3 * (p + STANDARD_ATMOSPHERE).abs().max(1.0);
             let fd = (f.bulk_modulus(B, p + h) - f.bulk_modulus(B, p - h)) / (2.0 * h);
             let (_, slope) = f.bulk_modulus_and_slope(B, p);
-            assert!((fd - slope).abs() < 1e-4 * slope.abs().max(1.0), "{p}: {fd} vs {slope}");
+            assert!(
+                (fd - slope).abs() < 1e-4 * slope.abs().max(1.0),
+                "{p}: {fd} vs {slope}"
+            );
             let dc = (f.compliance(B, p + h) - f.compliance(B, p - h)) / (2.0 * h);
             assert!((dc * f.bulk_modulus(B, p) - 1.0).abs() < 1e-5, "{p}");
         }
@@ -330,7 +346,11 @@ mod tests {
     #[test]
     fn out_of_range_is_named() {
         let mut f = EntrainedAir::isothermal(1.0);
-        assert!(f.validate().unwrap_err().to_string().contains("air_fraction"));
+        assert!(f
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("air_fraction"));
         f.fraction = 0.01;
         f.polytropic_index = 2.0;
         assert!(f

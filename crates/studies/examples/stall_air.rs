@@ -10,8 +10,15 @@ use hydrocyl_studies::chapter7::{Chapter7Test, Load, Shape};
 use hydrocyl_system::hybrid::WangHybrid;
 
 fn main() {
-    let args: Vec<f64> = std::env::args().skip(1).filter_map(|s| s.parse().ok()).collect();
-    let alphas = if args.is_empty() { vec![0.0, 0.001, 0.005, 0.01] } else { args };
+    let args: Vec<f64> = std::env::args()
+        .skip(1)
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    let alphas = if args.is_empty() {
+        vec![0.0, 0.001, 0.005, 0.01]
+    } else {
+        args
+    };
     println!("shape  alpha   n    stall r/e ms   charge r/e ms (travel mm)      lag e/r ms   drift mm  fric e/r N   min p1/p2 bar  min line bar  balance");
     for shape in [Shape::Square, Shape::Sine] {
         for &a in &alphas {
@@ -24,7 +31,10 @@ fn main() {
                 test.sample_interval = 1e-4;
                 test.max_steps = 2_000_000;
                 let mut rig = WangHybrid::preset();
-                rig.entrained_air = EntrainedAir { polytropic_index: n, ..EntrainedAir::isothermal(a) };
+                rig.entrained_air = EntrainedAir {
+                    polytropic_index: n,
+                    ..EntrainedAir::isothermal(a)
+                };
                 let r = match test.run_on(rig, Method::Rosenbrock) {
                     Ok(r) => r,
                     Err(e) => {
@@ -41,8 +51,15 @@ fn main() {
                         if (7.45..7.62).contains(&t) || (9.95..10.12).contains(&t) {
                             out += &format!(
                                 "{t:.4},{},{:e},{:.0},{:.0},{:.0},{:.0},{:.6},{:.5},{:e}\n",
-                                tr.command[k], tr.pump_flow[k], tr.pp1[k], tr.pp2[k], tr.p1[k], tr.p2[k],
-                                tr.position[k], tr.velocity[k], tr.spool[k]
+                                tr.command[k],
+                                tr.pump_flow[k],
+                                tr.pp1[k],
+                                tr.pp2[k],
+                                tr.p1[k],
+                                tr.p2[k],
+                                tr.position[k],
+                                tr.velocity[k],
+                                tr.spool[k]
                             );
                         }
                     }
@@ -50,7 +67,12 @@ fn main() {
                 }
                 let p = &r.phenomena;
                 let minp = |k: &str| {
-                    r.min_pressures.iter().filter(|(n, _)| n.contains(k)).map(|(_, p)| *p).fold(f64::INFINITY, f64::min) / 1e5
+                    r.min_pressures
+                        .iter()
+                        .filter(|(n, _)| n.contains(k))
+                        .map(|(_, p)| *p)
+                        .fold(f64::INFINITY, f64::min)
+                        / 1e5
                 };
                 println!(
                     "{:6} {a:6.4} {n:3.1}  {:5.2} / {:5.2}  {:5.1} / {:5.1} ({:.3} / {:.3})  {:5.1} / {:5.1}  {:+6.3}  {:5.0} / {:5.0}  {:6.3} / {:6.3}  {:6.3}  {:.1e}",

@@ -207,13 +207,27 @@ fn the_valve_is_centred_for_the_line_charging_and_air_lengthens_it() {
     let (liquid, aerated) = (run(0.0), run(0.005));
     let (a, b) = (liquid.phenomena, aerated.phenomena);
     for p in [&a, &b] {
-        assert!(p.charge_to_retract > 3e-3 && p.charge_to_extend > 3e-3, "{p:?}");
+        assert!(
+            p.charge_to_retract > 3e-3 && p.charge_to_extend > 3e-3,
+            "{p:?}"
+        );
         // the piston rings on the shut chambers but stays within 0.5 mm
-        assert!(p.charge_travel_retract < 5e-4 && p.charge_travel_extend < 5e-4, "{p:?}");
+        assert!(
+            p.charge_travel_retract < 5e-4 && p.charge_travel_extend < 5e-4,
+            "{p:?}"
+        );
     }
-    assert!(b.charge_to_retract > 1.5 * a.charge_to_retract, "{a:?} {b:?}");
+    assert!(
+        b.charge_to_retract > 1.5 * a.charge_to_retract,
+        "{a:?} {b:?}"
+    );
     assert!(b.charge_to_extend > 1.5 * a.charge_to_extend, "{a:?} {b:?}");
-    let lowest = |r: &Chapter7Run| r.min_pressures.iter().map(|m| m.1).fold(f64::INFINITY, f64::min);
+    let lowest = |r: &Chapter7Run| {
+        r.min_pressures
+            .iter()
+            .map(|m| m.1)
+            .fold(f64::INFINITY, f64::min)
+    };
     assert!(lowest(&liquid) < -101_325.0, "{}", lowest(&liquid));
     assert!(lowest(&aerated) > -101_325.0, "{}", lowest(&aerated));
     assert!(aerated.worst_balance() < 1e-6, "{:?}", aerated.balances);

@@ -83,7 +83,10 @@ fn an_evacuated_volume_fills_in_the_closed_form_time() {
     }
     let at_fill = sol.state(times.len() - 1)[ip];
     // 5 Pa is 5 µs of the 5.6 s fill at 1e6 Pa/s
-    assert!(at_fill.abs() < 5.0, "gauge {at_fill} Pa at the fill time {t_fill} s");
+    assert!(
+        at_fill.abs() < 5.0,
+        "gauge {at_fill} Pa at the fill time {t_fill} s"
+    );
 }
 
 /// Pumped out for 20 s (twice its content at atmosphere), the volume's
@@ -131,12 +134,18 @@ fn the_ledger_closes_and_the_stored_energy_is_the_compression_work() {
     let vol = c.component_index("vol").unwrap();
     let source = last[o + 4 * pump];
     let storage = last[o + 4 * vol + 2];
-    assert!((source - storage).abs() < 1e-8 * source.abs(), "{source} vs {storage}");
+    assert!(
+        (source - storage).abs() < 1e-8 * source.abs(),
+        "{source} vs {storage}"
+    );
     let p = last[state_of(&c, "vol", 0)];
     assert!(p > 1e6, "filled to {p} Pa");
     let air = hydrocyl_actuator::EntrainedAir::isothermal(0.005);
     let stored = air.stored_energy(7e8, p, 1e-4) - air.stored_energy(7e8, -0.9e5, 1e-4);
-    assert!((stored / storage - 1.0).abs() < 1e-6, "{stored} vs {storage}");
+    assert!(
+        (stored / storage - 1.0).abs() < 1e-6,
+        "{stored} vs {storage}"
+    );
 }
 
 /// A cylinder with both ports shut and a 20 kg mass thrown at 0.3 m/s: the
@@ -168,9 +177,7 @@ fn a_shut_chamber_is_a_boyle_gas_spring() {
     let (ix, iv) = (state_of(&c, "load", 0), state_of(&c, "load", 1));
     let (m1, m2) = (a1 * l, a2 * l);
     let eps = |p: f64| alpha * PA * (((p + PA) / PA).ln() + PA / (p + PA) - 1.0);
-    let energy = |x: &[f64]| {
-        0.5 * 20.0 * x[iv] * x[iv] + m1 * eps(x[ip1]) + m2 * eps(x[ip2])
-    };
+    let energy = |x: &[f64]| 0.5 * 20.0 * x[iv] * x[iv] + m1 * eps(x[ip1]) + m2 * eps(x[ip2]);
     let e0 = 0.5 * 20.0 * 0.3 * 0.3;
     let mut moved = 0.0f64;
     for (k, &t) in times.iter().enumerate() {
@@ -179,9 +186,17 @@ fn a_shut_chamber_is_a_boyle_gas_spring() {
         moved = moved.max(x[ix].abs());
         for (p, vol, m) in [(x[ip1], v1, m1), (x[ip2], v2, m2)] {
             let want = alpha * m * PA / (vol - m * (1.0 - alpha));
-            assert!(((p + PA) / want - 1.0).abs() < 1e-6, "t = {t}: P {} vs {want}", p + PA);
+            assert!(
+                ((p + PA) / want - 1.0).abs() < 1e-6,
+                "t = {t}: P {} vs {want}",
+                p + PA
+            );
         }
-        assert!((energy(x) / e0 - 1.0).abs() < 1e-6, "t = {t}: {} vs {e0}", energy(x));
+        assert!(
+            (energy(x) / e0 - 1.0).abs() < 1e-6,
+            "t = {t}: {} vs {e0}",
+            energy(x)
+        );
     }
     assert!(moved > 2e-3, "the piston moved {moved} m");
 }
@@ -197,7 +212,12 @@ fn a_vanishing_air_fraction_is_the_liquid_model() {
         v["components"]["cylinder"]["air_fraction"] = json!(alpha);
         v
     };
-    let sine = Signal::Sine { amplitude: 0.4, period_s: 0.4, bias: 0.0, phase_rad: 0.3 };
+    let sine = Signal::Sine {
+        amplitude: 0.4,
+        period_s: 0.4,
+        bias: 0.0,
+        phase_rad: 0.3,
+    };
     let times: Vec<f64> = (1..=40).map(|k| 0.01 * k as f64).collect();
     let mut runs = Vec::new();
     for alpha in [0.0, 1e-9] {
@@ -206,14 +226,26 @@ fn a_vanishing_air_fraction_is_the_liquid_model() {
         c.reset(0.0, &x0);
         let sol = run(&mut c, 0.4, times.clone());
         let (ix, ip) = (state_of(&c, "load", 0), state_of(&c, "cylinder", 0));
-        let lowest = (0..times.len()).map(|k| sol.state(k)[ip]).fold(f64::INFINITY, f64::min);
+        let lowest = (0..times.len())
+            .map(|k| sol.state(k)[ip])
+            .fold(f64::INFINITY, f64::min);
         assert!(lowest > 0.0, "p1 fell to {lowest}");
-        runs.push((0..times.len()).map(|k| sol.state(k)[ix]).collect::<Vec<f64>>());
+        runs.push(
+            (0..times.len())
+                .map(|k| sol.state(k)[ix])
+                .collect::<Vec<f64>>(),
+        );
     }
     let span = runs[0].iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let worst = runs[0].iter().zip(&runs[1]).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    let worst = runs[0]
+        .iter()
+        .zip(&runs[1])
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
     assert!(span > 1e-3, "the piston moved {span} m");
-    assert!(worst < 1e-5 * span, "α = 1e-9 differs by {worst} m of {span} m");
+    assert!(
+        worst < 1e-5 * span,
+        "α = 1e-9 differs by {worst} m of {span} m"
+    );
 }
 
 /// The analytic Jacobian of volumes and chambers with air equals central

@@ -134,21 +134,36 @@ fn entrained_air(s: &mut Section) {
     for shape in [Shape::Square, Shape::Sine] {
         let mut test = Chapter7Test::new(shape, Load::None);
         test.initial_position = -0.06;
-        let label = format!("entrained air 0.5 %, {}", test.label().replace(", no load", ""));
+        let label = format!(
+            "entrained air 0.5 %, {}",
+            test.label().replace(", no load", "")
+        );
         let mut rig = WangHybrid::preset();
         rig.entrained_air = hydrocyl_actuator::EntrainedAir::isothermal(AIR_FRACTION);
         let r = match test.run_on(rig, Method::Rosenbrock) {
             Ok(r) => r,
             Err(e) => {
-                s.check(&format!("{label}: run"), e.to_string(), "completes".into(), false);
+                s.check(
+                    &format!("{label}: run"),
+                    e.to_string(),
+                    "completes".into(),
+                    false,
+                );
                 continue;
             }
         };
-        let lowest = r.min_pressures.iter().map(|x| x.1).fold(f64::INFINITY, f64::min);
+        let lowest = r
+            .min_pressures
+            .iter()
+            .map(|x| x.1)
+            .fold(f64::INFINITY, f64::min);
         s.check(
             &format!("{label}: lowest pressure (chambers, pump lines)"),
             bar(lowest),
-            format!("> absolute zero {}", bar(-hydrocyl_actuator::fluid::STANDARD_ATMOSPHERE)),
+            format!(
+                "> absolute zero {}",
+                bar(-hydrocyl_actuator::fluid::STANDARD_ATMOSPHERE)
+            ),
             lowest > -hydrocyl_actuator::fluid::STANDARD_ATMOSPHERE,
         );
         s.check(
@@ -270,8 +285,8 @@ fn preset_as_shipped(s: &mut Section) {
         );
         s.note(&format!(
             "{label}: lag to 90 % of the target, extending {} / retracting {} ({}); steady dp extending {}, \
-             retracting {}; lowest chamber pressure {} ({} cavitation entries: the fluid model has no cavitation, a chamber \
-             below the vapour pressure has left its range)",
+             retracting {}; lowest chamber pressure {} ({} cavitation entries: the constant-B oil has no floor, a chamber \
+             below the vapour pressure has left its range; with entrained air none goes below absolute zero)",
             ms(p.lag_extend),
             ms(p.lag_retract),
             if p.lag_retract > p.lag_extend {

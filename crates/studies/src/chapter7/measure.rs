@@ -333,8 +333,8 @@ fn balances(
         - quad("cylinder", 2);
     push("chamber_1", in_c1, acc_c1);
     let in_c2 = quad("relief_2", 0) - quad("pilot_valve", 1);
-    let acc_c2 =
-        stored((v2a.si(), p2a), (v2b.si(), p2b)) + quad("cylinder", 3) - cyl.area_2.si() * (x_b - x_a);
+    let acc_c2 = stored((v2a.si(), p2a), (v2b.si(), p2b)) + quad("cylinder", 3)
+        - cyl.area_2.si() * (x_b - x_a);
     push("chamber_2", in_c2, acc_c2);
     out
 }
@@ -403,9 +403,11 @@ fn phenomena(test: &Chapter7Test, rig: &WangHybrid, tr: &Trace) -> Phenomena {
         if j < end {
             let centred: Vec<usize> = (k..j).filter(|&i| tr.spool[i].abs() <= 1e-12).collect();
             let time = centred.len() as f64 * test.sample_interval;
-            let (lo, hi) = centred.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &i| {
-                (a.min(tr.position[i]), b.max(tr.position[i]))
-            });
+            let (lo, hi) = centred
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &i| {
+                    (a.min(tr.position[i]), b.max(tr.position[i]))
+                });
             let travel = if centred.is_empty() { 0.0 } else { hi - lo };
             if dir > 0.0 {
                 ch_e.push(time);

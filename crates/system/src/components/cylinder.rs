@@ -86,7 +86,10 @@ impl TwoChamberCylinder {
     /// The chambers' effective bulk moduli `(B_eff(p1), B_eff(p2))` \[Pa\].
     fn moduli(&self, x: &[f64]) -> (f64, f64) {
         let b = self.cylinder.bulk_modulus.si();
-        (self.air.bulk_modulus(b, x[0]), self.air.bulk_modulus(b, x[1]))
+        (
+            self.air.bulk_modulus(b, x[0]),
+            self.air.bulk_modulus(b, x[1]),
+        )
     }
 
     /// `(dp1/dt, dp2/dt)` at this instant \[Pa·s⁻¹\]: the cylinder's rates

@@ -119,6 +119,26 @@ pub fn section() -> Section {
     s
 }
 
+/// Runs `test` on `rig`, or records the failure as a failed check.
+fn run_or_fail(
+    s: &mut Section,
+    label: &str,
+    test: &Chapter7Test,
+    rig: WangHybrid,
+    method: hydrocyl_integrators::Method,
+) -> Option<Chapter7Run> {
+    test.run_on(rig, method)
+        .map_err(|e| {
+            s.check(
+                &format!("{label}: run"),
+                e.to_string(),
+                "completes".into(),
+                false,
+            )
+        })
+        .ok()
+}
+
 /// Air fraction of the entrained-air runs: 0.5 % by volume at atmospheric
 /// pressure, inside the 0.1–1 % usually quoted for undissolved air in
 /// hydraulic oil (the rig's oil was not measured: assumed).
@@ -140,17 +160,8 @@ fn entrained_air(s: &mut Section) {
         );
         let mut rig = WangHybrid::preset();
         rig.entrained_air = hydrocyl_actuator::EntrainedAir::isothermal(AIR_FRACTION);
-        let r = match test.run_on(rig, Method::Rosenbrock) {
-            Ok(r) => r,
-            Err(e) => {
-                s.check(
-                    &format!("{label}: run"),
-                    e.to_string(),
-                    "completes".into(),
-                    false,
-                );
-                continue;
-            }
+        let Some(r) = run_or_fail(s, &label, &test, rig, Method::Rosenbrock) else {
+            continue;
         };
         let lowest = r
             .min_pressures
@@ -208,17 +219,14 @@ fn preset_as_shipped(s: &mut Section) {
             "preset as shipped, {}",
             test.label().replace(", no load", "")
         );
-        let r = match test.run_on(WangHybrid::preset(), Method::DormandPrince45) {
-            Ok(r) => r,
-            Err(e) => {
-                s.check(
-                    &format!("{label}: run"),
-                    e.to_string(),
-                    "completes".into(),
-                    false,
-                );
-                continue;
-            }
+        let Some(r) = run_or_fail(
+            s,
+            &label,
+            &test,
+            WangHybrid::preset(),
+            Method::DormandPrince45,
+        ) else {
+            continue;
         };
         for m in [Method::Rosenbrock, Method::Auto] {
             let what = format!("{label}: {m:?} agrees with DP45 (position NRMSE)");

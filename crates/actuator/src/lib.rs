@@ -15,6 +15,10 @@
 //!   from `P_LE` and the X factor (eqs 2.21, 2.22), X obtained numerically or
 //!   analytically ([`generalised::XMethod`]). It needs the valve's port
 //!   areas, so it merges valve and cylinder hydraulics into one subsystem.
+//! * [`fluid`] — the oil at low pressure: an entrained-air fraction makes the
+//!   effective bulk modulus `B_eff(p)` fall towards `n P` as the absolute
+//!   pressure falls, so no volume goes below absolute zero
+//!   ([`fluid::EntrainedAir`]; none = the constant `B` of eqs 2.10–2.15).
 //! * [`StrokeEnds`] — the hard stroke-end stops (positions and the switching
 //!   functions of the event-based stop used by the assembler).
 //!
@@ -44,7 +48,10 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod fluid;
 pub mod generalised;
+
+pub use fluid::EntrainedAir;
 
 use hydrocyl_ports::{Area, Force, Position, Pressure, Velocity, Volume, VolumeFlow};
 use serde::{Deserialize, Serialize};
@@ -76,6 +83,16 @@ pub enum ActuatorError {
         chamber: u8,
         /// The volume at the stroke end \[m³\].
         volume: f64,
+    },
+    /// A parameter outside its range.
+    #[error("parameter `{name}` must be in {range}, got {value}")]
+    OutOfRange {
+        /// Parameter name.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// The range, e.g. `[0, 1)`.
+        range: &'static str,
     },
     /// The rod side is larger than the cap side.
     #[error("area_2 ({a2} m^2) must not exceed area_1 ({a1} m^2) for a single-rod cylinder (gamma >= 1)")]

@@ -187,3 +187,48 @@ fn the_return_port_solve_is_cheap_on_the_rig() {
     assert!(evals / solves < 3.0, "{}", evals / solves);
     assert_eq!(get("return_port.solve_fallbacks"), 0.0);
 }
+
+/// Section 7.1's pressure charging on the preset as shipped: after each
+/// reversal the four-way valve stays centred while the pump charges the new
+/// line to the pilot shift pressure, for the time `V ∫dp/B_eff / Q` the
+/// lines take (docs/hybrid.md item 9). Entrained air (0.5 %, assumed) makes
+/// the lines softer, so the charging takes longer, and keeps every volume
+/// above absolute zero where the constant-B oil goes below it.
+#[test]
+fn the_valve_is_centred_for_the_line_charging_and_air_lengthens_it() {
+    let mut test = Chapter7Test::new(Shape::Square, Load::None);
+    test.initial_position = -0.06;
+    let run = |air: f64| {
+        let mut rig = WangHybrid::preset();
+        rig.entrained_air = hydrocyl_actuator::EntrainedAir::isothermal(air);
+        test.run_on(rig, hydrocyl_integrators::Method::Rosenbrock)
+            .expect("chapter-7 run")
+    };
+    let (liquid, aerated) = (run(0.0), run(0.005));
+    let (a, b) = (liquid.phenomena, aerated.phenomena);
+    for p in [&a, &b] {
+        assert!(
+            p.charge_to_retract > 3e-3 && p.charge_to_extend > 3e-3,
+            "{p:?}"
+        );
+        // the piston rings on the shut chambers but stays within 0.5 mm
+        assert!(
+            p.charge_travel_retract < 5e-4 && p.charge_travel_extend < 5e-4,
+            "{p:?}"
+        );
+    }
+    assert!(
+        b.charge_to_retract > 1.5 * a.charge_to_retract,
+        "{a:?} {b:?}"
+    );
+    assert!(b.charge_to_extend > 1.5 * a.charge_to_extend, "{a:?} {b:?}");
+    let lowest = |r: &Chapter7Run| {
+        r.min_pressures
+            .iter()
+            .map(|m| m.1)
+            .fold(f64::INFINITY, f64::min)
+    };
+    assert!(lowest(&liquid) < -101_325.0, "{}", lowest(&liquid));
+    assert!(lowest(&aerated) > -101_325.0, "{}", lowest(&aerated));
+    assert!(aerated.worst_balance() < 1e-6, "{:?}", aerated.balances);
+}

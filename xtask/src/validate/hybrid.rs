@@ -115,7 +115,89 @@ pub fn section() -> Section {
         Err(e) => s.note(&format!("square, no load, with the K H a term: {e}")),
     }
     preset_as_shipped(&mut s);
+    entrained_air(&mut s);
     s
+}
+
+/// Runs `test` on `rig`, or records the failure as a failed check.
+fn run_or_fail(
+    s: &mut Section,
+    label: &str,
+    test: &Chapter7Test,
+    rig: WangHybrid,
+    method: hydrocyl_integrators::Method,
+) -> Option<Chapter7Run> {
+    test.run_on(rig, method)
+        .map_err(|e| {
+            s.check(
+                &format!("{label}: run"),
+                e.to_string(),
+                "completes".into(),
+                false,
+            )
+        })
+        .ok()
+}
+
+/// Air fraction of the entrained-air runs: 0.5 % by volume at atmospheric
+/// pressure, inside the 0.1–1 % usually quoted for undissolved air in
+/// hydraulic oil (the rig's oil was not measured: assumed).
+const AIR_FRACTION: f64 = 0.005;
+
+/// The chapter-7 square and sine on the preset with entrained air in every
+/// volume (`hydrocyl_actuator::fluid`, isothermal, 0.5 % assumed): no
+/// pressure below absolute zero, mass conserved; the stall and the charging
+/// interval reported.
+fn entrained_air(s: &mut Section) {
+    use hydrocyl_integrators::Method;
+    s.note("Preset with entrained air (0.5 % by volume at 1 atm, isothermal; assumed, the usual 0.1-1 %), Rosenbrock:");
+    for shape in [Shape::Square, Shape::Sine] {
+        let mut test = Chapter7Test::new(shape, Load::None);
+        test.initial_position = -0.06;
+        let label = format!(
+            "entrained air 0.5 %, {}",
+            test.label().replace(", no load", "")
+        );
+        let mut rig = WangHybrid::preset();
+        rig.entrained_air = hydrocyl_actuator::EntrainedAir::isothermal(AIR_FRACTION);
+        let Some(r) = run_or_fail(s, &label, &test, rig, Method::Rosenbrock) else {
+            continue;
+        };
+        let lowest = r
+            .min_pressures
+            .iter()
+            .map(|x| x.1)
+            .fold(f64::INFINITY, f64::min);
+        s.check(
+            &format!("{label}: lowest pressure (chambers, pump lines)"),
+            bar(lowest),
+            format!(
+                "> absolute zero {}",
+                bar(-hydrocyl_actuator::fluid::STANDARD_ATMOSPHERE)
+            ),
+            lowest > -hydrocyl_actuator::fluid::STANDARD_ATMOSPHERE,
+        );
+        s.check(
+            &format!("{label}: mass balance, worst volume (V ΔC(p), C = ∫dp/B_eff)"),
+            format!("{:.1e}", r.worst_balance()),
+            "< 1e-6 of volume pumped".into(),
+            r.worst_balance() < 1e-6,
+        );
+        let p = r.phenomena;
+        s.note(&format!(
+            "{label}: stall (|v| < 1 mm/s) to retract / to extend {} / {}; valve centred {} / {} (piston travel \
+             {:.3} / {:.3} mm); lag {} / {}; drift {:+.2} mm per period",
+            ms(p.stall_to_retract),
+            ms(p.stall_to_extend),
+            ms(p.charge_to_retract),
+            ms(p.charge_to_extend),
+            p.charge_travel_retract * 1e3,
+            p.charge_travel_extend * 1e3,
+            ms(p.lag_extend),
+            ms(p.lag_retract),
+            p.drift_per_period * 1e3,
+        ));
+    }
 }
 
 /// The chapter-7 square and sine on the `wang-hybrid` preset as shipped
@@ -137,17 +219,14 @@ fn preset_as_shipped(s: &mut Section) {
             "preset as shipped, {}",
             test.label().replace(", no load", "")
         );
-        let r = match test.run_on(WangHybrid::preset(), Method::DormandPrince45) {
-            Ok(r) => r,
-            Err(e) => {
-                s.check(
-                    &format!("{label}: run"),
-                    e.to_string(),
-                    "completes".into(),
-                    false,
-                );
-                continue;
-            }
+        let Some(r) = run_or_fail(
+            s,
+            &label,
+            &test,
+            WangHybrid::preset(),
+            Method::DormandPrince45,
+        ) else {
+            continue;
         };
         for m in [Method::Rosenbrock, Method::Auto] {
             let what = format!("{label}: {m:?} agrees with DP45 (position NRMSE)");
@@ -180,8 +259,9 @@ fn preset_as_shipped(s: &mut Section) {
                 p.stall_to_retract > 1e-3,
             );
             s.note(&format!(
-                "{label}: stall to retract / to extend {stall}: the thesis's stall of several ms at EACH reversal is \
-                 NOT reproduced at retract -> extend (docs/hybrid.md item 9: each mechanism measured)"
+                "{label}: stall to retract / to extend {stall}: the piston stands still (|v| < 1 mm/s) for several ms \
+                 only at extend -> retract; at both reversals the valve stays centred for the pressure charging (next \
+                 check), but the piston rings on the shut chambers at up to 10 mm/s inside 0.03 mm (docs/hybrid.md item 9)"
             ));
             s.check(
                 &format!("{label}: slower rise when retracting (lag to 90 %, ext / ret)"),
@@ -190,6 +270,20 @@ fn preset_as_shipped(s: &mut Section) {
                 p.lag_retract > p.lag_extend,
             );
         }
+        // section 7.1's second factor: the pump charges the new line to the
+        // pilot shift pressure while the four-way valve is centred
+        s.check(
+            &format!("{label}: pressure charging, four-way valve centred (to retract / to extend)"),
+            format!(
+                "{} / {} (piston travel {:.3} / {:.3} mm)",
+                ms(p.charge_to_retract),
+                ms(p.charge_to_extend),
+                p.charge_travel_retract * 1e3,
+                p.charge_travel_extend * 1e3
+            ),
+            "> 1 ms at each reversal (7.1)".into(),
+            p.charge_to_retract > 1e-3 && p.charge_to_extend > 1e-3,
+        );
         drift_and_friction(s, &label, &p);
         s.check(
             &format!("{label}: mass balance"),
@@ -199,8 +293,8 @@ fn preset_as_shipped(s: &mut Section) {
         );
         s.note(&format!(
             "{label}: lag to 90 % of the target, extending {} / retracting {} ({}); steady dp extending {}, \
-             retracting {}; lowest chamber pressure {} ({} cavitation entries: the fluid model has no cavitation, a chamber \
-             below the vapour pressure has left its range)",
+             retracting {}; lowest chamber pressure {} ({} cavitation entries: the constant-B oil has no floor, a chamber \
+             below the vapour pressure has left its range; with entrained air none goes below absolute zero)",
             ms(p.lag_extend),
             ms(p.lag_retract),
             if p.lag_retract > p.lag_extend {

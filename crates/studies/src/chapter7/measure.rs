@@ -57,6 +57,20 @@ pub struct Phenomena {
     pub stall_to_retract: f64,
     /// Stall at the reversals from retracting to extending \[s\].
     pub stall_to_extend: f64,
+    /// The pressure-charging interval of section 7.1 at the extend→retract
+    /// reversal: the time the pilot-operated four-way valve stays centred
+    /// (both chambers shut) between the command's reversal and half the
+    /// target speed in the new direction, while the pump charges the new
+    /// line to the pilot shift pressure \[s\]. See [`super::stall`]: the
+    /// piston is not held still during it, it rings on the shut chambers.
+    pub charge_to_retract: f64,
+    /// Same at the retract→extend reversal \[s\].
+    pub charge_to_extend: f64,
+    /// Range of the piston's position during the charging interval,
+    /// extend→retract \[m\] (what a position sensor sees of the ringing).
+    pub charge_travel_retract: f64,
+    /// Same at the retract→extend reversal \[m\].
+    pub charge_travel_extend: f64,
     /// Time from reversal to 90 % of the target speed, extending \[s\].
     pub t90_extend: f64,
     /// Same, retracting \[s\].
@@ -272,6 +286,8 @@ fn balances(
     };
     let b_line = rig.bulk_modulus;
     let v_line = rig.pump_line_volume;
+    // C(p) = ∫dp/B_eff (p/B without air): the content a unit volume gains
+    let air = rig.entrained_air;
     let pump = quad("pump", 0);
     let mut out = Vec::new();
     let mut push = |name: &str, inflow: f64, accounted: f64| {
@@ -282,16 +298,30 @@ fn balances(
             relative_error: (inflow - accounted).abs() / pumped,
         });
     };
-    // pump lines: V/B Δp
+    // pump lines: V ΔC(p) (V/B Δp without air)
+    let line = |name: &str| {
+        let (pa, pb) = (state(name, 0, first), state(name, 0, last));
+        if air.is_none() {
+            v_line / b_line * (pb - pa)
+        } else {
+            v_line * (air.compliance(b_line, pb) - air.compliance(b_line, pa))
+        }
+    };
     let in_1 = pump - quad("relief_1", 0) - quad("relief_3_line_1", 0) + quad("check_1", 0);
-    let acc_1 = v_line / b_line * (state("line_1", 0, last) - state("line_1", 0, first));
-    push("pump_line_1", in_1, acc_1);
+    push("pump_line_1", in_1, line("line_1"));
     let in_2 = -pump - quad("relief_2", 0) - quad("relief_3_line_2", 0) + quad("check_2", 0);
-    let acc_2 = v_line / b_line * (state("line_2", 0, last) - state("line_2", 0, first));
-    push("pump_line_2", in_2, acc_2);
-    // chambers: ∫q1 = A1 Δx + [V1 p1/B] − ∫p1 A1 v/B;  ∫q2 = [V2 p2/B] + ∫p2 A2 v/B − A2 Δx
+    push("pump_line_2", in_2, line("line_2"));
+    // chambers: ∫q1 = A1 Δx + [V1 C(p1)] − ∫C(p1) A1 v;  ∫q2 = [V2 C(p2)] + ∫C(p2) A2 v − A2 Δx
     let cyl = &rig.cylinder;
     let b = cyl.bulk_modulus.si();
+    // Δ(V C(p)) between the window's ends
+    let stored = |(va, pa): (f64, f64), (vb, pb): (f64, f64)| {
+        if air.is_none() {
+            (vb * pb - va * pa) / b
+        } else {
+            vb * air.compliance(b, pb) - va * air.compliance(b, pa)
+        }
+    };
     let (x_a, x_b) = (state("load", 0, first), state("load", 0, last));
     let vols = |xp: f64| cyl.volumes(hydrocyl_ports::Position::new(xp));
     let (v1a, v2a) = vols(x_a);
@@ -299,12 +329,12 @@ fn balances(
     let (p1a, p2a) = (state("cylinder", 0, first), state("cylinder", 1, first));
     let (p1b, p2b) = (state("cylinder", 0, last), state("cylinder", 1, last));
     let in_c1 = quad("relief_1", 0) - quad("pilot_valve", 0);
-    let acc_c1 =
-        cyl.area_1.si() * (x_b - x_a) + (v1b.si() * p1b - v1a.si() * p1a) / b - quad("cylinder", 2);
+    let acc_c1 = cyl.area_1.si() * (x_b - x_a) + stored((v1a.si(), p1a), (v1b.si(), p1b))
+        - quad("cylinder", 2);
     push("chamber_1", in_c1, acc_c1);
     let in_c2 = quad("relief_2", 0) - quad("pilot_valve", 1);
-    let acc_c2 =
-        (v2b.si() * p2b - v2a.si() * p2a) / b + quad("cylinder", 3) - cyl.area_2.si() * (x_b - x_a);
+    let acc_c2 = stored((v2a.si(), p2a), (v2b.si(), p2b)) + quad("cylinder", 3)
+        - cyl.area_2.si() * (x_b - x_a);
     push("chamber_2", in_c2, acc_c2);
     out
 }
@@ -351,6 +381,7 @@ fn phenomena(test: &Chapter7Test, rig: &WangHybrid, tr: &Trace) -> Phenomena {
     let revs = reversals(tr, period);
     let (mut st_r, mut st_e, mut t9_e, mut t9_r) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let (mut lag_e, mut lag_r) = (Vec::new(), Vec::new());
+    let (mut ch_e, mut ch_r, mut tr_e, mut tr_r) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let half = (0.5 * period / test.sample_interval).round() as usize;
     for &(k, dir) in &revs {
         let end = (k + half).min(n - 1);
@@ -361,6 +392,29 @@ fn phenomena(test: &Chapter7Test, rig: &WangHybrid, tr: &Trace) -> Phenomena {
                 st_e.push(d);
             } else {
                 st_r.push(d);
+            }
+        }
+        // the charging interval: samples with the pilot spool centred before
+        // half the target speed in the new direction
+        let mut j = k;
+        while j < end && v[j] * dir < 0.5 * test.speed {
+            j += 1;
+        }
+        if j < end {
+            let centred: Vec<usize> = (k..j).filter(|&i| tr.spool[i].abs() <= 1e-12).collect();
+            let time = centred.len() as f64 * test.sample_interval;
+            let (lo, hi) = centred
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &i| {
+                    (a.min(tr.position[i]), b.max(tr.position[i]))
+                });
+            let travel = if centred.is_empty() { 0.0 } else { hi - lo };
+            if dir > 0.0 {
+                ch_e.push(time);
+                tr_e.push(travel);
+            } else {
+                ch_r.push(time);
+                tr_r.push(travel);
             }
         }
         // time to 90 % of the target speed in the new direction, and the same for the
@@ -429,6 +483,10 @@ fn phenomena(test: &Chapter7Test, rig: &WangHybrid, tr: &Trace) -> Phenomena {
     Phenomena {
         stall_to_retract: mean(st_r.into_iter()),
         stall_to_extend: mean(st_e.into_iter()),
+        charge_to_retract: mean(ch_r.into_iter()),
+        charge_to_extend: mean(ch_e.into_iter()),
+        charge_travel_retract: mean(tr_r.into_iter()),
+        charge_travel_extend: mean(tr_e.into_iter()),
         t90_extend: mean(t9_e.into_iter()),
         t90_retract: mean(t9_r.into_iter()),
         lag_extend: mean(lag_e.into_iter()),

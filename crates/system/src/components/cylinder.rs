@@ -4,7 +4,7 @@ use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe,
     Tangents, Wire, Wires,
 };
-use hydrocyl_actuator::Cylinder;
+use hydrocyl_actuator::{Cylinder, EntrainedAir};
 use hydrocyl_integrators::{Crossing, EventAction};
 use hydrocyl_ports::Pressure;
 
@@ -30,8 +30,11 @@ impl Cavitation {
 /// Cavitation is **reported**, not hidden: a switching function per chamber
 /// crosses zero when its pressure falls below `cavitation_pressure`, and the
 /// entries are counted ([`Component::diagnostics`] `cavitation_entries_1/2`).
-/// The fluid model is not changed below it (constant B), so a run with
-/// entries has left the model's range there.
+/// With no entrained air (`air` = [`EntrainedAir::NONE`], constant B) the
+/// fluid model is not changed below it, so a run with entries has left the
+/// model's range there; with air the chambers' bulk modulus is
+/// `B_eff(p)` ([`hydrocyl_actuator::fluid`]) and no chamber goes below
+/// absolute zero.
 #[derive(Debug)]
 pub struct TwoChamberCylinder {
     name: String,
@@ -44,6 +47,8 @@ pub struct TwoChamberCylinder {
     pub cavitation_pressure: f64,
     /// Initial (p1, p2) \[Pa\].
     pub initial_pressures: (f64, f64),
+    /// Entrained air in the chambers' oil (none: the constant B of eqs 2.10–2.15).
+    pub air: EntrainedAir,
     cav: [Cavitation; 2],
     a: HydraulicNode,
     b: HydraulicNode,
@@ -69,6 +74,7 @@ impl TwoChamberCylinder {
             cylinder,
             cavitation_pressure: 0.0,
             initial_pressures,
+            air: EntrainedAir::NONE,
             cav: [Cavitation::default(); 2],
             a: HydraulicNode::UNBOUND,
             b: HydraulicNode::UNBOUND,
@@ -77,16 +83,32 @@ impl TwoChamberCylinder {
         }
     }
 
-    /// `(dp1/dt, dp2/dt)` at this instant \[Pa·s⁻¹\].
+    /// The chambers' effective bulk moduli `(B_eff(p1), B_eff(p2))` \[Pa\].
+    fn moduli(&self, x: &[f64]) -> (f64, f64) {
+        let b = self.cylinder.bulk_modulus.si();
+        (
+            self.air.bulk_modulus(b, x[0]),
+            self.air.bulk_modulus(b, x[1]),
+        )
+    }
+
+    /// `(dp1/dt, dp2/dt)` at this instant \[Pa·s⁻¹\]: the cylinder's rates
+    /// with B replaced by `B_eff(p)` (exactly the cylinder's without air).
     fn rates(&self, x: &[f64], w: &Wires) -> (f64, f64) {
-        self.cylinder.pressure_rates(
+        let (d1, d2) = self.cylinder.pressure_rates(
             w.get(self.rod.position),
             w.get(self.rod.velocity),
             Pressure::new(x[0]),
             Pressure::new(x[1]),
             w.get(self.a.inflow),
             -w.get(self.b.inflow),
-        )
+        );
+        if self.air.is_none() {
+            return (d1, d2);
+        }
+        let b = self.cylinder.bulk_modulus.si();
+        let (b1, b2) = self.moduli(x);
+        (d1 * (b1 / b), d2 * (b2 / b))
     }
 }
 
@@ -114,6 +136,10 @@ impl Component for TwoChamberCylinder {
         // dp2/dt = B/V2 (A2 v + Cl (p1 − p2) − Ce2 p2 + Q2_in), V2 = A2 (L2 − x)
         let c = &self.cylinder;
         let (a1, a2, b) = (c.area_1.si(), c.area_2.si(), c.bulk_modulus.si());
+        let (s1, s2) = (
+            self.air.bulk_modulus_and_slope(b, x[0]),
+            self.air.bulk_modulus_and_slope(b, x[1]),
+        );
         let (cl, ce1, ce2) = (
             c.internal_leakage,
             c.external_leakage_1,
@@ -122,7 +148,10 @@ impl Component for TwoChamberCylinder {
         let (v1, v2) = c.volumes(w.get(self.rod.position));
         let (v1, v2) = (v1.si(), v2.si());
         let (d1, d2) = self.rates(x, w);
-        let (k1, k2) = (b / v1, b / v2);
+        let (k1, k2) = (s1.0 / v1, s2.0 / v2);
+        // B_eff(p): d/dp of (B_eff/V) n = B_eff'/B_eff · dp/dt + B_eff/V dn/dp
+        d.rate_state(0, 0, s1.1 / s1.0 * d1);
+        d.rate_state(1, 1, s2.1 / s2.0 * d2);
         d.rate_chain(0, k1, self.a.inflow);
         d.rate_state(0, 0, -k1 * (cl + ce1));
         d.rate_state(0, 1, k1 * cl);
@@ -138,16 +167,19 @@ impl Component for TwoChamberCylinder {
         let v = w.get(self.rod.velocity).si();
         let b = self.cylinder.bulk_modulus.si();
         let (a1, a2) = (self.cylinder.area_1.si(), self.cylinder.area_2.si());
+        let (b1, b2) = self.moduli(x);
+        let (c1, c2) = (self.air.compliance(b, x[0]), self.air.compliance(b, x[1]));
         d.quadrature_chain(0, 1.0, self.a.inflow);
         d.quadrature_chain(1, 1.0, self.b.inflow);
-        d.quadrature_state(2, 0, a1 * v / b);
-        d.quadrature_chain(2, x[0] * a1 / b, self.rod.velocity);
-        d.quadrature_state(3, 1, a2 * v / b);
-        d.quadrature_chain(3, x[1] * a2 / b, self.rod.velocity);
+        d.quadrature_state(2, 0, a1 * v / b1);
+        d.quadrature_chain(2, c1 * a1, self.rod.velocity);
+        d.quadrature_state(3, 1, a2 * v / b2);
+        d.quadrature_chain(3, c2 * a2, self.rod.velocity);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.cylinder
             .validate()
+            .and_then(|()| self.air.validate())
             .map_err(|e| BuildError::Component {
                 component: self.name.clone(),
                 message: e.to_string(),
@@ -213,12 +245,14 @@ impl Component for TwoChamberCylinder {
     }
     fn power(&self, _t: f64, x: &[f64], w: &Wires, dx: &[f64], p: &mut PowerTerms) {
         let (v1, v2) = self.cylinder.volumes(w.get(self.rod.position));
+        let (v1, v2) = (v1.si(), v2.si());
         let b = self.cylinder.bulk_modulus.si();
+        let (b1, b2) = self.moduli(x);
         let (p1, p2) = (Pressure::new(x[0]), Pressure::new(x[1]));
         let (ql, qe1, qe2) = self.cylinder.leakage(p1, p2);
-        p.storage = x[0] * v1.si() / b * dx[0] + x[1] * v2.si() / b * dx[1];
+        p.storage = x[0] * v1 / b1 * dx[0] + x[1] * v2 / b2 * dx[1];
         p.dissipated = ql.si() * (x[0] - x[1]) + qe1.si() * x[0] + qe2.si() * x[1];
-        p.stored = 0.5 * (v1.si() * x[0] * x[0] + v2.si() * x[1] * x[1]) / b;
+        p.stored = self.air.stored_energy(b, x[0], v1) + self.air.stored_energy(b, x[1], v2);
     }
     fn n_quadratures(&self) -> usize {
         4
@@ -230,15 +264,21 @@ impl Component for TwoChamberCylinder {
             .collect()
     }
     fn quadratures(&self, _t: f64, x: &[f64], w: &Wires, _dx: &[f64], q: &mut [f64]) {
-        // ∫Q1 dt, ∫Q2_in dt (the valve's flows), ∫p1 A1 v/B dt, ∫p2 A2 v/B dt:
-        // with these, ∫(Q1 − A1 v − V1/B dp1/dt) dt is computable exactly
-        // (∫V1/B dp1 = [V1 p1/B] − ∫p1 A1 v/B dt).
+        // ∫Q1 dt, ∫Q2_in dt (the valve's flows), ∫C(p1) A1 v dt, ∫C(p2) A2 v dt
+        // with C(p) = ∫dp/B_eff (p/B without air): with these,
+        // ∫(Q1 − A1 v − V1/B_eff dp1/dt) dt is computable exactly
+        // (∫V1 dC(p1) = [V1 C(p1)] − ∫C(p1) A1 v dt).
         let v = w.get(self.rod.velocity).si();
         let b = self.cylinder.bulk_modulus.si();
         q[0] = w.get(self.a.inflow).si();
         q[1] = w.get(self.b.inflow).si();
-        q[2] = x[0] * self.cylinder.area_1.si() * v / b;
-        q[3] = x[1] * self.cylinder.area_2.si() * v / b;
+        if self.air.is_none() {
+            q[2] = x[0] * self.cylinder.area_1.si() * v / b;
+            q[3] = x[1] * self.cylinder.area_2.si() * v / b;
+        } else {
+            q[2] = self.air.compliance(b, x[0]) * self.cylinder.area_1.si() * v;
+            q[3] = self.air.compliance(b, x[1]) * self.cylinder.area_2.si() * v;
+        }
     }
     fn probes(&self) -> Vec<Probe> {
         vec![

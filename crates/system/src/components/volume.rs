@@ -3,18 +3,22 @@
 use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, Netlist, PowerTerms, Probe, Tangents, Wires,
 };
+use hydrocyl_actuator::EntrainedAir;
 use hydrocyl_ports::{HydraulicPort, Pressure};
 
 /// A constant hydraulic volume (a pipeline, a hose, a pump line):
-/// `dp/dt = B/V ΣQ_in`.
+/// `dp/dt = B_eff(p)/V ΣQ_in`, `B_eff` the liquid's `B` without entrained
+/// air ([`hydrocyl_actuator::fluid`]).
 #[derive(Debug)]
 pub struct Volume {
     name: String,
     node_name: String,
     /// Volume V \[m³\].
     pub volume: f64,
-    /// Effective bulk modulus B \[Pa\].
+    /// Bulk modulus B of the liquid (the effective one without air) \[Pa\].
     pub bulk_modulus: f64,
+    /// Entrained air in the oil (none: the constant B).
+    pub air: EntrainedAir,
     /// Initial pressure \[Pa\].
     pub initial_pressure: f64,
     probe: Option<String>,
@@ -36,6 +40,7 @@ impl Volume {
             node_name: node.into(),
             volume,
             bulk_modulus,
+            air: EntrainedAir::NONE,
             initial_pressure,
             probe: probe.map(str::to_string),
             node: HydraulicNode::UNBOUND,
@@ -53,21 +58,29 @@ impl Component for Volume {
     fn publish_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
         d.state(self.node.pressure, 0, 1.0);
     }
-    fn derivative_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
-        d.rate_chain(0, self.bulk_modulus / self.volume, self.node.inflow);
+    fn derivative_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
+        let (b, slope) = self.air.bulk_modulus_and_slope(self.bulk_modulus, x[0]);
+        d.rate_chain(0, b / self.volume, self.node.inflow);
+        if slope != 0.0 {
+            d.rate_state(0, 0, slope / self.volume * w.get(self.node.inflow).si());
+        }
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         if !(self.volume > 0.0
             && self.volume.is_finite()
             && self.bulk_modulus > 0.0
-            && self.bulk_modulus.is_finite())
+            && self.bulk_modulus.is_finite()
+            && self.air.validate().is_ok())
         {
             return Err(BuildError::Component {
                 component: self.name.clone(),
-                message: format!(
-                    "volume {} m^3 and bulk modulus {} Pa must be positive",
-                    self.volume, self.bulk_modulus
-                ),
+                message: match self.air.validate() {
+                    Err(e) => e.to_string(),
+                    Ok(()) => format!(
+                        "volume {} m^3 and bulk modulus {} Pa must be positive",
+                        self.volume, self.bulk_modulus
+                    ),
+                },
             });
         }
         self.node = net.own_hydraulic(&self.node_name, Causality::Stored)?;
@@ -88,13 +101,14 @@ impl Component for Volume {
     fn publish(&self, _t: f64, x: &[f64], w: &mut Wires) {
         w.set(self.node.pressure, Pressure::new(x[0]));
     }
-    fn derivatives(&self, _t: f64, _x: &[f64], w: &Wires, dx: &mut [f64]) {
-        dx[0] = self.bulk_modulus / self.volume * w.get(self.node.inflow).si();
+    fn derivatives(&self, _t: f64, x: &[f64], w: &Wires, dx: &mut [f64]) {
+        let b = self.air.bulk_modulus(self.bulk_modulus, x[0]);
+        dx[0] = b / self.volume * w.get(self.node.inflow).si();
     }
     fn power(&self, _t: f64, x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         let port = HydraulicPort::new(Pressure::new(x[0]), w.get(self.node.inflow));
         p.storage = port.power().si();
-        p.stored = 0.5 * self.volume * x[0] * x[0] / self.bulk_modulus;
+        p.stored = self.air.stored_energy(self.bulk_modulus, x[0], self.volume);
     }
     fn probes(&self) -> Vec<Probe> {
         self.probe

@@ -48,7 +48,7 @@ use crate::circuit::{BuildError, Circuit, Component};
 use crate::rig::RigError;
 use crate::run::{Run, RunOptions};
 use crate::signal::Signal;
-use hydrocyl_actuator::Cylinder;
+use hydrocyl_actuator::{Cylinder, EntrainedAir};
 use hydrocyl_friction::{FrictionLaw, FrictionModel, Wang};
 use hydrocyl_ports::{Area, Position, Pressure};
 use hydrocyl_pump_motor::IdentifiedPump;
@@ -119,6 +119,10 @@ pub struct WangHybrid {
     pub vapour_pressure: f64,
     /// Initial piston position from mid-stroke \[m\].
     pub initial_position: f64,
+    /// Entrained air in the oil of every volume (pump lines and chambers);
+    /// none: the constant bulk moduli (`hydrocyl_actuator::fluid`).
+    #[serde(default)]
+    pub entrained_air: EntrainedAir,
 }
 
 impl Default for WangHybrid {
@@ -179,6 +183,7 @@ impl WangHybrid {
             tank_pressure: 0.0,
             vapour_pressure: -0.99e5,
             initial_position: 0.0,
+            entrained_air: EntrainedAir::NONE,
         }
     }
 

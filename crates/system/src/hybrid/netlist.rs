@@ -7,7 +7,7 @@
 use super::{WangHybrid, KIND};
 use crate::netlist::{self, registry::Instance};
 use crate::rig::RigError;
-use hydrocyl_actuator::Cylinder;
+use hydrocyl_actuator::{Cylinder, EntrainedAir};
 use hydrocyl_ports::{Area, Position, Pressure};
 use serde_json::{json, Value};
 
@@ -137,6 +137,14 @@ impl WangHybrid {
             "cavitation_pressure": self.vapour_pressure,
             "initial": { "position": self.initial_position, "velocity": 0.0, "p1": tank, "p2": tank }
         });
+        if !self.entrained_air.is_none() {
+            let a = &self.entrained_air;
+            for v in ["line_1", "line_2", "cylinder"] {
+                c[v]["air_fraction"] = json!(a.fraction);
+                c[v]["polytropic_index"] = json!(a.polytropic_index);
+                c[v]["atmospheric_pressure"] = json!(a.atmospheric_pressure);
+            }
+        }
         c["load"] = json!({
             "type": "mass",
             "mass": self.mass,
@@ -239,6 +247,18 @@ impl WangHybrid {
         let friction = get("friction")?;
         let tank = get("tank")?.get("pressure");
         let line = get("line_1")?;
+        let air = |i: &Instance| EntrainedAir {
+            fraction: i.get("air_fraction"),
+            polytropic_index: i.get("polytropic_index"),
+            atmospheric_pressure: i.get("atmospheric_pressure"),
+        };
+        let entrained_air = air(line);
+        if air(cyl) != entrained_air {
+            return Err(bad(
+                "components.cylinder.air_fraction",
+                "differs from the pump lines' entrained air; the hybrid rig's studies take one fluid in every volume",
+            ));
+        }
         let r = WangHybrid {
             kind: KIND.into(),
             pump: typed(get("pump")?, "")?,
@@ -271,6 +291,7 @@ impl WangHybrid {
                 .initial("position")
                 .or_else(|| load.initial("position"))
                 .unwrap_or(0.0),
+            entrained_air,
         };
         // the rig starts at rest with every volume at the tank pressure
         for (name, state) in [

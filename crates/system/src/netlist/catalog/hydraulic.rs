@@ -2,12 +2,50 @@
 //! mass balance on a fixed volume), fixed orifices (eqs 2.4–2.7) and a
 //! first-order pressure sensor.
 
-use super::super::registry::{param, ComponentType, Default::*, ParamSpec, Range, Role, StateSpec};
+use super::super::registry::{
+    param, ComponentType, Default::*, Instance, ParamSpec, Range, Role, StateSpec,
+};
 use super::{built, port, HYD};
 use crate::components::{FixedOrifice, PressureSource, Volume};
 use crate::sensor::LaggedPressureSensor;
+use hydrocyl_actuator::EntrainedAir;
 use hydrocyl_ports::{Area, Density, Pressure};
 use hydrocyl_valves::orifice::Orifice;
+
+/// The entrained-air parameters of a volume or a cylinder's chambers
+/// ([`EntrainedAir`]; `air_fraction` 0 is the constant-B liquid).
+pub(super) const AIR: [ParamSpec; 3] = [
+    param(
+        "air_fraction",
+        "-",
+        Value(0.0),
+        Range { lo: 0.0, hi: 1.0, lo_open: false, hi_open: true },
+        "entrained (undissolved) air, volume fraction at atmospheric pressure; 0 = pure liquid of constant B",
+    ),
+    param(
+        "polytropic_index",
+        "-",
+        Value(1.0),
+        Range { lo: 1.0, hi: 1.4, lo_open: false, hi_open: false },
+        "polytropic index n of the air (1 isothermal, 1.4 adiabatic)",
+    ),
+    param(
+        "atmospheric_pressure",
+        "Pa",
+        Value(hydrocyl_actuator::fluid::STANDARD_ATMOSPHERE),
+        Range::POSITIVE,
+        "absolute pressure at gauge zero (the air's reference)",
+    ),
+];
+
+/// The entrained air an instance's [`AIR`] parameters give.
+pub(super) fn air(i: &Instance) -> EntrainedAir {
+    EntrainedAir {
+        fraction: i.get("air_fraction"),
+        polytropic_index: i.get("polytropic_index"),
+        atmospheric_pressure: i.get("atmospheric_pressure"),
+    }
+}
 
 /// The orifice law's parameters under `prefix` (Cd, ρ, regularisation).
 macro_rules! orifice_params {
@@ -76,7 +114,7 @@ pub const TYPES: &[ComponentType] = &[
     },
     ComponentType {
         name: "volume",
-        summary: "a fixed volume of oil, dp/dt = B/V ΣQ (a line, a hose, a pump port)",
+        summary: "a fixed volume of oil, dp/dt = B_eff(p)/V ΣQ (a line, a hose, a pump port); B_eff = B without entrained air",
         ports: &[port(
             "port",
             HYD,
@@ -91,8 +129,11 @@ pub const TYPES: &[ComponentType] = &[
                 "Pa",
                 Required,
                 Range::POSITIVE,
-                "effective bulk modulus B",
+                "bulk modulus B of the liquid (the effective one without air)",
             ),
+            AIR[0],
+            AIR[1],
+            AIR[2],
         ],
         states: &[StateSpec {
             name: "pressure",
@@ -101,14 +142,16 @@ pub const TYPES: &[ComponentType] = &[
             doc: "initial pressure (gauge)",
         }],
         build: |i| {
-            built(Volume::new(
+            let mut v = Volume::new(
                 &i.name,
                 i.node("port"),
                 i.get("volume"),
                 i.get("bulk_modulus"),
                 i.initial("pressure").unwrap_or(0.0),
                 Some("p"),
-            ))
+            );
+            v.air = air(i);
+            built(v)
         },
         hints: None,
         probes: &[("p", "Pa")],

@@ -5,6 +5,7 @@
 use super::super::registry::{
     param, ComponentType, Default::*, Instance, ParamSpec, Range, Role, StateSpec,
 };
+use super::hydraulic::{air, AIR};
 use super::servo::{metering, METERING};
 use super::{built, join, port, HYD, MECH, SIG};
 use crate::circuit::Component;
@@ -87,6 +88,10 @@ const CYLINDER: [ParamSpec; 10] = [
         "chamber pressure below which cavitation is reported",
     ),
 ];
+
+/// The two-chamber cylinder's parameters: [`CYLINDER`] and the chambers'
+/// entrained air (the generalised form keeps the constant B).
+const TWO_CHAMBER: [ParamSpec; 13] = join(CYLINDER, AIR);
 
 pub(crate) fn cylinder(i: &Instance) -> Result<Cylinder, String> {
     let c = Cylinder {
@@ -181,7 +186,7 @@ pub const TYPES: &[ComponentType] = &[
             port("B", HYD, Role::Owns, false, "rod-side chamber (p2)"),
             port("rod", MECH, Role::Reads, false, "the rod: + extending"),
         ],
-        params: &CYLINDER,
+        params: &TWO_CHAMBER,
         states: &[
             StateSpec { name: "p1", unit: "Pa", default: Absent, doc: "initial cap-side pressure (default: the steady state at rest of the valve feeding it, section 3.3.4)" },
             StateSpec { name: "p2", unit: "Pa", default: Absent, doc: "initial rod-side pressure (default: as p1)" },
@@ -195,6 +200,7 @@ pub const TYPES: &[ComponentType] = &[
             let p = (p1, p2);
             let mut c = TwoChamberCylinder::new(&i.name, i.node("A"), i.node("B"), i.node("rod"), cylinder(i)?, p);
             c.cavitation_pressure = i.get("cavitation_pressure");
+            c.air = air(i);
             built(c)
         },
         hints: Some(rod_hints),

@@ -27,9 +27,11 @@
 //!   `(dFc/2) |tanh(v/v_t)|` (extending level `Fc + dFc/2`, retracting
 //!   `Fc − dFc/2`) and `external_force` `F0`.
 //!
-//! The bristle state is integrated exactly over each sample step with the
-//! velocity held at the step's mid value (z relaxes exponentially towards
-//! `g(v) sgn(v) / σ0`), so σ0 of 1e7 N/m at 100 Hz is no stiffness problem.
+//! The bench runs as its netlist ([`hydrocyl_system::netlist::migrate::bench`])
+//! through the one run path ([`BenchRun`]): the record's velocity,
+//! acceleration and pressures are the netlist's inputs (first-order hold
+//! between samples), the load cell its output; the bristle ODE is
+//! integrated by the run's solver.
 
 use std::collections::BTreeMap;
 
@@ -38,6 +40,7 @@ use thiserror::Error;
 
 use crate::catalog::{Balance, EffectId};
 use crate::data::ColumnMap;
+use hydrocyl_system::netlist::migrate::bench as net;
 
 /// Effects a friction bench can carry (the force balance's).
 pub const BENCH_EFFECTS: [EffectId; 7] = [
@@ -154,6 +157,26 @@ impl ParamRef {
                 let id = EffectId::from_id(e)?;
                 id.params().iter().find(|q| q.name == p)?;
                 Some(ParamRef::Effect(id, p.to_string()))
+            }
+        }
+    }
+
+    /// Its path in the bench's netlist (`<component>.<parameter>`, the one
+    /// parameter scheme): `friction.coulomb`, `drive.mass`, and each catalog
+    /// effect's parameter under the `friction_bench` name the migration's
+    /// table gives it ([`net::EFFECT_PARAMS`]: `viscous.b` is
+    /// `friction.viscous`).
+    pub fn path(&self) -> String {
+        match self {
+            ParamRef::Coulomb => format!("{}.coulomb", net::FRICTION),
+            ParamRef::Mass => format!("{}.mass", net::DRIVE),
+            ParamRef::Effect(id, p) => {
+                let target = net::EFFECT_PARAMS
+                    .iter()
+                    .find(|(e, q, _)| *e == id.id() && q == p)
+                    .map(|(_, _, t)| *t)
+                    .expect("every bench effect parameter is in the migration's table");
+                format!("{}.{target}", net::FRICTION)
             }
         }
     }
@@ -346,12 +369,13 @@ impl FrictionBench {
     }
 }
 
+#[cfg(test)]
 mod inverse;
 mod model;
 mod presets;
 mod signals;
 
-pub use model::{run_options, BenchInputs};
+pub use model::{run_options, BenchInputs, BenchRun};
 pub use presets::{preset, PRESETS};
 pub use signals::{bench_signals, BenchSignals};
 

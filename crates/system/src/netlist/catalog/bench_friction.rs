@@ -15,7 +15,7 @@
 //! `signal_pressure_source` holds a node at the pressure a signal gives (a
 //! bench record's measured chamber pressure, fed by a `command_input`).
 
-use super::super::registry::{param, ComponentType, Default::*, ParamSpec, Range, Role, StateSpec};
+use super::super::registry::{check_param, param, ComponentType, Default::*, ParamSpec, Range, Role, StateSpec};
 use super::{built, port, HYD, MECH, SIG};
 use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe,
@@ -94,6 +94,9 @@ pub struct BenchFriction {
     chambers: Option<(String, String)>,
     /// The law.
     pub law: BenchLaw,
+    /// Stribeck velocity and exponent, and σ1, kept while the hump or the
+    /// bristle is off (so that a parameter set on the built law keeps them).
+    shape: (f64, f64, f64),
     initial_z: f64,
     rod: MechanicalNode,
     p: Option<(Wire<Pressure>, Wire<Pressure>)>,
@@ -171,6 +174,54 @@ impl Component for BenchFriction {
     }
     fn probes(&self) -> Vec<Probe> {
         vec![Probe::of(format!("{}_force", self.name), self.force)]
+    }
+    /// Every parameter but a change of `sigma0` between 0 and > 0 (that
+    /// adds or removes the bristle state) and a seal gain `K > 0` without
+    /// the chamber ports; `stiction` switches the Stribeck hump on.
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), String> {
+        check_param("friction_bench", name, value)?;
+        let l = &mut self.law;
+        match name {
+            "coulomb" => l.coulomb = value,
+            "smoothing_velocity" => l.smoothing_velocity = value,
+            "viscous" => l.viscous = value,
+            "asymmetry" => l.asymmetry = value,
+            "external_force" => l.external_force = value,
+            "seal.h_acceleration" => l.h_acceleration = value,
+            "seal.k_pressure" if value > 0.0 && self.chambers.is_none() => {
+                return Err("the seal term needs the chamber ports `A` and `B` connected".into())
+            }
+            "seal.k_pressure" => l.k_pressure = value,
+            "stiction" => l.stribeck = Some((value, self.shape.0, self.shape.1)),
+            "stribeck_velocity" | "stribeck_exponent" => {
+                if name == "stribeck_velocity" {
+                    self.shape.0 = value;
+                } else {
+                    self.shape.1 = value;
+                }
+                if let Some((fs, _, _)) = l.stribeck {
+                    l.stribeck = Some((fs, self.shape.0, self.shape.1));
+                }
+            }
+            "sigma1" => {
+                self.shape.2 = value;
+                if let Some((s0, _)) = l.lugre {
+                    l.lugre = Some((s0, value));
+                }
+            }
+            "sigma0" => match (l.lugre, value > 0.0) {
+                (Some(_), true) => l.lugre = Some((value, self.shape.2)),
+                (None, false) => {}
+                _ => {
+                    return Err(
+                        "switching the bristle (sigma0 between 0 and > 0) changes the states: assemble again"
+                            .into(),
+                    )
+                }
+            },
+            _ => unreachable!("check_param knows friction_bench's parameters"),
+        }
+        Ok(())
     }
 }
 
@@ -346,6 +397,11 @@ pub const TYPES: &[ComponentType] = &[
                 rod_name: i.node("rod").into(),
                 chambers,
                 law,
+                shape: (
+                    i.get("stribeck_velocity"),
+                    i.get("stribeck_exponent"),
+                    i.get("sigma1"),
+                ),
                 initial_z: i.initial("z").unwrap_or(0.0),
                 rod: MechanicalNode::UNBOUND,
                 p: None,

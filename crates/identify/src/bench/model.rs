@@ -13,24 +13,39 @@ use hydrocyl_system::signal::Signal;
 use hydrocyl_system::simulation::Simulation;
 
 /// The solver options of a bench run with LuGre's bristle on a record whose
-/// largest sample interval is `h` \[s\]: fixed-step RK4 at `h / m`, `m` the
-/// least whole number with `r h / m <= 1`, `r = σ0 max|v| / min g` the
-/// bristle's fastest relaxation rate on the record \[1/s\].
+/// largest sample interval is `h` \[s\], `rate = σ0 max|v| / min g` the
+/// bristle's fastest relaxation rate on the record \[1/s\]:
 ///
-/// Why this solver: the fit differences the force with respect to σ0 and
-/// σ1, so the force must be smooth in them, which an adaptive step's
-/// choices are not (DP45 at rtol 1e-6 gives a σ0 derivative wrong by 1000×
-/// its size; rtol 1e-10 is smooth but 7× the cost of RK4 at the record's
-/// step). At `r h <= 1` RK4 is well inside its stability bound (2.78) and on
-/// the planted-LuGre fixture (500 Hz) its force is within 6e-3 N of DP45 at
-/// rtol 1e-12 (the noise is 0.5 N), its σ0 derivative within 0.2 %
+/// * fixed-step RK4 at `h / m`, `m` the least whole number with
+///   `rate h / m <= 1`, while `m <= 8`: the fit differences the force with
+///   respect to σ0 and σ1, so the force must be smooth in them, which an
+///   adaptive step's choices are not (DP45 at rtol 1e-6 gives a σ0
+///   derivative wrong by 1000× its size; at rtol 1e-10 it is smooth but 7×
+///   the cost of RK4 at the record's step). At `rate h / m <= 1` RK4 is well
+///   inside its stability bound (2.78);
+/// * stiffer (a bristle relaxing in under an eighth of a sample interval),
+///   the L-stable Rodas4 at rtol 1e-8 with steps of at most `h`, whose cost
+///   does not grow with σ0.
+///
+/// On the planted-LuGre fixture (500 Hz) the RK4 force is within 2e-2 N of
+/// DP45 at rtol 1e-12 (the noise is 0.5 N) and its σ0 derivative within 1 %
 /// (`solver_choice_on_the_lugre_fixture`).
 pub fn run_options(rate: f64, h: f64) -> RunOptions {
+    use hydrocyl_system::run::Solver;
     let m = (rate * h).ceil().max(1.0);
-    RunOptions {
-        solver: hydrocyl_system::run::Solver::Rk4,
-        rk4_step: h / m,
-        ..RunOptions::default()
+    if m <= 8.0 {
+        RunOptions {
+            solver: Solver::Rk4,
+            rk4_step: h / m,
+            ..RunOptions::default()
+        }
+    } else {
+        RunOptions {
+            solver: Solver::Rosenbrock,
+            rtol: 1e-8,
+            h_max: h,
+            ..RunOptions::default()
+        }
     }
 }
 
@@ -376,3 +391,5 @@ mod solver_choice {
         assert!(scale > 0.0 && derr < 1e-2 * scale, "σ0 step: {derr} of {scale}");
     }
 }
+
+

@@ -137,8 +137,15 @@ impl Component for BenchFriction {
             .map(|_| format!("{}.z", self.name))
             .collect()
     }
+    /// The bristle's scale is its steady deflection `Fc / σ0` (at least
+    /// 1e-12 m): the force σ0 z is then held to the tolerance of the force.
     fn state_scales(&self, s: &mut [f64]) {
-        s.fill(1.0e-4);
+        let s0 = self.law.lugre.map_or(0.0, |(s0, _)| s0);
+        s.fill(if s0 > 0.0 {
+            (self.law.coulomb.max(1e-3) / s0).max(1e-12)
+        } else {
+            1.0e-4
+        });
     }
     fn initial_state(&self, x: &mut [f64]) {
         x.fill(self.initial_z);

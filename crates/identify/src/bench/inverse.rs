@@ -1,11 +1,18 @@
-//! A test reference, not a run path: the bench's force balance written out
-//! by hand (the closed form of the module's documentation), independent of
-//! the netlist and its components. The bristle state is integrated over
-//! each sample step with the velocity held at the step's mid value (z
-//! relaxes exponentially towards `g(v) sgn(v) / σ0`), a discretisation the
-//! netlist (which integrates the ODE on the first-order-hold velocity) does
-//! not make: the two agree to the closed form for a static law and to that
-//! discretisation's error with LuGre.
+//! The bench's force balance written out by hand, the bristle state
+//! stepped over each sample interval with the velocity held at the
+//! interval's mid value (z relaxes exponentially towards `g(v) sgn(v) / σ0`:
+//! an exponential midpoint step of the bristle ODE, second order in the
+//! sample interval).
+//!
+//! Two uses:
+//! * the tests' independent reference for the bench's netlist run
+//!   ([`super::BenchRun`]): equal to the closed form for a static law, and
+//!   to this discretisation's error with LuGre;
+//! * the fit's evaluator **for LuGre only** (`diagnose`'s bench loop): the
+//!   netlist run integrates the bristle with RK4 (or Rodas4 when stiff) at
+//!   20× to 100× this step's cost per evaluation (issue 13's note: EMPS
+//!   3.7 s → 487 s), so the bristle's fits stay here for now. A static law
+//!   is fitted on the netlist run.
 
 use super::{BenchSignals, FrictionBench};
 use crate::catalog::EffectId;
@@ -39,7 +46,7 @@ impl FrictionBench {
 
     /// The reference force on one record, the bristle from the record's
     /// first forces.
-    pub(super) fn reference(&self, s: &BenchSignals) -> Vec<f64> {
+    pub(crate) fn reference(&self, s: &BenchSignals) -> Vec<f64> {
         self.simulate_from(s, false)
     }
 

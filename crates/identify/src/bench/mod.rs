@@ -369,7 +369,6 @@ impl FrictionBench {
     }
 }
 
-#[cfg(test)]
 mod inverse;
 mod model;
 mod presets;

@@ -51,6 +51,7 @@ impl FrictionBench {
     }
 
     /// The reference force with the bristle from rest.
+    #[cfg(test)]
     pub(super) fn reference_from_rest(&self, s: &BenchSignals) -> Vec<f64> {
         self.simulate_from(s, true)
     }

@@ -558,6 +558,91 @@ mod tests {
         }
     }
 
+    /// Parameters set on the built circuit by path give what a circuit
+    /// assembled with them gives (static law: sampled without integration,
+    /// equal to the integrated run; LuGre: integrated, `run_wires`), and
+    /// what cannot change in place is refused by path.
+    #[test]
+    fn parameters_set_on_a_built_circuit_equal_a_new_assembly() {
+        let law = json!({ "coulomb": 20.0, "smoothing_velocity": 1e-3, "sigma0": 1e5, "sigma1": 50.0 });
+        let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-3).collect();
+        let vel: Vec<f64> = t.iter().map(|&t| 0.03 * (9.0 * t).sin()).collect();
+        let sig = || {
+            let c = |x: f64| Signal::Constant { value: x };
+            [Signal::table(t.clone(), vel.clone()).unwrap(), c(0.2), c(4e5), c(1e5)]
+        };
+        let build = |law: &Value| {
+            let s = schematic(&bench(law.clone())).unwrap();
+            let names = ["drive", "acc", "p1", "p2"];
+            let inputs: Vec<_> = names.iter().map(|n| n.to_string()).zip(sig()).collect();
+            Simulation::of_circuit(assemble_inputs(&s, &inputs).unwrap())
+        };
+        let sets = [
+            ("friction.coulomb", 25.0),
+            ("friction.viscous", 300.0),
+            ("friction.stiction", 40.0),
+            ("friction.stribeck_velocity", 5e-3),
+            ("friction.sigma0", 3e5),
+            ("friction.sigma1", 80.0),
+            ("friction.seal.k_pressure", 1e-9),
+            ("friction.external_force", -3.0),
+            ("drive.mass", 3.0),
+            ("piston.area_2", 6e-4),
+        ];
+        let mut expect = law.clone();
+        for (path, v) in sets {
+            let name = path.split_once('.').unwrap();
+            match name {
+                ("friction", "seal.k_pressure") => expect["seal"] = json!({ "k_pressure": v }),
+                ("friction", p) => expect[p] = json!(v),
+                _ => {}
+            }
+        }
+        let mut fresh = bench(expect.clone());
+        fresh["components"]["drive"]["mass"] = json!(3.0);
+        fresh["components"]["piston"]["area_2"] = json!(6e-4);
+        let s = schematic(&fresh).unwrap();
+        let names = ["drive", "acc", "p1", "p2"];
+        let inputs: Vec<_> = names.iter().map(|n| n.to_string()).zip(sig()).collect();
+        let mut o = RunOptions::dp45();
+        o.rtol = 1e-10;
+        let mut want = Simulation::of_circuit(assemble_inputs(&s, &inputs).unwrap()).options(o.clone());
+        let mut got = build(&law).options(o.clone());
+        for (path, v) in sets {
+            got.set_parameter(path, v).unwrap();
+        }
+        let probe = |sim: &Simulation| {
+            let p = sim.circuit().probes().into_iter();
+            p.filter(|p| p.name == "drive.force").map(|p| p.wire).next().unwrap()
+        };
+        let force = probe(&got);
+        let a = got.run_wires(&t, &[force]).unwrap().swap_remove(0);
+        let b = want.run(&t).unwrap();
+        let b = b.channel("drive.force").unwrap();
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() < 1e-9 * y.abs().max(1.0), "{x} vs {y}");
+        }
+        // the bristle cannot be switched off in place, nor can a parameter
+        // the component does not have be set
+        let e = got.set_parameter("friction.sigma0", 0.0).unwrap_err().to_string();
+        assert!(e.contains("friction.sigma0") && e.contains("states"), "{e}");
+        let e = got.set_parameter("friction.warp", 1.0).unwrap_err().to_string();
+        assert!(e.contains("friction.warp"), "{e}");
+        let e = got.set_parameter("friction.coulomb", -1.0).unwrap_err().to_string();
+        assert!(e.contains("friction.coulomb"), "{e}");
+        // LuGre's force depends on the bristle: not sampled without integration
+        let e = got.sample_state_free(&t, &[force]).unwrap_err().to_string();
+        assert!(e.contains("friction.z"), "{e}");
+        // a static law: sampled without integration, the integrated run's force
+        let mut stat = expect.clone();
+        stat.as_object_mut().unwrap().remove("sigma0");
+        let mut sim = build(&stat).options(o);
+        let w = probe(&sim);
+        let sampled = sim.sample_state_free(&t, &[w]).unwrap().swap_remove(0);
+        let run = sim.run(&t).unwrap();
+        assert_eq!(sampled.as_slice(), run.channel("drive.force").unwrap());
+    }
+
     #[test]
     fn a_half_connected_or_pressure_less_seal_is_refused() {
         let mut v = bench(json!({

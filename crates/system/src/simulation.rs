@@ -28,10 +28,10 @@
 //! ```
 
 use crate::circuit::Circuit;
-use crate::wires::AnyWire;
 use crate::rig::{self, RigError};
 use crate::run::{run, Run, RunOptions, SimError};
 use crate::signal::Signal;
+use crate::wires::AnyWire;
 use hydrocyl_integrators::{solve, OdeSystem};
 use serde_json::Value;
 

@@ -445,7 +445,10 @@ mod tests {
             assert_eq!(ParamRef::parse(&p.path()), Some(p.clone()));
             assert_eq!(ParamRef::parse(&p.label()), Some(p));
         }
-        assert_eq!(ParamRef::parse("friction.viscous"), ParamRef::parse("viscous.b"));
+        assert_eq!(
+            ParamRef::parse("friction.viscous"),
+            ParamRef::parse("viscous.b")
+        );
         assert_eq!(ParamRef::parse("friction.warp"), None);
     }
 }

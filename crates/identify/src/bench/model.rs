@@ -7,10 +7,10 @@
 use super::{BenchSignals, FrictionBench};
 use crate::catalog::EffectId;
 use hydrocyl_system::netlist::{self, migrate::bench as net};
-use hydrocyl_system::AnyWire;
 use hydrocyl_system::run::RunOptions;
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::simulation::Simulation;
+use hydrocyl_system::AnyWire;
 
 /// The solver options of a bench run with LuGre's bristle on a record whose
 /// largest sample interval is `h` \[s\], `rate = σ0 max|v| / min g` the
@@ -144,7 +144,9 @@ impl FrictionBench {
     /// `drive.mass` and every parameter of each effect that is on
     /// ([`ParamRef::path`]).
     fn path_values(&self) -> impl Iterator<Item = (String, f64)> + '_ {
-        self.all_params().into_iter().map(|p| (p.path(), self.get(&p)))
+        self.all_params()
+            .into_iter()
+            .map(|p| (p.path(), self.get(&p)))
     }
 }
 
@@ -359,7 +361,10 @@ mod solver_choice {
         let mut rig = FrictionBench::from_json(&text).unwrap();
         let s0 = ParamRef::Effect(EffectId::LugreDynamics, "sigma0".into());
         rig.set(&s0, 2e5);
-        rig.set(&ParamRef::Effect(EffectId::LugreDynamics, "sigma1".into()), 600.0);
+        rig.set(
+            &ParamRef::Effect(EffectId::LugreDynamics, "sigma1".into()),
+            600.0,
+        );
         let rec = Record::read_mapped(&dir.join("bench-lugre_dynamics.csv"), &rig.columns).unwrap();
         let (s, _) = super::super::bench_signals(&rec, None, false).unwrap();
         let inputs = BenchInputs::of(&s).unwrap();
@@ -379,17 +384,29 @@ mod solver_choice {
             let mut o = RunOptions::dp45();
             o.rtol = 1e-12;
             net.sim.set_options(o);
-            net.sim.run_wires(&s.t, &[net.force]).unwrap().swap_remove(0)
+            net.sim
+                .run_wires(&s.t, &[net.force])
+                .unwrap()
+                .swap_remove(0)
         };
         let (fr, gr) = (reference(&rig), reference(&stepped));
-        let worst = f.iter().zip(&fr).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        let worst = f
+            .iter()
+            .zip(&fr)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
         assert!(worst < 2e-2, "force off the reference by {worst} N");
         let d: Vec<f64> = g.iter().zip(&f).map(|(a, b)| a - b).collect();
         let dr: Vec<f64> = gr.iter().zip(&fr).map(|(a, b)| a - b).collect();
         let scale = dr.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let derr = d.iter().zip(&dr).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-        assert!(scale > 0.0 && derr < 1e-2 * scale, "σ0 step: {derr} of {scale}");
+        let derr = d
+            .iter()
+            .zip(&dr)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            scale > 0.0 && derr < 1e-2 * scale,
+            "σ0 step: {derr} of {scale}"
+        );
     }
 }
-
-

@@ -295,7 +295,10 @@ mod tests {
                     (EffectId::Viscous, &[("b", 0.0)]),
                 ])
             );
-            assert_eq!(r.refit, ["friction.coulomb", "friction.sigma0", "friction.viscous"]);
+            assert_eq!(
+                r.refit,
+                ["friction.coulomb", "friction.sigma0", "friction.viscous"]
+            );
             assert_eq!(r.columns.0[&Signal::Time], "time_ms [ms]");
         }
         let r = preset("emps").unwrap();
@@ -311,7 +314,10 @@ mod tests {
             r.friction.effects,
             effects(&[(EffectId::Viscous, &[("b", 100.0)])])
         );
-        assert_eq!(r.refit, ["friction.coulomb", "drive.mass", "friction.viscous"]);
+        assert_eq!(
+            r.refit,
+            ["friction.coulomb", "drive.mass", "friction.viscous"]
+        );
         assert!(preset("leaney-moog").is_none());
     }
 }

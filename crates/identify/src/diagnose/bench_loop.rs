@@ -54,7 +54,9 @@ impl<'a> Bench<'a> {
 
     /// The predicted force of `rig` on every record.
     fn simulate_all(&self, rig: &FrictionBench) -> Vec<Vec<f64>> {
-        (0..self.sigs.len()).map(|k| self.simulate(rig, k)).collect()
+        (0..self.sigs.len())
+            .map(|k| self.simulate(rig, k))
+            .collect()
     }
 
     fn range(&self, s: &BenchSignals, part: Part) -> std::ops::Range<usize> {

@@ -10,7 +10,9 @@
 //! force pushes. This is the inverse model of the robotics IDIM practice: for
 //! a bench whose drive imposes the motion it is the well-posed simulation.
 
-use super::super::registry::{check_param, param, ComponentType, Default::*, Range, Role, StateSpec};
+use super::super::registry::{
+    check_param, param, ComponentType, Default::*, Range, Role, StateSpec,
+};
 use super::{built, port, HYD, MECH, SIG};
 use crate::circuit::{
     BuildError, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe, Wire, Wires,

@@ -15,7 +15,9 @@
 //! `signal_pressure_source` holds a node at the pressure a signal gives (a
 //! bench record's measured chamber pressure, fed by a `command_input`).
 
-use super::super::registry::{check_param, param, ComponentType, Default::*, ParamSpec, Range, Role, StateSpec};
+use super::super::registry::{
+    check_param, param, ComponentType, Default::*, ParamSpec, Range, Role, StateSpec,
+};
 use super::{built, port, HYD, MECH, SIG};
 use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe,
@@ -564,12 +566,18 @@ mod tests {
     /// what cannot change in place is refused by path.
     #[test]
     fn parameters_set_on_a_built_circuit_equal_a_new_assembly() {
-        let law = json!({ "coulomb": 20.0, "smoothing_velocity": 1e-3, "sigma0": 1e5, "sigma1": 50.0 });
+        let law =
+            json!({ "coulomb": 20.0, "smoothing_velocity": 1e-3, "sigma0": 1e5, "sigma1": 50.0 });
         let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-3).collect();
         let vel: Vec<f64> = t.iter().map(|&t| 0.03 * (9.0 * t).sin()).collect();
         let sig = || {
             let c = |x: f64| Signal::Constant { value: x };
-            [Signal::table(t.clone(), vel.clone()).unwrap(), c(0.2), c(4e5), c(1e5)]
+            [
+                Signal::table(t.clone(), vel.clone()).unwrap(),
+                c(0.2),
+                c(4e5),
+                c(1e5),
+            ]
         };
         let build = |law: &Value| {
             let s = schematic(&bench(law.clone())).unwrap();
@@ -606,14 +614,18 @@ mod tests {
         let inputs: Vec<_> = names.iter().map(|n| n.to_string()).zip(sig()).collect();
         let mut o = RunOptions::dp45();
         o.rtol = 1e-10;
-        let mut want = Simulation::of_circuit(assemble_inputs(&s, &inputs).unwrap()).options(o.clone());
+        let mut want =
+            Simulation::of_circuit(assemble_inputs(&s, &inputs).unwrap()).options(o.clone());
         let mut got = build(&law).options(o.clone());
         for (path, v) in sets {
             got.set_parameter(path, v).unwrap();
         }
         let probe = |sim: &Simulation| {
             let p = sim.circuit().probes().into_iter();
-            p.filter(|p| p.name == "drive.force").map(|p| p.wire).next().unwrap()
+            p.filter(|p| p.name == "drive.force")
+                .map(|p| p.wire)
+                .next()
+                .unwrap()
         };
         let force = probe(&got);
         let a = got.run_wires(&t, &[force]).unwrap().swap_remove(0);
@@ -624,11 +636,20 @@ mod tests {
         }
         // the bristle cannot be switched off in place, nor can a parameter
         // the component does not have be set
-        let e = got.set_parameter("friction.sigma0", 0.0).unwrap_err().to_string();
+        let e = got
+            .set_parameter("friction.sigma0", 0.0)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("friction.sigma0") && e.contains("states"), "{e}");
-        let e = got.set_parameter("friction.warp", 1.0).unwrap_err().to_string();
+        let e = got
+            .set_parameter("friction.warp", 1.0)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("friction.warp"), "{e}");
-        let e = got.set_parameter("friction.coulomb", -1.0).unwrap_err().to_string();
+        let e = got
+            .set_parameter("friction.coulomb", -1.0)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("friction.coulomb"), "{e}");
         // LuGre's force depends on the bristle: not sampled without integration
         let e = got.sample_state_free(&t, &[force]).unwrap_err().to_string();

@@ -356,7 +356,7 @@ pub fn lookup(name: &str) -> Option<&'static ComponentType> {
 
 /// Checks `value` for parameter `param` of component type `ty` against the
 /// parameter's declared range (what a built component's
-/// [`Component::set_parameter`](crate::circuit::Component::set_parameter)
+/// [`Component::set_parameter`]
 /// accepts); the error says the range and unit.
 pub fn check_param(ty: &str, param: &str, value: f64) -> Result<(), String> {
     let spec = lookup(ty)

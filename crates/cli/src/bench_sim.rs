@@ -7,7 +7,7 @@
 //! `time, position, velocity, p1, p2, force` (SI). Velocity and acceleration
 //! come from the same smoother `diagnose` uses; the bristle starts from the
 //! record's measured force when it has one, else at rest. The bench runs as
-//! its netlist through the one run path (`FrictionBench::simulate_netlist`:
+//! its netlist through the one run path (`FrictionBench::simulate`:
 //! the record's velocity, acceleration and pressures are the netlist's inputs).
 
 use crate::error::CliError;
@@ -63,9 +63,9 @@ pub fn simulate(bench: &FrictionBench, input: &Path) -> Result<String, CliError>
         .map_err(|e| CliError::Input(e.to_string()))?;
     let inputs = BenchInputs::of(&s).map_err(CliError::Input)?;
     let force = if measured_force {
-        bench.simulate_netlist(&s, &inputs)
+        bench.simulate(&s, &inputs)
     } else {
-        bench.simulate_netlist_from_rest(&s, &inputs)
+        bench.simulate_from_rest(&s, &inputs)
     }
     .map_err(|e| CliError::Input(format!("{}: {e}", input.display())))?;
     if let Some(i) = force.iter().position(|f| !f.is_finite()) {

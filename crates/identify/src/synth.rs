@@ -89,6 +89,24 @@ pub fn planted(id: EffectId) -> BTreeMap<String, f64> {
     }
 }
 
+/// How many times finer than the record the true model's inputs are sampled
+/// when a record is generated: the bench's inputs hold each sample linearly
+/// to the next, so LuGre's bristle sees the exact velocity to 1e-6 of it.
+pub const OVERSAMPLE: usize = 8;
+
+/// The true model's load-cell force on [`motion`] at `n` samples of `dt`:
+/// the bench's netlist ([`FrictionBench::simulate`]) driven by the exact
+/// motion sampled [`OVERSAMPLE`] times finer, read at the record's samples.
+pub fn true_force(truth: &FrictionBench, n: usize, dt: f64) -> Vec<f64> {
+    let k = OVERSAMPLE;
+    let fine = motion((n - 1) * k + 1, dt / k as f64);
+    let inputs = crate::bench::BenchInputs::of(&fine).expect("a generated motion is a valid input");
+    let f = truth
+        .simulate(&fine, &inputs)
+        .expect("the true bench simulates on its generated motion");
+    f.into_iter().step_by(k).collect()
+}
+
 /// The exact motion and pressure of a generated record: `n` samples at `dt`
 /// (position by trapezoidal integration of the velocity, zero mean).
 pub fn motion(n: usize, dt: f64) -> BenchSignals {
@@ -138,7 +156,7 @@ pub fn record(
     seed: u64,
 ) -> Record {
     let m = motion(n, dt);
-    let mut force = truth.simulate(&m);
+    let mut force = true_force(truth, n, dt);
     let x = m.x.clone();
     match foreign {
         Foreign::None => {}

@@ -286,6 +286,19 @@ pub trait Component {
 
     /// Called once before a run from a given state (reset counters, set modes).
     fn reset(&mut self, _t: f64, _x: &[f64], _w: &Wires) {}
+
+    /// Changes parameter `name` (its netlist name, `seal.k_pressure`) of the
+    /// built component to `value` (SI), for a caller that runs one circuit
+    /// many times with different parameters (a fit) without assembling it
+    /// again. A parameter the component cannot change in place (one that
+    /// changes its states or ports) is an error saying so; the default
+    /// refuses every parameter.
+    fn set_parameter(&mut self, name: &str, _value: f64) -> Result<(), String> {
+        Err(format!(
+            "`{name}` cannot be changed on the built `{}`: set it in the netlist and assemble again",
+            self.name()
+        ))
+    }
 }
 
 /// The assembled circuit: one ODE system over all component states, plus
@@ -456,6 +469,24 @@ impl Circuit {
     /// Index of the component named `name`.
     pub fn component_index(&self, name: &str) -> Option<usize> {
         self.comps.iter().position(|c| c.name() == name)
+    }
+
+    /// Sets parameter `path` (`<component>.<parameter>`, the netlist's
+    /// scheme) of the built circuit to `value` (SI) without assembling it
+    /// again ([`Component::set_parameter`]; errors name the path). The wire
+    /// table is evaluated afresh at the next call.
+    pub fn set_parameter(&mut self, path: &str, value: f64) -> Result<(), String> {
+        let (comp, name) = path
+            .split_once('.')
+            .ok_or_else(|| format!("`{path}` is not `<component>.<parameter>`"))?;
+        let i = self
+            .component_index(comp)
+            .ok_or_else(|| format!("`{path}`: no component `{comp}` in the circuit"))?;
+        self.comps[i]
+            .set_parameter(name, value)
+            .map_err(|why| format!("`{path}`: {why}"))?;
+        self.filled.borrow_mut().valid = false;
+        Ok(())
     }
 
     /// The state range of component `i`.

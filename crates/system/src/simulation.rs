@@ -31,6 +31,7 @@ use crate::circuit::Circuit;
 use crate::rig::{self, RigError};
 use crate::run::{run, Run, RunOptions, SimError};
 use crate::signal::Signal;
+use crate::wires::AnyWire;
 use hydrocyl_integrators::{solve, OdeSystem};
 use serde_json::Value;
 
@@ -110,6 +111,112 @@ impl Simulation {
             SimError::Build(b) => RigError::from(b),
             other => RigError::Sim(other.to_string()),
         })
+    }
+
+    /// Sets parameter `path` (`<component>.<parameter>`) of the assembled
+    /// circuit to `value` (SI) for the next runs, without assembling or
+    /// checking the netlist again ([`Circuit::set_parameter`]): what a fit
+    /// that runs one circuit many times does. A parameter the component
+    /// cannot change in place is an error naming the path.
+    pub fn set_parameter(&mut self, path: &str, value: f64) -> Result<(), RigError> {
+        self.circuit
+            .set_parameter(path, value)
+            .map_err(|why| RigError::Invalid {
+                path: path.to_string(),
+                why,
+            })
+    }
+
+    /// Replaces the initial state of the next runs (as
+    /// [`Simulation::initial_state`], on a simulation kept between runs).
+    pub fn set_initial_state(&mut self, x0: Vec<f64>) {
+        self.initial = x0;
+    }
+
+    /// Runs as [`Simulation::run`] but reads only `wires` (e.g. one probe's,
+    /// [`Circuit::find_wire`]) at every output time, from the states the
+    /// solver reached there: `out[k][i]` is wire `k` at `t_eval[i]`. For a
+    /// circuit without events (whose components have no modes that a later
+    /// time could have switched); one with events is an error.
+    pub fn run_wires(
+        &mut self,
+        t_eval: &[f64],
+        wires: &[AnyWire],
+    ) -> Result<Vec<Vec<f64>>, RigError> {
+        if self.circuit.n_events() > 0 {
+            return Err(RigError::Sim(
+                "run_wires: the circuit has events; read its probes from Simulation::run".into(),
+            ));
+        }
+        let channels = std::mem::replace(&mut self.options.channels, false);
+        let run = self.run(t_eval);
+        self.options.channels = channels;
+        let run = run?;
+        let mut out = vec![Vec::with_capacity(t_eval.len()); wires.len()];
+        let mut row = vec![0.0; wires.len()];
+        for (i, &t) in run.time.iter().enumerate() {
+            self.circuit.read_wires(t, run.state(i), wires, &mut row);
+            for (o, v) in out.iter_mut().zip(&row) {
+                o.push(*v);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Reads `wires` at every time of `t_eval` with the state held at the
+    /// initial state, integrating nothing: for outputs that no state reaches,
+    /// e.g. the load cell of a bench whose drive imposes the motion and whose
+    /// friction law is static (the only state, the drive's position, feeds no
+    /// force), which are then algebraic in the inputs. Checked at the first
+    /// time: moving each state by its scale must leave every wire unchanged,
+    /// else an error (integrate with [`Simulation::run_wires`]).
+    pub fn sample_state_free(
+        &mut self,
+        t_eval: &[f64],
+        wires: &[AnyWire],
+    ) -> Result<Vec<Vec<f64>>, RigError> {
+        let Some(&t0) = t_eval.first() else {
+            return Ok(vec![Vec::new(); wires.len()]);
+        };
+        let n = self.circuit.n_states();
+        if self.initial.len() != n || self.circuit.n_events() > 0 {
+            return Err(RigError::Sim(format!(
+                "sample_state_free: {} initial values for {n} states{}",
+                self.initial.len(),
+                if self.circuit.n_events() > 0 {
+                    ", and the circuit has events"
+                } else {
+                    ""
+                }
+            )));
+        }
+        let x0 = self.initial.clone();
+        self.circuit.reset(t0, &x0);
+        let mut at0 = vec![0.0; wires.len()];
+        self.circuit.read_wires(t0, &x0, wires, &mut at0);
+        let scales = self.circuit.atol(1.0);
+        let mut moved = vec![0.0; wires.len()];
+        for k in 0..n {
+            let mut x = x0.clone();
+            x[k] += scales[k].max(1e-6);
+            self.circuit.read_wires(t0, &x, wires, &mut moved);
+            if let Some(j) = (0..wires.len()).find(|&j| moved[j].to_bits() != at0[j].to_bits()) {
+                return Err(RigError::Sim(format!(
+                    "sample_state_free: `{}` depends on the state `{}`",
+                    self.circuit.wire_name(wires[j]),
+                    self.circuit.state_names()[k]
+                )));
+            }
+        }
+        let mut out = vec![Vec::with_capacity(t_eval.len()); wires.len()];
+        let mut row = vec![0.0; wires.len()];
+        for &t in t_eval {
+            self.circuit.read_wires(t, &x0, wires, &mut row);
+            for (o, v) in out.iter_mut().zip(&row) {
+                o.push(*v);
+            }
+        }
+        Ok(out)
     }
 
     /// Starts stepping at `t0` from the initial state (the circuit reset

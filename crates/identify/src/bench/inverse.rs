@@ -1,15 +1,18 @@
-//! The bench's inverse model: the predicted load-cell force of a
-//! [`FrictionBench`] on one record's motion and pressures (the force
-//! balance and friction law of the module's documentation), the bristle
-//! state integrated exactly over each sample step.
+//! The bench's force balance written out by hand, the bristle state
+//! stepped over each sample interval with the velocity held at the
+//! interval's mid value (z relaxes exponentially towards `g(v) sgn(v) / σ0`:
+//! an exponential midpoint step of the bristle ODE, second order in the
+//! sample interval).
 //!
-//! It is the same model as the bench's netlist ([`super::model`], run
-//! through `Simulation`): equal to 1e-9 of the force's range on every bench
-//! fixture for the static law; for LuGre it holds the velocity at each
-//! step's mid value where the netlist integrates the bristle ODE. The bench
-//! fit (`diagnose`) still runs on it: through `Simulation` the fit took
-//! 4.8× as long on the 12 s / 1 kHz record and the planted-LuGre test's σ0
-//! left its 95 % interval (issue 13's note).
+//! Two uses:
+//! * the tests' independent reference for the bench's netlist run
+//!   ([`super::BenchRun`]): equal to the closed form for a static law, and
+//!   to this discretisation's error with LuGre;
+//! * the fit's evaluator **for LuGre only** (`diagnose`'s bench loop): the
+//!   netlist run integrates the bristle with RK4 (or Rodas4 when stiff) at
+//!   20× to 100× this step's cost per evaluation (issue 13's note: EMPS
+//!   3.7 s → 487 s), so the bristle's fits stay here for now. A static law
+//!   is fitted on the netlist run.
 
 use super::{BenchSignals, FrictionBench};
 use crate::catalog::EffectId;
@@ -41,17 +44,15 @@ impl FrictionBench {
         }
     }
 
-    /// Simulates the bench on one record: the predicted load-cell force at
-    /// every sample. The bristle state starts from the value that explains
-    /// the first five samples' force (limited to the steady range).
-    pub fn simulate(&self, s: &BenchSignals) -> Vec<f64> {
+    /// The reference force on one record, the bristle from the record's
+    /// first forces.
+    pub(crate) fn reference(&self, s: &BenchSignals) -> Vec<f64> {
         self.simulate_from(s, false)
     }
 
-    /// Simulates the bench with the bristle deflection starting at zero (at
-    /// rest) instead of from the measured force: what `hydrocyl simulate`
-    /// does for a record that has no force to start from.
-    pub fn simulate_from_rest(&self, s: &BenchSignals) -> Vec<f64> {
+    /// The reference force with the bristle from rest.
+    #[cfg(test)]
+    pub(super) fn reference_from_rest(&self, s: &BenchSignals) -> Vec<f64> {
         self.simulate_from(s, true)
     }
 
@@ -188,12 +189,12 @@ mod tests {
         lug.insert("sigma1".to_string(), 50.0);
         r.friction.effects.insert(EffectId::LugreDynamics, lug);
         let s = signals(|_| 0.01, 500, 1e-3);
-        let f = r.simulate(&s);
+        let f = r.reference(&s);
         let expect = 5.0 - 3e5 * 4.9e-4;
         assert!((f[499] - expect).abs() < 1e-6, "{} vs {expect}", f[499]);
         // Static model gives the same steady value.
         r.friction.effects.clear();
-        let g = r.simulate(&s);
+        let g = r.reference(&s);
         assert!((g[499] - expect).abs() < 1e-6);
     }
 
@@ -211,7 +212,7 @@ mod tests {
         let dt = 1e-4;
         let v0 = 1e-4;
         let s = signals(|_| v0, 2000, dt);
-        let f = r.simulate(&s);
+        let f = r.reference(&s);
         for i in [10, 100, 400, 1999] {
             let x = v0 * dt * i as f64;
             let closed = 5.0 * (1.0 - (-1e6 * x / 5.0).exp());
@@ -266,7 +267,7 @@ mod tests {
                 a,
                 t,
             };
-            let model = bench.simulate_from_rest(&s);
+            let model = bench.reference_from_rest(&s);
             let scale = model.iter().fold(0.0f64, |m, f| m.max(f.abs()));
             let worst = f
                 .iter()

@@ -27,9 +27,11 @@
 //!   `(dFc/2) |tanh(v/v_t)|` (extending level `Fc + dFc/2`, retracting
 //!   `Fc − dFc/2`) and `external_force` `F0`.
 //!
-//! The bristle state is integrated exactly over each sample step with the
-//! velocity held at the step's mid value (z relaxes exponentially towards
-//! `g(v) sgn(v) / σ0`), so σ0 of 1e7 N/m at 100 Hz is no stiffness problem.
+//! The bench runs as its netlist ([`hydrocyl_system::netlist::migrate::bench`])
+//! through the one run path ([`BenchRun`]): the record's velocity,
+//! acceleration and pressures are the netlist's inputs (first-order hold
+//! between samples), the load cell its output; the bristle ODE is
+//! integrated by the run's solver.
 
 use std::collections::BTreeMap;
 
@@ -38,6 +40,7 @@ use thiserror::Error;
 
 use crate::catalog::{Balance, EffectId};
 use crate::data::ColumnMap;
+use hydrocyl_system::netlist::migrate::bench as net;
 
 /// Effects a friction bench can carry (the force balance's).
 pub const BENCH_EFFECTS: [EffectId; 7] = [
@@ -144,8 +147,13 @@ pub enum ParamRef {
 }
 
 impl ParamRef {
-    /// Parses `Fc`, `m` or `effect.param`.
+    /// Parses a netlist path of the bench (`friction.coulomb`,
+    /// `drive.mass`, `friction.viscous`: [`ParamRef::path`]) or the catalog
+    /// name `Fc`, `m` or `effect.param` (`viscous.b`) of older rig files.
     pub fn parse(s: &str) -> Option<ParamRef> {
+        if let Some(p) = ParamRef::from_path(s) {
+            return Some(p);
+        }
         match s {
             "Fc" => Some(ParamRef::Coulomb),
             "m" => Some(ParamRef::Mass),
@@ -155,6 +163,41 @@ impl ParamRef {
                 id.params().iter().find(|q| q.name == p)?;
                 Some(ParamRef::Effect(id, p.to_string()))
             }
+        }
+    }
+
+    /// Its path in the bench's netlist (`<component>.<parameter>`, the one
+    /// parameter scheme): `friction.coulomb`, `drive.mass`, and each catalog
+    /// effect's parameter under the `friction_bench` name the migration's
+    /// table gives it ([`net::EFFECT_PARAMS`]: `viscous.b` is
+    /// `friction.viscous`).
+    pub fn path(&self) -> String {
+        match self {
+            ParamRef::Coulomb => format!("{}.coulomb", net::FRICTION),
+            ParamRef::Mass => format!("{}.mass", net::DRIVE),
+            ParamRef::Effect(id, p) => {
+                let target = net::EFFECT_PARAMS
+                    .iter()
+                    .find(|(e, q, _)| *e == id.id() && q == p)
+                    .map(|(_, _, t)| *t)
+                    .expect("every bench effect parameter is in the migration's table");
+                format!("{}.{target}", net::FRICTION)
+            }
+        }
+    }
+
+    /// The parameter at a netlist path of the bench ([`ParamRef::path`]'s
+    /// inverse), or `None`.
+    pub fn from_path(path: &str) -> Option<ParamRef> {
+        let (comp, name) = path.split_once('.')?;
+        match (comp, name) {
+            (net::DRIVE, "mass") => Some(ParamRef::Mass),
+            (net::FRICTION, "coulomb") => Some(ParamRef::Coulomb),
+            (net::FRICTION, target) => net::EFFECT_PARAMS
+                .iter()
+                .find(|(_, _, t)| *t == target)
+                .and_then(|(e, p, _)| Some(ParamRef::Effect(EffectId::from_id(e)?, p.to_string()))),
+            _ => None,
         }
     }
 
@@ -256,7 +299,9 @@ impl FrictionBench {
         for r in &self.refit {
             let p = ParamRef::parse(r).ok_or_else(|| RigError::Parameter {
                 place: "refit".into(),
-                reason: format!("'{r}' is not Fc, m or effect.param"),
+                reason: format!(
+                    "'{r}' is not a bench parameter (`friction.coulomb`, `drive.mass`, `friction.<parameter>`, or Fc, m, effect.param)"
+                ),
             })?;
             if let ParamRef::Effect(id, _) = &p {
                 if !self.friction.effects.contains_key(id) {
@@ -351,7 +396,7 @@ mod model;
 mod presets;
 mod signals;
 
-pub use model::{run_options, BenchInputs};
+pub use model::{run_options, BenchInputs, BenchRun};
 pub use presets::{preset, PRESETS};
 pub use signals::{bench_signals, BenchSignals};
 
@@ -377,5 +422,33 @@ mod tests {
         assert!(e.contains("does not have"), "{e}");
         let e = FrictionBench::from_json(&ok.replace(r#""mass":1"#, r#""mass":-1"#)).unwrap_err();
         assert!(e.contains("mass"), "{e}");
+    }
+
+    /// Every fitted parameter has a netlist path of the bench's circuit (one
+    /// of `rig::parameters` of its netlist), and the path reads back as the
+    /// same parameter; the catalog names of older files still parse.
+    #[test]
+    fn fit_targets_are_netlist_paths() {
+        let mut all = crate::synth::base_rig();
+        for id in BENCH_EFFECTS {
+            all.friction.effects.insert(id, crate::synth::planted(id));
+        }
+        let paths: Vec<String> = hydrocyl_system::netlist::parameters(&all.netlist().unwrap())
+            .unwrap()
+            .into_iter()
+            .map(|p| p.path)
+            .collect();
+        let params = all.all_params();
+        assert_eq!(params.len(), 2 + 10);
+        for p in params {
+            assert!(paths.contains(&p.path()), "{} not in {paths:?}", p.path());
+            assert_eq!(ParamRef::parse(&p.path()), Some(p.clone()));
+            assert_eq!(ParamRef::parse(&p.label()), Some(p));
+        }
+        assert_eq!(
+            ParamRef::parse("friction.viscous"),
+            ParamRef::parse("viscous.b")
+        );
+        assert_eq!(ParamRef::parse("friction.warp"), None);
     }
 }

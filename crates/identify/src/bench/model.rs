@@ -10,19 +10,43 @@ use hydrocyl_system::netlist::{self, migrate::bench as net};
 use hydrocyl_system::run::RunOptions;
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::simulation::Simulation;
+use hydrocyl_system::AnyWire;
 
-/// The solver options of a bench run: DP45. A static law's force is
-/// algebraic in the inputs and needs no tolerance (the default's 1e-6 only
-/// steers the position state); LuGre's bristle state is integrated at 1e-10,
-/// so that the force's dependence on σ0, σ1 is smooth to well below the
-/// finite-difference steps of the fit (at 1e-6 the step-size choices show
-/// through and the fit of σ0 stalls).
-pub fn run_options(lugre: bool) -> RunOptions {
-    let mut o = RunOptions::dp45();
-    if lugre {
-        o.rtol = 1e-10;
+/// The solver options of a bench run with LuGre's bristle on a record whose
+/// largest sample interval is `h` \[s\], `rate = σ0 max|v| / min g` the
+/// bristle's fastest relaxation rate on the record \[1/s\]:
+///
+/// * fixed-step RK4 at `h / m`, `m` the least whole number with
+///   `rate h / m <= 1`, while `m <= 8`: the fit differences the force with
+///   respect to σ0 and σ1, so the force must be smooth in them, which an
+///   adaptive step's choices are not (DP45 at rtol 1e-6 gives a σ0
+///   derivative wrong by 1000× its size; at rtol 1e-10 it is smooth but 7×
+///   the cost of RK4 at the record's step). At `rate h / m <= 1` RK4 is well
+///   inside its stability bound (2.78);
+/// * stiffer (a bristle relaxing in under an eighth of a sample interval),
+///   the L-stable Rodas4 at rtol 1e-8 with steps of at most `h`, whose cost
+///   does not grow with σ0.
+///
+/// On the planted-LuGre fixture (500 Hz) the RK4 force is within 2e-2 N of
+/// DP45 at rtol 1e-12 (the noise is 0.5 N) and its σ0 derivative within 1 %
+/// (`solver_choice_on_the_lugre_fixture`).
+pub fn run_options(rate: f64, h: f64) -> RunOptions {
+    use hydrocyl_system::run::Solver;
+    let m = (rate * h).ceil().max(1.0);
+    if m <= 8.0 {
+        RunOptions {
+            solver: Solver::Rk4,
+            rk4_step: h / m,
+            ..RunOptions::default()
+        }
+    } else {
+        RunOptions {
+            solver: Solver::Rosenbrock,
+            rtol: 1e-8,
+            h_max: h,
+            ..RunOptions::default()
+        }
     }
-    o
 }
 
 /// One record's inputs to the bench netlist, built once per record and
@@ -30,6 +54,8 @@ pub fn run_options(lugre: bool) -> RunOptions {
 #[derive(Clone, Debug)]
 pub struct BenchInputs {
     signals: Vec<(String, Signal)>,
+    v_max: f64,
+    h_max: f64,
 }
 
 impl BenchInputs {
@@ -43,7 +69,11 @@ impl BenchInputs {
             .map(|n| n.to_string())
             .zip([table(&s.v)?, table(&s.a)?, table(&s.p1)?, table(&s.p2)?])
             .collect();
-        Ok(BenchInputs { signals })
+        Ok(BenchInputs {
+            signals,
+            v_max: s.v.iter().fold(0.0, |m, v| m.max(v.abs())),
+            h_max: s.t.windows(2).fold(0.0, |m, w| m.max(w[1] - w[0])),
+        })
     }
 }
 
@@ -55,25 +85,23 @@ impl FrictionBench {
     }
 
     /// Simulates the bench on one record: the predicted load-cell force at
-    /// every sample. The bristle state starts from the value that explains
-    /// the first five samples' force (limited to the steady range).
-    pub fn simulate_netlist(
-        &self,
-        s: &BenchSignals,
-        inputs: &BenchInputs,
-    ) -> Result<Vec<f64>, String> {
-        self.run(s, inputs, false)
+    /// every sample, the bench's netlist assembled for this call
+    /// ([`BenchRun`]; a fit keeps one and reuses it). The bristle state
+    /// starts from the value that explains the first five samples' force
+    /// (limited to the steady range).
+    pub fn simulate(&self, s: &BenchSignals, inputs: &BenchInputs) -> Result<Vec<f64>, String> {
+        BenchRun::new(self, inputs)?.force(self, s, false)
     }
 
     /// Simulates the bench with the bristle deflection starting at zero (at
     /// rest) instead of from the measured force: what `hydrocyl simulate`
     /// does for a record that has no force to start from.
-    pub fn simulate_netlist_from_rest(
+    pub fn simulate_from_rest(
         &self,
         s: &BenchSignals,
         inputs: &BenchInputs,
     ) -> Result<Vec<f64>, String> {
-        self.run(s, inputs, true)
+        BenchRun::new(self, inputs)?.force(self, s, true)
     }
 
     /// The bristle deflection that explains the mean friction of the first
@@ -112,27 +140,116 @@ impl FrictionBench {
         }
     }
 
-    fn run(
-        &self,
-        s: &BenchSignals,
-        inputs: &BenchInputs,
-        at_rest: bool,
-    ) -> Result<Vec<f64>, String> {
-        let mut v = self.netlist()?;
-        if !at_rest && self.has(EffectId::LugreDynamics) {
-            v["components"][net::FRICTION]["initial"] =
-                serde_json::json!({ "z": self.initial_z(s) });
-        }
+    /// The fitted parameters as netlist paths and values: `friction.coulomb`,
+    /// `drive.mass` and every parameter of each effect that is on
+    /// ([`ParamRef::path`]).
+    fn path_values(&self) -> impl Iterator<Item = (String, f64)> + '_ {
+        self.all_params()
+            .into_iter()
+            .map(|p| (p.path(), self.get(&p)))
+    }
+}
+
+/// The bench's netlist assembled once on one record's inputs and run as
+/// often as wanted with the parameters of a [`FrictionBench`] set on the
+/// built circuit by their netlist paths (no reassembly): the one run path
+/// ([`Simulation`]) as a fit uses it.
+///
+/// * A static law has no state the force depends on (the drive's position
+///   feeds no force): the load cell is read at the sample times with no
+///   integration ([`Simulation::sample_state_free`], which checks that).
+/// * LuGre's bristle is integrated ([`Simulation::run_wires`], reading only
+///   the load cell) with [`run_options`] (fixed-step RK4 at the record's step or a fraction of it).
+///
+/// When the effects switched on change (a bristle or a Stribeck hump added
+/// or removed), the circuit is assembled again.
+pub struct BenchRun {
+    inputs: BenchInputs,
+    /// The record's largest |v| \[m/s\] and largest sample interval \[s\].
+    v_max: f64,
+    h_max: f64,
+    effects: Vec<EffectId>,
+    sim: Simulation,
+    force: AnyWire,
+    z: Option<usize>,
+}
+
+impl BenchRun {
+    /// Assembles `bench`'s netlist on `inputs`.
+    pub fn new(bench: &FrictionBench, inputs: &BenchInputs) -> Result<Self, String> {
+        let v = bench.netlist()?;
         let schematic = netlist::schematic(&v).map_err(|e| e.to_string())?;
         let circuit =
             netlist::assemble_inputs(&schematic, &inputs.signals).map_err(|e| e.to_string())?;
-        let run = Simulation::of_circuit(circuit)
-            .options(run_options(self.has(EffectId::LugreDynamics)))
-            .run(&s.t)
-            .map_err(|e| format!("{}: {e}", s.source))?;
-        run.channel("force")
-            .map(<[f64]>::to_vec)
-            .ok_or_else(|| "the bench netlist has no `force` output".into())
+        let force = circuit
+            .probes()
+            .into_iter()
+            .find(|p| p.name == "force")
+            .ok_or("the bench netlist has no `force` output")?
+            .wire;
+        let z = circuit
+            .state_names()
+            .iter()
+            .position(|n| *n == format!("{}.z", net::FRICTION));
+        Ok(BenchRun {
+            inputs: inputs.clone(),
+            v_max: inputs.v_max,
+            h_max: inputs.h_max,
+            effects: bench.friction.effects.keys().copied().collect(),
+            sim: Simulation::of_circuit(circuit),
+            force,
+            z,
+        })
+    }
+
+    /// The predicted load-cell force of `bench` on record `s` (whose inputs
+    /// this run was built on), the bristle from rest when `at_rest`, else
+    /// from the record's first forces.
+    pub fn force(
+        &mut self,
+        bench: &FrictionBench,
+        s: &BenchSignals,
+        at_rest: bool,
+    ) -> Result<Vec<f64>, String> {
+        if !bench
+            .friction
+            .effects
+            .keys()
+            .copied()
+            .eq(self.effects.iter().copied())
+        {
+            *self = BenchRun::new(bench, &self.inputs)?;
+        }
+        for (path, value) in bench.path_values() {
+            self.sim
+                .set_parameter(&path, value)
+                .map_err(|e| e.to_string())?;
+        }
+        let err = |e: hydrocyl_system::rig::RigError| format!("{}: {e}", s.source);
+        let mut out = match self.z {
+            Some(k) => {
+                let mut x0 = self.sim.circuit().initial_state();
+                x0[k] = if at_rest { 0.0 } else { bench.initial_z(s) };
+                self.sim.set_initial_state(x0);
+                let s0 = bench.eff(EffectId::LugreDynamics, "sigma0");
+                let g_min = match bench.has(EffectId::Stribeck) {
+                    true => bench
+                        .friction
+                        .coulomb
+                        .min(bench.eff(EffectId::Stribeck, "Fs")),
+                    false => bench.friction.coulomb,
+                }
+                .max(1e-9);
+                self.sim
+                    .set_options(run_options(s0 * self.v_max / g_min, self.h_max));
+                self.sim.run_wires(&s.t, &[self.force]).map_err(err)?
+            }
+            None => self
+                .sim
+                .sample_state_free(&s.t, &[self.force])
+                .map_err(err)?,
+        };
+        Ok(out.swap_remove(0))
     }
 }
 
@@ -187,8 +304,8 @@ mod tests {
                 all.set(&super::super::ParamRef::Effect(id, p.into()), v);
             }
             for (r, tol) in [(&rig, 1e-9), (&all, 1e-9)] {
-                let new = r.simulate_netlist(&s, &inputs).unwrap();
-                let old = r.simulate(&s);
+                let new = r.simulate(&s, &inputs).unwrap();
+                let old = r.reference(&s);
                 let scale = old.iter().fold(0.0f64, |m, f| m.max(f.abs()));
                 let worst = new
                     .iter()
@@ -205,8 +322,8 @@ mod tests {
                         v,
                     );
                 }
-                let new = lugre.simulate_netlist(&s, &inputs).unwrap();
-                let old = lugre.simulate(&s);
+                let new = lugre.simulate(&s, &inputs).unwrap();
+                let old = lugre.reference(&s);
                 let scale = old.iter().fold(0.0f64, |m, f| m.max(f.abs()));
                 let rms = (new
                     .iter()
@@ -223,5 +340,73 @@ mod tests {
             seen += 1;
         }
         assert!(seen >= 11, "{seen} bench fixtures");
+    }
+}
+
+#[cfg(test)]
+mod solver_choice {
+    use super::*;
+    use crate::bench::ParamRef;
+    use crate::data::Record;
+
+    /// The bench's LuGre run ([`run_options`]) on the planted-LuGre
+    /// fixture's record (500 Hz, σ0 = 2e5, σ1 = 600): its force is within
+    /// 2e-2 N of DP45 at rtol 1e-12 (the record's noise is 0.5 N), and the
+    /// force's change for a 1e-6 relative step in σ0 (what the fit
+    /// differences) is the reference's to 1 %.
+    #[test]
+    fn solver_choice_on_the_lugre_fixture() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/measured");
+        let text = std::fs::read_to_string(dir.join("bench-none.rig.json")).unwrap();
+        let mut rig = FrictionBench::from_json(&text).unwrap();
+        let s0 = ParamRef::Effect(EffectId::LugreDynamics, "sigma0".into());
+        rig.set(&s0, 2e5);
+        rig.set(
+            &ParamRef::Effect(EffectId::LugreDynamics, "sigma1".into()),
+            600.0,
+        );
+        let rec = Record::read_mapped(&dir.join("bench-lugre_dynamics.csv"), &rig.columns).unwrap();
+        let (s, _) = super::super::bench_signals(&rec, None, false).unwrap();
+        let inputs = BenchInputs::of(&s).unwrap();
+        let mut stepped = rig.clone();
+        stepped.set(&s0, 2e5 * (1.0 + 1e-6));
+        let mut run = BenchRun::new(&rig, &inputs).unwrap();
+        let (f, g) = (
+            run.force(&rig, &s, false).unwrap(),
+            run.force(&stepped, &s, false).unwrap(),
+        );
+        // the reference: DP45 at rtol 1e-12 on the same circuit
+        let reference = |r: &FrictionBench| {
+            let mut net = BenchRun::new(r, &inputs).unwrap();
+            let mut x0 = net.sim.circuit().initial_state();
+            x0[net.z.unwrap()] = r.initial_z(&s);
+            net.sim.set_initial_state(x0);
+            let mut o = RunOptions::dp45();
+            o.rtol = 1e-12;
+            net.sim.set_options(o);
+            net.sim
+                .run_wires(&s.t, &[net.force])
+                .unwrap()
+                .swap_remove(0)
+        };
+        let (fr, gr) = (reference(&rig), reference(&stepped));
+        let worst = f
+            .iter()
+            .zip(&fr)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 2e-2, "force off the reference by {worst} N");
+        let d: Vec<f64> = g.iter().zip(&f).map(|(a, b)| a - b).collect();
+        let dr: Vec<f64> = gr.iter().zip(&fr).map(|(a, b)| a - b).collect();
+        let scale = dr.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let derr = d
+            .iter()
+            .zip(&dr)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            scale > 0.0 && derr < 1e-2 * scale,
+            "σ0 step: {derr} of {scale}"
+        );
     }
 }

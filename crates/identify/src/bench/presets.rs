@@ -29,7 +29,7 @@ const TUDELFT_COLUMNS: &[(Signal, &str)] = &[
     (Signal::P2, "pressure_bar_gauge [bar]"),
     (Signal::Force, "force_N [N]"),
 ];
-const TUDELFT_REFIT: &[&str] = &["Fc", "lugre_dynamics.sigma0", "viscous.b"];
+const TUDELFT_REFIT: &[&str] = &["friction.coulomb", "friction.sigma0", "friction.viscous"];
 
 const IDENTIFICATION: [Identification; 3] = [
     Identification {
@@ -51,7 +51,7 @@ const IDENTIFICATION: [Identification; 3] = [
             (Signal::Position, "qm_motor_position_m"),
             (Signal::Force, "force_N(=gtau*vir)"),
         ],
-        refit: &["Fc", "m", "viscous.b"],
+        refit: &["friction.coulomb", "drive.mass", "friction.viscous"],
         smoothing_velocity: 1e-3,
     },
 ];
@@ -295,7 +295,10 @@ mod tests {
                     (EffectId::Viscous, &[("b", 0.0)]),
                 ])
             );
-            assert_eq!(r.refit, ["Fc", "lugre_dynamics.sigma0", "viscous.b"]);
+            assert_eq!(
+                r.refit,
+                ["friction.coulomb", "friction.sigma0", "friction.viscous"]
+            );
             assert_eq!(r.columns.0[&Signal::Time], "time_ms [ms]");
         }
         let r = preset("emps").unwrap();
@@ -311,7 +314,10 @@ mod tests {
             r.friction.effects,
             effects(&[(EffectId::Viscous, &[("b", 100.0)])])
         );
-        assert_eq!(r.refit, ["Fc", "m", "viscous.b"]);
+        assert_eq!(
+            r.refit,
+            ["friction.coulomb", "drive.mass", "friction.viscous"]
+        );
         assert!(preset("leaney-moog").is_none());
     }
 }

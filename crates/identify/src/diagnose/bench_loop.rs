@@ -3,6 +3,7 @@
 //! probes (delay, spring).
 
 use super::*;
+use crate::bench::{BenchInputs, BenchRun};
 
 /// Which samples a residual uses.
 #[derive(Clone, Copy, PartialEq)]
@@ -15,9 +16,49 @@ pub(super) enum Part {
 pub(super) struct Bench<'a> {
     sigs: &'a [BenchSignals],
     holdout: f64,
+    /// One assembled bench netlist per record, run again with each
+    /// parameter set ([`BenchRun`]).
+    runs: Vec<std::cell::RefCell<BenchRun>>,
 }
 
-impl Bench<'_> {
+impl<'a> Bench<'a> {
+    fn new(rig: &FrictionBench, sigs: &'a [BenchSignals], holdout: f64) -> Result<Self, String> {
+        let runs = sigs
+            .iter()
+            .map(|s| {
+                let inputs = BenchInputs::of(s)?;
+                BenchRun::new(rig, &inputs).map(std::cell::RefCell::new)
+            })
+            .collect::<Result<_, String>>()?;
+        Ok(Bench {
+            sigs,
+            holdout,
+            runs,
+        })
+    }
+
+    /// The predicted force of `rig` on record `k` (a failed simulation is
+    /// a force of NaN everywhere: the fit's step is then refused).
+    fn simulate(&self, rig: &FrictionBench, k: usize) -> Vec<f64> {
+        let s = &self.sigs[k];
+        if rig.has(EffectId::LugreDynamics) {
+            // the bristle's fits stay on the exponential-midpoint evaluator
+            // (bench::inverse's documentation says why)
+            return rig.reference(s);
+        }
+        self.runs[k]
+            .borrow_mut()
+            .force(rig, s, false)
+            .unwrap_or_else(|_| vec![f64::NAN; s.t.len()])
+    }
+
+    /// The predicted force of `rig` on every record.
+    fn simulate_all(&self, rig: &FrictionBench) -> Vec<Vec<f64>> {
+        (0..self.sigs.len())
+            .map(|k| self.simulate(rig, k))
+            .collect()
+    }
+
     fn range(&self, s: &BenchSignals, part: Part) -> std::ops::Range<usize> {
         let n = s.t.len();
         let cut = ((1.0 - self.holdout) * n as f64) as usize;
@@ -30,8 +71,8 @@ impl Bench<'_> {
 
     fn residual(&self, rig: &FrictionBench, part: Part, out: &mut Vec<f64>) {
         out.clear();
-        for s in self.sigs {
-            let sim = rig.simulate(s);
+        for (k, s) in self.sigs.iter().enumerate() {
+            let sim = self.simulate(rig, k);
             for i in self.range(s, part) {
                 out.push(s.force[i] - sim[i]);
             }
@@ -187,8 +228,9 @@ pub(super) fn initial_guess(
 /// Out-of-catalog probes on the current model: a time shift of the measured
 /// force (transport delay, up to ±40 samples) and a force proportional to
 /// the position (a spring the catalog lacks).
-pub(super) fn probes(rig: &FrictionBench, sigs: &[BenchSignals]) -> Vec<Probe> {
-    let sims: Vec<Vec<f64>> = sigs.iter().map(|s| rig.simulate(s)).collect();
+pub(super) fn probes(rig: &FrictionBench, b: &Bench<'_>) -> Vec<Probe> {
+    let sigs = b.sigs;
+    let sims = b.simulate_all(rig);
     let rss0: f64 = sigs
         .iter()
         .zip(&sims)
@@ -278,13 +320,9 @@ pub fn diagnose_bench(
         smoother.get_or_insert(info);
         sigs.push(s);
     }
-    let b = Bench {
-        sigs: &sigs,
-        holdout: opts.holdout,
-    };
+    let b = Bench::new(rig, &sigs, opts.holdout).map_err(DiagnoseError::Rig)?;
     let measured: Vec<f64> = sigs.iter().flat_map(|s| s.force.iter().copied()).collect();
-    let sim_all =
-        |rig: &FrictionBench| -> Vec<f64> { sigs.iter().flat_map(|s| rig.simulate(s)).collect() };
+    let sim_all = |rig: &FrictionBench| -> Vec<f64> { b.simulate_all(rig).concat() };
     let channel = |rig: &FrictionBench| -> BTreeMap<String, f64> {
         let mut m = BTreeMap::new();
         m.insert("force".to_string(), nrmse(&measured, &sim_all(rig)));
@@ -404,7 +442,7 @@ pub fn diagnose_bench(
         let probe = if rig.steady_state {
             Vec::new()
         } else {
-            probes(&model, &sigs)
+            probes(&model, &b)
         }
         .into_iter()
         .max_by(|a, b| a.explained_share.total_cmp(&b.explained_share));
@@ -513,9 +551,11 @@ pub fn diagnose_bench(
         "force".to_string(),
         (noise_ss / measured.len() as f64).sqrt() / range,
     );
+    let (before_f, after_f) = (b.simulate_all(&before), b.simulate_all(&model));
     let traces = sigs
         .iter()
-        .map(|s| {
+        .zip(before_f.into_iter().zip(after_f))
+        .map(|(s, (before_f, after_f))| {
             // Show friction (the force minus the pressure force), not the
             // pressure-dominated load-cell force.
             let pf: Vec<f64> = (0..s.t.len())
@@ -529,8 +569,8 @@ pub fn diagnose_bench(
                 velocity: s.v.clone(),
                 channel: "friction".into(),
                 measured: minus(s.force.clone()),
-                before: minus(before.simulate(s)),
-                after: minus(model.simulate(s)),
+                before: minus(before_f),
+                after: minus(after_f),
                 regressor: first_added.map(|id| {
                     let vt = model.friction.smoothing_velocity;
                     let k = model.get(&ParamRef::Effect(EffectId::PressureViscous, "K".into()));

@@ -354,6 +354,25 @@ pub fn lookup(name: &str) -> Option<&'static ComponentType> {
     types().iter().find(|t| t.name == name)
 }
 
+/// Checks `value` for parameter `param` of component type `ty` against the
+/// parameter's declared range (what a built component's
+/// [`Component::set_parameter`]
+/// accepts); the error says the range and unit.
+pub fn check_param(ty: &str, param: &str, value: f64) -> Result<(), String> {
+    let spec = lookup(ty)
+        .and_then(|t| t.params.iter().find(|p| p.name == param))
+        .ok_or_else(|| format!("`{ty}` has no parameter `{param}`"))?;
+    if spec.range.contains(value) {
+        Ok(())
+    } else {
+        Err(format!(
+            "{value} is outside {} [{}]",
+            spec.range.describe(),
+            spec.unit
+        ))
+    }
+}
+
 /// The catalog as Markdown (the docs table and `hydrocyl components`):
 /// one section per type with its ports, parameters and states.
 pub fn catalog_markdown() -> String {

@@ -10,7 +10,9 @@
 //! force pushes. This is the inverse model of the robotics IDIM practice: for
 //! a bench whose drive imposes the motion it is the well-posed simulation.
 
-use super::super::registry::{param, ComponentType, Default::*, Range, Role, StateSpec};
+use super::super::registry::{
+    check_param, param, ComponentType, Default::*, Range, Role, StateSpec,
+};
 use super::{built, port, HYD, MECH, SIG};
 use crate::circuit::{
     BuildError, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe, Wire, Wires,
@@ -107,6 +109,16 @@ impl Component for ImposedMotion {
         p.storage = (self.mass + w.get(self.rod.added_mass).si()) * v * a;
         p.stored = 0.5 * self.mass * v * v;
     }
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), String> {
+        check_param("imposed_motion", name, value)?;
+        match name {
+            "mass" => self.mass = value,
+            "force_sign" if value == 1.0 || value == -1.0 => self.force_sign = value,
+            "force_sign" => return Err(format!("force_sign must be 1 or -1, got {value}")),
+            _ => unreachable!("check_param knows imposed_motion's parameters"),
+        }
+        Ok(())
+    }
     fn probes(&self) -> Vec<Probe> {
         vec![
             Probe::of("position", self.rod.position),
@@ -162,6 +174,14 @@ impl Component for Piston {
     }
     fn power(&self, _t: f64, _x: &[f64], _w: &Wires, _dx: &[f64], _p: &mut PowerTerms) {
         // lossless: the hydraulic power in is the mechanical power out
+    }
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), String> {
+        check_param("piston", name, value)?;
+        match name {
+            "area_1" => self.area_1 = value,
+            _ => self.area_2 = value,
+        }
+        Ok(())
     }
     fn probes(&self) -> Vec<Probe> {
         vec![Probe::of(format!("{}_force", self.name), self.force)]

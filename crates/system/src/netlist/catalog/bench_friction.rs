@@ -15,7 +15,9 @@
 //! `signal_pressure_source` holds a node at the pressure a signal gives (a
 //! bench record's measured chamber pressure, fed by a `command_input`).
 
-use super::super::registry::{param, ComponentType, Default::*, ParamSpec, Range, Role, StateSpec};
+use super::super::registry::{
+    check_param, param, ComponentType, Default::*, ParamSpec, Range, Role, StateSpec,
+};
 use super::{built, port, HYD, MECH, SIG};
 use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe,
@@ -94,6 +96,9 @@ pub struct BenchFriction {
     chambers: Option<(String, String)>,
     /// The law.
     pub law: BenchLaw,
+    /// Stribeck velocity and exponent, and σ1, kept while the hump or the
+    /// bristle is off (so that a parameter set on the built law keeps them).
+    shape: (f64, f64, f64),
     initial_z: f64,
     rod: MechanicalNode,
     p: Option<(Wire<Pressure>, Wire<Pressure>)>,
@@ -134,8 +139,15 @@ impl Component for BenchFriction {
             .map(|_| format!("{}.z", self.name))
             .collect()
     }
+    /// The bristle's scale is its steady deflection `Fc / σ0` (at least
+    /// 1e-12 m): the force σ0 z is then held to the tolerance of the force.
     fn state_scales(&self, s: &mut [f64]) {
-        s.fill(1.0e-4);
+        let s0 = self.law.lugre.map_or(0.0, |(s0, _)| s0);
+        s.fill(if s0 > 0.0 {
+            (self.law.coulomb.max(1e-3) / s0).max(1e-12)
+        } else {
+            1.0e-4
+        });
     }
     fn initial_state(&self, x: &mut [f64]) {
         x.fill(self.initial_z);
@@ -171,6 +183,54 @@ impl Component for BenchFriction {
     }
     fn probes(&self) -> Vec<Probe> {
         vec![Probe::of(format!("{}_force", self.name), self.force)]
+    }
+    /// Every parameter but a change of `sigma0` between 0 and > 0 (that
+    /// adds or removes the bristle state) and a seal gain `K > 0` without
+    /// the chamber ports; `stiction` switches the Stribeck hump on.
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), String> {
+        check_param("friction_bench", name, value)?;
+        let l = &mut self.law;
+        match name {
+            "coulomb" => l.coulomb = value,
+            "smoothing_velocity" => l.smoothing_velocity = value,
+            "viscous" => l.viscous = value,
+            "asymmetry" => l.asymmetry = value,
+            "external_force" => l.external_force = value,
+            "seal.h_acceleration" => l.h_acceleration = value,
+            "seal.k_pressure" if value > 0.0 && self.chambers.is_none() => {
+                return Err("the seal term needs the chamber ports `A` and `B` connected".into())
+            }
+            "seal.k_pressure" => l.k_pressure = value,
+            "stiction" => l.stribeck = Some((value, self.shape.0, self.shape.1)),
+            "stribeck_velocity" | "stribeck_exponent" => {
+                if name == "stribeck_velocity" {
+                    self.shape.0 = value;
+                } else {
+                    self.shape.1 = value;
+                }
+                if let Some((fs, _, _)) = l.stribeck {
+                    l.stribeck = Some((fs, self.shape.0, self.shape.1));
+                }
+            }
+            "sigma1" => {
+                self.shape.2 = value;
+                if let Some((s0, _)) = l.lugre {
+                    l.lugre = Some((s0, value));
+                }
+            }
+            "sigma0" => match (l.lugre, value > 0.0) {
+                (Some(_), true) => l.lugre = Some((value, self.shape.2)),
+                (None, false) => {}
+                _ => {
+                    return Err(
+                        "switching the bristle (sigma0 between 0 and > 0) changes the states: assemble again"
+                            .into(),
+                    )
+                }
+            },
+            _ => unreachable!("check_param knows friction_bench's parameters"),
+        }
+        Ok(())
     }
 }
 
@@ -346,6 +406,11 @@ pub const TYPES: &[ComponentType] = &[
                 rod_name: i.node("rod").into(),
                 chambers,
                 law,
+                shape: (
+                    i.get("stribeck_velocity"),
+                    i.get("stribeck_exponent"),
+                    i.get("sigma1"),
+                ),
                 initial_z: i.initial("z").unwrap_or(0.0),
                 rod: MechanicalNode::UNBOUND,
                 p: None,
@@ -493,6 +558,110 @@ mod tests {
             let closed = 5.0 * (1.0 - (-1e5 * (x0 + v0 * tk) / 5.0).exp());
             assert!((f[k] - closed).abs() < 1e-7, "t {tk}: {} vs {closed}", f[k]);
         }
+    }
+
+    /// Parameters set on the built circuit by path give what a circuit
+    /// assembled with them gives (static law: sampled without integration,
+    /// equal to the integrated run; LuGre: integrated, `run_wires`), and
+    /// what cannot change in place is refused by path.
+    #[test]
+    fn parameters_set_on_a_built_circuit_equal_a_new_assembly() {
+        let law =
+            json!({ "coulomb": 20.0, "smoothing_velocity": 1e-3, "sigma0": 1e5, "sigma1": 50.0 });
+        let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-3).collect();
+        let vel: Vec<f64> = t.iter().map(|&t| 0.03 * (9.0 * t).sin()).collect();
+        let sig = || {
+            let c = |x: f64| Signal::Constant { value: x };
+            [
+                Signal::table(t.clone(), vel.clone()).unwrap(),
+                c(0.2),
+                c(4e5),
+                c(1e5),
+            ]
+        };
+        let build = |law: &Value| {
+            let s = schematic(&bench(law.clone())).unwrap();
+            let names = ["drive", "acc", "p1", "p2"];
+            let inputs: Vec<_> = names.iter().map(|n| n.to_string()).zip(sig()).collect();
+            Simulation::of_circuit(assemble_inputs(&s, &inputs).unwrap())
+        };
+        let sets = [
+            ("friction.coulomb", 25.0),
+            ("friction.viscous", 300.0),
+            ("friction.stiction", 40.0),
+            ("friction.stribeck_velocity", 5e-3),
+            ("friction.sigma0", 3e5),
+            ("friction.sigma1", 80.0),
+            ("friction.seal.k_pressure", 1e-9),
+            ("friction.external_force", -3.0),
+            ("drive.mass", 3.0),
+            ("piston.area_2", 6e-4),
+        ];
+        let mut expect = law.clone();
+        for (path, v) in sets {
+            let name = path.split_once('.').unwrap();
+            match name {
+                ("friction", "seal.k_pressure") => expect["seal"] = json!({ "k_pressure": v }),
+                ("friction", p) => expect[p] = json!(v),
+                _ => {}
+            }
+        }
+        let mut fresh = bench(expect.clone());
+        fresh["components"]["drive"]["mass"] = json!(3.0);
+        fresh["components"]["piston"]["area_2"] = json!(6e-4);
+        let s = schematic(&fresh).unwrap();
+        let names = ["drive", "acc", "p1", "p2"];
+        let inputs: Vec<_> = names.iter().map(|n| n.to_string()).zip(sig()).collect();
+        let mut o = RunOptions::dp45();
+        o.rtol = 1e-10;
+        let mut want =
+            Simulation::of_circuit(assemble_inputs(&s, &inputs).unwrap()).options(o.clone());
+        let mut got = build(&law).options(o.clone());
+        for (path, v) in sets {
+            got.set_parameter(path, v).unwrap();
+        }
+        let probe = |sim: &Simulation| {
+            let p = sim.circuit().probes().into_iter();
+            p.filter(|p| p.name == "drive.force")
+                .map(|p| p.wire)
+                .next()
+                .unwrap()
+        };
+        let force = probe(&got);
+        let a = got.run_wires(&t, &[force]).unwrap().swap_remove(0);
+        let b = want.run(&t).unwrap();
+        let b = b.channel("drive.force").unwrap();
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() < 1e-9 * y.abs().max(1.0), "{x} vs {y}");
+        }
+        // the bristle cannot be switched off in place, nor can a parameter
+        // the component does not have be set
+        let e = got
+            .set_parameter("friction.sigma0", 0.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("friction.sigma0") && e.contains("states"), "{e}");
+        let e = got
+            .set_parameter("friction.warp", 1.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("friction.warp"), "{e}");
+        let e = got
+            .set_parameter("friction.coulomb", -1.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("friction.coulomb"), "{e}");
+        // LuGre's force depends on the bristle: not sampled without integration
+        let e = got.sample_state_free(&t, &[force]).unwrap_err().to_string();
+        assert!(e.contains("friction.z"), "{e}");
+        // a static law: sampled without integration, the integrated run's force
+        let mut stat = expect.clone();
+        stat.as_object_mut().unwrap().remove("sigma0");
+        let mut sim = build(&stat).options(o);
+        let w = probe(&sim);
+        let sampled = sim.sample_state_free(&t, &[w]).unwrap().swap_remove(0);
+        let run = sim.run(&t).unwrap();
+        assert_eq!(sampled.as_slice(), run.channel("drive.force").unwrap());
     }
 
     #[test]

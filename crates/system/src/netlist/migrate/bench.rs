@@ -25,6 +25,10 @@ pub const INPUTS: [&str; 4] = ["drive", "acceleration", "p1", "p2"];
 /// The friction component's name in a bench netlist.
 pub const FRICTION: &str = "friction";
 
+/// The drive's name in a bench netlist (the `imposed_motion` with the
+/// moving mass and the load cell).
+pub const DRIVE: &str = "drive";
+
 /// The catalog effects a friction bench carries, each parameter with the
 /// `friction_bench` parameter it is.
 pub const EFFECT_PARAMS: &[(&str, &str, &str)] = &[
@@ -174,7 +178,7 @@ pub fn to_netlist(v: &Value) -> Result<Value, RigError> {
         "name": f.name,
         "description": "a friction bench (migrated from a `friction-bench` file): the drive imposes the record's velocity (input `drive`) and acceleration (input `acceleration`); the chambers hold the record's pressures (inputs `p1`, `p2`); the load cell reads `drive.force`",
         "components": {
-            "drive": {
+            DRIVE: {
                 "type": "imposed_motion",
                 "mass": f.mass,
                 "force_sign": f.force_sign,

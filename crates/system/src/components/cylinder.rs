@@ -272,13 +272,8 @@ impl Component for TwoChamberCylinder {
         let b = self.cylinder.bulk_modulus.si();
         q[0] = w.get(self.a.inflow).si();
         q[1] = w.get(self.b.inflow).si();
-        if self.air.is_none() {
-            q[2] = x[0] * self.cylinder.area_1.si() * v / b;
-            q[3] = x[1] * self.cylinder.area_2.si() * v / b;
-        } else {
-            q[2] = self.air.compliance(b, x[0]) * self.cylinder.area_1.si() * v;
-            q[3] = self.air.compliance(b, x[1]) * self.cylinder.area_2.si() * v;
-        }
+        q[2] = self.air.compliance(b, x[0]) * self.cylinder.area_1.si() * v;
+        q[3] = self.air.compliance(b, x[1]) * self.cylinder.area_2.si() * v;
     }
     fn probes(&self) -> Vec<Probe> {
         vec![

@@ -66,23 +66,21 @@ impl Component for Volume {
         }
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
+        let invalid = |message: String| BuildError::Component {
+            component: self.name.clone(),
+            message,
+        };
         if !(self.volume > 0.0
             && self.volume.is_finite()
             && self.bulk_modulus > 0.0
-            && self.bulk_modulus.is_finite()
-            && self.air.validate().is_ok())
+            && self.bulk_modulus.is_finite())
         {
-            return Err(BuildError::Component {
-                component: self.name.clone(),
-                message: match self.air.validate() {
-                    Err(e) => e.to_string(),
-                    Ok(()) => format!(
-                        "volume {} m^3 and bulk modulus {} Pa must be positive",
-                        self.volume, self.bulk_modulus
-                    ),
-                },
-            });
+            return Err(invalid(format!(
+                "volume {} m^3 and bulk modulus {} Pa must be positive",
+                self.volume, self.bulk_modulus
+            )));
         }
+        self.air.validate().map_err(|e| invalid(e.to_string()))?;
         self.node = net.own_hydraulic(&self.node_name, Causality::Stored)?;
         Ok(())
     }

@@ -1,14 +1,16 @@
 #!/usr/bin/env python3
 """Issue 17: candidate stall measures on the chapter-7 square and sine (section 7.1-7.2),
 on the wang-hybrid preset as shipped and on the controls (the chapter-9 solenoid variant, which
-has no charging interval; a smooth constant-deceleration turn). Runs `hydrocyl simulate` (pass its
+has no charging interval; the preset with a tenth of the pilot spring, whose charging interval is
+under 1 ms; a smooth constant-deceleration turn). Runs `hydrocyl simulate` (pass its
 path) at 0.1 ms from 60 mm below mid-stroke and prints, per reversal direction, mean over the
 reversals after the first period, in ms:
 
   |v|     time with |v| < 1 mm/s from the command's reversal to half the new speed (chapter7::stall)
   lp30/50 the same on the velocity low-passed (2nd-order Butterworth, forward-backward) at 30/50 Hz,
           below the shut column's natural frequency (~90 Hz at 20 kg, ~40 Hz with the K H added mass)
-  ma10    the same on the velocity averaged over 10 ms (about one ringing period), centred
+  ma10    the same on the mean velocity over 10 ms (about one ringing period), centred, from the
+          position: (x(t + 5 ms) - x(t - 5 ms)) / 10 ms
   centred time the four-way valve is centred (pilot_spool = 0; solenoid |spool| < its 0.05 threshold)
   travel  the piston's position range in the centred samples [mm]
   band    time the position stays within 0.037 mm (one sensor count) of its turning point
@@ -67,18 +69,13 @@ def lowpass(x, fc):
     return one(one(x)[::-1])[::-1]
 
 
-def movavg(v, m):
-    h, n, c = m // 2, len(v), [0.0]
-    for x in v:
-        c.append(c[-1] + x)
-    return [(c[min(n, i + h + 1)] - c[max(0, i - h)]) / (min(n, i + h + 1) - max(0, i - h)) for i in range(n)]
-
-
 def measures(c):
     t, v, x, u = c["time"], c["velocity"], c["position"], c["command"]
     n = len(t)
     spool, thr_sp = (c["pilot_spool"], 0.0) if "pilot_spool" in c else (c.get("spool"), 0.05)
-    sig = {"|v|": v, "lp30": lowpass(v, 30), "lp50": lowpass(v, 50), "ma10": movavg(v, 101)}
+    h = 50  # the mean velocity over 10 ms, centred: (x(t + 5 ms) - x(t - 5 ms)) / 10 ms
+    ma10 = [(x[min(i + h, n - 1)] - x[max(i - h, 0)]) / ((min(i + h, n - 1) - max(i - h, 0)) * DT) for i in range(n)]
+    sig = {"|v|": v, "lp30": lowpass(v, 30), "lp50": lowpass(v, 50), "ma10": ma10}
     out = {}
     for k in range(1, n):
         if t[k] <= T or (u[k - 1] > 0) == (u[k] > 0) or t[k] + 0.5 * T > t[-1] + 1e-9:
@@ -118,13 +115,20 @@ def main():
     os.makedirs(d, exist_ok=True)
     commands(d)
     rigs = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "fixtures", "rigs")
-    for rig in ("wang-hybrid", "wang-hybrid-solenoid"):
+    # the preset, the solenoid variant, and the preset with a tenth of the pilot spring (shift pressure
+    # ~1 bar instead of 10.34: the same circuit with almost no charging interval)
+    runs = (("wang-hybrid", []), ("wang-hybrid-solenoid", []),
+            ("wang-hybrid", ["pilot_valve.spring_rate=1.379e8"]))
+    for rig, sets in runs:
         for shape in ("square", "sine"):
             out = os.path.join(d, f"{rig}-{shape}.csv")
-            subprocess.run([exe, "simulate", "--quiet", "--rig", os.path.join(rigs, rig + ".json"),
-                            "--command", os.path.join(d, shape + ".csv"), "--out", out,
-                            "--set", "cylinder.initial.position=-0.06"], check=True)
-            show(f"{rig} {shape}", measures(load(out)))
+            args = [exe, "simulate", "--quiet", "--rig", os.path.join(rigs, rig + ".json"),
+                    "--command", os.path.join(d, shape + ".csv"), "--out", out,
+                    "--set", "cylinder.initial.position=-0.06"]
+            for x in sets:
+                args += ["--set", x]
+            subprocess.run(args, check=True)
+            show(f"{rig}{' ' + ' '.join(sets) if sets else ''} {shape}", measures(load(out)))
     # a smooth turn: constant deceleration a through v = 0 (no dwell, no ringing), 0.2 Hz square timing
     for a in (2.0, 4.0):
         t = [k * DT for k in range(int(3 * T / DT) + 1)]

@@ -112,9 +112,11 @@ fn reversals(c: &Csv) -> Vec<Reversal> {
         };
         let (half, t90) = (after(0.5), after(0.9));
         let centred: Vec<usize> = (k..half).filter(|&i| c.spool[i] == 0.0).collect();
-        let (lo, hi) = centred.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| {
-            (lo.min(c.position[i]), hi.max(c.position[i]))
-        });
+        let (lo, hi) = centred
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| {
+                (lo.min(c.position[i]), hi.max(c.position[i]))
+            });
         let standstill = (k..half)
             .map(|i| inside(c.velocity[i], c.velocity[i + 1]) * (c.time[i + 1] - c.time[i]))
             .sum();
@@ -171,7 +173,11 @@ fn simulate_square(sets: &[&str]) -> Csv {
         c.args(["--set", s]);
     }
     let st = c.output().unwrap();
-    assert!(st.status.success(), "{}", String::from_utf8_lossy(&st.stderr));
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
     let c = read(&out);
     assert_eq!(c.time.len(), n + 1);
     c
@@ -205,7 +211,12 @@ fn the_preset_as_shipped_stalls_rises_slower_retracting_and_drifts_on_the_thesis
     let x = |t: f64| c.position[(t / DT).round() as usize];
     for p in 0..3 {
         let p = p as f64 * PERIOD;
-        assert!(x(p + PERIOD) > x(p), "period from {p} s: {} -> {}", x(p), x(p + PERIOD));
+        assert!(
+            x(p + PERIOD) > x(p),
+            "period from {p} s: {} -> {}",
+            x(p),
+            x(p + PERIOD)
+        );
     }
     assert!(x(3.0 * PERIOD) - x(0.0) > 1e-3, "{} -> {}", x(0.0), x(15.0));
 }

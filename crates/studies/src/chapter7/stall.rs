@@ -26,7 +26,10 @@
 //! tried and rejected: it counts a smooth turn at the square's 2–4 m/s²
 //! deceleration as several ms of stall, or shortens a true dwell by the
 //! averaging interval. A smooth turn at deceleration `a` counts `2 × 1 mm/s / a`
-//! here (0.5–1 ms).
+//! here (0.5–1 ms). docs/hybrid.md ("The stall at a reversal: which
+//! measure") compares every candidate on the preset and on controls without
+//! the charging interval: none of the velocity measures separates them, the
+//! charging interval ([`super::Phenomena::charge_to_retract`]) does.
 //!
 //! **Sampling.** The ringing's period (~5 ms) is a few samples of the 1-ms
 //! traces validate measures, so a ringing stall is resolved only to a few ms

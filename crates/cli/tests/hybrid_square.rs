@@ -163,22 +163,20 @@ fn simulate_square(sets: &[&str]) -> Csv {
     let cmd = dir.path().join("square.csv");
     std::fs::write(&cmd, s).unwrap();
     let out = dir.path().join("out.csv");
-    let mut c = Command::new(env!("CARGO_BIN_EXE_hydrocyl"));
-    c.args(["simulate", "--rig", "wang-hybrid", "--quiet", "--command"])
-        .arg(&cmd)
-        .arg("--out")
-        .arg(&out)
-        .args(["--set", "cylinder.initial.position=-0.06"]);
-    for s in sets {
-        c.args(["--set", s]);
+    let (cmd, out) = (cmd.to_str().unwrap(), out.to_str().unwrap());
+    let mut args = vec!["simulate", "--rig", "wang-hybrid", "--quiet"];
+    args.extend(["--command", cmd, "--out", out]);
+    // the test's start position; `sets` after it
+    for s in std::iter::once(&"cylinder.initial.position=-0.06").chain(sets) {
+        args.extend(["--set", s]);
     }
-    let st = c.output().unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
-    let c = read(&out);
+    let st = Command::new(env!("CARGO_BIN_EXE_hydrocyl"))
+        .args(&args)
+        .output()
+        .unwrap();
+    let why = String::from_utf8_lossy(&st.stderr);
+    assert!(st.status.success(), "{args:?}: {why}");
+    let c = read(Path::new(out));
     assert_eq!(c.time.len(), n + 1);
     c
 }

@@ -5,7 +5,7 @@
 
 use crate::error::CliError;
 use std::fs::File;
-use std::io::{BufWriter, Write as _};
+use std::io::{BufWriter, IoSlice, Write as _};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -158,6 +158,39 @@ impl Outputs {
             path: f.path.display().to_string(),
             source,
         })
+    }
+
+    /// Appends `pieces`, one after the other, to output `id` (with as few
+    /// system calls and copies as the buffer allows: pieces larger than it
+    /// go straight to the file).
+    pub fn write_all(&mut self, id: OutputId, pieces: &[Vec<u8>]) -> Result<(), CliError> {
+        let f = &mut self.files[id.0];
+        let w = f.writer.as_mut().ok_or_else(|| CliError::Io {
+            path: f.path.display().to_string(),
+            source: std::io::Error::other("written after it was closed"),
+        })?;
+        let mut slices: Vec<IoSlice<'_>> = pieces.iter().map(|p| IoSlice::new(p)).collect();
+        let mut left = &mut slices[..];
+        IoSlice::advance_slices(&mut left, 0);
+        while !left.is_empty() {
+            match w.write_vectored(left) {
+                Ok(0) => {
+                    return Err(CliError::Io {
+                        path: f.path.display().to_string(),
+                        source: std::io::ErrorKind::WriteZero.into(),
+                    })
+                }
+                Ok(n) => IoSlice::advance_slices(&mut left, n),
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(source) => {
+                    return Err(CliError::Io {
+                        path: f.path.display().to_string(),
+                        source,
+                    })
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Flushes every output (with `fsync`, to the disk), then renames them

@@ -6,8 +6,15 @@
 //! and column.
 
 use crate::error::CliError;
-use hydrocyl_identify::plaincsv::PlainCsv;
-use std::path::Path;
+use hydrocyl_identify::plaincsv::{PlainCsv, Rows};
+use hydrocyl_system::signal::Signal;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+
+/// Bodies of at least this many bytes are parsed on every core
+/// ([`PlainCsv::columns`]); a shorter one on the reading thread alone,
+/// which [`Ahead`] runs beside the rest of the start-up.
+const PARALLEL_ABOVE: usize = 1 << 20;
 
 /// What a rig's command is, by the port that reads it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -154,11 +161,21 @@ pub fn columns_of<'a>(
     })
 }
 
-/// The fast path of [`read_command`] for plain numeric CSV; `None` sends the
+/// The fast path of [`parse_command`] for plain numeric CSV; `None` sends the
 /// text to the full reader, which also reports every error.
 fn read_plain(text: &str, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
     let csv = PlainCsv::new(text)?;
-    let mut cols = csv.columns(&[c.time, c.command])?;
+    let wanted = [c.time, c.command];
+    let body = csv.body().as_bytes();
+    let mut cols = if body.len() >= PARALLEL_ABOVE {
+        csv.columns(&wanted)?
+    } else {
+        let rows = Rows::new(csv.width(), &wanted)?;
+        let hint = body.len() / (8 * csv.width()).max(1) + 1;
+        let mut out = vec![Vec::with_capacity(hint), Vec::with_capacity(hint)];
+        rows.parse(body, &mut out)?;
+        out
+    };
     let mut u = cols.pop()?;
     let mut t = cols.pop()?;
     if c.time_factor != 1.0 {
@@ -173,18 +190,98 @@ fn read_plain(text: &str, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
     Some((t, u))
 }
 
-/// Reads the command CSV: `(time [s], command [unit])`; errors name file,
-/// row and column.
-pub fn read_command(path: &Path, unit: CommandUnit) -> Result<(Vec<f64>, Vec<f64>), CliError> {
-    let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| CliError::Io {
-        path: file.clone(),
+/// The bytes of file `path` (an error names it).
+pub fn read_bytes(path: &Path) -> Result<Vec<u8>, CliError> {
+    std::fs::read(path).map_err(|source| CliError::Io {
+        path: path.display().to_string(),
         source,
-    })?;
-    parse_command(&file, &bytes, unit)
+    })
 }
 
-/// [`read_command`] on the bytes of file `file`.
+/// A command file read whole, as a run takes it.
+pub struct Table {
+    /// The sample times \[s\] (the output times).
+    pub times: Vec<f64>,
+    /// The command as a signal of time.
+    pub signal: Signal,
+    /// Samples outside ±1 (a normalised command; else 0).
+    pub outside: usize,
+    /// The largest sample in magnitude and its time (a normalised command).
+    pub peak: (f64, f64),
+}
+
+/// Reads the command CSV `bytes` of file `path` as a [`Table`]: errors
+/// name file, row and column.
+pub fn read_table(path: &Path, bytes: &[u8], unit: CommandUnit) -> Result<Table, CliError> {
+    let file = path.display().to_string();
+    let (t, u) = parse_command(&file, bytes, unit)?;
+    let (outside, peak) = if unit == CommandUnit::Normalised {
+        let outside = u.iter().filter(|x| x.abs() > 1.0).count();
+        let peak = t
+            .iter()
+            .zip(&u)
+            .fold((0.0, f64::NAN), |(p, tp), (&tk, &uk)| {
+                if uk.abs() > f64::abs(p) {
+                    (uk, tk)
+                } else {
+                    (p, tp)
+                }
+            });
+        (outside, peak)
+    } else {
+        (0, (0.0, f64::NAN))
+    };
+    let times = t.clone();
+    let signal = Signal::table(t, u).map_err(|e| CliError::Input(format!("{file}: {e}")))?;
+    Ok(Table {
+        times,
+        signal,
+        outside,
+        peak,
+    })
+}
+
+/// A command file read ahead: a thread reads it while the rig is read and
+/// checked, parses it once told the rig's unit ([`Ahead::parse`]), and
+/// hands the [`Table`] over at [`Ahead::table`]. A file longer than
+/// `stream_above` bytes is left to the streamed reader (`None`).
+pub struct Ahead {
+    unit: mpsc::Sender<CommandUnit>,
+    thread: std::thread::JoinHandle<Result<Option<Table>, CliError>>,
+}
+
+impl Ahead {
+    /// Starts reading `path`.
+    pub fn start(path: PathBuf, stream_above: u64) -> Self {
+        let (unit, told) = mpsc::channel::<CommandUnit>();
+        let thread = std::thread::spawn(move || {
+            if std::fs::metadata(&path).is_ok_and(|m| m.len() > stream_above) {
+                return Ok(None);
+            }
+            let bytes = read_bytes(&path);
+            // the run stopped before it needed the command: nothing to say
+            let Ok(unit) = told.recv() else {
+                return Ok(None);
+            };
+            read_table(&path, &bytes?, unit).map(Some)
+        });
+        Ahead { unit, thread }
+    }
+
+    /// Tells the thread the rig's unit: it parses the file now.
+    pub fn parse(&self, unit: CommandUnit) {
+        let _ = self.unit.send(unit);
+    }
+
+    /// The table (after [`Ahead::parse`]), `None` for a file to stream.
+    pub fn table(self) -> Result<Option<Table>, CliError> {
+        self.thread
+            .join()
+            .map_err(|_| CliError::Input("the command file's reader failed".into()))?
+    }
+}
+
+/// The command CSV `bytes` of file `file` as `(time [s], command [unit])`.
 pub fn parse_command(
     file: &str,
     bytes: &[u8],

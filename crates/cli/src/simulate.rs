@@ -40,7 +40,7 @@
 //! first; without it the operating system writes it back when it likes, as
 //! for any ordinary file).
 
-use crate::command::{read_command, CommandUnit};
+use crate::command::{read_bytes, read_table, Ahead, CommandUnit};
 use crate::command_stream;
 use crate::error::CliError;
 use crate::output::Outputs;
@@ -302,6 +302,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let Some((bench, net)) = crate::bench_sim::load(&args.rig, &args.set)? {
         return run_bench(&args, &bench, &net);
     }
+    // the command file is read (and parsed once the rig's unit is known) on
+    // a thread of its own while the rig is read and checked
+    let ahead = match &args.command {
+        Some(path) if !args.print_rig => Some(Ahead::start(path.clone(), args.stream_above)),
+        _ => None,
+    };
     let mut value = rig::load(&args.rig).map_err(rig_err)?;
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(rig_err)?;
@@ -350,11 +356,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if rig::preset(&args.rig).is_none() {
         inputs.push(("--rig", rig_path));
     }
+    let unit = command_unit(&checked);
+    if let Some(a) = &ahead {
+        a.parse(unit);
+    }
     let mut outputs = Outputs::new(&inputs);
     let id = outputs.file("--out", &out)?;
     let mut outputs = Some(outputs);
     crate::progress::mark("output created");
-    let unit = command_unit(&checked);
     let opts = RunOptions {
         solver,
         rtol: args.rtol,
@@ -363,14 +372,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     // a long file is checked in a first pass and read during the run a
     // buffer at a time; a short one (or one that is not plain CSV) is read whole
-    let size = std::fs::metadata(&cmd_path).map_or(0, |m| m.len());
-    let long = if size > args.stream_above {
-        command_stream::scan(&cmd_path, unit)?
-    } else {
-        None
+    let table = match ahead {
+        Some(a) => a.table()?,
+        None => None,
     };
-    let (rows, t0, t1, signal, mut input) = match long {
-        Some((scan, chunks)) => {
+    let long = match table {
+        Some(_) => None,
+        None => command_stream::scan(&cmd_path, unit)?,
+    };
+    let (rows, t0, t1, signal, mut input) = match (long, table) {
+        (Some((scan, chunks)), _) => {
             if unit == CommandUnit::Normalised && !args.quiet {
                 warn_clamped(&cmd_path, scan.outside, scan.peak);
             }
@@ -385,27 +396,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 Input::Stream(table, chunks),
             )
         }
-        None => {
-            let (t, u) = read_command(&cmd_path, unit)?;
+        (None, table) => {
+            let table = match table {
+                Some(t) => t,
+                // not plain enough to stream: read whole
+                None => read_table(&cmd_path, &read_bytes(&cmd_path)?, unit)?,
+            };
             if unit == CommandUnit::Normalised && !args.quiet {
-                let outside = u.iter().filter(|x| x.abs() > 1.0).count();
-                let peak = t
-                    .iter()
-                    .zip(&u)
-                    .fold((0.0, f64::NAN), |(p, tp), (&tk, &uk)| {
-                        if uk.abs() > f64::abs(p) {
-                            (uk, tk)
-                        } else {
-                            (p, tp)
-                        }
-                    });
-                warn_clamped(&cmd_path, outside, peak);
+                warn_clamped(&cmd_path, table.outside, table.peak);
             }
+            let t = &table.times;
             let (rows, t0, t1) = (t.len(), t[0], t[t.len() - 1]);
-            let times = t.clone();
-            let signal = Signal::table(t, u)
-                .map_err(|e| CliError::Input(format!("{}: {e}", cmd_path.display())))?;
-            (rows, t0, t1, signal, Input::Table(times))
+            (rows, t0, t1, table.signal, Input::Table(table.times))
         }
     };
     crate::progress::mark("command read");

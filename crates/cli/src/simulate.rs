@@ -117,18 +117,19 @@ pub struct Args {
     /// during the run instead of whole (tests set it low).
     #[arg(long, hide = true, default_value_t = 16 << 20)]
     stream_above: u64,
-    /// Where the writer thread reads the probes: the solve's thread reads a
-    /// block's itself (on a circuit of its own) while the writer is this
-    /// many blocks behind (tests set 0: always, or a large number: never).
-    #[arg(long, hide = true, default_value_t = 2)]
+    /// While this many blocks wait for the writer thread, the solve's thread
+    /// makes the next block's text itself (reading its probes on a circuit
+    /// of its own) rather than queue it (default: the queue's bound; tests
+    /// set 0: always).
+    #[arg(long, hide = true, default_value_t = crate::writer::QUEUE)]
     probes_behind: usize,
 }
 
 /// Output times per block of a streamed run: the memory a run needs grows
 /// with this, not with the record. Blocks this small let the writer thread
 /// read the probes of, format and write one block while the solve computes
-/// the next, and keep what is left when the solve ends (the blocks the
-/// writer is behind, at most `--probes-behind` and the last) short.
+/// the next, and the two threads share what is left when the solve ends
+/// finely ([`crate::writer`]).
 const BLOCK: usize = 1 << 8;
 
 /// Samples of the command window of a streamed command file.
@@ -237,9 +238,13 @@ pub(crate) fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result
         } else {
             f64::NEG_INFINITY
         };
-        // one comparison per value: NaN and ±∞ fail the first test
-        let ok = |v: f64| v.is_finite() && v >= floor;
-        if c.values.iter().all(|&v| ok(v)) {
+        // NaN and ±∞ give NaN in v − v; no early exit inside a chunk, so
+        // that the test is made on several values at once
+        let ok = |v: f64| (v - v == 0.0) & (v >= floor);
+        if c.values
+            .chunks(16)
+            .all(|ch| ch.iter().fold(true, |a, &v| a & ok(v)))
+        {
             return None;
         }
         let k = c.values.iter().position(|&v| !ok(v))?;
@@ -423,8 +428,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut failed: Option<CliError> = None;
     let mut done = 0usize;
     let mut min_p = f64::INFINITY;
-    // the solve's thread's maker (a third circuit when the probes are read
-    // outside the solve), made when first needed
+    // the solve's thread's maker, made when first needed: during the solve
+    // (the writer far behind) on a third circuit, after it on the solving one
     let mut own: Option<Maker> = None;
     let (streamed, written) = match (second, &input) {
         (Some(signal), Input::Table(times)) if c.history_free() => {
@@ -444,9 +449,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
             let o = outputs
                 .take()
                 .ok_or_else(|| CliError::Input("no output".into()))?;
+            // the signal is copied where a circuit is built from it
+            let signal = std::sync::Arc::new(signal);
             let on_writer = {
                 let (reader, signal) = (reader.clone(), signal.clone());
-                Box::new(move || reader(signal))
+                Box::new(move || reader(Signal::clone(&signal)))
             };
             let w = Writer::start(
                 o,
@@ -458,7 +465,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 },
                 on_writer,
             );
-            let mut build = || reader(signal.clone());
+            let build = || reader(Signal::clone(&signal));
             let streamed = {
                 let mut sink = |t: &[f64], x: &[f64]| -> Result<(), String> {
                     done += t.len();
@@ -480,7 +487,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 runner::run_streaming_states(&mut c, &x0, times, &opts, BLOCK, &mut sink)
             };
             crate::progress::mark("solve done");
-            (streamed, Some(w.finish(&mut own, &mut build)))
+            // the solving circuit is free now: it reads the probes of the
+            // solve's share of what is left (history-free: the same values)
+            let mut solving = Some(c);
+            let mut after = || match solving.take() {
+                Some(c) => ProbeReader::new(c, &x0, t0, &opts)
+                    .map(Maker::states)
+                    .map_err(|e| CliError::Input(e.to_string())),
+                None => build(),
+            };
+            (streamed, Some(w.finish(&mut own, &mut after)))
         }
         _ => {
             let mut writer: Option<Writer> = None;
@@ -562,8 +578,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         return Ok(());
     }
     let cav = run.cavitation_entries();
-    eprintln!(
-        "hydrocyl: simulated {:.4} s ({rows} rows) in {:.3} s, {:.3} s of it solving ({} {}: {} steps, {} rejected, {} rhs); {}",
+    // one write: stderr is not buffered
+    let line = format!(
+        "hydrocyl: simulated {:.4} s ({rows} rows) in {:.3} s, {:.3} s of it solving ({} {}: {} steps, {} rejected, {} rhs); {}\n",
         t1 - t0,
         crate::progress::wall(),
         run.wall.as_secs_f64(),
@@ -581,5 +598,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "no cavitation".to_string()
         }
     );
+    let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
     Ok(())
 }

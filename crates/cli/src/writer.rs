@@ -19,9 +19,10 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 /// copied into it).
 const WRITE_AT: usize = 1 << 17;
 
-/// Blocks waiting for a thread at most (bounds the memory when the disk is
-/// slower than the solve).
-const QUEUE: usize = 16;
+/// Blocks waiting for a thread at most: the memory stays that of this many
+/// blocks (a few MB) whatever the record's length. Beyond it the solve's
+/// thread makes blocks itself (`--probes-behind`).
+pub const QUEUE: usize = 256;
 
 /// One block of a run's output: its times and either its channels (one
 /// column after the other, `time.len()` each, [`Rows::Channels`]) or its

@@ -367,7 +367,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let mut outputs = Outputs::new(&inputs);
     let id = outputs.file("--out", &out)?;
-    let mut outputs = Some(outputs);
     crate::progress::mark("output created");
     let opts = RunOptions {
         solver,
@@ -416,12 +415,50 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
     };
     crate::progress::mark("command read");
-    // a history-free circuit's probes are read on the writer thread, on a
-    // second circuit of the rig (the solve's thread then only solves)
-    let second = matches!(input, Input::Table(_)).then(|| signal.clone());
-    let mut c = checked
-        .circuit(signal)
-        .map_err(|e| CliError::Input(e.to_string()))?;
+    // the writer thread starts now: on a table, it builds a circuit of its
+    // own to read the probes on while this thread builds the solving one
+    let checked = std::sync::Arc::new(checked);
+    let o = outputs;
+    let (mut c, w, table) = match &input {
+        Input::Table(times) => {
+            let t0 = times[0];
+            let signal = std::sync::Arc::new(signal);
+            // a circuit of the rig to read the probes on: `None` when they
+            // depend on the circuit's history (read on the solving one)
+            let reader = {
+                let (checked, signal, opts) = (checked.clone(), signal.clone(), opts.clone());
+                move || -> Result<Option<Maker>, CliError> {
+                    let c = checked
+                        .circuit(Signal::clone(&signal))
+                        .map_err(|e| CliError::Input(e.to_string()))?;
+                    if !c.history_free() {
+                        return Ok(None);
+                    }
+                    // the solving circuit's initial state (built alike)
+                    let x0 = c.initial_state();
+                    let r = ProbeReader::new(c, &x0, t0, &opts)
+                        .map_err(|e| CliError::Input(e.to_string()))?;
+                    Ok(Some(Maker::states(r)))
+                }
+            };
+            let on_writer = {
+                let reader = reader.clone();
+                Box::new(move || reader().map(Option::unwrap_or_default))
+            };
+            let w = Writer::start(o, id, on_writer);
+            let c = checked
+                .circuit(Signal::clone(&signal))
+                .map_err(|e| CliError::Input(e.to_string()))?;
+            (c, w, Some((reader, t0)))
+        }
+        Input::Stream(..) => {
+            let w = Writer::start(o, id, Box::new(|| Ok(Maker::default())));
+            let c = checked
+                .circuit(signal)
+                .map_err(|e| CliError::Input(e.to_string()))?;
+            (c, w, None)
+        }
+    };
     let x0 = c.initial_state();
     crate::progress::mark("circuit built");
     let mut bar = Progress::new("simulate", rows as u64, args.progress, args.quiet);
@@ -431,41 +468,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // the solve's thread's maker, made when first needed: during the solve
     // (the writer far behind) on a third circuit, after it on the solving one
     let mut own: Option<Maker> = None;
-    let (streamed, written) = match (second, &input) {
-        (Some(signal), Input::Table(times)) if c.history_free() => {
-            let t0 = times[0];
-            let checked = std::sync::Arc::new(checked);
-            let reader = {
-                let (checked, x0, opts) = (checked.clone(), x0.clone(), opts.clone());
-                move |signal: Signal| -> Result<Maker, CliError> {
-                    let c = checked
-                        .circuit(signal)
-                        .map_err(|e| CliError::Input(e.to_string()))?;
-                    let r = ProbeReader::new(c, &x0, t0, &opts)
-                        .map_err(|e| CliError::Input(e.to_string()))?;
-                    Ok(Maker::states(r))
-                }
+    let streamed = match (table, &input) {
+        (Some((reader, t0)), Input::Table(times)) if c.history_free() => {
+            w.rows(Rows::States {
+                unit,
+                solver,
+                rk4_step: args.rk4_step,
+            });
+            let build = || -> Result<Maker, CliError> {
+                reader()?.ok_or_else(|| CliError::Input("no probe reader".into()))
             };
-            let o = outputs
-                .take()
-                .ok_or_else(|| CliError::Input("no output".into()))?;
-            // the signal is copied where a circuit is built from it
-            let signal = std::sync::Arc::new(signal);
-            let on_writer = {
-                let (reader, signal) = (reader.clone(), signal.clone());
-                Box::new(move || reader(Signal::clone(&signal)))
-            };
-            let w = Writer::start(
-                o,
-                id,
-                Rows::States {
-                    unit,
-                    solver,
-                    rk4_step: args.rk4_step,
-                },
-                on_writer,
-            );
-            let build = || reader(Signal::clone(&signal));
             let streamed = {
                 let mut sink = |t: &[f64], x: &[f64]| -> Result<(), String> {
                     done += t.len();
@@ -478,7 +490,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
                         return w.push(fill).map_err(|e| e.to_string());
                     }
                     if own.is_none() {
-                        crate::progress::mark("solve: own probe reader");
                         own = Some(build().map_err(|e| e.to_string())?);
                     }
                     let m = own.as_mut().ok_or("no maker")?;
@@ -496,29 +507,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
                     .map_err(|e| CliError::Input(e.to_string())),
                 None => build(),
             };
-            (streamed, Some(w.finish(&mut own, &mut after)))
+            let written = w.finish(&mut own, &mut after);
+            (streamed, written)
         }
         _ => {
-            let mut writer: Option<Writer> = None;
             let streamed = {
                 let mut sink = |block: &Run| -> Result<(), String> {
                     let r = check_solution(block, solver, args.rk4_step).and_then(|()| {
-                        if writer.is_none() {
+                        if !w.has_rows() {
                             let mut header = column_headers(block, unit).join(",").into_bytes();
                             header.push(b'\n');
-                            let o = outputs
-                                .take()
-                                .ok_or_else(|| CliError::Input("no output".into()))?;
-                            writer = Some(Writer::start(
-                                o,
-                                id,
-                                Rows::Channels(header),
-                                Box::new(|| Ok(Maker::default())),
-                            ));
+                            w.rows(Rows::Channels(header));
                         }
-                        let Some(w) = writer.as_ref() else {
-                            return Ok(());
-                        };
                         let fill = |b: &mut Block| {
                             b.time.extend_from_slice(&block.time);
                             b.values.reserve(block.channels.len() * block.time.len());
@@ -551,26 +551,22 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 }
             };
             crate::progress::mark("solve done");
-            let written = writer.map(|w| w.finish(&mut own, &mut || Ok(Maker::default())));
+            let written = w.finish(&mut own, &mut || Ok(Maker::default()));
             (streamed, written)
         }
     };
     bar.finish();
     // the writer's error (a failed write, a bad solution) first: the
     // solve's is its echo
-    let written = written.transpose();
-    let run = match (streamed, failed, written) {
+    let (streamed, written) = streamed;
+    let (outputs, run) = match (streamed, failed, written) {
         (_, _, Err(e)) | (_, Some(e), _) => return Err(e),
         (Err(e), None, _) => return Err(solver_hint(rig::RigError::Sim(e.to_string()))),
-        (Ok(r), None, Ok(w)) => {
-            if let Some((o, p)) = w {
-                outputs = Some(o);
-                min_p = min_p.min(p);
-            }
-            r
+        (Ok(r), None, Ok((o, p))) => {
+            min_p = min_p.min(p);
+            (o, r)
         }
     };
-    let outputs = outputs.ok_or_else(|| CliError::Input("no output".into()))?;
     crate::progress::mark("writer joined");
     outputs.commit(args.fsync)?;
     crate::progress::mark("output committed");

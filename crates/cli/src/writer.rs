@@ -148,7 +148,8 @@ struct Sink {
 }
 
 struct Shared {
-    rows: Rows,
+    /// Set before the first block is handed over ([`Writer::rows`]).
+    rows: std::sync::OnceLock<Rows>,
     work: Mutex<Work>,
     /// Signalled when a block is queued or taken, or the work closes or stops.
     work_cv: Condvar,
@@ -206,7 +207,10 @@ impl Shared {
     fn make(&self, maker: &mut Maker, seq: usize, block: Block) {
         let mut text = lock(&self.sink).free.pop().unwrap_or_default();
         text.clear();
-        let r = maker.piece(&self.rows, seq, &block, &mut text);
+        let r = match self.rows.get() {
+            Some(rows) => maker.piece(rows, seq, &block, &mut text),
+            None => Err(CliError::Input("the output's rows are not set".into())),
+        };
         lock(&self.work).free.push(block);
         match r {
             Ok(p) => {
@@ -235,15 +239,16 @@ pub struct Writer {
 impl Writer {
     /// Starts the writer thread on `outputs` (file `id`), which it hands
     /// back at [`Writer::finish`]; its [`Maker`] is made there by `maker`
-    /// (a circuit stays on the thread that built it).
+    /// (a circuit stays on the thread that built it) while the solve's
+    /// thread builds its own. What the blocks hold is said before the first
+    /// is handed over ([`Writer::rows`]).
     pub fn start(
         mut outputs: Outputs,
         id: OutputId,
-        rows: Rows,
         maker: Box<dyn FnOnce() -> Result<Maker, CliError> + Send>,
     ) -> Self {
         let shared = Arc::new(Shared {
-            rows,
+            rows: std::sync::OnceLock::new(),
             work: Mutex::new(Work::default()),
             work_cv: Condvar::new(),
             sink: Mutex::new(Sink {
@@ -325,6 +330,16 @@ impl Writer {
             shared,
             thread: Some(thread),
         }
+    }
+
+    /// Says what the blocks hold (once, before the first is handed over).
+    pub fn rows(&self, rows: Rows) {
+        let _ = self.shared.rows.set(rows);
+    }
+
+    /// Whether [`Writer::rows`] was said.
+    pub fn has_rows(&self) -> bool {
+        self.shared.rows.get().is_some()
     }
 
     /// Blocks handed over and not yet taken by a thread.
@@ -421,6 +436,21 @@ impl Writer {
             (Ok((_, Err(e))), None) => Err(e),
             (Ok((outputs, Ok(()))), None) => Ok((outputs, lock(&self.shared.sink).min_p)),
             (Err(_), _) => Err(CliError::Input("the output writer failed".into())),
+        }
+    }
+}
+
+impl Drop for Writer {
+    /// A writer not finished (the run failed first) stops its thread and
+    /// waits for it, so that the outputs it holds are dropped (their
+    /// temporaries removed) before the process ends.
+    fn drop(&mut self) {
+        if let Some(thread) = self.thread.take() {
+            self.shared.fail(
+                usize::MAX,
+                CliError::Input("the run stopped before its end".into()),
+            );
+            let _ = thread.join();
         }
     }
 }

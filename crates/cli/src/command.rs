@@ -6,15 +6,14 @@
 //! and column.
 
 use crate::error::CliError;
-use hydrocyl_identify::plaincsv::{PlainCsv, Rows};
+use hydrocyl_identify::plaincsv::{Body, PlainCsv, Rows};
 use hydrocyl_system::signal::Signal;
 use std::path::{Path, PathBuf};
-use std::sync::mpsc;
+use std::sync::{mpsc, Arc};
 
-/// Bodies of at least this many bytes are parsed on every core
-/// ([`PlainCsv::columns`]); a shorter one on the reading thread alone,
-/// which [`Ahead`] runs beside the rest of the start-up.
-const PARALLEL_ABOVE: usize = 1 << 20;
+/// Plain bodies of at least this many bytes are parsed in two halves by
+/// [`Ahead`]'s two threads; a shorter one by its reading thread alone.
+const SPLIT_ABOVE: usize = 1 << 16;
 
 /// What a rig's command is, by the port that reads it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -165,17 +164,12 @@ pub fn columns_of<'a>(
 /// text to the full reader, which also reports every error.
 fn read_plain(text: &str, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
     let csv = PlainCsv::new(text)?;
-    let wanted = [c.time, c.command];
-    let body = csv.body().as_bytes();
-    let mut cols = if body.len() >= PARALLEL_ABOVE {
-        csv.columns(&wanted)?
-    } else {
-        let rows = Rows::new(csv.width(), &wanted)?;
-        let hint = body.len() / (8 * csv.width()).max(1) + 1;
-        let mut out = vec![Vec::with_capacity(hint), Vec::with_capacity(hint)];
-        rows.parse(body, &mut out)?;
-        out
-    };
+    finish_plain(csv.columns(&[c.time, c.command])?, c)
+}
+
+/// The time and command columns read by the fast path, put in seconds and
+/// the rig's unit; `None` (the full reader) unless the times increase.
+fn finish_plain(mut cols: Vec<Vec<f64>>, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
     let mut u = cols.pop()?;
     let mut t = cols.pop()?;
     if c.time_factor != 1.0 {
@@ -215,6 +209,11 @@ pub struct Table {
 pub fn read_table(path: &Path, bytes: &[u8], unit: CommandUnit) -> Result<Table, CliError> {
     let file = path.display().to_string();
     let (t, u) = parse_command(&file, bytes, unit)?;
+    table_of(&file, t, u, unit)
+}
+
+/// The [`Table`] of file `file`'s samples `(t, u)`.
+fn table_of(file: &str, t: Vec<f64>, u: Vec<f64>, unit: CommandUnit) -> Result<Table, CliError> {
     let (outside, peak) = if unit == CommandUnit::Normalised {
         let outside = u.iter().filter(|x| x.abs() > 1.0).count();
         let peak = t
@@ -241,31 +240,98 @@ pub fn read_table(path: &Path, bytes: &[u8], unit: CommandUnit) -> Result<Table,
     })
 }
 
+/// The fast path's view of command CSV `bytes` (of file `file`): the
+/// plain text and where its columns are; `None` for the full reader.
+fn plain_columns<'a>(
+    file: &str,
+    bytes: &'a [u8],
+    unit: CommandUnit,
+) -> Option<(PlainCsv<'a>, Columns)> {
+    let text = std::str::from_utf8(bytes).ok()?;
+    let csv = PlainCsv::new(text)?;
+    // the header as the full reader reads it
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let headers = rdr.headers().ok()?.clone();
+    let c = columns_of(file, headers.iter(), unit).ok()?;
+    Some((csv, c))
+}
+
+/// Where a plain body long enough to halve is cut: after the line end at
+/// or after its middle.
+fn cut_of(body: &[u8]) -> Option<usize> {
+    if body.len() < SPLIT_ABOVE {
+        return None;
+    }
+    let mid = body.len() / 2;
+    let at = body[mid..].iter().position(|&b| b == b'\n')?;
+    Some(mid + at + 1).filter(|&cut| cut < body.len())
+}
+
+/// The time and command cells of the whole lines `piece` (see [`Rows::parse`]).
+fn parse_piece(csv: &PlainCsv, c: &Columns, piece: &[u8]) -> Option<(Body, Vec<Vec<f64>>)> {
+    let rows = Rows::new(csv.width(), &[c.time, c.command])?;
+    let hint = piece.len() / (8 * csv.width()).max(1) + 1;
+    let mut out = vec![Vec::with_capacity(hint), Vec::with_capacity(hint)];
+    let end = rows.parse(piece, &mut out)?;
+    Some((end, out))
+}
+
+/// What the reading thread of [`Ahead`] hands back.
+enum Read {
+    /// The table read whole (`None`: a file to stream).
+    Whole(Option<Table>),
+    /// The first half of a long plain body (the caller reads the second).
+    Half(Option<(Body, Vec<Vec<f64>>)>),
+}
+
 /// A command file read ahead: a thread reads it while the rig is read and
-/// checked, parses it once told the rig's unit ([`Ahead::parse`]), and
-/// hands the [`Table`] over at [`Ahead::table`]. A file longer than
-/// `stream_above` bytes is left to the streamed reader (`None`).
+/// checked, and parses it once told the rig's unit ([`Ahead::table`]); a
+/// long plain body is parsed in halves, the second by the thread that
+/// waits for the table. A file longer than `stream_above` bytes is left to
+/// the streamed reader (`None`).
 pub struct Ahead {
+    path: PathBuf,
     unit: mpsc::Sender<CommandUnit>,
-    thread: std::thread::JoinHandle<Result<Option<Table>, CliError>>,
+    bytes: mpsc::Receiver<Arc<Vec<u8>>>,
+    thread: std::thread::JoinHandle<Result<Read, CliError>>,
 }
 
 impl Ahead {
     /// Starts reading `path`.
     pub fn start(path: PathBuf, stream_above: u64) -> Self {
         let (unit, told) = mpsc::channel::<CommandUnit>();
+        let (send, bytes) = mpsc::channel::<Arc<Vec<u8>>>();
+        let file = path.clone();
         let thread = std::thread::spawn(move || {
+            let path = file;
             if std::fs::metadata(&path).is_ok_and(|m| m.len() > stream_above) {
-                return Ok(None);
+                return Ok(Read::Whole(None));
             }
-            let bytes = read_bytes(&path);
+            let read = read_bytes(&path).map(Arc::new);
+            if let Ok(b) = &read {
+                let _ = send.send(b.clone());
+            }
             // the run stopped before it needed the command: nothing to say
             let Ok(unit) = told.recv() else {
-                return Ok(None);
+                return Ok(Read::Whole(None));
             };
-            read_table(&path, &bytes?, unit).map(Some)
+            let bytes = read?;
+            if let Some((csv, c)) = plain_columns(&path.display().to_string(), &bytes, unit) {
+                let body = csv.body().as_bytes();
+                if let Some(cut) = cut_of(body) {
+                    return Ok(Read::Half(parse_piece(&csv, &c, &body[..cut])));
+                }
+            }
+            read_table(&path, &bytes, unit).map(|t| Read::Whole(Some(t)))
         });
-        Ahead { unit, thread }
+        Ahead {
+            path,
+            unit,
+            bytes,
+            thread,
+        }
     }
 
     /// Tells the thread the rig's unit: it parses the file now.
@@ -273,11 +339,43 @@ impl Ahead {
         let _ = self.unit.send(unit);
     }
 
-    /// The table (after [`Ahead::parse`]), `None` for a file to stream.
-    pub fn table(self) -> Result<Option<Table>, CliError> {
-        self.thread
+    /// The table in `unit` (after [`Ahead::parse`]), `None` for a file to
+    /// stream; the second half of a long body is parsed here meanwhile.
+    pub fn table(self, unit: CommandUnit) -> Result<Option<Table>, CliError> {
+        let file = self.path.display().to_string();
+        let bytes = self.bytes.recv().ok();
+        let second = bytes.as_ref().and_then(|b| {
+            let (csv, c) = plain_columns(&file, b, unit)?;
+            let body = csv.body().as_bytes();
+            let piece = &body[cut_of(body)?..];
+            let blank = piece.iter().all(|&b| b == b'\n' || b == b'\r');
+            Some((parse_piece(&csv, &c, piece), blank, c))
+        });
+        let read = self
+            .thread
             .join()
-            .map_err(|_| CliError::Input("the command file's reader failed".into()))?
+            .map_err(|_| CliError::Input("the command file's reader failed".into()))??;
+        let (first, bytes) = match (read, bytes) {
+            (Read::Whole(t), _) => return Ok(t),
+            (Read::Half(first), Some(bytes)) => (first, bytes),
+            (Read::Half(_), None) => return Err(CliError::Input(format!("{file}: not read"))),
+        };
+        // both halves plain (blank lines only at the very end), or the
+        // full reader, which names what is wrong
+        let joined = second.and_then(|(second, blank, c)| {
+            let ((end, mut cols), (_, rest)) = (first?, second?);
+            if end == Body::BlankEnd && !blank {
+                return None;
+            }
+            for (a, b) in cols.iter_mut().zip(rest) {
+                a.extend_from_slice(&b);
+            }
+            finish_plain(cols, &c)
+        });
+        match joined {
+            Some((t, u)) => table_of(&file, t, u, unit).map(Some),
+            None => read_table(&self.path, &bytes, unit).map(Some),
+        }
     }
 }
 

@@ -377,7 +377,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // a long file is checked in a first pass and read during the run a
     // buffer at a time; a short one (or one that is not plain CSV) is read whole
     let table = match ahead {
-        Some(a) => a.table()?,
+        Some(a) => a.table(unit)?,
         None => None,
     };
     let long = match table {

@@ -269,10 +269,16 @@ fn cut_of(body: &[u8]) -> Option<usize> {
     Some(mid + at + 1).filter(|&cut| cut < body.len())
 }
 
-/// The time and command cells of the whole lines `piece` (see [`Rows::parse`]).
-fn parse_piece(csv: &PlainCsv, c: &Columns, piece: &[u8]) -> Option<(Body, Vec<Vec<f64>>)> {
+/// The time and command cells of the whole lines `piece` (see
+/// [`Rows::parse`]), in columns with room for `room` more bytes of lines.
+fn parse_piece(
+    csv: &PlainCsv,
+    c: &Columns,
+    piece: &[u8],
+    room: usize,
+) -> Option<(Body, Vec<Vec<f64>>)> {
     let rows = Rows::new(csv.width(), &[c.time, c.command])?;
-    let hint = piece.len() / (8 * csv.width()).max(1) + 1;
+    let hint = (piece.len() + room) / (8 * csv.width()).max(1) + 1;
     let mut out = vec![Vec::with_capacity(hint), Vec::with_capacity(hint)];
     let end = rows.parse(piece, &mut out)?;
     Some((end, out))
@@ -295,7 +301,8 @@ pub struct Ahead {
     path: PathBuf,
     unit: mpsc::Sender<CommandUnit>,
     bytes: mpsc::Receiver<Arc<Vec<u8>>>,
-    thread: std::thread::JoinHandle<Result<Read, CliError>>,
+    /// The thread's result, sent as its last act (its exit is not waited for).
+    read: mpsc::Receiver<Result<Read, CliError>>,
 }
 
 impl Ahead {
@@ -303,35 +310,48 @@ impl Ahead {
     pub fn start(path: PathBuf, stream_above: u64) -> Self {
         let (unit, told) = mpsc::channel::<CommandUnit>();
         let (send, bytes) = mpsc::channel::<Arc<Vec<u8>>>();
+        let (done, read) = mpsc::channel::<Result<Read, CliError>>();
         let file = path.clone();
-        let thread = std::thread::spawn(move || {
+        std::thread::spawn(move || {
             let path = file;
-            if std::fs::metadata(&path).is_ok_and(|m| m.len() > stream_above) {
-                return Ok(Read::Whole(None));
-            }
-            let read = read_bytes(&path).map(Arc::new);
-            if let Ok(b) = &read {
-                let _ = send.send(b.clone());
-            }
-            // the run stopped before it needed the command: nothing to say
-            let Ok(unit) = told.recv() else {
-                return Ok(Read::Whole(None));
-            };
-            let bytes = read?;
-            if let Some((csv, c)) = plain_columns(&path.display().to_string(), &bytes, unit) {
-                let body = csv.body().as_bytes();
-                if let Some(cut) = cut_of(body) {
-                    return Ok(Read::Half(parse_piece(&csv, &c, &body[..cut])));
-                }
-            }
-            read_table(&path, &bytes, unit).map(|t| Read::Whole(Some(t)))
+            let _ = done.send(Self::read(&path, stream_above, &send, &told));
         });
         Ahead {
             path,
             unit,
             bytes,
-            thread,
+            read,
         }
+    }
+
+    /// The reading thread's work.
+    fn read(
+        path: &Path,
+        stream_above: u64,
+        send: &mpsc::Sender<Arc<Vec<u8>>>,
+        told: &mpsc::Receiver<CommandUnit>,
+    ) -> Result<Read, CliError> {
+        if std::fs::metadata(path).is_ok_and(|m| m.len() > stream_above) {
+            return Ok(Read::Whole(None));
+        }
+        let read = read_bytes(path).map(Arc::new);
+        if let Ok(b) = &read {
+            let _ = send.send(b.clone());
+        }
+        // the run stopped before it needed the command: nothing to say
+        let Ok(unit) = told.recv() else {
+            return Ok(Read::Whole(None));
+        };
+        let bytes = read?;
+        if let Some((csv, c)) = plain_columns(&path.display().to_string(), &bytes, unit) {
+            let body = csv.body().as_bytes();
+            if let Some(cut) = cut_of(body) {
+                // with room for the second half, appended to it
+                let first = parse_piece(&csv, &c, &body[..cut], body.len() - cut);
+                return Ok(Read::Half(first));
+            }
+        }
+        read_table(path, &bytes, unit).map(|t| Read::Whole(Some(t)))
     }
 
     /// Tells the thread the rig's unit: it parses the file now.
@@ -349,11 +369,11 @@ impl Ahead {
             let body = csv.body().as_bytes();
             let piece = &body[cut_of(body)?..];
             let blank = piece.iter().all(|&b| b == b'\n' || b == b'\r');
-            Some((parse_piece(&csv, &c, piece), blank, c))
+            Some((parse_piece(&csv, &c, piece, 0), blank, c))
         });
         let read = self
-            .thread
-            .join()
+            .read
+            .recv()
             .map_err(|_| CliError::Input("the command file's reader failed".into()))??;
         let (first, bytes) = match (read, bytes) {
             (Read::Whole(t), _) => return Ok(t),

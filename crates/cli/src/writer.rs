@@ -233,7 +233,9 @@ type Written = (Outputs, Result<(), CliError>);
 /// with the solve's thread.
 pub struct Writer {
     shared: Arc<Shared>,
-    thread: Option<std::thread::JoinHandle<Written>>,
+    /// The thread's outputs and result, sent as its last act (its exit is
+    /// not waited for); `None` once received.
+    written: Option<std::sync::mpsc::Receiver<Written>>,
 }
 
 impl Writer {
@@ -260,7 +262,8 @@ impl Writer {
             sink_cv: Condvar::new(),
         });
         let sh = shared.clone();
-        let thread = std::thread::spawn(move || {
+        let (send, written) = std::sync::mpsc::channel::<Written>();
+        std::thread::spawn(move || {
             let mut maker = match maker() {
                 Ok(m) => Some(m),
                 Err(e) => {
@@ -324,11 +327,11 @@ impl Writer {
                 Ok(())
             };
             crate::progress::mark("writer: done");
-            (outputs, result)
+            let _ = send.send((outputs, result));
         });
         Writer {
             shared,
-            thread: Some(thread),
+            written: Some(written),
         }
     }
 
@@ -425,13 +428,13 @@ impl Writer {
             }
         }
         crate::progress::mark("solve's thread: done helping");
-        let thread = self
-            .thread
+        let written = self
+            .written
             .take()
-            .ok_or_else(|| CliError::Input("no writer".into()))?;
-        let joined = thread.join();
+            .ok_or_else(|| CliError::Input("no writer".into()))?
+            .recv();
         let error = lock(&self.shared.sink).error.take();
-        match (joined, error) {
+        match (written, error) {
             (Ok(_), Some((_, e))) => Err(e),
             (Ok((_, Err(e))), None) => Err(e),
             (Ok((outputs, Ok(()))), None) => Ok((outputs, lock(&self.shared.sink).min_p)),
@@ -442,15 +445,15 @@ impl Writer {
 
 impl Drop for Writer {
     /// A writer not finished (the run failed first) stops its thread and
-    /// waits for it, so that the outputs it holds are dropped (their
-    /// temporaries removed) before the process ends.
+    /// takes the outputs back, so that they are dropped (their temporaries
+    /// removed) before the process ends.
     fn drop(&mut self) {
-        if let Some(thread) = self.thread.take() {
+        if let Some(written) = self.written.take() {
             self.shared.fail(
                 usize::MAX,
                 CliError::Input("the run stopped before its end".into()),
             );
-            let _ = thread.join();
+            drop(written.recv());
         }
     }
 }

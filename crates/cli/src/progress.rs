@@ -28,7 +28,11 @@ pub fn mark(label: &'static str) {
         std::env::var_os("HYDROCYL_PHASES").map(|_| std::sync::Mutex::new(Vec::new()))
     });
     if let (Some(m), Some(s)) = (marks, START.get()) {
-        let thread = if std::thread::current().name() == Some("main") { 0 } else { 1 };
+        let thread = if std::thread::current().name() == Some("main") {
+            0
+        } else {
+            1
+        };
         if let Ok(mut m) = m.lock() {
             m.push((label, thread, s.elapsed()));
         }

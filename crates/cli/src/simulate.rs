@@ -45,9 +45,9 @@ use crate::command_stream;
 use crate::error::CliError;
 use crate::output::Outputs;
 use crate::progress::Progress;
+use crate::writer::{Block, Maker, Rows, Writer};
 use hydrocyl_identify::bench::FrictionBench;
 use hydrocyl_system::rig;
-use crate::writer::{Block, Maker, Rows, Writer};
 use hydrocyl_system::run::{self as runner, ProbeReader, Run, RunOptions, Solver};
 use hydrocyl_system::signal::{Signal, StreamedTable};
 use std::path::{Path, PathBuf};
@@ -567,7 +567,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             (o, r)
         }
     };
-    crate::progress::mark("writer joined");
+    crate::progress::mark("writer finished");
     outputs.commit(args.fsync)?;
     crate::progress::mark("output committed");
     if args.quiet {

@@ -386,7 +386,11 @@ impl Writer {
     /// Makes a block filled by `fill` into its piece here, with `maker`
     /// (the solve's thread, while the writer is behind); an error when the
     /// work has stopped.
-    pub fn make_here(&self, maker: &mut Maker, fill: impl FnOnce(&mut Block)) -> Result<(), CliError> {
+    pub fn make_here(
+        &self,
+        maker: &mut Maker,
+        fill: impl FnOnce(&mut Block),
+    ) -> Result<(), CliError> {
         let block = self.block(fill);
         let seq = {
             let mut w = lock(&self.shared.work);

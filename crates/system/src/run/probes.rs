@@ -132,6 +132,7 @@ impl ProbeReader {
     pub fn read_channels(&mut self, t: &[f64], x: &[f64], out: &mut Run) {
         out.time.clear();
         out.time.extend_from_slice(t);
-        self.probes.read_channels(&self.circuit, t, x, &mut out.channels);
+        self.probes
+            .read_channels(&self.circuit, t, x, &mut out.channels);
     }
 }

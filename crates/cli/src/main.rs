@@ -79,7 +79,6 @@ fn definition() -> clap::Command {
 fn main() {
     progress::start();
     progress::mark("main");
-    output::remove_temporaries_on_signal();
     let cli = match Cli::from_arg_matches(&definition().get_matches()) {
         Ok(c) => c,
         Err(e) => e.exit(),

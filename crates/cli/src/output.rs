@@ -24,16 +24,22 @@ use std::sync::Mutex;
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// Installs the SIGINT/SIGTERM handler that removes every pending temporary
-/// file and exits with code 130. Call once, at start-up.
+/// file and exits with code 130 (once; later calls wait for the first).
+/// [`Outputs::file`] calls it before it creates a temporary; a command may
+/// call it earlier on a thread of its own (the handler's thread is started
+/// off the main thread's path).
 pub fn remove_temporaries_on_signal() {
-    let _ = ctrlc::set_handler(|| {
-        if let Ok(mut p) = PENDING.lock() {
-            for f in p.drain(..) {
-                let _ = std::fs::remove_file(f);
+    static HANDLER: std::sync::Once = std::sync::Once::new();
+    HANDLER.call_once(|| {
+        let _ = ctrlc::set_handler(|| {
+            if let Ok(mut p) = PENDING.lock() {
+                for f in p.drain(..) {
+                    let _ = std::fs::remove_file(f);
+                }
             }
-        }
-        eprintln!("hydrocyl: interrupted; no output written");
-        std::process::exit(130);
+            eprintln!("hydrocyl: interrupted; no output written");
+            std::process::exit(130);
+        });
     });
 }
 
@@ -125,6 +131,7 @@ impl Outputs {
         self.check(option, path)?;
         let name = path.file_name().unwrap_or_default().to_string_lossy();
         let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
+        remove_temporaries_on_signal();
         let f = File::create(&tmp).map_err(|source| CliError::Io {
             path: format!("{option} {}", path.display()),
             source,

@@ -313,8 +313,6 @@ impl Ahead {
         let (done, read) = mpsc::channel::<Result<Read, CliError>>();
         let file = path.clone();
         std::thread::spawn(move || {
-            // the signal handler's thread is started here, off the main path
-            crate::output::remove_temporaries_on_signal();
             let path = file;
             let _ = done.send(Self::read(&path, stream_above, &send, &told));
         });

@@ -25,9 +25,8 @@ static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// Installs the SIGINT/SIGTERM handler that removes every pending temporary
 /// file and exits with code 130 (once; later calls wait for the first).
-/// [`Outputs::file`] calls it before it creates a temporary; a command may
-/// call it earlier on a thread of its own (the handler's thread is started
-/// off the main thread's path).
+/// [`Outputs::file`] calls it before it creates a temporary; `simulate`
+/// calls it earlier, while its command file is read on another thread.
 pub fn remove_temporaries_on_signal() {
     static HANDLER: std::sync::Once = std::sync::Once::new();
     HANDLER.call_once(|| {

@@ -313,6 +313,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Some(path) if !args.print_rig => Some(Ahead::start(path.clone(), args.stream_above)),
         _ => None,
     };
+    // meanwhile (the command is the longer task): the signal handler's thread
+    crate::output::remove_temporaries_on_signal();
     let mut value = rig::load(&args.rig).map_err(rig_err)?;
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(rig_err)?;

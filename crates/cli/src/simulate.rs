@@ -30,15 +30,17 @@
 //! column and unit come from the netlist (the port that reads the input).
 //!
 //! Every input is checked and the output's temporary file created before the
-//! run ([`crate::output`]); the run is streamed in blocks
-//! ([`hydrocyl_system::run::run_streaming`]), each formatted and written by
-//! a second thread while the solve computes the next ([`Writer`]); a
-//! history-free rig's probes are read there too, on a second circuit
-//! ([`hydrocyl_system::run::run_streaming_states`],
-//! [`hydrocyl_system::run::ProbeReader`]), and the temporary is renamed into place at the end, so a failed
-//! or interrupted run leaves no file (`--fsync` also flushes it to the disk
-//! first; without it the operating system writes it back when it likes, as
-//! for any ordinary file).
+//! run ([`crate::output`]); the command file is read meanwhile on a thread of
+//! its own ([`crate::command::Ahead`]). The run is streamed in blocks
+//! ([`hydrocyl_system::run::run_streaming`]); each block's text is made by
+//! the writer thread while the solve computes the next, and by both threads
+//! once the solve has ended, and written in order ([`crate::writer`]); a
+//! history-free rig's probes are read there too, on a circuit of each
+//! thread's own ([`hydrocyl_system::run::run_streaming_states`],
+//! [`hydrocyl_system::run::ProbeReader`]). The temporary is put in place at
+//! the end, so a failed or interrupted run leaves no file and the old one as
+//! it was (`--fsync` also flushes it to the disk first; without it the
+//! operating system writes it back when it likes, as for any ordinary file).
 
 use crate::command::{read_bytes, read_table, Ahead, CommandUnit};
 use crate::command_stream;
@@ -470,7 +472,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // the solve's thread's maker, made when first needed: during the solve
     // (the writer far behind) on a third circuit, after it on the solving one
     let mut own: Option<Maker> = None;
-    let streamed = match (table, &input) {
+    let (streamed, written) = match (table, &input) {
         (Some((reader, t0)), Input::Table(times)) if c.history_free() => {
             w.rows(Rows::States {
                 unit,
@@ -560,7 +562,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
     bar.finish();
     // the writer's error (a failed write, a bad solution) first: the
     // solve's is its echo
-    let (streamed, written) = streamed;
     let (outputs, run) = match (streamed, failed, written) {
         (_, _, Err(e)) | (_, Some(e), _) => return Err(e),
         (Err(e), None, _) => return Err(solver_hint(rig::RigError::Sim(e.to_string()))),

@@ -18,8 +18,10 @@ pub fn start() {
 /// Phase marks of the process, kept when the environment variable
 /// `HYDROCYL_PHASES` is set (to profile `hydrocyl simulate`): each a label,
 /// the thread and the time since [`start`].
-static MARKS: OnceLock<Option<std::sync::Mutex<Vec<(&'static str, u64, Duration)>>>> =
-    OnceLock::new();
+static MARKS: OnceLock<Option<std::sync::Mutex<Vec<Mark>>>> = OnceLock::new();
+
+/// A phase mark: label, thread (0 = main) and time since [`start`].
+type Mark = (&'static str, u64, Duration);
 
 /// Records phase `label` (see [`MARKS`]); a no-op unless `HYDROCYL_PHASES`
 /// is set.

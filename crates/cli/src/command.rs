@@ -6,8 +6,14 @@
 //! and column.
 
 use crate::error::CliError;
-use hydrocyl_identify::plaincsv::PlainCsv;
-use std::path::Path;
+use hydrocyl_identify::plaincsv::{Body, PlainCsv, Rows};
+use hydrocyl_system::signal::Signal;
+use std::path::{Path, PathBuf};
+use std::sync::{mpsc, Arc};
+
+/// Plain bodies of at least this many bytes are parsed in two halves by
+/// [`Ahead`]'s two threads; a shorter one by its reading thread alone.
+const SPLIT_ABOVE: usize = 1 << 16;
 
 /// What a rig's command is, by the port that reads it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -154,11 +160,16 @@ pub fn columns_of<'a>(
     })
 }
 
-/// The fast path of [`read_command`] for plain numeric CSV; `None` sends the
+/// The fast path of [`parse_command`] for plain numeric CSV; `None` sends the
 /// text to the full reader, which also reports every error.
 fn read_plain(text: &str, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
     let csv = PlainCsv::new(text)?;
-    let mut cols = csv.columns(&[c.time, c.command])?;
+    finish_plain(csv.columns(&[c.time, c.command])?, c)
+}
+
+/// The time and command columns read by the fast path, put in seconds and
+/// the rig's unit; `None` (the full reader) unless the times increase.
+fn finish_plain(mut cols: Vec<Vec<f64>>, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
     let mut u = cols.pop()?;
     let mut t = cols.pop()?;
     if c.time_factor != 1.0 {
@@ -173,18 +184,222 @@ fn read_plain(text: &str, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
     Some((t, u))
 }
 
-/// Reads the command CSV: `(time [s], command [unit])`; errors name file,
-/// row and column.
-pub fn read_command(path: &Path, unit: CommandUnit) -> Result<(Vec<f64>, Vec<f64>), CliError> {
-    let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| CliError::Io {
-        path: file.clone(),
+/// The bytes of file `path` (an error names it).
+pub fn read_bytes(path: &Path) -> Result<Vec<u8>, CliError> {
+    std::fs::read(path).map_err(|source| CliError::Io {
+        path: path.display().to_string(),
         source,
-    })?;
-    parse_command(&file, &bytes, unit)
+    })
 }
 
-/// [`read_command`] on the bytes of file `file`.
+/// A command file read whole, as a run takes it.
+pub struct Table {
+    /// The sample times \[s\] (the output times).
+    pub times: Vec<f64>,
+    /// The command as a signal of time.
+    pub signal: Signal,
+    /// Samples outside ±1 (a normalised command; else 0).
+    pub outside: usize,
+    /// The largest sample in magnitude and its time (a normalised command).
+    pub peak: (f64, f64),
+}
+
+/// Reads the command CSV `bytes` of file `path` as a [`Table`]: errors
+/// name file, row and column.
+pub fn read_table(path: &Path, bytes: &[u8], unit: CommandUnit) -> Result<Table, CliError> {
+    let file = path.display().to_string();
+    let (t, u) = parse_command(&file, bytes, unit)?;
+    table_of(&file, t, u, unit)
+}
+
+/// The [`Table`] of file `file`'s samples `(t, u)`.
+fn table_of(file: &str, t: Vec<f64>, u: Vec<f64>, unit: CommandUnit) -> Result<Table, CliError> {
+    let (outside, peak) = if unit == CommandUnit::Normalised {
+        let outside = u.iter().filter(|x| x.abs() > 1.0).count();
+        let peak = t
+            .iter()
+            .zip(&u)
+            .fold((0.0, f64::NAN), |(p, tp), (&tk, &uk)| {
+                if uk.abs() > f64::abs(p) {
+                    (uk, tk)
+                } else {
+                    (p, tp)
+                }
+            });
+        (outside, peak)
+    } else {
+        (0, (0.0, f64::NAN))
+    };
+    let times = t.clone();
+    let signal = Signal::table(t, u).map_err(|e| CliError::Input(format!("{file}: {e}")))?;
+    Ok(Table {
+        times,
+        signal,
+        outside,
+        peak,
+    })
+}
+
+/// The fast path's view of command CSV `bytes` (of file `file`): the
+/// plain text and where its columns are; `None` for the full reader.
+fn plain_columns<'a>(
+    file: &str,
+    bytes: &'a [u8],
+    unit: CommandUnit,
+) -> Option<(PlainCsv<'a>, Columns)> {
+    let text = std::str::from_utf8(bytes).ok()?;
+    let csv = PlainCsv::new(text)?;
+    // the header as the full reader reads it
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let headers = rdr.headers().ok()?.clone();
+    let c = columns_of(file, headers.iter(), unit).ok()?;
+    Some((csv, c))
+}
+
+/// Where a plain body long enough to halve is cut: after the line end at
+/// or after its middle.
+fn cut_of(body: &[u8]) -> Option<usize> {
+    if body.len() < SPLIT_ABOVE {
+        return None;
+    }
+    let mid = body.len() / 2;
+    let at = body[mid..].iter().position(|&b| b == b'\n')?;
+    Some(mid + at + 1).filter(|&cut| cut < body.len())
+}
+
+/// The time and command cells of the whole lines `piece` (see
+/// [`Rows::parse`]), in columns with room for `room` more bytes of lines.
+fn parse_piece(
+    csv: &PlainCsv,
+    c: &Columns,
+    piece: &[u8],
+    room: usize,
+) -> Option<(Body, Vec<Vec<f64>>)> {
+    let rows = Rows::new(csv.width(), &[c.time, c.command])?;
+    let hint = (piece.len() + room) / (8 * csv.width()).max(1) + 1;
+    let mut out = vec![Vec::with_capacity(hint), Vec::with_capacity(hint)];
+    let end = rows.parse(piece, &mut out)?;
+    Some((end, out))
+}
+
+/// What the reading thread of [`Ahead`] hands back.
+enum Read {
+    /// The table read whole (`None`: a file to stream).
+    Whole(Option<Table>),
+    /// The first half of a long plain body (the caller reads the second).
+    Half(Option<(Body, Vec<Vec<f64>>)>),
+}
+
+/// A command file read ahead: a thread reads it while the rig is read and
+/// checked, and parses it once told the rig's unit ([`Ahead::table`]); a
+/// long plain body is parsed in halves, the second by the thread that
+/// waits for the table. A file longer than `stream_above` bytes is left to
+/// the streamed reader (`None`).
+pub struct Ahead {
+    path: PathBuf,
+    unit: mpsc::Sender<CommandUnit>,
+    bytes: mpsc::Receiver<Arc<Vec<u8>>>,
+    /// The thread's result, sent as its last act (its exit is not waited for).
+    read: mpsc::Receiver<Result<Read, CliError>>,
+}
+
+impl Ahead {
+    /// Starts reading `path`.
+    pub fn start(path: PathBuf, stream_above: u64) -> Self {
+        let (unit, told) = mpsc::channel::<CommandUnit>();
+        let (send, bytes) = mpsc::channel::<Arc<Vec<u8>>>();
+        let (done, read) = mpsc::channel::<Result<Read, CliError>>();
+        let file = path.clone();
+        std::thread::spawn(move || {
+            let path = file;
+            let _ = done.send(Self::read(&path, stream_above, &send, &told));
+        });
+        Ahead {
+            path,
+            unit,
+            bytes,
+            read,
+        }
+    }
+
+    /// The reading thread's work.
+    fn read(
+        path: &Path,
+        stream_above: u64,
+        send: &mpsc::Sender<Arc<Vec<u8>>>,
+        told: &mpsc::Receiver<CommandUnit>,
+    ) -> Result<Read, CliError> {
+        if std::fs::metadata(path).is_ok_and(|m| m.len() > stream_above) {
+            return Ok(Read::Whole(None));
+        }
+        let read = read_bytes(path).map(Arc::new);
+        if let Ok(b) = &read {
+            let _ = send.send(b.clone());
+        }
+        // the run stopped before it needed the command: nothing to say
+        let Ok(unit) = told.recv() else {
+            return Ok(Read::Whole(None));
+        };
+        let bytes = read?;
+        if let Some((csv, c)) = plain_columns(&path.display().to_string(), &bytes, unit) {
+            let body = csv.body().as_bytes();
+            if let Some(cut) = cut_of(body) {
+                // with room for the second half, appended to it
+                let first = parse_piece(&csv, &c, &body[..cut], body.len() - cut);
+                return Ok(Read::Half(first));
+            }
+        }
+        read_table(path, &bytes, unit).map(|t| Read::Whole(Some(t)))
+    }
+
+    /// Tells the thread the rig's unit: it parses the file now.
+    pub fn parse(&self, unit: CommandUnit) {
+        let _ = self.unit.send(unit);
+    }
+
+    /// The table in `unit` (after [`Ahead::parse`]), `None` for a file to
+    /// stream; the second half of a long body is parsed here meanwhile.
+    pub fn table(self, unit: CommandUnit) -> Result<Option<Table>, CliError> {
+        let file = self.path.display().to_string();
+        let bytes = self.bytes.recv().ok();
+        let second = bytes.as_ref().and_then(|b| {
+            let (csv, c) = plain_columns(&file, b, unit)?;
+            let body = csv.body().as_bytes();
+            let piece = &body[cut_of(body)?..];
+            let blank = piece.iter().all(|&b| b == b'\n' || b == b'\r');
+            Some((parse_piece(&csv, &c, piece, 0), blank, c))
+        });
+        let read = self
+            .read
+            .recv()
+            .map_err(|_| CliError::Input("the command file's reader failed".into()))??;
+        let (first, bytes) = match (read, bytes) {
+            (Read::Whole(t), _) => return Ok(t),
+            (Read::Half(first), Some(bytes)) => (first, bytes),
+            (Read::Half(_), None) => return Err(CliError::Input(format!("{file}: not read"))),
+        };
+        // both halves plain (blank lines only at the very end), or the
+        // full reader, which names what is wrong
+        let joined = second.and_then(|(second, blank, c)| {
+            let ((end, mut cols), (_, rest)) = (first?, second?);
+            if end == Body::BlankEnd && !blank {
+                return None;
+            }
+            for (a, b) in cols.iter_mut().zip(rest) {
+                a.extend_from_slice(&b);
+            }
+            finish_plain(cols, &c)
+        });
+        match joined {
+            Some((t, u)) => table_of(&file, t, u, unit).map(Some),
+            None => read_table(&self.path, &bytes, unit).map(Some),
+        }
+    }
+}
+
+/// The command CSV `bytes` of file `file` as `(time [s], command [unit])`.
 pub fn parse_command(
     file: &str,
     bytes: &[u8],

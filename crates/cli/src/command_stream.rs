@@ -9,7 +9,7 @@
 //! time, as a [`CommandSource`]. Both read *plain* CSV only (the fast path
 //! of [`hydrocyl_identify::plaincsv`]); a file that is not plain (quotes, a
 //! blank line inside, a bad cell) makes [`scan`] return `None`, and the
-//! caller reads it whole with [`crate::command::read_command`], which
+//! caller reads it whole with [`crate::command::read_table`], which
 //! accepts any CSV and words every error.
 
 use crate::command::{columns_of, CommandUnit};

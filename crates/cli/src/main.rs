@@ -17,6 +17,7 @@ mod presets;
 mod progress;
 mod rigfile;
 mod simulate;
+mod writer;
 mod xfactor;
 
 use clap::{CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
@@ -77,12 +78,16 @@ fn definition() -> clap::Command {
 
 fn main() {
     progress::start();
-    output::remove_temporaries_on_signal();
+    progress::mark("main");
     let cli = match Cli::from_arg_matches(&definition().get_matches()) {
         Ok(c) => c,
         Err(e) => e.exit(),
     };
-    if let Err(e) = run(cli) {
+    progress::mark("arguments parsed");
+    let r = run(cli);
+    progress::mark("end");
+    progress::print_marks();
+    if let Err(e) = r {
         eprintln!("hydrocyl: error: {e}");
         std::process::exit(2);
     }

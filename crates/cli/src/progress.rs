@@ -15,6 +15,44 @@ pub fn start() {
     let _ = START.set(Instant::now());
 }
 
+/// Phase marks of the process, kept when the environment variable
+/// `HYDROCYL_PHASES` is set (to profile `hydrocyl simulate`): each a label,
+/// the thread and the time since [`start`].
+static MARKS: OnceLock<Option<std::sync::Mutex<Vec<Mark>>>> = OnceLock::new();
+
+/// A phase mark: label, thread (0 = main) and time since [`start`].
+type Mark = (&'static str, u64, Duration);
+
+/// Records phase `label` (see [`MARKS`]); a no-op unless `HYDROCYL_PHASES`
+/// is set.
+pub fn mark(label: &'static str) {
+    let marks = MARKS.get_or_init(|| {
+        std::env::var_os("HYDROCYL_PHASES").map(|_| std::sync::Mutex::new(Vec::new()))
+    });
+    if let (Some(m), Some(s)) = (marks, START.get()) {
+        let thread = if std::thread::current().name() == Some("main") {
+            0
+        } else {
+            1
+        };
+        if let Ok(mut m) = m.lock() {
+            m.push((label, thread, s.elapsed()));
+        }
+    }
+}
+
+/// Prints the phase marks to stderr (with `HYDROCYL_PHASES`), one line
+/// each: milliseconds since the start, thread (0 = main), label.
+pub fn print_marks() {
+    if let Some(Some(m)) = MARKS.get() {
+        if let Ok(m) = m.lock() {
+            for (label, thread, t) in m.iter() {
+                eprintln!("phase {:8.3} ms  [{thread}] {label}", t.as_secs_f64() * 1e3);
+            }
+        }
+    }
+}
+
 /// Wall time since [`start`] \[s\].
 pub fn wall() -> f64 {
     START.get().map_or(0.0, |s| s.elapsed().as_secs_f64())

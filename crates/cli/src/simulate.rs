@@ -30,21 +30,24 @@
 //! column and unit come from the netlist (the port that reads the input).
 //!
 //! Every input is checked and the output's temporary file created before the
-//! run ([`crate::output`]); the run is streamed in blocks
-//! ([`hydrocyl_system::run::run_streaming`]), each formatted and written by
-//! a second thread while the solve computes the next ([`Writer`]); a
-//! history-free rig's probes are read there too, on a second circuit
-//! ([`hydrocyl_system::run::run_streaming_states`],
-//! [`hydrocyl_system::run::ProbeReader`]), and the temporary is renamed into place at the end, so a failed
-//! or interrupted run leaves no file (`--fsync` also flushes it to the disk
-//! first; without it the operating system writes it back when it likes, as
-//! for any ordinary file).
+//! run ([`crate::output`]); the command file is read meanwhile on a thread of
+//! its own ([`crate::command::Ahead`]). The run is streamed in blocks
+//! ([`hydrocyl_system::run::run_streaming`]); each block's text is made by
+//! the writer thread while the solve computes the next, and by both threads
+//! once the solve has ended, and written in order ([`crate::writer`]); a
+//! history-free rig's probes are read there too, on a circuit of each
+//! thread's own ([`hydrocyl_system::run::run_streaming_states`],
+//! [`hydrocyl_system::run::ProbeReader`]). The temporary is put in place at
+//! the end, so a failed or interrupted run leaves no file and the old one as
+//! it was (`--fsync` also flushes it to the disk first; without it the
+//! operating system writes it back when it likes, as for any ordinary file).
 
-use crate::command::{read_command, CommandUnit};
+use crate::command::{read_bytes, read_table, Ahead, CommandUnit};
 use crate::command_stream;
 use crate::error::CliError;
-use crate::output::{OutputId, Outputs};
+use crate::output::Outputs;
 use crate::progress::Progress;
+use crate::writer::{Block, Maker, Rows, Writer};
 use hydrocyl_identify::bench::FrictionBench;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{self as runner, ProbeReader, Run, RunOptions, Solver};
@@ -116,218 +119,23 @@ pub struct Args {
     /// during the run instead of whole (tests set it low).
     #[arg(long, hide = true, default_value_t = 16 << 20)]
     stream_above: u64,
-    /// Where the writer thread reads the probes: the solve's thread reads a
-    /// block's itself (on a circuit of its own) while the writer is this
-    /// many blocks behind (tests set 0: always, or a large number: never).
-    #[arg(long, hide = true, default_value_t = 2)]
+    /// While this many blocks wait for the writer thread, the solve's thread
+    /// makes the next block's text itself (reading its probes on a circuit
+    /// of its own) rather than queue it (default: the queue's bound; tests
+    /// set 0: always).
+    #[arg(long, hide = true, default_value_t = crate::writer::QUEUE)]
     probes_behind: usize,
 }
 
 /// Output times per block of a streamed run: the memory a run needs grows
 /// with this, not with the record. Blocks this small let the writer thread
 /// read the probes of, format and write one block while the solve computes
-/// the next, and keep what is left when the solve ends (the blocks the
-/// writer is behind, at most `--probes-behind` and the last) short.
+/// the next, and the two threads share what is left when the solve ends
+/// finely ([`crate::writer`]).
 const BLOCK: usize = 1 << 8;
-
-/// The writer thread writes its text once it holds this many bytes (more
-/// than the output's buffer, [`crate::output`]: written past it, not copied
-/// into it).
-const WRITE_AT: usize = 1 << 17;
 
 /// Samples of the command window of a streamed command file.
 const WINDOW: usize = 1 << 18;
-
-/// Blocks queued for the writer thread at most (bounds the memory when the
-/// disk is slower than the solve).
-const QUEUE: usize = 16;
-
-/// One block of a run's output for the writer thread: its times and either
-/// its channels (one column after the other, `time.len()` each) or, when the
-/// writer reads the probes itself ([`OnWriter`]), its full states
-/// (row-major).
-#[derive(Default)]
-struct Block {
-    time: Vec<f64>,
-    values: Vec<f64>,
-    /// `values` are channels (with [`OnWriter`]: read on the solve's
-    /// thread while the writer was behind).
-    channels: bool,
-}
-
-/// The probes read on the writer thread: a second circuit of the rig, made
-/// there by `make` (a circuit stays on the thread that built it), and what
-/// the solve's sink would otherwise do with each block (the header, the
-/// solution check).
-struct OnWriter {
-    make: Box<dyn FnOnce() -> Result<ProbeReader, CliError> + Send>,
-    unit: CommandUnit,
-    solver: Solver,
-    rk4_step: f64,
-}
-
-/// What the writer thread hands back: the outputs, its first error, and the
-/// lowest sampled chamber pressure of the blocks whose probes it read.
-type Written = (Outputs, Result<(), CliError>, f64);
-
-/// The writer thread of `hydrocyl simulate`: it formats the blocks the solve
-/// sends (the header first) and writes them to the output, so that the text
-/// of one block is made on the second core while the solve computes the
-/// next; with [`OnWriter`] it also reads the blocks' probes, so that the
-/// solve's core only solves. Blocks' memory goes back to the solve for reuse
-/// (the memory stays that of [`QUEUE`] blocks, whatever the record's length).
-struct Writer {
-    send: Option<std::sync::mpsc::SyncSender<Block>>,
-    recycled: std::sync::mpsc::Receiver<Block>,
-    thread: Option<std::thread::JoinHandle<Written>>,
-    /// Blocks sent and not yet written.
-    pending: std::sync::Arc<std::sync::atomic::AtomicUsize>,
-}
-
-impl Writer {
-    /// Starts the thread on `outputs` (file `id`), which it hands back at
-    /// [`Writer::finish`]. Blocks of channels (`probes` `None`) are written
-    /// after `header`; blocks of states have their probes read by `probes`,
-    /// the header made from the first.
-    fn start(
-        mut outputs: Outputs,
-        id: OutputId,
-        header: Vec<u8>,
-        probes: Option<OnWriter>,
-    ) -> Self {
-        let (send, recv) = std::sync::mpsc::sync_channel::<Block>(QUEUE);
-        let (back, recycled) = std::sync::mpsc::channel::<Block>();
-        let pending = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
-        let written = pending.clone();
-        let thread = std::thread::spawn(move || {
-            let mut text = header;
-            let mut min_p = f64::INFINITY;
-            let (mut reader, on) = match probes {
-                Some(on) => match (on.make)() {
-                    Ok(r) => (Some(r), Some((on.unit, on.solver, on.rk4_step))),
-                    Err(e) => return (outputs, Err(e), min_p),
-                },
-                None => (None, None),
-            };
-            let mut run = Run::default();
-            let mut headed = reader.is_none();
-            let mut result = Ok(());
-            for block in recv {
-                let columns: Vec<&[f64]> = match (reader.as_mut(), on) {
-                    (Some(r), Some((unit, solver, rk4_step))) => {
-                        if block.channels {
-                            r.read(&[], &[], &mut run);
-                            run.time.extend_from_slice(&block.time);
-                            let n = block.time.len().max(1);
-                            for (c, v) in run.channels.iter_mut().zip(block.values.chunks_exact(n))
-                            {
-                                c.values.extend_from_slice(v);
-                            }
-                        } else {
-                            r.read(&block.time, &block.values, &mut run);
-                        }
-                        result = check_solution(&run, solver, rk4_step);
-                        min_p = min_p.min(run.min_chamber_pressure());
-                        if !headed {
-                            headed = true;
-                            text = column_headers(&run, unit).join(",").into_bytes();
-                            text.push(b'\n');
-                        }
-                        std::iter::once(&run.time)
-                            .chain(run.channels.iter().map(|c| &c.values))
-                            .map(Vec::as_slice)
-                            .collect()
-                    }
-                    _ => std::iter::once(block.time.as_slice())
-                        .chain(block.values.chunks_exact(block.time.len().max(1)))
-                        .collect(),
-                };
-                if result.is_ok() {
-                    hydrocyl_identify::plaincsv::append_rows(&columns, &mut text);
-                    // written in pieces larger than the file's buffer, which
-                    // then takes them without a copy
-                    if text.len() >= WRITE_AT {
-                        result = outputs.write(id, &text);
-                        text.clear();
-                    }
-                }
-                // the solve may be gone already: then the block is just freed
-                let _ = back.send(block);
-                written.fetch_sub(1, std::sync::atomic::Ordering::Relaxed);
-                if result.is_err() {
-                    // the solve's next block finds the thread gone and stops
-                    break;
-                }
-            }
-            if result.is_ok() && !text.is_empty() {
-                result = outputs.write(id, &text);
-            }
-            (outputs, result, min_p)
-        });
-        Writer {
-            send: Some(send),
-            recycled,
-            thread: Some(thread),
-            pending,
-        }
-    }
-
-    /// Blocks sent and not yet written.
-    fn behind(&self) -> usize {
-        self.pending.load(std::sync::atomic::Ordering::Relaxed)
-    }
-
-    /// Queues a block filled by `fill` (in a recycled one); an error when
-    /// the thread has stopped (a failed write or a bad solution, which
-    /// [`Writer::finish`] reports).
-    fn push(&mut self, fill: impl FnOnce(&mut Block)) -> Result<(), CliError> {
-        let mut block = self.recycled.try_recv().unwrap_or_default();
-        block.time.clear();
-        block.values.clear();
-        fill(&mut block);
-        let stopped = || CliError::Input("the output writer stopped".into());
-        let send = self.send.as_ref().ok_or_else(stopped)?;
-        self.pending
-            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        send.send(block).map_err(|_| stopped())
-    }
-
-    /// Queues `run`'s channels.
-    fn push_channels(&mut self, run: &Run) -> Result<(), CliError> {
-        self.push(|b| {
-            b.channels = true;
-            b.time.extend_from_slice(&run.time);
-            b.values.reserve(run.channels.len() * run.time.len());
-            for c in &run.channels {
-                b.values.extend_from_slice(&c.values);
-            }
-        })
-    }
-
-    /// Queues raw times and states, for the probes read on the thread.
-    fn push_states(&mut self, t: &[f64], x: &[f64]) -> Result<(), CliError> {
-        self.push(|b| {
-            b.channels = false;
-            b.time.extend_from_slice(t);
-            b.values.extend_from_slice(x);
-        })
-    }
-
-    /// Waits for the thread to write every block; the outputs back and the
-    /// lowest chamber pressure it read, or its first error.
-    fn finish(mut self) -> Result<(Outputs, f64), CliError> {
-        drop(self.send.take());
-        let thread = self
-            .thread
-            .take()
-            .ok_or_else(|| CliError::Input("no writer".into()))?;
-        match thread.join() {
-            Ok((outputs, Ok(()), min_p)) => Ok((outputs, min_p)),
-            Ok((_, Err(e), _)) => Err(e),
-            Err(_) => Err(CliError::Input("the output writer failed".into())),
-        }
-    }
-}
 
 /// The CSV header of a run: `time [s]`, then each channel as `name [unit]`
 /// (the in-memory channel names stay bare; the readers take both forms).
@@ -424,7 +232,7 @@ const ABSURD_PRESSURE_PA: f64 = 10.0 * rig::ABSOLUTE_VACUUM_GAUGE_PA;
 
 /// Checks the solution for the signs of an unstable integration (a
 /// non-finite value, a chamber pressure far below vacuum) and names the fix.
-fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result<(), CliError> {
+pub(crate) fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result<(), CliError> {
     let bad = run.channels.iter().find_map(|c| {
         let chamber = c.unit == "Pa" && matches!(c.name.as_str(), "p1" | "p2");
         let floor = if chamber {
@@ -432,9 +240,13 @@ fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result<(), CliErr
         } else {
             f64::NEG_INFINITY
         };
-        // one comparison per value: NaN and ±∞ fail the first test
-        let ok = |v: f64| v.is_finite() && v >= floor;
-        if c.values.iter().all(|&v| ok(v)) {
+        // NaN and ±∞ fail the first test; no early exit inside a chunk, so
+        // that the test is made on several values at once
+        let ok = |v: f64| v.is_finite() & (v >= floor);
+        if c.values
+            .chunks(16)
+            .all(|ch| ch.iter().fold(true, |a, &v| a & ok(v)))
+        {
             return None;
         }
         let k = c.values.iter().position(|&v| !ok(v))?;
@@ -497,13 +309,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let Some((bench, net)) = crate::bench_sim::load(&args.rig, &args.set)? {
         return run_bench(&args, &bench, &net);
     }
+    // the command file is read (and parsed once the rig's unit is known) on
+    // a thread of its own while the rig is read and checked
+    let ahead = match &args.command {
+        Some(path) if !args.print_rig => Some(Ahead::start(path.clone(), args.stream_above)),
+        _ => None,
+    };
+    // meanwhile (the command is the longer task): the signal handler's thread
+    crate::output::remove_temporaries_on_signal();
     let mut value = rig::load(&args.rig).map_err(rig_err)?;
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(rig_err)?;
     }
     let kind = value.get("kind").and_then(|k| k.as_str());
+    crate::progress::mark("rig loaded");
     let checked = crate::rigfile::check(&value, &args.rig)?;
     check_initial_pressures(&checked)?;
+    crate::progress::mark("rig checked");
     if args.print_rig {
         // a netlist is printed with every parameter written out (defaults
         // filled in), under the paths `--set` takes
@@ -543,10 +365,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if rig::preset(&args.rig).is_none() {
         inputs.push(("--rig", rig_path));
     }
+    let unit = command_unit(&checked);
+    if let Some(a) = &ahead {
+        a.parse(unit);
+    }
     let mut outputs = Outputs::new(&inputs);
     let id = outputs.file("--out", &out)?;
-    let mut outputs = Some(outputs);
-    let unit = command_unit(&checked);
+    crate::progress::mark("output created");
     let opts = RunOptions {
         solver,
         rtol: args.rtol,
@@ -555,14 +380,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     // a long file is checked in a first pass and read during the run a
     // buffer at a time; a short one (or one that is not plain CSV) is read whole
-    let size = std::fs::metadata(&cmd_path).map_or(0, |m| m.len());
-    let long = if size > args.stream_above {
-        command_stream::scan(&cmd_path, unit)?
-    } else {
-        None
+    let table = match ahead {
+        Some(a) => a.table(unit)?,
+        None => None,
     };
-    let (rows, t0, t1, signal, mut input) = match long {
-        Some((scan, chunks)) => {
+    let long = match table {
+        Some(_) => None,
+        None => command_stream::scan(&cmd_path, unit)?,
+    };
+    let (rows, t0, t1, signal, mut input) = match (long, table) {
+        (Some((scan, chunks)), _) => {
             if unit == CommandUnit::Normalised && !args.quiet {
                 warn_clamped(&cmd_path, scan.outside, scan.peak);
             }
@@ -577,150 +404,182 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 Input::Stream(table, chunks),
             )
         }
-        None => {
-            let (t, u) = read_command(&cmd_path, unit)?;
+        (None, table) => {
+            let table = match table {
+                Some(t) => t,
+                // not plain enough to stream: read whole
+                None => read_table(&cmd_path, &read_bytes(&cmd_path)?, unit)?,
+            };
             if unit == CommandUnit::Normalised && !args.quiet {
-                let outside = u.iter().filter(|x| x.abs() > 1.0).count();
-                let peak = t
-                    .iter()
-                    .zip(&u)
-                    .fold((0.0, f64::NAN), |(p, tp), (&tk, &uk)| {
-                        if uk.abs() > f64::abs(p) {
-                            (uk, tk)
-                        } else {
-                            (p, tp)
-                        }
-                    });
-                warn_clamped(&cmd_path, outside, peak);
+                warn_clamped(&cmd_path, table.outside, table.peak);
             }
+            let t = &table.times;
             let (rows, t0, t1) = (t.len(), t[0], t[t.len() - 1]);
-            let times = t.clone();
-            let signal = Signal::table(t, u)
-                .map_err(|e| CliError::Input(format!("{}: {e}", cmd_path.display())))?;
-            (rows, t0, t1, signal, Input::Table(times))
+            (rows, t0, t1, table.signal, Input::Table(table.times))
         }
     };
-    // a history-free circuit's probes are read on the writer thread, on a
-    // second circuit of the rig (the solve's thread then only solves)
-    let second = matches!(input, Input::Table(_)).then(|| signal.clone());
-    let mut c = checked
-        .circuit(signal)
-        .map_err(|e| CliError::Input(e.to_string()))?;
+    crate::progress::mark("command read");
+    // the writer thread starts now: on a table, it builds a circuit of its
+    // own to read the probes on while this thread builds the solving one
+    let checked = std::sync::Arc::new(checked);
+    let o = outputs;
+    let (mut c, w, table) = match &input {
+        Input::Table(times) => {
+            let t0 = times[0];
+            let signal = std::sync::Arc::new(signal);
+            // a circuit of the rig to read the probes on: `None` when they
+            // depend on the circuit's history (read on the solving one)
+            let reader = {
+                let (checked, signal, opts) = (checked.clone(), signal.clone(), opts.clone());
+                move || -> Result<Option<Maker>, CliError> {
+                    let c = checked
+                        .circuit(Signal::clone(&signal))
+                        .map_err(|e| CliError::Input(e.to_string()))?;
+                    if !c.history_free() {
+                        return Ok(None);
+                    }
+                    // the solving circuit's initial state (built alike)
+                    let x0 = c.initial_state();
+                    let r = ProbeReader::new(c, &x0, t0, &opts)
+                        .map_err(|e| CliError::Input(e.to_string()))?;
+                    Ok(Some(Maker::states(r)))
+                }
+            };
+            let on_writer = {
+                let reader = reader.clone();
+                Box::new(move || reader().map(Option::unwrap_or_default))
+            };
+            let w = Writer::start(o, id, on_writer);
+            let c = checked
+                .circuit(Signal::clone(&signal))
+                .map_err(|e| CliError::Input(e.to_string()))?;
+            (c, w, Some((reader, t0)))
+        }
+        Input::Stream(..) => {
+            let w = Writer::start(o, id, Box::new(|| Ok(Maker::default())));
+            let c = checked
+                .circuit(signal)
+                .map_err(|e| CliError::Input(e.to_string()))?;
+            (c, w, None)
+        }
+    };
     let x0 = c.initial_state();
+    crate::progress::mark("circuit built");
     let mut bar = Progress::new("simulate", rows as u64, args.progress, args.quiet);
     let mut failed: Option<CliError> = None;
     let mut done = 0usize;
     let mut min_p = f64::INFINITY;
-    let mut writer: Option<Writer> = None;
-    let on_writer = match (second, &input) {
-        (Some(signal), Input::Table(times)) if c.history_free() => {
-            let (x0, t0, opts) = (x0.clone(), times[0], opts.clone());
-            let checked = std::sync::Arc::new(checked);
-            let own = (checked.clone(), signal.clone());
-            let make = move || {
-                let c = checked
-                    .circuit(signal)
-                    .map_err(|e| CliError::Input(e.to_string()))?;
-                ProbeReader::new(c, &x0, t0, &opts).map_err(|e| CliError::Input(e.to_string()))
-            };
-            Some((
-                OnWriter {
-                    make: Box::new(make),
-                    unit,
-                    solver,
-                    rk4_step: args.rk4_step,
-                },
-                own,
-            ))
-        }
-        _ => None,
-    };
-    let streamed = if let Some((on, (rig, third))) = on_writer {
-        let Input::Table(times) = &input else {
-            return Err(CliError::Input("no command table".into()));
-        };
-        let o = outputs
-            .take()
-            .ok_or_else(|| CliError::Input("no output".into()))?;
-        let w = writer.insert(Writer::start(o, id, Vec::new(), Some(on)));
-        // the solve's own reader (a third circuit), made when first needed
-        let mut own: Option<ProbeReader> = None;
-        let mut block = Run::default();
-        let t0 = times[0];
-        let mut sink = |t: &[f64], x: &[f64]| -> Result<(), String> {
-            done += t.len();
-            bar.set("rows", done as u64, rows as u64);
-            if w.behind() < args.probes_behind {
-                return w.push_states(t, x).map_err(|e| e.to_string());
-            }
-            let r = match own.as_mut() {
-                Some(r) => r,
-                None => {
-                    let c = rig.circuit(third.clone()).map_err(|e| e.to_string())?;
-                    own.insert(ProbeReader::new(c, &x0, t0, &opts).map_err(|e| e.to_string())?)
-                }
-            };
-            r.read(t, x, &mut block);
-            w.push_channels(&block).map_err(|e| e.to_string())
-        };
-        runner::run_streaming_states(&mut c, &x0, times, &opts, BLOCK, &mut sink)
-    } else {
-        let mut sink = |block: &Run| -> Result<(), String> {
-            let r = check_solution(block, solver, args.rk4_step).and_then(|()| {
-                if writer.is_none() {
-                    let mut header = column_headers(block, unit).join(",").into_bytes();
-                    header.push(b'\n');
-                    let o = outputs
-                        .take()
-                        .ok_or_else(|| CliError::Input("no output".into()))?;
-                    writer = Some(Writer::start(o, id, header, None));
-                }
-                match writer.as_mut() {
-                    Some(w) => w.push_channels(block),
-                    None => Ok(()),
-                }
+    // the solve's thread's maker, made when first needed: during the solve
+    // (the writer far behind) on a third circuit, after it on the solving one
+    let mut own: Option<Maker> = None;
+    let (streamed, written) = match (table, &input) {
+        (Some((reader, t0)), Input::Table(times)) if c.history_free() => {
+            w.rows(Rows::States {
+                unit,
+                solver,
+                rk4_step: args.rk4_step,
             });
-            done += block.time.len();
-            min_p = min_p.min(block.min_chamber_pressure());
-            bar.set("rows", done as u64, rows as u64);
-            r.map_err(|e| {
-                let m = e.to_string();
-                failed = Some(e);
-                m
-            })
-        };
-        match &mut input {
-            Input::Table(times) => {
-                runner::run_streaming(&mut c, &x0, times, &opts, BLOCK, &mut sink)
-            }
-            Input::Stream(table, chunks) => {
-                runner::run_command_stream(&mut c, &x0, table, chunks, t1, &opts, BLOCK, &mut sink)
-            }
+            let build = || -> Result<Maker, CliError> {
+                reader()?.ok_or_else(|| CliError::Input("no probe reader".into()))
+            };
+            let streamed = {
+                let mut sink = |t: &[f64], x: &[f64]| -> Result<(), String> {
+                    done += t.len();
+                    bar.set("rows", done as u64, rows as u64);
+                    let fill = |b: &mut Block| {
+                        b.time.extend_from_slice(t);
+                        b.values.extend_from_slice(x);
+                    };
+                    if w.behind() < args.probes_behind {
+                        return w.push(fill).map_err(|e| e.to_string());
+                    }
+                    if own.is_none() {
+                        own = Some(build().map_err(|e| e.to_string())?);
+                    }
+                    let m = own.as_mut().ok_or("no maker")?;
+                    w.make_here(m, fill).map_err(|e| e.to_string())
+                };
+                runner::run_streaming_states(&mut c, &x0, times, &opts, BLOCK, &mut sink)
+            };
+            crate::progress::mark("solve done");
+            // the solving circuit is free now: it reads the probes of the
+            // solve's share of what is left (history-free: the same values)
+            let mut solving = Some(c);
+            let mut after = || match solving.take() {
+                Some(c) => ProbeReader::new(c, &x0, t0, &opts)
+                    .map(Maker::states)
+                    .map_err(|e| CliError::Input(e.to_string())),
+                None => build(),
+            };
+            let written = w.finish(&mut own, &mut after);
+            (streamed, written)
+        }
+        _ => {
+            let streamed = {
+                let mut sink = |block: &Run| -> Result<(), String> {
+                    let r = check_solution(block, solver, args.rk4_step).and_then(|()| {
+                        if !w.has_rows() {
+                            let mut header = column_headers(block, unit).join(",").into_bytes();
+                            header.push(b'\n');
+                            w.rows(Rows::Channels(header));
+                        }
+                        let fill = |b: &mut Block| {
+                            b.time.extend_from_slice(&block.time);
+                            b.values.reserve(block.channels.len() * block.time.len());
+                            for c in &block.channels {
+                                b.values.extend_from_slice(&c.values);
+                            }
+                        };
+                        if w.behind() < args.probes_behind {
+                            w.push(fill)
+                        } else {
+                            w.make_here(own.get_or_insert_with(Maker::default), fill)
+                        }
+                    });
+                    done += block.time.len();
+                    min_p = min_p.min(block.min_chamber_pressure());
+                    bar.set("rows", done as u64, rows as u64);
+                    r.map_err(|e| {
+                        let m = e.to_string();
+                        failed = Some(e);
+                        m
+                    })
+                };
+                match &mut input {
+                    Input::Table(times) => {
+                        runner::run_streaming(&mut c, &x0, times, &opts, BLOCK, &mut sink)
+                    }
+                    Input::Stream(table, chunks) => runner::run_command_stream(
+                        &mut c, &x0, table, chunks, t1, &opts, BLOCK, &mut sink,
+                    ),
+                }
+            };
+            crate::progress::mark("solve done");
+            let written = w.finish(&mut own, &mut || Ok(Maker::default()));
+            (streamed, written)
         }
     };
     bar.finish();
     // the writer's error (a failed write, a bad solution) first: the
     // solve's is its echo
-    let written = writer.map(Writer::finish).transpose();
-    let run = match (streamed, failed, written) {
+    let (outputs, run) = match (streamed, failed, written) {
         (_, _, Err(e)) | (_, Some(e), _) => return Err(e),
         (Err(e), None, _) => return Err(solver_hint(rig::RigError::Sim(e.to_string()))),
-        (Ok(r), None, Ok(w)) => {
-            if let Some((o, p)) = w {
-                outputs = Some(o);
-                min_p = min_p.min(p);
-            }
-            r
+        (Ok(r), None, Ok((o, p))) => {
+            min_p = min_p.min(p);
+            (o, r)
         }
     };
-    let outputs = outputs.ok_or_else(|| CliError::Input("no output".into()))?;
+    crate::progress::mark("writer finished");
     outputs.commit(args.fsync)?;
+    crate::progress::mark("output committed");
     if args.quiet {
         return Ok(());
     }
     let cav = run.cavitation_entries();
-    eprintln!(
-        "hydrocyl: simulated {:.4} s ({rows} rows) in {:.3} s, {:.3} s of it solving ({} {}: {} steps, {} rejected, {} rhs); {}",
+    // one write: stderr is not buffered
+    let line = format!(
+        "hydrocyl: simulated {:.4} s ({rows} rows) in {:.3} s, {:.3} s of it solving ({} {}: {} steps, {} rejected, {} rhs); {}\n",
         t1 - t0,
         crate::progress::wall(),
         run.wall.as_secs_f64(),
@@ -738,5 +597,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "no cavitation".to_string()
         }
     );
+    let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
     Ok(())
 }

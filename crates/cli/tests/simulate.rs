@@ -593,11 +593,13 @@ fn netlist_errors_name_the_path_and_line() {
     assert!(!out.exists());
 }
 
-/// The output written block by block by the writer thread (several blocks
-/// here) is, byte for byte, the in-process run of the same command written
-/// in one piece, wherever its probes were read: on the writer thread (a
-/// second circuit), on the solve's thread (`--probes-behind 0`: a third
-/// circuit), or as the writer falls behind (the default).
+/// The output written block by block (several blocks here) is, byte for
+/// byte, the in-process run of the same command written in one piece,
+/// whichever thread made each block's text: the writer thread (on a second
+/// circuit), the solve's thread during the solve (`--probes-behind 0`:
+/// every block, on a third circuit; `2`: while the writer is two behind),
+/// or both after the solve (the default and `1000`: the solve's thread on
+/// the solving circuit).
 #[test]
 fn the_written_rows_are_the_in_process_run_byte_for_byte() {
     use hydrocyl_identify::plaincsv::{run_columns, write_columns};
@@ -619,6 +621,7 @@ fn the_written_rows_are_the_in_process_run_byte_for_byte() {
     for extra in [
         &[][..],
         &["--probes-behind", "0"],
+        &["--probes-behind", "2"],
         &["--probes-behind", "1000"],
     ] {
         let out = dir.path().join("out.csv");
@@ -631,5 +634,111 @@ fn the_written_rows_are_the_in_process_run_byte_for_byte() {
             "{extra:?}"
         );
         assert!(body(&written) == body(&whole), "{extra:?}: the rows differ");
+    }
+}
+
+/// The temporaries left in `dir` (none after any run, good or failed).
+fn temporaries(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter(|n| n.contains(".tmp"))
+        .collect()
+}
+
+/// An output that exists is replaced by a run that succeeds (swapped into
+/// place, its old content removed) and kept as it was by one that fails —
+/// on a bad command cell in the second half of a long file (read by the
+/// other thread), and on an unstable solution found while writing.
+#[test]
+fn an_existing_output_is_replaced_by_a_good_run_and_kept_by_a_failed_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows = square(4000, 1e-3);
+    let cmd = write_command(dir.path(), "cmd.csv", &rows);
+    let out = dir.path().join("out.csv");
+    std::fs::write(&out, "old content\n").unwrap();
+    simulate_ok("leaney-moog", &cmd, &out, &[]);
+    let written = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(written.lines().count(), rows.len() + 1);
+    assert!(
+        temporaries(dir.path()).is_empty(),
+        "{:?}",
+        temporaries(dir.path())
+    );
+    // a bad cell at row 3501 (the second half of the body)
+    let mut text = std::fs::read_to_string(&cmd).unwrap();
+    let line = text.lines().nth(3500).unwrap().to_string();
+    text = text.replacen(&line, &line.replacen(",x", "z,x", 1), 1);
+    let bad = dir.path().join("bad.csv");
+    std::fs::write(&bad, &text).unwrap();
+    std::fs::write(&out, "old content\n").unwrap();
+    for (command, extra, needle) in [
+        (&bad, &[][..], "row 3501, column `command`"),
+        (
+            &cmd,
+            &["--solver", "rk4", "--rk4-step", "2e-2"][..],
+            "unstable",
+        ),
+    ] {
+        let st = hydrocyl()
+            .args(["simulate", "--rig", "leaney-moog", "--command"])
+            .arg(command)
+            .arg("--out")
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&st.stderr);
+        assert_eq!(st.status.code(), Some(2), "{err}");
+        assert!(err.contains(needle), "{needle}: {err}");
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "old content\n");
+        assert!(
+            temporaries(dir.path()).is_empty(),
+            "{:?}",
+            temporaries(dir.path())
+        );
+    }
+}
+
+/// A long command file is parsed in two halves on two threads; blank lines
+/// inside it (which the full reader skips) or only at its end give the run
+/// of the same samples without them.
+#[test]
+fn a_long_command_file_read_in_halves_is_the_same_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows = square(4000, 1e-3);
+    let cmd = write_command(dir.path(), "cmd.csv", &rows);
+    let out = dir.path().join("out.csv");
+    simulate_ok("leaney-moog", &cmd, &out, &[]);
+    let reference = std::fs::read_to_string(&out).unwrap();
+    let text = std::fs::read_to_string(&cmd).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let blank_at = |ks: &[usize], end: bool| {
+        let mut s = String::new();
+        for (k, l) in lines.iter().enumerate() {
+            if ks.contains(&k) {
+                s.push('\n');
+            }
+            s.push_str(l);
+            s.push('\n');
+        }
+        if end {
+            s.push_str("\n\r\n");
+        }
+        s
+    };
+    // around the middle, where the body is cut, and at the end
+    for (ks, end) in [
+        (&[1990, 2010][..], false),
+        (&[2001][..], false),
+        (&[][..], true),
+    ] {
+        let other = dir.path().join("blank.csv");
+        std::fs::write(&other, blank_at(ks, end)).unwrap();
+        simulate_ok("leaney-moog", &other, &out, &[]);
+        assert!(
+            std::fs::read_to_string(&out).unwrap() == reference,
+            "{ks:?} {end}: the rows differ"
+        );
     }
 }

@@ -126,4 +126,13 @@ impl ProbeReader {
     pub fn read(&mut self, t: &[f64], x: &[f64], out: &mut Run) {
         self.probes.read(&self.circuit, t, x, out);
     }
+
+    /// [`ProbeReader::read`] without the states: `out`'s time and channels
+    /// are replaced, its states left as they are.
+    pub fn read_channels(&mut self, t: &[f64], x: &[f64], out: &mut Run) {
+        out.time.clear();
+        out.time.extend_from_slice(t);
+        self.probes
+            .read_channels(&self.circuit, t, x, &mut out.channels);
+    }
 }

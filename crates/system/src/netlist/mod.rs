@@ -30,11 +30,15 @@
 //!   required port is connected.
 //! * `outputs` (optional): output columns → probes `component.probe`. Without
 //!   it every probe is an output named `component.probe`.
+//! * `identify` (optional): what `hydrocyl diagnose` needs beyond the
+//!   circuit — the model it builds, the record's column map, the parameter
+//!   paths it refits, the steady-state flag ([`identify`]).
 //!
 //! The parameter path of every value is `<component>.<parameter>` and
 //! `<component>.initial.<state>` — in `--set`, [`parameters`] and the docs.
 //! The components' order is the state vector's order.
 
+pub mod identify;
 mod inputs;
 pub mod locate;
 pub mod migrate;

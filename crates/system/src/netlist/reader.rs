@@ -34,6 +34,8 @@ pub struct Schematic {
     pub outputs: Vec<(String, String)>,
     /// The nodes: name → (domain, the ports on it as `component.port`).
     pub nodes: BTreeMap<String, (Domain, Vec<String>)>,
+    /// The identification section (`identify`), when the file has one.
+    pub identify: Option<super::identify::Identify>,
 }
 
 impl Schematic {
@@ -290,12 +292,13 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
             "components",
             "connections",
             "outputs",
+            "identify",
         ]
         .contains(&k.as_str())
         {
             return err(
                 k.clone(),
-                "unknown key (a netlist has kind, name, description, components, connections, outputs)",
+                "unknown key (a netlist has kind, name, description, components, connections, outputs, identify)",
             );
         }
     }
@@ -568,10 +571,16 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
         }
     }
 
+    let identify = root
+        .get("identify")
+        .map(|v| super::identify::read(v, &instances))
+        .transpose()?;
+
     Ok(Schematic {
         name,
         instances,
         outputs,
         nodes,
+        identify,
     })
 }

@@ -481,3 +481,24 @@ fn plot_residual(
     root.present()?;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hydrocyl_identify::data::Signal;
+
+    /// A cylinder netlist's identification section gives diagnose its column
+    /// map; a bad role is refused by its path.
+    #[test]
+    fn a_cylinder_netlist_brings_its_column_map() {
+        let mut v = hydrocyl_system::rig::preset("leaney-moog").unwrap();
+        assert_eq!(net_columns(&v).unwrap(), ColumnMap::default());
+        v["identify"] = serde_json::json!({ "columns": { "position": "x_mm [mm]" } });
+        let map = net_columns(&v).unwrap();
+        assert_eq!(map.0[&Signal::Position], "x_mm [mm]");
+        assert!(matches!(net_rig_with_columns(&v), Ok(Rig::Net(_, m)) if m == map));
+        v["identify"]["columns"] = serde_json::json!({ "x": "x_mm [mm]" });
+        let e = net_columns(&v).unwrap_err();
+        assert!(e.contains("identify.columns.x"), "{e}");
+    }
+}

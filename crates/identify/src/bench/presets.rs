@@ -114,9 +114,12 @@ impl FrictionBench {
             }
             None => v,
         };
-        let s = netlist::read(net)
-            .map_err(|e| hydrocyl_system::rig::RigError::from(e).to_string())?;
-        let Some(id) = s.identify.filter(|i| i.model == IdentifyModel::FrictionBench) else {
+        let s =
+            netlist::read(net).map_err(|e| hydrocyl_system::rig::RigError::from(e).to_string())?;
+        let Some(id) = s
+            .identify
+            .filter(|i| i.model == IdentifyModel::FrictionBench)
+        else {
             return Err(format!(
                 "`identify.model`: not a friction bench (a bench rig file's identification section names the model \"{}\")",
                 IdentifyModel::FrictionBench.name()
@@ -124,9 +127,8 @@ impl FrictionBench {
         };
         let mut b = FrictionBench::from_netlist(net, SMOOTHING_VELOCITY)?;
         for (role, header) in &id.columns {
-            let sig = Signal::from_name(role).ok_or_else(|| {
-                format!("`identify.columns.{role}`: not a measured-data signal")
-            })?;
+            let sig = Signal::from_name(role)
+                .ok_or_else(|| format!("`identify.columns.{role}`: not a measured-data signal"))?;
             b.columns.0.insert(sig, header.clone());
         }
         b.refit = id.refit;
@@ -332,7 +334,12 @@ mod tests {
             assert!(is_bench_rig(&new) && is_bench_rig(&old));
             let printed = hydrocyl_system::netlist::expanded(&new).unwrap();
             for v in [&new, &printed, &old] {
-                assert_eq!(FrictionBench::from_rig(v).unwrap(), declared, "{}", path.display());
+                assert_eq!(
+                    FrictionBench::from_rig(v).unwrap(),
+                    declared,
+                    "{}",
+                    path.display()
+                );
             }
             let mut set = new.clone();
             hydrocyl_system::rig::apply_set(&mut set, "friction.viscous=123").unwrap();

@@ -32,7 +32,7 @@
 //! The reader checks every key, role, path and type; each error names its
 //! JSON path (`identify.refit[1]`).
 
-use super::reader::NetlistError;
+use super::reader::{kind_of as type_name, NetlistError};
 use super::registry::Instance;
 use serde_json::{Map, Value};
 use std::collections::BTreeMap;
@@ -96,17 +96,6 @@ fn err<T>(path: impl Into<String>, why: impl Into<String>) -> Result<T, NetlistE
     })
 }
 
-fn type_name(v: &Value) -> &'static str {
-    match v {
-        Value::Null => "null",
-        Value::Bool(_) => "a boolean",
-        Value::Number(_) => "a number",
-        Value::String(_) => "a string",
-        Value::Array(_) => "an array",
-        Value::Object(_) => "an object",
-    }
-}
-
 /// The name of the component of the friction-bench model that the record's
 /// motion drives.
 pub const BENCH_DRIVE: &str = "drive";
@@ -163,7 +152,10 @@ pub fn read(v: &Value, instances: &[Instance]) -> Result<Identify, NetlistError>
         Some(other) => {
             return err(
                 "identify.refit",
-                format!("must be an array of parameter paths, got {}", type_name(other)),
+                format!(
+                    "must be an array of parameter paths, got {}",
+                    type_name(other)
+                ),
             )
         }
     };
@@ -324,14 +316,54 @@ mod tests {
             ("", json!([]), "identify", "must be an object"),
             ("/colour", json!(1), "identify.colour", "unknown key"),
             ("/model", json!("robot"), "identify.model", "cylinder"),
-            ("/columns", json!(["force"]), "identify.columns", "an object"),
-            ("/columns/torque", json!("T [N]"), "identify.columns.torque", "unknown column role"),
-            ("/columns/force", json!(3), "identify.columns.force", "got a number"),
-            ("/refit", json!("friction.coulomb"), "identify.refit", "an array"),
-            ("/refit/1", json!("friction.warp"), "identify.refit[1]", "no parameter `warp`"),
-            ("/refit/1", json!("motor.mass"), "identify.refit[1]", "no component `motor`"),
-            ("/refit/1", json!("friction.coulomb"), "identify.refit[1]", "listed twice"),
-            ("/steady_state", json!("yes"), "identify.steady_state", "true or false"),
+            (
+                "/columns",
+                json!(["force"]),
+                "identify.columns",
+                "an object",
+            ),
+            (
+                "/columns/torque",
+                json!("T [N]"),
+                "identify.columns.torque",
+                "unknown column role",
+            ),
+            (
+                "/columns/force",
+                json!(3),
+                "identify.columns.force",
+                "got a number",
+            ),
+            (
+                "/refit",
+                json!("friction.coulomb"),
+                "identify.refit",
+                "an array",
+            ),
+            (
+                "/refit/1",
+                json!("friction.warp"),
+                "identify.refit[1]",
+                "no parameter `warp`",
+            ),
+            (
+                "/refit/1",
+                json!("motor.mass"),
+                "identify.refit[1]",
+                "no component `motor`",
+            ),
+            (
+                "/refit/1",
+                json!("friction.coulomb"),
+                "identify.refit[1]",
+                "listed twice",
+            ),
+            (
+                "/steady_state",
+                json!("yes"),
+                "identify.steady_state",
+                "true or false",
+            ),
         ];
         for (ptr, bad, path, why) in cases {
             let mut v = bench();
@@ -346,7 +378,10 @@ mod tests {
                 }
             }
             let e = RigError::from(read(&v).unwrap_err()).to_string();
-            assert!(e.contains(&format!("`{path}`")) && e.contains(why), "{ptr}: {e}");
+            assert!(
+                e.contains(&format!("`{path}`")) && e.contains(why),
+                "{ptr}: {e}"
+            );
             assert_eq!(e.lines().count(), 1, "{e}");
         }
         // refits and steady states are a friction bench's
@@ -369,22 +404,33 @@ mod tests {
         }
         v["outputs"] = json!({});
         let e = RigError::from(read(&v).unwrap_err()).to_string();
-        assert!(e.contains("`identify.model`") && e.contains("`drive`"), "{e}");
+        assert!(
+            e.contains("`identify.model`") && e.contains("`drive`"),
+            "{e}"
+        );
     }
 
     /// A key given twice in the file's identification section is refused by
     /// the file reader with its path and line.
     #[test]
     fn a_duplicate_key_is_refused_with_its_path() {
-        let text = serde_json::to_string_pretty(&bench())
-            .unwrap()
-            .replacen("\"steady_state\": true", "\"steady_state\": true, \"steady_state\": false", 1);
-        let dir = std::env::temp_dir().join(format!("hydrocyl-identify-dup-{}", std::process::id()));
+        let text = serde_json::to_string_pretty(&bench()).unwrap().replacen(
+            "\"steady_state\": true",
+            "\"steady_state\": true, \"steady_state\": false",
+            1,
+        );
+        let dir =
+            std::env::temp_dir().join(format!("hydrocyl-identify-dup-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let f = dir.join("dup.json");
         std::fs::write(&f, text).unwrap();
-        let e = crate::rig::load(f.to_str().unwrap()).unwrap_err().to_string();
+        let e = crate::rig::load(f.to_str().unwrap())
+            .unwrap_err()
+            .to_string();
         std::fs::remove_dir_all(&dir).ok();
-        assert!(e.contains("identify.steady_state") && e.contains("duplicate key"), "{e}");
+        assert!(
+            e.contains("identify.steady_state") && e.contains("duplicate key"),
+            "{e}"
+        );
     }
 }

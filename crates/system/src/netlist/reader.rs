@@ -84,7 +84,8 @@ fn flatten(
     Ok(())
 }
 
-fn kind_of(v: &Value) -> &'static str {
+/// What a JSON value is, for messages (`a string`, `an array`, ...).
+pub(super) fn kind_of(v: &Value) -> &'static str {
     match v {
         Value::Null => "null",
         Value::Bool(_) => "a boolean",

@@ -78,7 +78,9 @@ impl BenchInputs {
 }
 
 impl FrictionBench {
-    /// The bench's netlist ([`net::to_netlist`] of its declaration).
+    /// The bench's netlist with its identification section
+    /// ([`net::to_netlist`] of its declaration): what a bench rig file holds
+    /// (`make_fixtures` writes it, [`FrictionBench::from_rig`] reads it back).
     pub fn netlist(&self) -> Result<serde_json::Value, String> {
         let v = serde_json::to_value(self).map_err(|e| e.to_string())?;
         net::to_netlist(&v).map_err(|e| e.to_string())

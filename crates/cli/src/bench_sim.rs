@@ -1,5 +1,6 @@
-//! `hydrocyl simulate` on a `friction-bench` rig (`spec/measured-data.md`,
-//! the rig kind of `hydrocyl-identify`): the drive imposes the motion, so the
+//! `hydrocyl simulate` on a friction-bench rig file (`spec/measured-data.md`:
+//! a netlist whose `identify` section names the `friction-bench` model, or an
+//! older `friction-bench` file read as that netlist): the drive imposes the motion, so the
 //! bench's input is not a command but the motion itself. The `--command` file
 //! is a record in the measured-data format (through the rig's column map) with
 //! `time`, `position` or `velocity`, and `p1`/`p2` where the bench has
@@ -15,11 +16,11 @@ use hydrocyl_identify::bench::{self, bench_signals, BenchInputs, FrictionBench};
 use hydrocyl_identify::data::{Record, Signal};
 use std::path::Path;
 
-/// A `friction-bench` rig file read for the CLI, or `None` for any other
-/// `--rig`: the bench (identification fields from the file, the circuit
-/// from its netlist after `sets`) and its netlist (what `--print-rig`
-/// shows; `--set` takes its `<component>.<parameter>` paths). Errors name
-/// the JSON path.
+/// A friction-bench rig file read for the CLI ([`bench::is_bench_rig`]),
+/// or `None` for any other `--rig`: the bench (the circuit and the
+/// identification section of its netlist after `sets`) and its netlist
+/// (what `--print-rig` shows; `--set` takes its `<component>.<parameter>`
+/// paths). Errors name the JSON path and line.
 pub fn load(
     spec: &str,
     sets: &[String],
@@ -28,20 +29,21 @@ pub fn load(
     if rig::preset(spec).is_some() {
         return Ok(None);
     }
-    let Some(file) = std::fs::read_to_string(spec)
+    let is_bench = std::fs::read_to_string(spec)
         .ok()
         .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-        .filter(|v| v.get("kind").and_then(|k| k.as_str()) == Some(bench::KIND))
-    else {
+        .is_some_and(|v| bench::is_bench_rig(&v));
+    if !is_bench {
         return Ok(None);
-    };
+    }
     let err = |e: rig::RigError| CliError::Input(e.to_string());
     let mut net = rig::load(spec).map_err(err)?;
     for s in sets {
         rig::apply_set(&mut net, s).map_err(err)?;
     }
-    let bench = FrictionBench::from_file_and_netlist(&file, &net)
-        .map_err(|e| CliError::Input(format!("{spec}: {e}")))?;
+    rig::check(&net).map_err(|e| err(rig::at_line(e, spec)))?;
+    let bench =
+        FrictionBench::from_rig(&net).map_err(|e| CliError::Input(format!("{spec}: {e}")))?;
     Ok(Some((bench, net)))
 }
 

@@ -20,8 +20,9 @@ use crate::progress::Progress;
 #[derive(clap::Args)]
 pub struct Args {
     /// Rig: a preset name (valve rig: leaney-moog; friction benches:
-    /// tudelft-seal-25, tudelft-seal-257, emps) or a rig JSON file
-    /// (kind valve-cylinder or friction-bench).
+    /// tudelft-seal-25, tudelft-seal-257, emps) or a rig JSON file (a
+    /// netlist, its `identify` section naming the model, columns and refits;
+    /// or an older valve-cylinder or friction-bench file, read as its netlist).
     #[arg(long)]
     pub rig: String,
     /// Measured record(s) (CSV); repeat for several records of one rig
@@ -60,8 +61,26 @@ pub struct Args {
 enum Rig {
     Bench(FrictionBench),
     /// Any netlist with a cylinder on a mass (the valve rig, the hybrid rig,
-    /// a user's circuit), or a `valve-cylinder` rig file as its netlist.
-    Net(Box<Model>),
+    /// a user's circuit), or a `valve-cylinder` rig file as its netlist;
+    /// with the column map of its identification section.
+    Net(Box<Model>, ColumnMap),
+}
+
+/// The column map of a netlist's identification section (`identify.columns`).
+fn net_columns(v: &serde_json::Value) -> Result<ColumnMap, String> {
+    let s = hydrocyl_system::netlist::read(v)
+        .map_err(|e| hydrocyl_system::rig::RigError::from(e).to_string())?;
+    let mut map = ColumnMap::default();
+    for (role, header) in s.identify.map(|i| i.columns).unwrap_or_default() {
+        let sig = hydrocyl_identify::data::Signal::from_name(&role)
+            .ok_or_else(|| format!("`identify.columns.{role}`: not a measured-data signal"))?;
+        map.0.insert(sig, header);
+    }
+    Ok(map)
+}
+
+fn net_rig_with_columns(v: &serde_json::Value) -> Result<Rig, String> {
+    Ok(Rig::Net(Box::new(net_rig(v)?), net_columns(v)?))
 }
 
 fn net_rig(v: &serde_json::Value) -> Result<Model, String> {
@@ -82,9 +101,7 @@ fn load_rig(spec: &str) -> Result<Rig, CliError> {
         ))
     };
     if let Some(v) = hydrocyl_system::rig::preset(spec) {
-        return net_rig(&v)
-            .map(|r| Rig::Net(Box::new(r)))
-            .map_err(|e| unsupported(&e));
+        return net_rig_with_columns(&v).map_err(|e| unsupported(&e));
     }
     if !Path::new(spec).exists() {
         return Err(CliError::Input(format!(
@@ -92,7 +109,8 @@ fn load_rig(spec: &str) -> Result<Rig, CliError> {
             crate::presets::names()
         )));
     }
-    // a friction-bench file: its identification fields and its netlist
+    // a friction bench (a netlist whose identification section names the
+    // `friction-bench` model, or an older `friction-bench` file)
     if let Some((b, _)) = crate::bench_sim::load(spec, &[])? {
         return Ok(Rig::Bench(b));
     }
@@ -100,9 +118,9 @@ fn load_rig(spec: &str) -> Result<Rig, CliError> {
     let v = hydrocyl_system::rig::load(spec).map_err(|e| CliError::Input(e.to_string()))?;
     match v.get("kind").and_then(|k| k.as_str()).unwrap_or("") {
         // an older rig kind (`valve-cylinder`) is read as its netlist (rig::load)
-        k if k == hydrocyl_system::netlist::KIND => net_rig(&v)
-            .map(|r| Rig::Net(Box::new(r)))
-            .map_err(|e| unsupported(&e)),
+        k if k == hydrocyl_system::netlist::KIND => {
+            net_rig_with_columns(&v).map_err(|e| unsupported(&e))
+        }
         k => Err(unsupported(&format!(
             "kind '{k}' (kinds: {}, {}, {})",
             bench::KIND,
@@ -162,7 +180,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let columns = match &rig {
         Rig::Bench(b) => b.columns.clone(),
-        Rig::Net(_) => ColumnMap::default(),
+        Rig::Net(_, columns) => columns.clone(),
     };
     let records = args
         .data
@@ -196,7 +214,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 .map_err(|e| CliError::Input(e.to_string()))?;
             (o.report, o.traces)
         }
-        Rig::Net(v) => {
+        Rig::Net(v, _) => {
             if records.len() != 1 {
                 return Err(CliError::Input(format!(
                     "--data: a circuit rig is diagnosed on one record at a time ({} given)",
@@ -462,4 +480,25 @@ fn plot_residual(
     )?;
     root.present()?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hydrocyl_identify::data::Signal;
+
+    /// A cylinder netlist's identification section gives diagnose its column
+    /// map; a bad role is refused by its path.
+    #[test]
+    fn a_cylinder_netlist_brings_its_column_map() {
+        let mut v = hydrocyl_system::rig::preset("leaney-moog").unwrap();
+        assert_eq!(net_columns(&v).unwrap(), ColumnMap::default());
+        v["identify"] = serde_json::json!({ "columns": { "position": "x_mm [mm]" } });
+        let map = net_columns(&v).unwrap();
+        assert_eq!(map.0[&Signal::Position], "x_mm [mm]");
+        assert!(matches!(net_rig_with_columns(&v), Ok(Rig::Net(_, m)) if m == map));
+        v["identify"]["columns"] = serde_json::json!({ "x": "x_mm [mm]" });
+        let e = net_columns(&v).unwrap_err();
+        assert!(e.contains("identify.columns.x"), "{e}");
+    }
 }

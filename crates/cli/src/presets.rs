@@ -2,7 +2,6 @@
 //! each: name, kind and what it is.
 
 use crate::error::CliError;
-use hydrocyl_identify::bench;
 use hydrocyl_system::rig;
 
 /// Arguments of `hydrocyl presets` (none).
@@ -35,24 +34,15 @@ pub fn all() -> Vec<(&'static str, String, String)> {
             .unwrap_or_default();
         (kind, what)
     };
-    let mut out: Vec<_> = rig::PRESETS
+    // the friction-bench presets are netlists of `rig::PRESETS` too
+    // (`bench::PRESETS` is their identification view, not more rigs)
+    rig::PRESETS
         .iter()
         .map(|p| {
             let (k, d) = describe(&(p.json)());
             (p.name, k, d)
         })
-        .collect();
-    for name in bench::PRESETS {
-        let v = bench::preset(name)
-            .and_then(|b| serde_json::to_value(b).ok())
-            .unwrap_or_default();
-        let (k, mut d) = describe(&v);
-        if d.is_empty() {
-            d = "friction bench driven by its measured motion".into();
-        }
-        out.push((name, k, d));
-    }
-    out
+        .collect()
 }
 
 /// The preset names, comma-separated (for `--rig`'s help).
@@ -61,7 +51,6 @@ pub fn names() -> String {
     rig::PRESETS
         .iter()
         .map(|p| p.name)
-        .chain(bench::PRESETS.iter().copied())
         .collect::<Vec<_>>()
         .join(", ")
 }

@@ -273,7 +273,7 @@ fn rig_files_and_print_rig_round_trip() {
 fn an_older_rig_kind_runs_and_prints_as_its_netlist() {
     let dir = tempfile::tempdir().unwrap();
     let old = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/measured/festo-hanging-load.rig.json");
+        .join("../../fixtures/legacy/festo-hanging-load.rig.json");
     let st = hydrocyl()
         .args([
             "simulate",
@@ -394,7 +394,7 @@ fn friction_bench_is_simulated_from_its_motion() {
     let rig: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(fx.join("bench-none.rig.json")).unwrap())
             .unwrap();
-    let area = rig["area2"].as_f64().unwrap();
+    let area = rig["components"]["piston"]["area_2"].as_f64().unwrap();
     let floor = (0.5f64.powi(2) + (2e3 * area).powi(2)).sqrt();
     let truth = rms("bench-none.rig.json", "bench-none.csv");
     assert!(

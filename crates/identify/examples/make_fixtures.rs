@@ -1,10 +1,13 @@
 //! Writes the generated friction-bench fixtures of `fixtures/measured/`:
-//! `cargo run -p hydrocyl-identify --example make_fixtures -- fixtures/measured`.
+//! `cargo run -p hydrocyl-identify --example make_fixtures -- fixtures/measured`
+//! (`-- --rigs-only fixtures/measured` writes the rig files alone and leaves
+//! the records as they are).
 //!
 //! Each case is a record of [`synth::truth_with`] (the declared bench plus
 //! the planted effects at realistic magnitude) on [`synth::motion`], 8 s at
 //! 500 Hz, with the default sensor noise, and the declared rig (the truth
-//! without the planted effects) as `<case>.rig.json`.
+//! without the planted effects) as `<case>.rig.json`: the bench's netlist
+//! with its identification section (`FrictionBench::netlist`).
 //!
 //! The valve-rig records `valve-<effect>.csv` ([`synth::valve_fixture_cases`])
 //! are `leaney-moog` with one effect on at [`synth::valve_planted`]'s
@@ -17,13 +20,27 @@ use hydrocyl_identify::data::{write_atomic, Signal};
 use hydrocyl_identify::synth::{self, Noise};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let rigs_only = args.iter().any(|a| a == "--rigs-only");
     let dir = PathBuf::from(
-        std::env::args()
-            .nth(1)
+        args.iter()
+            .find(|a| !a.starts_with("--"))
+            .cloned()
             .unwrap_or_else(|| "fixtures/measured".into()),
     );
     std::fs::create_dir_all(&dir)?;
     for case in synth::fixture_cases() {
+        let mut declared = synth::declared_for(&case.planted);
+        declared.name = case.name.clone();
+        let json = serde_json::to_string_pretty(&declared.netlist()?)? + "\n";
+        write_atomic(
+            &dir.join(format!("{}.rig.json", case.name)),
+            json.as_bytes(),
+        )?;
+        if rigs_only {
+            println!("{}: rig file", case.name);
+            continue;
+        }
         let truth = synth::truth_with(&case.planted);
         let rec = synth::record(
             &truth,
@@ -47,17 +64,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ));
         }
         write_atomic(&dir.join(format!("{}.csv", case.name)), csv.as_bytes())?;
-        let mut declared = synth::declared_for(&case.planted);
-        declared.name = case.name.clone();
-        let json = serde_json::to_string_pretty(&declared)?;
-        write_atomic(
-            &dir.join(format!("{}.rig.json", case.name)),
-            json.as_bytes(),
-        )?;
         println!(
             "{}: planted {:?}, foreign {:?}",
             case.name, case.planted, case.foreign
         );
+    }
+    if rigs_only {
+        return Ok(());
     }
     // Valve rig (leaney-moog): nothing missing, and each valve-rig effect alone.
     for (name, planted) in synth::valve_fixture_cases() {

@@ -11,7 +11,8 @@ use proptest::prelude::*;
 /// Every record in `fixtures/measured/` that `diagnose` reads (a
 /// `<name>.csv` with its `<name>.rig.json`, and the generated `valve-*`
 /// records) is in the measured-data format: it reads without error, with
-/// strictly increasing time, and its rig file parses with a `kind`. (The other
+/// strictly increasing time, and its rig file is a netlist that checks (older
+/// rig kinds are kept in `fixtures/legacy/` only). (The other
 /// CSVs there are reduced tables of real data sets, read by the friction crate
 /// in their own documented layouts.)
 #[test]
@@ -33,7 +34,8 @@ fn every_diagnose_record_reads() {
         if rig_file.exists() {
             let v: serde_json::Value =
                 serde_json::from_str(&std::fs::read_to_string(&rig_file).unwrap()).unwrap();
-            assert!(v["kind"].is_string(), "{}", rig_file.display());
+            assert_eq!(v["kind"], "netlist", "{}", rig_file.display());
+            rig::check(&v).unwrap_or_else(|e| panic!("{}: {e}", rig_file.display()));
         }
     }
 }

@@ -52,7 +52,8 @@ pub fn section() -> Section {
         let rigf = dir.join(format!("{}.rig.json", case.name));
         let loaded = std::fs::read_to_string(&rigf)
             .map_err(|e| format!("{}: {e}", rigf.display()))
-            .and_then(|t| FrictionBench::from_json(&t))
+            .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
+            .and_then(|v| FrictionBench::from_rig(&v))
             .and_then(|rig| {
                 Record::read(&csv)
                     .map(|r| (rig, r))

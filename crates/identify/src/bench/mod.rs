@@ -397,7 +397,7 @@ mod presets;
 mod signals;
 
 pub use model::{run_options, BenchInputs, BenchRun};
-pub use presets::{preset, PRESETS};
+pub use presets::{is_bench_rig, preset, PRESETS, SMOOTHING_VELOCITY};
 pub use signals::{bench_signals, BenchSignals};
 
 #[cfg(test)]

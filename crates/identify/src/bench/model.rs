@@ -78,7 +78,9 @@ impl BenchInputs {
 }
 
 impl FrictionBench {
-    /// The bench's netlist ([`net::to_netlist`] of its declaration).
+    /// The bench's netlist with its identification section
+    /// ([`net::to_netlist`] of its declaration): what a bench rig file holds
+    /// (`make_fixtures` writes it, [`FrictionBench::from_rig`] reads it back).
     pub fn netlist(&self) -> Result<serde_json::Value, String> {
         let v = serde_json::to_value(self).map_err(|e| e.to_string())?;
         net::to_netlist(&v).map_err(|e| e.to_string())
@@ -279,11 +281,12 @@ mod tests {
             let Some(stem) = name.strip_suffix(".rig.json") else {
                 continue;
             };
-            let text = std::fs::read_to_string(&path).unwrap();
-            if !text.contains(super::super::KIND) {
+            let v: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+            if !super::super::is_bench_rig(&v) {
                 continue;
             }
-            let rig = FrictionBench::from_json(&text).unwrap();
+            let rig = FrictionBench::from_rig(&v).unwrap();
             let csv = path.with_file_name(format!("{stem}.csv"));
             if !csv.exists() {
                 continue; // mr-damper: its record is not in the repository
@@ -358,7 +361,7 @@ mod solver_choice {
     fn solver_choice_on_the_lugre_fixture() {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/measured");
         let text = std::fs::read_to_string(dir.join("bench-none.rig.json")).unwrap();
-        let mut rig = FrictionBench::from_json(&text).unwrap();
+        let mut rig = FrictionBench::from_rig(&serde_json::from_str(&text).unwrap()).unwrap();
         let s0 = ParamRef::Effect(EffectId::LugreDynamics, "sigma0".into());
         rig.set(&s0, 2e5);
         rig.set(

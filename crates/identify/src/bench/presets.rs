@@ -1,6 +1,10 @@
-//! The built-in friction-bench presets: the identification view of the
-//! bench netlists of `fixtures/rigs/` ([`FrictionBench::from_netlist`])
-//! plus what identification needs beyond the circuit (column map, refit).
+//! How a friction bench is read: the built-in presets (the identification
+//! view of the bench netlists of `fixtures/rigs/`,
+//! [`FrictionBench::from_netlist`], plus what identification needs beyond
+//! the circuit: column map, refit) and rig files — a netlist whose
+//! identification section names the `friction-bench` model
+//! ([`FrictionBench::from_rig`]), or an older `friction-bench` file read
+//! as that netlist (`hydrocyl_system::rig::load` migrates it).
 
 use std::collections::BTreeMap;
 
@@ -81,7 +85,58 @@ pub fn preset(name: &str) -> Option<FrictionBench> {
     Some(rig)
 }
 
+/// The law's tanh smoothing velocity \[m/s\] of a rig file's bench whose
+/// netlist law has none (LuGre, `friction_lugre`).
+pub const SMOOTHING_VELOCITY: f64 = 1e-3;
+
+/// `true` when a rig value is a friction bench for identification: a
+/// netlist whose `identify.model` is `friction-bench`, or an older
+/// `friction-bench` file.
+pub fn is_bench_rig(v: &serde_json::Value) -> bool {
+    v.pointer("/identify/model").and_then(|m| m.as_str())
+        == Some(hydrocyl_system::netlist::identify::IdentifyModel::FrictionBench.name())
+        || v.get("kind").and_then(|k| k.as_str()) == Some(KIND)
+}
+
 impl FrictionBench {
+    /// The bench of a rig value for identification: a netlist with the
+    /// `friction-bench` identification section (its columns, refits and
+    /// steady-state flag; the circuit's view by [`FrictionBench::from_netlist`]),
+    /// or an older `friction-bench` file migrated to that netlist
+    /// (`hydrocyl_system::netlist::migrate`). Errors name the JSON path.
+    pub fn from_rig(v: &serde_json::Value) -> Result<Self, String> {
+        use hydrocyl_system::netlist::{self, identify::IdentifyModel};
+        let migrated;
+        let net = match netlist::migrate::migrate(v).map_err(|e| e.to_string())? {
+            Some(n) => {
+                migrated = n;
+                &migrated
+            }
+            None => v,
+        };
+        let s =
+            netlist::read(net).map_err(|e| hydrocyl_system::rig::RigError::from(e).to_string())?;
+        let Some(id) = s
+            .identify
+            .filter(|i| i.model == IdentifyModel::FrictionBench)
+        else {
+            return Err(format!(
+                "`identify.model`: not a friction bench (a bench rig file's identification section names the model \"{}\")",
+                IdentifyModel::FrictionBench.name()
+            ));
+        };
+        let mut b = FrictionBench::from_netlist(net, SMOOTHING_VELOCITY)?;
+        for (role, header) in &id.columns {
+            let sig = Signal::from_name(role)
+                .ok_or_else(|| format!("`identify.columns.{role}`: not a measured-data signal"))?;
+            b.columns.0.insert(sig, header.clone());
+        }
+        b.refit = id.refit;
+        b.steady_state = id.steady_state;
+        b.validate().map_err(|e| e.to_string())?;
+        Ok(b)
+    }
+
     /// The identification view of a friction-bench netlist: one
     /// `imposed_motion` drive (mass, load-cell sign), at most one `piston`
     /// (areas) and one friction law on the rod, `friction_coulomb_viscous`
@@ -179,9 +234,11 @@ impl FrictionBench {
                 (fc, smoothing_velocity)
             }
             "friction_bench" => {
-                // an effect is on when the file gives any of its parameters
-                let raw = &v["components"][law.name.as_str()];
-                let given = |t: &str| t.split('.').try_fold(raw, |o, k| o.get(k)).is_some();
+                // an effect is declared when the law has it: its first
+                // parameter ([`net::EFFECT_PARAMS`]: the Stribeck hump's
+                // stiction level, σ0, b, ...) given off the type's default
+                // (so a netlist printed with every default written out,
+                // `--print-rig`, declares what the file declared)
                 let mut ids: Vec<&str> = net::EFFECT_PARAMS.iter().map(|(e, _, _)| *e).collect();
                 ids.dedup();
                 for id in ids {
@@ -190,10 +247,13 @@ impl FrictionBench {
                         .filter(|(e, _, _)| *e == id)
                         .map(|(_, p, target)| (*p, *target))
                         .collect();
-                    if let (Some(eid), true) = (
-                        EffectId::from_id(id),
-                        params.iter().any(|(_, t)| given(t)),
-                    ) {
+                    let first = params[0].1;
+                    let default = law.ty.param(first).and_then(|p| match p.default {
+                        hydrocyl_system::netlist::registry::Default::Value(d) => Some(d),
+                        _ => None,
+                    });
+                    let declared = law.opt(first).is_some_and(|x| Some(x) != default);
+                    if let (Some(eid), true) = (EffectId::from_id(id), declared) {
                         let vals: Vec<(&str, f64)> =
                             params.iter().map(|(p, t)| (*p, law.get(t))).collect();
                         on(eid, &vals);
@@ -241,34 +301,88 @@ impl FrictionBench {
 mod tests {
     use super::*;
 
-    /// Every `friction-bench` fixture read back from its migrated netlist is
-    /// the file's declaration, field for field (so diagnose fits the same
-    /// model from the same start whichever way the file is read), and a
-    /// `--set` on the netlist reaches the bench.
+    fn fixtures() -> std::path::PathBuf {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
+    }
+
+    fn json(path: &std::path::Path) -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+    }
+
+    /// Each older `friction-bench` file kept in `fixtures/legacy/` reads as
+    /// the same bench, field for field, as the file's own declaration: its
+    /// netlist in `fixtures/measured/`, that netlist with every default
+    /// written out (`--print-rig`), and the older file itself (migrated). So
+    /// `diagnose` fits the same model from the same start whichever file it
+    /// is given; and a `--set` on the netlist reaches the bench.
     #[test]
-    fn bench_files_read_back_from_their_netlists() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/measured");
+    fn legacy_bench_files_read_as_their_netlists() {
         let mut seen = 0;
-        for entry in std::fs::read_dir(dir).unwrap() {
+        for entry in std::fs::read_dir(fixtures().join("legacy")).unwrap() {
             let path = entry.unwrap().path();
-            let text = std::fs::read_to_string(&path).unwrap_or_default();
-            let Ok(file) = serde_json::from_str::<serde_json::Value>(&text) else {
-                continue;
-            };
-            if file.get("kind").and_then(|k| k.as_str()) != Some(KIND) {
+            let old = json(&path);
+            if old.get("kind").and_then(|k| k.as_str()) != Some(KIND) {
                 continue;
             }
-            let declared = FrictionBench::from_json(&text).unwrap();
-            let mut net = hydrocyl_system::rig::load(path.to_str().unwrap()).unwrap();
-            assert_eq!(net["kind"], "netlist");
-            let back = FrictionBench::from_file_and_netlist(&file, &net).unwrap();
-            assert_eq!(back, declared, "{}", path.display());
-            hydrocyl_system::rig::apply_set(&mut net, "friction.viscous=123").unwrap();
-            let set = FrictionBench::from_file_and_netlist(&file, &net).unwrap();
+            let mut declared = FrictionBench::from_json(&old.to_string()).unwrap();
+            // the older file's catalog names (`Fc`, `viscous.b`) as netlist paths
+            for r in declared.refit.iter_mut() {
+                *r = super::super::ParamRef::parse(r).unwrap().path();
+            }
+            let new = json(&fixtures().join("measured").join(path.file_name().unwrap()));
+            assert_eq!(new["kind"], "netlist");
+            assert!(is_bench_rig(&new) && is_bench_rig(&old));
+            let printed = hydrocyl_system::netlist::expanded(&new).unwrap();
+            for v in [&new, &printed, &old] {
+                assert_eq!(
+                    FrictionBench::from_rig(v).unwrap(),
+                    declared,
+                    "{}",
+                    path.display()
+                );
+            }
+            let mut set = new.clone();
+            hydrocyl_system::rig::apply_set(&mut set, "friction.viscous=123").unwrap();
+            let set = FrictionBench::from_rig(&set).unwrap();
             assert_eq!(set.friction.effects[&EffectId::Viscous]["b"], 123.0);
             seen += 1;
         }
-        assert!(seen >= 12, "{seen}");
+        assert!(seen >= 3, "{seen}");
+    }
+
+    /// Every generated bench fixture's rig file is what `make_fixtures`
+    /// writes for its case (the declared bench's netlist), so the files are
+    /// generated, not edited.
+    #[test]
+    fn generated_bench_rig_files_are_the_generators() {
+        for case in crate::synth::fixture_cases() {
+            let mut declared = crate::synth::declared_for(&case.planted);
+            declared.name = case.name.clone();
+            let file = json(
+                &fixtures()
+                    .join("measured")
+                    .join(format!("{}.rig.json", case.name)),
+            );
+            assert_eq!(file, declared.netlist().unwrap(), "{}", case.name);
+            assert_eq!(FrictionBench::from_rig(&file).unwrap(), declared);
+        }
+    }
+
+    /// A netlist that is not a friction bench is refused by path.
+    #[test]
+    fn a_cylinder_netlist_is_not_a_bench() {
+        let v = hydrocyl_system::rig::preset("leaney-moog").unwrap();
+        assert!(!is_bench_rig(&v));
+        let e = FrictionBench::from_rig(&v).unwrap_err();
+        assert!(e.contains("identify.model"), "{e}");
+    }
+
+    /// The identification section's column roles are the measured-data
+    /// format's signals.
+    #[test]
+    fn column_roles_are_the_formats_signals() {
+        let names: Vec<&str> = Signal::ALL.iter().map(|s| s.name()).collect();
+        assert_eq!(names, hydrocyl_system::netlist::identify::COLUMN_ROLES);
     }
 
     /// The presets' identification view is the declaration the bench had

@@ -10,8 +10,14 @@
 //!   circuit of `fixtures/rigs/wang-hybrid.json` with the file's values.
 //! * `friction-bench` ([`bench::to_netlist`]): the bench's drive, measured
 //!   pressures, piston and `friction_bench` law; its identification fields
-//!   (catalog refits, column map) stay with `hydrocyl-identify`, which reads
-//!   them from the file.
+//!   (refits, column map, steady-state flag) become the netlist's
+//!   identification section ([`crate::netlist::identify`]).
+//!
+//! Older files keep loading: every command that takes a rig file reads them
+//! through this conversion, with the results of their netlists
+//! (`fixtures/legacy/` keeps one of each kind, tested against its netlist in
+//! `fixtures/measured/`). `hydrocyl simulate --rig OLD.json --print-rig >
+//! NEW.json` writes the netlist.
 //!
 //! The typed rigs stay the identification and study views of their
 //! circuits (`ValveRig::from_netlist`, `WangHybrid::from_netlist`,
@@ -154,7 +160,7 @@ mod tests {
     #[test]
     fn a_migrated_valve_rig_reads_back_as_the_same_rig() {
         let festo: Value = serde_json::from_str(include_str!(
-            "../../../../fixtures/measured/festo-hanging-load.rig.json"
+            "../../../../fixtures/legacy/festo-hanging-load.rig.json"
         ))
         .unwrap();
         let leaney = serde_json::to_value(ValveRig::leaney_moog()).unwrap();
@@ -163,6 +169,32 @@ mod tests {
             let back = ValveRig::from_netlist(&migrate(&old).unwrap().unwrap()).unwrap();
             assert_eq!(back, typed, "{}", typed.name);
         }
+    }
+
+    /// Each older file kept in `fixtures/legacy/` loads as the netlist that
+    /// replaced it in `fixtures/measured/`, parameter for parameter (both
+    /// with every default written out): the same circuit and the same
+    /// identification section, so every command gives the same results on
+    /// either file.
+    #[test]
+    fn legacy_files_load_as_their_netlists() {
+        let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
+        let mut seen = 0;
+        for entry in std::fs::read_dir(fixtures.join("legacy")).unwrap() {
+            let old = entry.unwrap().path();
+            let new = fixtures.join("measured").join(old.file_name().unwrap());
+            let loaded = crate::rig::load(old.to_str().unwrap()).unwrap();
+            let file = crate::rig::load(new.to_str().unwrap()).unwrap();
+            assert_eq!(file["kind"], crate::netlist::KIND, "{}", new.display());
+            assert_eq!(
+                crate::netlist::expanded(&loaded).unwrap(),
+                crate::netlist::expanded(&file).unwrap(),
+                "{}",
+                old.display()
+            );
+            seen += 1;
+        }
+        assert!(seen >= 4, "{seen}");
     }
 
     #[test]

@@ -30,11 +30,15 @@
 //!   required port is connected.
 //! * `outputs` (optional): output columns → probes `component.probe`. Without
 //!   it every probe is an output named `component.probe`.
+//! * `identify` (optional): what `hydrocyl diagnose` needs beyond the
+//!   circuit — the model it builds, the record's column map, the parameter
+//!   paths it refits, the steady-state flag ([`identify`]).
 //!
 //! The parameter path of every value is `<component>.<parameter>` and
 //! `<component>.initial.<state>` — in `--set`, [`parameters`] and the docs.
 //! The components' order is the state vector's order.
 
+pub mod identify;
 mod inputs;
 pub mod locate;
 pub mod migrate;
@@ -289,12 +293,22 @@ pub fn set(v: &mut Value, path: &str, value: Value) -> Result<(), RigError> {
         .and_then(Value::as_object_mut)
         .ok_or_else(|| unknown(" (the netlist has no components)".into()))?;
     let names: Vec<String> = comps.keys().cloned().collect();
+    // a friction bench has no cylinder and no load: its drive carries the
+    // moving mass and the rod's position
+    let drive = comps
+        .iter()
+        .find(|(_, c)| c.get("type").and_then(Value::as_str) == Some("imposed_motion"))
+        .map(|(n, _)| n.clone())
+        .filter(|_| comp == "cylinder" || comp == "load");
     let obj = comps
         .get_mut(comp)
         .and_then(Value::as_object_mut)
         .ok_or_else(|| {
+            let bench = drive.map_or(String::new(), |d| {
+                format!("; a bench's drive `{d}` carries the moving mass and the rod's position: `{d}.mass`, `{d}.initial.position`")
+            });
             unknown(format!(
-                " (no component `{comp}`; components: {})",
+                " (no component `{comp}`; components: {}{bench})",
                 names.join(", ")
             ))
         })?;
@@ -361,4 +375,30 @@ pub fn expanded(v: &Value) -> Result<Value, RigError> {
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    /// `--set cylinder.…`/`load.…` on a friction bench (no cylinder, no
+    /// load) names the drive's paths that hold the mass and the position.
+    #[test]
+    fn a_bench_set_names_the_drives_paths() {
+        for preset in ["emps", "tudelft-seal-25"] {
+            let mut v = crate::rig::preset(preset).unwrap();
+            for path in ["cylinder.initial.position", "load.mass"] {
+                let e = super::set(&mut v, path, 0.01.into())
+                    .unwrap_err()
+                    .to_string();
+                assert!(
+                    e.contains("`drive.initial.position`") && e.contains("`drive.mass`"),
+                    "{e}"
+                );
+            }
+            super::set(&mut v, "drive.initial.position", 0.01.into()).unwrap();
+            let e = super::set(&mut v, "pump.speed", 1.0.into())
+                .unwrap_err()
+                .to_string();
+            assert!(!e.contains("drive.mass"), "{e}");
+        }
+    }
 }

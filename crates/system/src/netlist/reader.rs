@@ -34,6 +34,8 @@ pub struct Schematic {
     pub outputs: Vec<(String, String)>,
     /// The nodes: name → (domain, the ports on it as `component.port`).
     pub nodes: BTreeMap<String, (Domain, Vec<String>)>,
+    /// The identification section (`identify`), when the file has one.
+    pub identify: Option<super::identify::Identify>,
 }
 
 impl Schematic {
@@ -82,7 +84,8 @@ fn flatten(
     Ok(())
 }
 
-fn kind_of(v: &Value) -> &'static str {
+/// What a JSON value is, for messages (`a string`, `an array`, ...).
+pub(super) fn kind_of(v: &Value) -> &'static str {
     match v {
         Value::Null => "null",
         Value::Bool(_) => "a boolean",
@@ -290,12 +293,13 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
             "components",
             "connections",
             "outputs",
+            "identify",
         ]
         .contains(&k.as_str())
         {
             return err(
                 k.clone(),
-                "unknown key (a netlist has kind, name, description, components, connections, outputs)",
+                "unknown key (a netlist has kind, name, description, components, connections, outputs, identify)",
             );
         }
     }
@@ -568,10 +572,16 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
         }
     }
 
+    let identify = root
+        .get("identify")
+        .map(|v| super::identify::read(v, &instances))
+        .transpose()?;
+
     Ok(Schematic {
         name,
         instances,
         outputs,
         nodes,
+        identify,
     })
 }

@@ -5,7 +5,10 @@
 //! `friction_bench` law with the file's Coulomb level and catalog effects.
 //!
 //! The file's identification fields (`refit`, `columns`, `steady_state`)
-//! are not part of the circuit: `hydrocyl-identify` reads them from the file.
+//! become the netlist's identification section ([`crate::netlist::identify`],
+//! model `friction-bench`), the refits under their netlist paths
+//! ([`refit_path`]: `Fc` is `friction.coulomb`, `viscous.b` is
+//! `friction.viscous`).
 
 use super::typed;
 use crate::netlist::registry;
@@ -46,7 +49,7 @@ pub const EFFECT_PARAMS: &[(&str, &str, &str)] = &[
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-#[allow(dead_code)] // identification's fields are read by hydrocyl-identify
+#[allow(dead_code)] // `kind` is matched before
 struct BenchFile {
     kind: String,
     name: String,
@@ -62,7 +65,30 @@ struct BenchFile {
     #[serde(default)]
     refit: Vec<String>,
     #[serde(default)]
-    columns: Value,
+    columns: Map<String, Value>,
+}
+
+/// The netlist path of a fitted parameter as a `friction-bench` file names
+/// it: a netlist path (`friction.coulomb`, `drive.mass`,
+/// `friction.<parameter>`) as it is, or the catalog name `Fc`, `m` or
+/// `effect.param` (`viscous.b` → `friction.viscous`, through
+/// [`EFFECT_PARAMS`]); `None` for anything else.
+pub fn refit_path(name: &str) -> Option<String> {
+    match name {
+        "Fc" => return Some(format!("{FRICTION}.coulomb")),
+        "m" => return Some(format!("{DRIVE}.mass")),
+        _ => {}
+    }
+    let (a, b) = name.split_once('.')?;
+    if let Some((_, _, target)) = EFFECT_PARAMS.iter().find(|(e, p, _)| *e == a && *p == b) {
+        return Some(format!("{FRICTION}.{target}"));
+    }
+    let known = match a {
+        DRIVE => b == "mass",
+        FRICTION => b == "coulomb" || EFFECT_PARAMS.iter().any(|(_, _, t)| *t == b),
+        _ => false,
+    };
+    known.then(|| name.to_string())
 }
 
 #[derive(Deserialize)]
@@ -173,10 +199,35 @@ pub fn to_netlist(v: &Value) -> Result<Value, RigError> {
             }
         }
     }
-    Ok(json!({
+    let mut identify = Map::new();
+    identify.insert(
+        "model".into(),
+        json!(crate::netlist::identify::IdentifyModel::FrictionBench.name()),
+    );
+    if !f.columns.is_empty() {
+        identify.insert("columns".into(), Value::Object(f.columns.clone()));
+    }
+    if !f.refit.is_empty() {
+        let paths = f
+            .refit
+            .iter()
+            .enumerate()
+            .map(|(k, r)| {
+                refit_path(r).map(Value::from).ok_or_else(|| RigError::Invalid {
+                    path: format!("refit[{k}]"),
+                    why: format!("`{r}` is not a bench parameter (`friction.coulomb`, `drive.mass`, `friction.<parameter>`, or Fc, m, effect.param)"),
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        identify.insert("refit".into(), Value::Array(paths));
+    }
+    if f.steady_state {
+        identify.insert("steady_state".into(), json!(true));
+    }
+    let n = json!({
         "kind": crate::netlist::KIND,
         "name": f.name,
-        "description": "a friction bench (migrated from a `friction-bench` file): the drive imposes the record's velocity (input `drive`) and acceleration (input `acceleration`); the chambers hold the record's pressures (inputs `p1`, `p2`); the load cell reads `drive.force`",
+        "description": "a friction bench: the drive imposes the record's velocity (input `drive`) and acceleration (input `acceleration`); the chambers hold the record's pressures (inputs `p1`, `p2`); the load cell reads `drive.force`",
         "components": {
             DRIVE: {
                 "type": "imposed_motion",
@@ -207,8 +258,20 @@ pub fn to_netlist(v: &Value) -> Result<Value, RigError> {
             "p2": "chamber_2.p",
             "force": "drive.force",
             "friction_force": "friction.force"
-        }
-    }))
+        },
+        "identify": Value::Object(identify)
+    });
+    // the identification section checked here, so that its errors name the
+    // file's own keys (`columns.torque`, `refit[1]`)
+    crate::netlist::read(&n).map_err(|e| RigError::Invalid {
+        path: e
+            .path
+            .strip_prefix("identify.")
+            .unwrap_or(&e.path)
+            .to_string(),
+        why: e.why,
+    })?;
+    Ok(n)
 }
 
 #[cfg(test)]

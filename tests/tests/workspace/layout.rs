@@ -83,3 +83,76 @@ fn every_crate_opens_its_docs_with_a_title_and_a_compiled_example() {
         assert!(examples >= 2, "{} has no example", lib.display());
     }
 }
+
+/// The `hydrocyl-*` crates a manifest lists under `[dependencies]` (not dev
+/// or build), without the prefix.
+fn workspace_dependencies(manifest: &str) -> Vec<String> {
+    let mut in_deps = false;
+    let mut deps = Vec::new();
+    for line in manifest.lines() {
+        let line = line.trim();
+        if line.starts_with('[') {
+            in_deps = line == "[dependencies]";
+            continue;
+        }
+        if let Some(name) = line.strip_prefix("hydrocyl-").filter(|_| in_deps) {
+            let name = name.split(|c: char| c == ' ' || c == '=' || c == '.').next();
+            deps.push(name.unwrap().to_string());
+        }
+    }
+    deps
+}
+
+#[test]
+fn architecture_graph_is_the_transitive_reduction_of_the_manifests() {
+    use std::collections::{BTreeMap, BTreeSet};
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    let mut dirs: Vec<_> = std::fs::read_dir(root().join("crates"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    dirs.push(root().join("xtask"));
+    for dir in dirs {
+        let Ok(manifest) = std::fs::read_to_string(dir.join("Cargo.toml")) else {
+            continue;
+        };
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        graph.insert(name, workspace_dependencies(&manifest).into_iter().collect());
+    }
+    let reaches = |from: &str, to: &str, skip_direct: bool| -> bool {
+        let mut stack: Vec<&str> = graph[from]
+            .iter()
+            .filter(|d| !(skip_direct && d.as_str() == to))
+            .map(String::as_str)
+            .collect();
+        let mut seen = BTreeSet::new();
+        while let Some(n) = stack.pop() {
+            if n == to {
+                return true;
+            }
+            if seen.insert(n) {
+                stack.extend(graph[n].iter().map(String::as_str));
+            }
+        }
+        false
+    };
+    let mut expected = BTreeSet::new();
+    for (from, deps) in &graph {
+        for to in deps {
+            if !reaches(from, to, true) {
+                expected.insert(format!("{from} --> {to}"));
+            }
+        }
+    }
+    let doc = std::fs::read_to_string(root().join("docs/architecture.md")).unwrap();
+    let drawn: BTreeSet<String> = doc
+        .lines()
+        .map(str::trim)
+        .filter(|l| l.contains(" --> "))
+        .map(str::to_string)
+        .collect();
+    assert_eq!(
+        drawn, expected,
+        "docs/architecture.md's graph vs the transitive reduction of the crates' [dependencies]"
+    );
+}

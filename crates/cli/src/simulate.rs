@@ -589,10 +589,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         run.stats.rejected,
         run.stats.rhs_evals,
         if cav > 0 {
-            format!(
-                "CAVITATION: a chamber entered cavitation {cav} times between the output samples (lowest sampled chamber pressure {:.0} Pa)",
-                min_p
-            )
+            let lowest = if min_p.is_finite() {
+                format!("lowest sampled chamber pressure {min_p:.0} Pa")
+            } else {
+                "no chamber pressure among the outputs".to_string()
+            };
+            format!("CAVITATION: a chamber entered cavitation {cav} times between the output samples ({lowest})")
         } else {
             "no cavitation".to_string()
         }

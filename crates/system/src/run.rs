@@ -215,12 +215,17 @@ impl Run {
             .sum()
     }
 
-    /// Lowest value of the chamber pressure channels `p1`, `p2` \[Pa\].
+    /// Lowest value of the chamber pressure channels \[Pa\]: `p1`, `p2` and
+    /// every cylinder's `<cylinder>.p1`, `<cylinder>.p2`; infinite when the
+    /// outputs hold none.
     pub fn min_chamber_pressure(&self) -> f64 {
-        ["p1", "p2"]
+        self.channels
             .iter()
-            .filter_map(|n| self.channel(n))
-            .flat_map(|v| v.iter().copied())
+            .filter(|c| {
+                let probe = c.name.rsplit('.').next().unwrap_or(&c.name);
+                probe == "p1" || probe == "p2"
+            })
+            .flat_map(|c| c.values.iter().copied())
             .fold(f64::INFINITY, f64::min)
     }
 }

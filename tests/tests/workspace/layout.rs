@@ -96,7 +96,9 @@ fn workspace_dependencies(manifest: &str) -> Vec<String> {
             continue;
         }
         if let Some(name) = line.strip_prefix("hydrocyl-").filter(|_| in_deps) {
-            let name = name.split(|c: char| c == ' ' || c == '=' || c == '.').next();
+            let name = name
+                .split(|c: char| c == ' ' || c == '=' || c == '.')
+                .next();
             deps.push(name.unwrap().to_string());
         }
     }
@@ -117,7 +119,10 @@ fn architecture_graph_is_the_transitive_reduction_of_the_manifests() {
             continue;
         };
         let name = dir.file_name().unwrap().to_string_lossy().into_owned();
-        graph.insert(name, workspace_dependencies(&manifest).into_iter().collect());
+        graph.insert(
+            name,
+            workspace_dependencies(&manifest).into_iter().collect(),
+        );
     }
     let reaches = |from: &str, to: &str, skip_direct: bool| -> bool {
         let mut stack: Vec<&str> = graph[from]

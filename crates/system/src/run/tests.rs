@@ -178,3 +178,26 @@ fn probes_read_on_a_second_circuit_are_the_runs() {
     assert!(!c.history_free());
     assert!(ProbeReader::new(c, &x0, t[0], &opts).is_err());
 }
+
+#[test]
+fn min_chamber_pressure_reads_every_cylinders_chambers_and_nothing_else() {
+    let channel = |name: &str, values: Vec<f64>| Channel {
+        name: name.into(),
+        unit: "Pa",
+        values,
+    };
+    let mut r = Run {
+        time: vec![0.0, 1.0],
+        channels: vec![
+            channel("cylinder_1.p1", vec![3e5, 2e5]),
+            channel("cylinder_2.p2", vec![1e5, -4e4]),
+            channel("line_1.p", vec![-9e5, -9e5]),
+        ],
+        ..Run::default()
+    };
+    assert_eq!(r.min_chamber_pressure(), -4e4);
+    r.channels.push(channel("p1", vec![-5e4, 0.0]));
+    assert_eq!(r.min_chamber_pressure(), -5e4);
+    r.channels.clear();
+    assert_eq!(r.min_chamber_pressure(), f64::INFINITY);
+}

@@ -82,18 +82,24 @@ impl<'a> PlainCsv<'a> {
     /// Reads the columns `wanted` (indices into the header; each becomes one
     /// output vector, in the order given) from every data row. `None` when a
     /// row has a number of cells other than the header's, a blank line
-    /// precedes more data, or a wanted cell is not a finite number.
+    /// precedes more data, a wanted cell is not a finite number, or a data
+    /// line holds a quote or a lone carriage return.
     ///
     /// A long body is read in consecutive pieces (whole lines each), one per
-    /// core, and the pieces' columns joined: the values are the same.
+    /// core ([`PlainCsv::threads`]), and the pieces' columns joined: the
+    /// values are the same.
     pub fn columns(&self, wanted: &[usize]) -> Option<Vec<Vec<f64>>> {
-        let body = self.body.as_bytes();
-        let threads = if body.len() < PARALLEL_BYTES {
+        self.columns_on(wanted, self.threads())
+    }
+
+    /// The threads [`PlainCsv::columns`] reads with: one per core (at most
+    /// 8) for a body of at least 128 KiB, else one.
+    pub fn threads(&self) -> usize {
+        if self.body.len() < PARALLEL_BYTES {
             1
         } else {
             std::thread::available_parallelism().map_or(1, |n| n.get().min(8))
-        };
-        self.columns_on(wanted, threads)
+        }
     }
 
     /// [`PlainCsv::columns`] on at most `threads` threads (one piece each).

@@ -438,7 +438,11 @@ fn csv_per_row() -> Result<(), String> {
     }) / rows;
     let text = String::from_utf8(write_columns(&names, &columns)).map_err(|e| e.to_string())?;
     let wanted: Vec<usize> = (0..names.len()).collect();
-    let threads = |text: &str| PlainCsv::new(text).map(|p| p.threads()).ok_or("not plain CSV");
+    let threads = |text: &str| {
+        PlainCsv::new(text)
+            .map(|p| p.threads())
+            .ok_or("not plain CSV")
+    };
     let read_threads = threads(&text)?;
     let read_par = median_ns(|| {
         PlainCsv::new(&text)

@@ -108,7 +108,9 @@ impl<'a> PlainCsv<'a> {
         let body = self.body.as_bytes();
         // rows estimated from the first line's length (a quarter more for
         // longer lines below it); a wrong guess only costs a reallocation
-        let line = memchr::memchr(b'\n', body).map_or(body.len(), |i| i + 1).max(1);
+        let line = memchr::memchr(b'\n', body)
+            .map_or(body.len(), |i| i + 1)
+            .max(1);
         let rows_in = |bytes: usize| bytes / line + bytes / (4 * line) + 2;
         let read = |piece: &[u8], hint: usize| -> Option<(Body, Vec<Vec<f64>>)> {
             let mut out: Vec<Vec<f64>> = wanted.iter().map(|_| Vec::with_capacity(hint)).collect();
@@ -563,7 +565,10 @@ mod tests {
         ] {
             let p = PlainCsv::new(t).unwrap();
             assert!(p.columns(&[0, 1]).is_none(), "{why}: {t:?}");
-            assert!(p.columns(&[0]).is_none(), "{why} in an unwanted cell: {t:?}");
+            assert!(
+                p.columns(&[0]).is_none(),
+                "{why} in an unwanted cell: {t:?}"
+            );
         }
         let p = PlainCsv::new("t,u\r\n0, 1 \r\n2,3\r\n\r\n").unwrap();
         assert_eq!(p.columns(&[0, 1]).unwrap(), [[0.0, 2.0], [1.0, 3.0]]);

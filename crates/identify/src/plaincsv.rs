@@ -26,12 +26,14 @@
 //! ([`PlainCsv::columns`], [`write_columns_in_parts`] with [`write_parts`]).
 
 /// Bodies at least this long are read on every core ([`PlainCsv::columns`]):
-/// below it, starting a thread (some 30 µs) costs more than it saves
-/// (128 KiB is ~700 rows of 10 full-precision columns, ~100 µs of parsing).
+/// below it, starting and joining a thread (10–40 µs measured on the
+/// 2-core machine under load) and joining the pieces cost too much of what
+/// they save (128 KiB is ~750 rows of 10 full-precision columns, ~160 µs of
+/// parsing on one thread).
 const PARALLEL_BYTES: usize = 1 << 17;
 
 /// Cells each part of a parallel write has at least ([`write_parts`]):
-/// 8192 cells are ~150 µs of formatting, several times a thread's start.
+/// 8192 cells are ~160 µs of formatting, several times a thread's start.
 const WRITE_PART_CELLS: usize = 1 << 13;
 
 /// A CSV text without quoting, split into its header and its data lines.

@@ -17,10 +17,24 @@
 //! fast); they are written with [`zmij`] (shortest text that parses back to
 //! the same `f64`). [`Rows`] reads data lines in pieces, for a file read a
 //! buffer at a time.
+//!
+//! Both directions skip the number conversion where a cell repeats the one
+//! above it (a held command, a supply pressure, a saturated spool): the
+//! writer copies the text above when the value is the same bits, the reader
+//! takes the value above when the text is the same bytes. Long tables are
+//! split into blocks of whole rows, one per core
+//! ([`PlainCsv::columns`], [`write_columns_in_parts`] with [`write_parts`]).
 
 /// Bodies at least this long are read on every core ([`PlainCsv::columns`]):
-/// below it, starting the threads costs more than they save.
-const PARALLEL_BYTES: usize = 1 << 16;
+/// below it, starting and joining a thread (10–40 µs measured on the
+/// 2-core machine under load) and joining the pieces cost too much of what
+/// they save (128 KiB is ~750 rows of 10 full-precision columns, ~160 µs of
+/// parsing on one thread).
+const PARALLEL_BYTES: usize = 1 << 17;
+
+/// Cells each part of a parallel write has at least ([`write_parts`]):
+/// 8192 cells are ~160 µs of formatting, several times a thread's start.
+const WRITE_PART_CELLS: usize = 1 << 13;
 
 /// A CSV text without quoting, split into its header and its data lines.
 #[derive(Clone, Debug)]
@@ -41,14 +55,16 @@ impl<'a> PlainCsv<'a> {
         if text.starts_with('\u{feff}') {
             return None;
         }
-        // one pass: no quote, no lone carriage return (a line end to the full reader)
-        if !Rows::plain_bytes(text.as_bytes()) {
+        let (line, body) = match memchr::memchr(b'\n', text.as_bytes()) {
+            Some(i) => (&text[..=i], &text[i + 1..]),
+            None => (text, ""),
+        };
+        // no quote, no lone carriage return (a line end to the full reader);
+        // the data lines are checked as they are read
+        if !Rows::plain_bytes(line.as_bytes()) {
             return None;
         }
-        let (header, body) = match text.find('\n') {
-            Some(i) => (strip_cr(&text[..i]), &text[i + 1..]),
-            None => (strip_cr(text), ""),
-        };
+        let header = strip_cr(line.strip_suffix('\n').unwrap_or(line));
         if header.trim().is_empty() {
             return None;
         }
@@ -68,25 +84,43 @@ impl<'a> PlainCsv<'a> {
     /// Reads the columns `wanted` (indices into the header; each becomes one
     /// output vector, in the order given) from every data row. `None` when a
     /// row has a number of cells other than the header's, a blank line
-    /// precedes more data, or a wanted cell is not a finite number.
+    /// precedes more data, a wanted cell is not a finite number, or a data
+    /// line holds a quote or a lone carriage return.
     ///
     /// A long body is read in consecutive pieces (whole lines each), one per
-    /// core, and the pieces' columns joined: the values are the same.
+    /// core ([`PlainCsv::threads`]), and the pieces' columns joined: the
+    /// values are the same.
     pub fn columns(&self, wanted: &[usize]) -> Option<Vec<Vec<f64>>> {
-        let rows = Rows::new(self.width(), wanted)?;
-        let body = self.body.as_bytes();
-        let threads = if body.len() < PARALLEL_BYTES {
+        self.columns_on(wanted, self.threads())
+    }
+
+    /// The threads [`PlainCsv::columns`] reads with: one per core (at most
+    /// 8) for a body of at least 128 KiB, else one.
+    pub fn threads(&self) -> usize {
+        if self.body.len() < PARALLEL_BYTES {
             1
         } else {
             std::thread::available_parallelism().map_or(1, |n| n.get().min(8))
-        };
-        let read = |piece: &[u8]| -> Option<(Body, Vec<Vec<f64>>)> {
-            let hint = piece.len() / (8 * rows.width).max(1) + 1;
+        }
+    }
+
+    /// [`PlainCsv::columns`] on at most `threads` threads (one piece each).
+    pub fn columns_on(&self, wanted: &[usize], threads: usize) -> Option<Vec<Vec<f64>>> {
+        let rows = Rows::new(self.width(), wanted)?;
+        let body = self.body.as_bytes();
+        // rows estimated from the first line's length (a quarter more for
+        // longer lines below it); a wrong guess only costs a reallocation
+        let line = memchr::memchr(b'\n', body)
+            .map_or(body.len(), |i| i + 1)
+            .max(1);
+        let rows_in = |bytes: usize| bytes / line + bytes / (4 * line) + 2;
+        let read = |piece: &[u8], hint: usize| -> Option<(Body, Vec<Vec<f64>>)> {
             let mut out: Vec<Vec<f64>> = wanted.iter().map(|_| Vec::with_capacity(hint)).collect();
             Some((rows.parse(piece, &mut out)?, out))
         };
+        let threads = threads.clamp(1, 8);
         if threads == 1 {
-            return read(body).map(|(_, out)| out);
+            return read(body, rows_in(body.len())).map(|(_, out)| out);
         }
         // cut after the line end at or after each share of the bytes
         let mut cuts = vec![0];
@@ -100,9 +134,10 @@ impl<'a> PlainCsv<'a> {
         let parts: Vec<Option<(Body, Vec<Vec<f64>>)>> = std::thread::scope(|s| {
             let handles: Vec<_> = pieces[1..]
                 .iter()
-                .map(|&p| s.spawn(move || read(p)))
+                .map(|&p| s.spawn(move || read(p, rows_in(p.len()))))
                 .collect();
-            std::iter::once(read(pieces[0]))
+            // the first piece's columns take the others' rows after its own
+            std::iter::once(read(pieces[0], rows_in(body.len())))
                 .chain(handles.into_iter().map(|h| h.join().ok().flatten()))
                 .collect()
         });
@@ -110,7 +145,7 @@ impl<'a> PlainCsv<'a> {
         let mut blank_end = false;
         for (piece, part) in pieces.iter().zip(parts) {
             // after blank lines only blank lines may follow (as in `parse`)
-            if blank_end && !piece.iter().all(|&c| c == b'\n' || c == b'\r') {
+            if blank_end && !blank_tail(piece) {
                 return None;
             }
             let (end, cols) = part?;
@@ -146,18 +181,20 @@ pub enum Body {
 #[derive(Clone, Debug)]
 pub struct Rows {
     width: usize,
-    /// Column index → output slot (`usize::MAX`: not wanted).
-    slot: Vec<usize>,
+    /// Per column: its output slot (`usize::MAX`: not wanted) and the byte
+    /// that ends its cell (`,`, the last `\n`).
+    slot: Vec<(usize, u8)>,
 }
 
 impl Rows {
     /// Rows of `width` cells of which the columns `wanted` are read;
     /// `None` when a wanted column is not among them.
     pub fn new(width: usize, wanted: &[usize]) -> Option<Self> {
-        let mut slot = vec![usize::MAX; width];
+        let mut slot = vec![(usize::MAX, b','); width];
         for (k, &j) in wanted.iter().enumerate() {
-            *slot.get_mut(j)? = k;
+            slot.get_mut(j)?.0 = k;
         }
+        slot.last_mut()?.1 = b'\n';
         Some(Self { width, slot })
     }
 
@@ -169,84 +206,151 @@ impl Rows {
     }
 
     /// Appends the wanted cells of the lines in `b` (whole lines) to `out`
-    /// (one vector per wanted column). `None` as for [`PlainCsv::columns`];
-    /// a blank line is plain only when nothing but blank lines follows it,
-    /// here or in a later piece ([`Body::BlankEnd`]).
+    /// (one vector per wanted column). `None` as for [`PlainCsv::columns`],
+    /// and where the bytes are not plain ([`Rows::plain_bytes`]); a blank
+    /// line is plain only when nothing but blank lines follows it, here or
+    /// in a later piece ([`Body::BlankEnd`]).
+    ///
+    /// One pass: each wanted cell is parsed where it starts, and the parser
+    /// says where its number ends. A cell whose text is the text of the cell
+    /// above it (a held command, a supply pressure) takes that cell's value
+    /// without being parsed again.
     pub fn parse(&self, b: &[u8], out: &mut [Vec<f64>]) -> Option<Body> {
         let len = b.len();
+        // per column, the text of the cell above (start, length; length 0:
+        // none to compare with) and its value
+        let mut above: Vec<(usize, usize, f64)> = vec![(0, 0, 0.0); self.width];
         let mut pos = 0;
         while pos < len {
             if b[pos] == b'\n' || b[pos] == b'\r' {
                 // the full reader skips blank lines, which shifts its row
                 // numbers away from the line numbers: only a blank end is plain
-                if b[pos..].iter().all(|&c| c == b'\n' || c == b'\r') {
-                    return Some(Body::BlankEnd);
-                }
-                return None;
+                return blank_tail(&b[pos..]).then_some(Body::BlankEnd);
             }
-            let mut n = 0;
-            loop {
-                let k = *self.slot.get(n)?;
-                n += 1;
-                // one pass: a wanted cell is parsed where it starts and must
-                // end at its separator; an unwanted one is skipped
+            for (&(k, sep), a) in self.slot.iter().zip(above.iter_mut()) {
                 let end = if k == usize::MAX {
-                    memchr::memchr2(b',', b'\n', &b[pos..]).map_or(len, |i| pos + i)
+                    skip_cell(b, pos)?
                 } else {
-                    let (v, end) = number_at(b, pos)?;
+                    let (v, end) = match repeat(b, pos, a) {
+                        Some(end) => (a.2, end),
+                        None => {
+                            let (v, start, n) = number_at(b, pos)?;
+                            // texts longer than any shortest round trip
+                            // (24 bytes) are not compared
+                            *a = (start, if n <= MAX_CELL { n } else { 0 }, v);
+                            (v, start + n)
+                        }
+                    };
                     out[k].push(v);
-                    end
+                    cell_end(b, end)?
                 };
-                pos = end + 1;
-                if end == len || b[end] == b'\n' {
-                    break;
+                // a cell ends at a comma, the last at the line's end
+                if *b.get(end).unwrap_or(&b'\n') != sep {
+                    return None;
                 }
-            }
-            if n != self.width {
-                return None;
+                pos = end + 1;
             }
         }
         Some(Body::Rows)
     }
 }
 
-/// Whether `c` is white space a cell may carry around its number (what
-/// `<[u8]>::trim_ascii` takes off, but the line feed, which ends the line).
+/// Whether `b` is nothing but line ends (`\n`, `\r\n`).
+fn blank_tail(b: &[u8]) -> bool {
+    b.iter()
+        .enumerate()
+        .all(|(i, &c)| c == b'\n' || (c == b'\r' && b.get(i + 1) == Some(&b'\n')))
+}
+
+/// Whether `c` is white space a cell may carry before its number (what
+/// `<[u8]>::trim_ascii` takes off, but the line ends); after it, also a
+/// carriage return just before the line feed.
 #[inline]
 fn blank(c: u8) -> bool {
-    matches!(c, b' ' | b'\t' | b'\r' | b'\x0c')
+    matches!(c, b' ' | b'\t' | b'\x0c')
+}
+
+/// The end of the cell (the index of its `,` or `\n`, or `b.len()`) whose
+/// number ends at `e`: blanks may follow the number, nothing else.
+#[inline]
+fn cell_end(b: &[u8], mut e: usize) -> Option<usize> {
+    while e < b.len() {
+        match b[e] {
+            b',' | b'\n' => return Some(e),
+            c if blank(c) => e += 1,
+            b'\r' if b.get(e + 1) == Some(&b'\n') => e += 1,
+            _ => return None,
+        }
+    }
+    Some(e)
+}
+
+/// The end of an unwanted cell that starts at `pos` (as [`cell_end`]);
+/// `None` when it holds a quote or a lone carriage return.
+fn skip_cell(b: &[u8], pos: usize) -> Option<usize> {
+    let mut e = pos;
+    while e < b.len() {
+        match b[e] {
+            b',' | b'\n' => return Some(e),
+            b'"' => return None,
+            b'\r' if b.get(e + 1) != Some(&b'\n') => return None,
+            _ => e += 1,
+        }
+    }
+    Some(e)
+}
+
+/// Eight bytes of `b` from `i` as one word.
+#[inline(always)]
+fn word(b: &[u8], i: usize) -> u64 {
+    let mut w = [0u8; 8];
+    w.copy_from_slice(&b[i..i + 8]);
+    u64::from_le_bytes(w)
+}
+
+/// Where the number ends if the cell at `pos` repeats the text of the cell
+/// above, `(start, n, _)` in `above`: the same `n` bytes, then a byte no
+/// number goes on with (so the parser would stop there too, with the same
+/// value). `None` when it does not, or when that is not quickly seen.
+#[inline(always)]
+fn repeat(b: &[u8], pos: usize, above: &(usize, usize, f64)) -> Option<usize> {
+    let (a, n, _) = *above;
+    // the words read stay inside `b` (`a < pos`, n <= MAX_CELL)
+    if n == 0 || pos + MAX_CELL >= b.len() {
+        return None;
+    }
+    let same = if n <= 8 {
+        (word(b, a) ^ word(b, pos)) & (u64::MAX >> (64 - 8 * n)) == 0
+    } else {
+        word(b, a) == word(b, pos)
+            && word(b, a + n - 8) == word(b, pos + n - 8)
+            && (n <= 16 || word(b, a + 8) == word(b, pos + 8))
+    };
+    let next = b[pos + n];
+    (same && (next == b',' || next == b'\n' || next == b'\r' || blank(next))).then_some(pos + n)
 }
 
 /// The finite number of the cell that starts at `start` in `b`, parsed as
 /// `str::parse::<f64>` parses the trimmed cell (the Eisel–Lemire algorithm,
 /// `fast-float2`, which reads `inf`/`nan` spellings and a leading `+` as it
-/// does and refuses the rest), and the index of the byte that ends the cell
-/// (`,`, `\n` or `b.len()`); `None` when the trimmed cell is anything but a
-/// finite number.
+/// does and refuses the rest), where its text starts and its length (what
+/// follows is for [`cell_end`] to judge); `None` when there is no such
+/// number or it is not finite.
 #[inline]
-fn number_at(b: &[u8], start: usize) -> Option<(f64, usize)> {
+fn number_at(b: &[u8], start: usize) -> Option<(f64, usize, usize)> {
     let mut i = start;
     while i < b.len() && blank(b[i]) {
         i += 1;
     }
     let (v, n): (f64, usize) = fast_float2::parse_partial(&b[i..]).ok()?;
-    let mut end = i + n;
-    while end < b.len() && blank(b[end]) {
-        end += 1;
-    }
-    if end < b.len() && b[end] != b',' && b[end] != b'\n' {
-        return None;
-    }
-    v.is_finite().then_some((v, end))
+    v.is_finite().then_some((v, i, n))
 }
 
 /// [`number_at`] on one whole cell.
 #[cfg(test)]
 fn number(cell: &[u8]) -> Option<f64> {
-    match number_at(cell, 0) {
-        Some((v, end)) if end == cell.len() => Some(v),
-        _ => None,
-    }
+    let (v, start, n) = number_at(cell, 0)?;
+    (cell_end(cell, start + n)? == cell.len()).then_some(v)
 }
 
 /// The longest text zmij writes for an `f64`.
@@ -288,37 +392,79 @@ pub fn run_columns(run: &hydrocyl_system::run::Run) -> (Vec<&str>, Vec<&[f64]>) 
     (names, columns)
 }
 
+/// Columns formatted before any of their texts is copied out: zmij writes
+/// a text with several narrow stores, and reading it back at once with wide
+/// loads stalls until they reach the cache; a group later they have.
+const GROUP: usize = 16;
+
+/// Rows put together between two growths of the output.
+const CHUNK_ROWS: usize = 64;
+
 /// Appends rows `rows` of `columns` as CSV lines (shortest round-trip text).
 /// A value equal (bit for bit) to the one above it in its column is not
 /// formatted again: its text is copied from the row above (a supply
 /// pressure, a held command).
+///
+/// The output grows by a chunk of rows at their longest at a time, the rows
+/// are written into it in place (no row buffer, no copy of a row), and it is
+/// cut back to what was written.
 fn write_rows(columns: &[&[f64]], rows: std::ops::Range<usize>, out: &mut Vec<u8>) {
-    let mut buf = zmij::Buffer::new();
-    // a row is put together in `row`, then appended with one copy
-    let mut row = vec![0u8; columns.len() * (MAX_CELL + 1) + 1];
-    // per column, the row above's value (bits) and its text's place in `out`
-    let mut above: Vec<(u64, usize, usize)> = vec![(0, 0, 0); columns.len()];
-    out.reserve(rows.len() * columns.len() * 20);
-    for k in rows {
+    let width = columns.len();
+    if width == 0 {
+        return;
+    }
+    let row_max = width * (MAX_CELL + 1);
+    let mut bufs: Vec<zmij::Buffer> = (0..width).map(|_| zmij::Buffer::new()).collect();
+    // per column, the row above's value (bits) and its text's place in
+    // `out` (start, length; length 0: no row above)
+    let mut above: Vec<(u64, usize, usize)> = vec![(0, 0, 0); width];
+    // where the row above starts in `out`
+    // room for every row at its longest: the chunks below never move it
+    out.reserve(rows.len() * row_max);
+    let mut prev = out.len();
+    let mut last = prev;
+    let mut k = rows.start;
+    while k < rows.end {
+        let n = (rows.end - k).min(CHUNK_ROWS);
         let base = out.len();
-        let mut at = 0;
-        for (c, a) in columns.iter().zip(above.iter_mut()) {
-            let bits = c[k].to_bits();
-            let start = at;
-            at = if a.2 > 0 && a.0 == bits {
-                put_short(&mut row, at, &out[a.1..a.1 + a.2])
-            } else {
-                put_short(&mut row, at, buf.format(c[k]).as_bytes())
-            };
-            *a = (bits, base + start, at - start);
-            row[at] = b',';
-            at += 1;
+        out.resize(base + n * row_max, 0);
+        // the chunk and the row above it, whose texts a repeat copies
+        let d = &mut out[prev..];
+        let mut at = base - prev;
+        for k in k..k + n {
+            let row = at;
+            for ((cols, bufs), above) in columns
+                .chunks(GROUP)
+                .zip(bufs.chunks_mut(GROUP))
+                .zip(above.chunks_mut(GROUP))
+            {
+                // the group's formatted texts; empty: the text above repeats
+                let mut texts: [&[u8]; GROUP] = [&[]; GROUP];
+                for (((t, c), b), a) in texts.iter_mut().zip(cols).zip(bufs).zip(above.iter()) {
+                    if a.2 == 0 || a.0 != c[k].to_bits() {
+                        *t = b.format(c[k]).as_bytes();
+                    }
+                }
+                for ((t, c), a) in texts.iter().zip(cols).zip(above.iter_mut()) {
+                    let start = at;
+                    at = if t.is_empty() {
+                        let (done, rest) = d.split_at_mut(at);
+                        at + put_short(rest, 0, &done[a.1 - prev..a.1 - prev + a.2])
+                    } else {
+                        put_short(d, at, t)
+                    };
+                    *a = (c[k].to_bits(), prev + start, at - start);
+                    d[at] = b',';
+                    at += 1;
+                }
+            }
+            // the last separator becomes the line end
+            d[at - 1] = b'\n';
+            last = prev + row;
         }
-        // the last separator becomes the line end
-        if at > 0 {
-            row[at - 1] = b'\n';
-        }
-        out.extend_from_slice(&row[..at]);
+        out.truncate(prev + at);
+        prev = last;
+        k += n;
     }
 }
 
@@ -338,9 +484,18 @@ pub fn write_columns(names: &[&str], columns: &[&[f64]]) -> Vec<u8> {
         .unwrap_or_default()
 }
 
-/// [`write_columns`] formatted by `parts` threads, each a contiguous block of
-/// rows (the header goes with the first): the parts, in order, are the text.
-/// Writing them one after the other spares the copy of a concatenation.
+/// How many parts [`write_columns_in_parts`] pays to use for `rows` rows of
+/// `width` columns: one per core (at most 8), as long as each part has at
+/// least 8192 cells.
+pub fn write_parts(rows: usize, width: usize) -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
+    (rows.saturating_mul(width) / WRITE_PART_CELLS).clamp(1, cores)
+}
+
+/// [`write_columns`] formatted by `parts` threads (this one and `parts - 1`
+/// started for it), each a contiguous block of rows (the header goes with
+/// the first): the parts, in order, are the text. Writing them one after
+/// the other spares the copy of a concatenation.
 pub fn write_columns_in_parts(names: &[&str], columns: &[&[f64]], parts: usize) -> Vec<Vec<u8>> {
     let mut head = names.join(",").into_bytes();
     head.push(b'\n');
@@ -349,15 +504,13 @@ pub fn write_columns_in_parts(names: &[&str], columns: &[&[f64]], parts: usize) 
     let bounds: Vec<usize> = (0..=parts).map(|i| i * rows / parts).collect();
     let mut out: Vec<Vec<u8>> = vec![Vec::new(); parts];
     out[0] = head;
-    if parts == 1 {
-        write_rows(columns, 0..rows, &mut out[0]);
-        return out;
-    }
+    let (first, rest) = out.split_at_mut(1);
     std::thread::scope(|s| {
-        for (i, o) in out.iter_mut().enumerate() {
-            let range = bounds[i]..bounds[i + 1];
+        for (i, o) in rest.iter_mut().enumerate() {
+            let range = bounds[i + 1]..bounds[i + 2];
             s.spawn(move || write_rows(columns, range, o));
         }
+        write_rows(columns, 0..bounds[1], &mut first[0]);
     });
     out
 }
@@ -405,6 +558,55 @@ mod tests {
         let p = PlainCsv::new("time,u\n0,NaN\n").unwrap();
         assert!(p.columns(&[1]).is_none(), "not finite");
         assert!(p.columns(&[0]).is_some(), "unwanted cells are not parsed");
+        // the data lines are checked as they are read, wanted cell or not
+        for (t, why) in [
+            ("t,u\n0,\"1\"\n", "a quote"),
+            ("t,u\n0,1\r2,3\n", "a lone carriage return"),
+            ("t,u\n0,1\n\r", "a lone carriage return at the end"),
+            ("t,u\n0, 1\r\r\n", "a carriage return before another"),
+        ] {
+            let p = PlainCsv::new(t).unwrap();
+            assert!(p.columns(&[0, 1]).is_none(), "{why}: {t:?}");
+            assert!(
+                p.columns(&[0]).is_none(),
+                "{why} in an unwanted cell: {t:?}"
+            );
+        }
+        let p = PlainCsv::new("t,u\r\n0, 1 \r\n2,3\r\n\r\n").unwrap();
+        assert_eq!(p.columns(&[0, 1]).unwrap(), [[0.0, 2.0], [1.0, 3.0]]);
+    }
+
+    /// A cell whose text repeats the one above it reads as if parsed, also
+    /// where the text above is only a prefix of it or it carries blanks.
+    #[test]
+    fn repeated_texts_read_as_parsed() {
+        let cells = [
+            "7000000.0",
+            "7000000.0",
+            "7000000.01",
+            "7000000.0 ",
+            " 7000000.0",
+            "7000000.0e0",
+            "7000000.0",
+            "7000000.0e",
+            "7000000.0",
+            "0.13641301660791483",
+            "0.136413016607914830",
+            "0.13641301660791483\t",
+            "0.13641301660791483",
+        ];
+        let mut text = String::from("a,b\n");
+        for c in cells {
+            text.push_str(&format!("{c},{c}\r\n"));
+        }
+        // the long tail keeps every cell above within the compared window
+        text.push_str(&"1,2\n".repeat(20));
+        let bad = text.replace("7000000.0e,7000000.0e", "7000000.0,7000000.0");
+        assert_eq!(full(&text, &[0, 1]), None, "`7000000.0e` is not a number");
+        assert_eq!(PlainCsv::new(&text).unwrap().columns(&[0, 1]), None);
+        let fast = PlainCsv::new(&bad).unwrap().columns(&[1, 0]);
+        assert_eq!(fast, full(&bad, &[1, 0]));
+        assert_eq!(fast.unwrap()[0][..3], [7e6, 7e6, 7000000.01]);
     }
 
     /// The cell parser takes what `str::parse::<f64>` takes, the same value.
@@ -508,6 +710,38 @@ mod tests {
     }
 
     proptest! {
+        /// What is written reads back bit for bit, in any number of parts or
+        /// blocks, across the writer's chunks of rows, where values repeat.
+        #[test]
+        fn round_trip_is_exact(
+            cells in proptest::collection::vec(
+                (any::<f64>().prop_filter("finite", |v| v.is_finite()), any::<f64>(), 0u8..4),
+                1..60),
+        ) {
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            for (x, y, times) in &cells {
+                for _ in 0..=*times {
+                    a.push(*x);
+                    b.push(if y.is_finite() { *y } else { -0.0 });
+                }
+            }
+            let text = write_columns(&["a", "b"], &[&a, &b]);
+            for parts in [2, 3] {
+                prop_assert_eq!(&write_columns_in_parts(&["a", "b"], &[&a, &b], parts).concat(), &text);
+            }
+            let mut blocks = b"a,b\n".to_vec();
+            for k in (0..a.len()).step_by(7) {
+                let e = (k + 7).min(a.len());
+                append_rows(&[&a[k..e], &b[k..e]], &mut blocks);
+            }
+            prop_assert_eq!(&blocks, &text);
+            let text = String::from_utf8(text).unwrap();
+            let back = PlainCsv::new(&text).unwrap().columns(&[0, 1]).unwrap();
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            prop_assert_eq!(bits(&back[0]), bits(&a));
+            prop_assert_eq!(bits(&back[1]), bits(&b));
+        }
+
         /// Every cell is the shortest round-trip text of its value, also
         /// where a value repeats the one above it (its text copied) or
         /// differs from it only in sign (0.0 below -0.0).

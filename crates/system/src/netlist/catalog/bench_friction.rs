@@ -21,7 +21,7 @@ use super::super::registry::{
 use super::{built, port, HYD, MECH, SIG};
 use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe,
-    Wire, Wires,
+    Tangents, Wire, Wires,
 };
 use hydrocyl_ports::{Force, Mass, Pressure};
 
@@ -86,6 +86,72 @@ impl BenchLaw {
     pub fn added_mass(&self) -> f64 {
         self.k_pressure * self.h_acceleration
     }
+
+    /// `dg/dv` \[N·s·m⁻¹\] (0 without the hump; the one-sided slope of the
+    /// `+` side at `v = 0` with `α = 1`).
+    pub fn g_slope(&self, v: f64) -> f64 {
+        match self.stribeck {
+            Some((fs, vs, al)) => {
+                let vs = vs.max(1e-12);
+                let r = (v / vs).abs();
+                let (e, de) = if al == 1.0 {
+                    (r, 1.0)
+                } else if r == 0.0 {
+                    (0.0, if al > 1.0 { 0.0 } else { f64::INFINITY })
+                } else {
+                    let e = r.powf(al);
+                    (e, al * e / r)
+                };
+                -(fs - self.coulomb) * (-e).exp() * de * v.signum() / vs
+            }
+            None => 0.0,
+        }
+    }
+
+    /// The partials of [`BenchLaw::force`] and [`BenchLaw::z_rate`] at
+    /// `(v, p1, p2, z)` (the bench's analytic tangents).
+    pub fn partials(&self, v: f64, p1: f64, p2: f64, z: f64) -> BenchPartials {
+        let vt = self.smoothing_velocity;
+        let th = (v / vt).tanh();
+        let dth = (1.0 - th * th) / vt;
+        let (g, dg) = (self.g(v), self.g_slope(v));
+        let mut d = BenchPartials::default();
+        match self.lugre {
+            Some((s0, s1)) => {
+                let gg = g.max(1e-9);
+                let dgg = if g > 1e-9 { dg } else { 0.0 };
+                // ż = v − σ0 |v| z / g
+                d.dzdot_dz = -s0 * v.abs() / gg;
+                d.dzdot_dv = 1.0 - s0 * z * (v.signum() * gg - v.abs() * dgg) / (gg * gg);
+                d.df_dz = s0 + s1 * d.dzdot_dz;
+                d.df_dv = s1 * d.dzdot_dv;
+            }
+            None => d.df_dv = dg * th + g * dth,
+        }
+        let dp = p1 - p2;
+        d.df_dv += self.viscous + self.k_pressure * dp * dp + 0.5 * self.asymmetry * th.signum() * dth;
+        d.df_dp1 = 2.0 * self.k_pressure * dp * v;
+        d.df_dp2 = -d.df_dp1;
+        d
+    }
+}
+
+/// Partial derivatives of the bench law (SI): of the friction force `F`
+/// ([`BenchLaw::force`]) and of the bristle's rate `ż`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BenchPartials {
+    /// ∂F/∂v.
+    pub df_dv: f64,
+    /// ∂F/∂p1.
+    pub df_dp1: f64,
+    /// ∂F/∂p2.
+    pub df_dp2: f64,
+    /// ∂F/∂z.
+    pub df_dz: f64,
+    /// ∂ż/∂v.
+    pub dzdot_dv: f64,
+    /// ∂ż/∂z.
+    pub dzdot_dz: f64,
 }
 
 /// The bench law on a rod, reading the chamber pressures at `A` and `B`.
@@ -122,6 +188,32 @@ impl BenchFriction {
 impl Component for BenchFriction {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
+        let v = w.get(self.rod.velocity).si();
+        let (p1, p2) = self.pressures(w);
+        let j = self.law.partials(v, p1, p2, self.z(x));
+        d.chain(self.force, j.df_dv, self.rod.velocity);
+        if let Some((a, b)) = self.p {
+            d.chain(self.force, j.df_dp1, a);
+            d.chain(self.force, j.df_dp2, b);
+        }
+        if self.law.lugre.is_some() {
+            d.state(self.force, 0, j.df_dz);
+        }
+        d.chain(self.rod.force, -1.0, self.force);
+    }
+    fn derivative_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
+        if self.law.lugre.is_some() {
+            let v = w.get(self.rod.velocity).si();
+            let (p1, p2) = self.pressures(w);
+            let j = self.law.partials(v, p1, p2, x[0]);
+            d.rate_state(0, 0, j.dzdot_dz);
+            d.rate_chain(0, j.dzdot_dv, self.rod.velocity);
+        }
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.rod = net.mechanical(&self.rod_name);
@@ -248,6 +340,12 @@ pub struct SignalPressureSource {
 impl Component for SignalPressureSource {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.chain(self.node.pressure, 1.0, self.signal);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.signal = net.signal(&self.signal_name);

@@ -391,7 +391,6 @@ impl FrictionBench {
     }
 }
 
-mod inverse;
 mod model;
 mod presets;
 mod signals;

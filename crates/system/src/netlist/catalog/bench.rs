@@ -114,8 +114,9 @@ impl Component for ImposedMotion {
         let f = self.force_sign * self.drive_force(t, w);
         w.set(self.force, Force::new(f));
     }
-    fn derivatives(&self, t: f64, _x: &[f64], _w: &Wires, dx: &mut [f64]) {
-        dx[0] = self.velocity.value_hinted(t, &self.hint);
+    fn derivatives(&self, _t: f64, _x: &[f64], w: &Wires, dx: &mut [f64]) {
+        // the velocity `publish` set from the command
+        dx[0] = w.get(self.rod.velocity).si();
     }
     fn power(&self, t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         let v = self.velocity.value_hinted(t, &self.hint);

@@ -24,6 +24,7 @@ use crate::circuit::{
     Tangents, Wire, Wires,
 };
 use hydrocyl_ports::{Force, Mass, Pressure};
+use std::cell::Cell;
 
 /// The coefficients of the bench law \[SI\].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,31 +51,55 @@ pub struct BenchLaw {
 }
 
 impl BenchLaw {
-    /// g(v): the Coulomb level plus the Stribeck hump if any \[N\].
-    pub fn g(&self, v: f64) -> f64 {
-        match self.stribeck {
+    /// What the law's terms need of the velocity `v`: g(v) (the Coulomb
+    /// level plus the Stribeck hump if any), dg/dv (0 without the hump; the
+    /// one-sided slope of the `+` side at `v = 0` with `α = 1`) and
+    /// tanh(v/v_t), computed once (one power, one exponential, one tanh).
+    pub fn shape(&self, v: f64) -> Shape {
+        let th = (v / self.smoothing_velocity).tanh();
+        let (g, dg) = match self.stribeck {
             Some((fs, vs, al)) => {
-                let r = (v / vs.max(1e-12)).abs();
-                let e = if al == 1.0 { r } else { r.powf(al) };
-                self.coulomb + (fs - self.coulomb) * (-e).exp()
+                let vs = vs.max(1e-12);
+                let r = (v / vs).abs();
+                let (e, de) = if al == 1.0 {
+                    (r, 1.0)
+                } else if r == 0.0 {
+                    (0.0, if al > 1.0 { 0.0 } else { f64::INFINITY })
+                } else {
+                    let e = r.powf(al);
+                    (e, al * e / r)
+                };
+                let hump = (fs - self.coulomb) * (-e).exp();
+                (self.coulomb + hump, -hump * de * v.signum() / vs)
             }
-            None => self.coulomb,
-        }
+            None => (self.coulomb, 0.0),
+        };
+        Shape { v, g, dg, th }
     }
 
     /// The bristle's rate `ż` at deflection `z` \[m·s⁻¹\].
     pub fn z_rate(&self, v: f64, z: f64) -> f64 {
+        self.z_rate_at(&self.shape(v), z)
+    }
+
+    /// [`BenchLaw::z_rate`] at a velocity's [`Shape`].
+    pub fn z_rate_at(&self, s: &Shape, z: f64) -> f64 {
         let s0 = self.lugre.map_or(0.0, |(s0, _)| s0);
-        v - s0 * v.abs() * z / self.g(v).max(1e-9)
+        s.v - s0 * s.v.abs() * z / s.g.max(1e-9)
     }
 
     /// The friction force without the acceleration term `K H a` and without
     /// `F0` \[N\] (+ opposing + motion), at deflection `z`.
     pub fn force(&self, v: f64, p1: f64, p2: f64, z: f64) -> f64 {
-        let th = (v / self.smoothing_velocity).tanh();
+        self.force_at(&self.shape(v), p1, p2, z)
+    }
+
+    /// [`BenchLaw::force`] at a velocity's [`Shape`].
+    pub fn force_at(&self, s: &Shape, p1: f64, p2: f64, z: f64) -> f64 {
+        let (v, th) = (s.v, s.th);
         let mut f = match self.lugre {
-            Some((s0, s1)) => s0 * z + s1 * self.z_rate(v, z),
-            None => self.g(v) * th,
+            Some((s0, s1)) => s0 * z + s1 * self.z_rate_at(s, z),
+            None => s.g * th,
         };
         f += self.viscous * v;
         f += self.k_pressure * (p1 - p2).powi(2) * v;
@@ -87,34 +112,12 @@ impl BenchLaw {
         self.k_pressure * self.h_acceleration
     }
 
-    /// `dg/dv` \[N·s·m⁻¹\] (0 without the hump; the one-sided slope of the
-    /// `+` side at `v = 0` with `α = 1`).
-    pub fn g_slope(&self, v: f64) -> f64 {
-        match self.stribeck {
-            Some((fs, vs, al)) => {
-                let vs = vs.max(1e-12);
-                let r = (v / vs).abs();
-                let (e, de) = if al == 1.0 {
-                    (r, 1.0)
-                } else if r == 0.0 {
-                    (0.0, if al > 1.0 { 0.0 } else { f64::INFINITY })
-                } else {
-                    let e = r.powf(al);
-                    (e, al * e / r)
-                };
-                -(fs - self.coulomb) * (-e).exp() * de * v.signum() / vs
-            }
-            None => 0.0,
-        }
-    }
-
-    /// The partials of [`BenchLaw::force`] and [`BenchLaw::z_rate`] at
-    /// `(v, p1, p2, z)` (the bench's analytic tangents).
-    pub fn partials(&self, v: f64, p1: f64, p2: f64, z: f64) -> BenchPartials {
-        let vt = self.smoothing_velocity;
-        let th = (v / vt).tanh();
-        let dth = (1.0 - th * th) / vt;
-        let (g, dg) = (self.g(v), self.g_slope(v));
+    /// The partials of [`BenchLaw::force_at`] and [`BenchLaw::z_rate_at`]
+    /// at a velocity's [`Shape`] and `(p1, p2, z)` (the bench's analytic
+    /// tangents).
+    pub fn partials_at(&self, s: &Shape, p1: f64, p2: f64, z: f64) -> BenchPartials {
+        let (v, g, dg, th) = (s.v, s.g, s.dg, s.th);
+        let dth = (1.0 - th * th) / self.smoothing_velocity;
         let mut d = BenchPartials::default();
         match self.lugre {
             Some((s0, s1)) => {
@@ -134,6 +137,19 @@ impl BenchLaw {
         d.df_dp2 = -d.df_dp1;
         d
     }
+}
+
+/// What the bench law needs of one velocity ([`BenchLaw::shape`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shape {
+    /// The velocity \[m·s⁻¹\].
+    pub v: f64,
+    /// g(v) \[N\].
+    pub g: f64,
+    /// dg/dv \[N·s·m⁻¹\].
+    pub dg: f64,
+    /// tanh(v / v_t).
+    pub th: f64,
 }
 
 /// Partial derivatives of the bench law (SI): of the friction force `F`
@@ -169,9 +185,25 @@ pub struct BenchFriction {
     rod: MechanicalNode,
     p: Option<(Wire<Pressure>, Wire<Pressure>)>,
     force: Wire<Force>,
+    /// The law's [`Shape`] at the last velocity asked (a run evaluates the
+    /// force, the bristle's rate and their tangents at one velocity);
+    /// cleared when a parameter changes.
+    last: Cell<Option<Shape>>,
 }
 
 impl BenchFriction {
+    /// The law's shape at the rod's velocity.
+    fn shape(&self, w: &Wires) -> Shape {
+        let v = w.get(self.rod.velocity).si();
+        match self.last.get() {
+            Some(s) if s.v.to_bits() == v.to_bits() => s,
+            _ => {
+                let s = self.law.shape(v);
+                self.last.set(Some(s));
+                s
+            }
+        }
+    }
     fn pressures(&self, w: &Wires) -> (f64, f64) {
         self.p
             .map_or((0.0, 0.0), |(a, b)| (w.get(a).si(), w.get(b).si()))
@@ -193,9 +225,8 @@ impl Component for BenchFriction {
         true
     }
     fn evaluate_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
-        let v = w.get(self.rod.velocity).si();
         let (p1, p2) = self.pressures(w);
-        let j = self.law.partials(v, p1, p2, self.z(x));
+        let j = self.law.partials_at(&self.shape(w), p1, p2, self.z(x));
         d.chain(self.force, j.df_dv, self.rod.velocity);
         if let Some((a, b)) = self.p {
             d.chain(self.force, j.df_dp1, a);
@@ -208,9 +239,8 @@ impl Component for BenchFriction {
     }
     fn derivative_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
         if self.law.lugre.is_some() {
-            let v = w.get(self.rod.velocity).si();
             let (p1, p2) = self.pressures(w);
-            let j = self.law.partials(v, p1, p2, x[0]);
+            let j = self.law.partials_at(&self.shape(w), p1, p2, x[0]);
             d.rate_state(0, 0, j.dzdot_dz);
             d.rate_chain(0, j.dzdot_dv, self.rod.velocity);
         }
@@ -245,16 +275,15 @@ impl Component for BenchFriction {
         x.fill(self.initial_z);
     }
     fn evaluate(&self, _t: f64, x: &[f64], w: &mut Wires) {
-        let v = w.get(self.rod.velocity).si();
         let (p1, p2) = self.pressures(w);
-        let f = self.law.force(v, p1, p2, self.z(x)) + self.law.external_force;
+        let f = self.law.force_at(&self.shape(w), p1, p2, self.z(x)) + self.law.external_force;
         w.add(self.rod.force, Force::new(-f));
         w.add(self.rod.added_mass, Mass::new(self.law.added_mass()));
         w.set(self.force, Force::new(f));
     }
     fn derivatives(&self, _t: f64, x: &[f64], w: &Wires, dx: &mut [f64]) {
         if self.law.lugre.is_some() {
-            dx[0] = self.law.z_rate(w.get(self.rod.velocity).si(), x[0]);
+            dx[0] = self.law.z_rate_at(&self.shape(w), x[0]);
         }
     }
     fn power(&self, _t: f64, x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
@@ -281,6 +310,7 @@ impl Component for BenchFriction {
     /// the chamber ports; `stiction` switches the Stribeck hump on.
     fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), String> {
         check_param("friction_bench", name, value)?;
+        self.last.set(None);
         let l = &mut self.law;
         match name {
             "coulomb" => l.coulomb = value,
@@ -513,6 +543,7 @@ pub const TYPES: &[ComponentType] = &[
                 rod: MechanicalNode::UNBOUND,
                 p: None,
                 force: Wire::UNBOUND,
+                last: Cell::new(None),
             })
         },
         hints: None,

@@ -74,8 +74,15 @@ fn second_order_against_a_tight_reference() {
         atol: vec![1e-14],
         ..Options::default()
     };
-    let reference = solve(Method::DormandPrince45, &mut vdp, 0.0, &[2.0, 0.0], t_end, &tight)
-        .unwrap();
+    let reference = solve(
+        Method::DormandPrince45,
+        &mut vdp,
+        0.0,
+        &[2.0, 0.0],
+        t_end,
+        &tight,
+    )
+    .unwrap();
     let exact = reference.last().unwrap().to_vec();
     let ns = [40, 80, 160, 320, 640];
     let errs: Vec<f64> = ns
@@ -159,8 +166,14 @@ fn lugre_bristle_closed_form_mild_and_stiff() {
                     ..Options::default()
                 },
             );
-            let bad = rk.map_or(true, |s| (s.last().unwrap()[0] - exact[0]).abs() * b.k > 1.0);
-            assert!(bad, "RK4 was expected to fail at rate·h = {}", b.k * 0.05 * h);
+            let bad = rk.map_or(true, |s| {
+                (s.last().unwrap()[0] - exact[0]).abs() * b.k > 1.0
+            });
+            assert!(
+                bad,
+                "RK4 was expected to fail at rate·h = {}",
+                b.k * 0.05 * h
+            );
         }
     }
 }

@@ -385,8 +385,14 @@ mod tests {
     }
 
     fn lugre(r: &mut FrictionBench, s0: f64, s1: f64) {
-        r.set(&ParamRef::Effect(EffectId::LugreDynamics, "sigma0".into()), s0);
-        r.set(&ParamRef::Effect(EffectId::LugreDynamics, "sigma1".into()), s1);
+        r.set(
+            &ParamRef::Effect(EffectId::LugreDynamics, "sigma0".into()),
+            s0,
+        );
+        r.set(
+            &ParamRef::Effect(EffectId::LugreDynamics, "sigma1".into()),
+            s1,
+        );
     }
 
     /// Monotone motion from z = 0 with σ1 = 0: `dz/dx = 1 − σ0 z / Fc`, so
@@ -401,11 +407,16 @@ mod tests {
             lugre(&mut r, s0, 0.0);
             let (dt, v0) = (1e-4, 1e-4);
             let s = signals(|_| v0, 2000, dt);
-            let f = r.simulate_from_rest(&s, &BenchInputs::of(&s).unwrap()).unwrap();
+            let f = r
+                .simulate_from_rest(&s, &BenchInputs::of(&s).unwrap())
+                .unwrap();
             for (i, fi) in f.iter().enumerate() {
                 let x = v0 * dt * i as f64;
                 let closed = 5.0 * -(-s0 * x / 5.0).exp_m1() + 3e5 * 4.9e-4;
-                assert!((fi - closed).abs() < 1e-9 * 5.0, "σ0 {s0}, i {i}: {fi} vs {closed}");
+                assert!(
+                    (fi - closed).abs() < 1e-9 * 5.0,
+                    "σ0 {s0}, i {i}: {fi} vs {closed}"
+                );
             }
         }
     }
@@ -468,7 +479,11 @@ mod tests {
         x0[fine.z.unwrap()] = rig.initial_z(&s);
         fine.sim.set_initial_state(x0);
         fine.sim.set_options(run_options(inputs.h_max / 2.0));
-        let f2 = fine.sim.run_wires(&s.t, &[fine.force]).unwrap().swap_remove(0);
+        let f2 = fine
+            .sim
+            .run_wires(&s.t, &[fine.force])
+            .unwrap()
+            .swap_remove(0);
         let (w2, e2) = (worst(&f2, &fr), rms(&f2, &fr));
         eprintln!("two steps a sample: worst {w2:.3e} N, rms {e2:.3e} N");
         assert!(w2 < w / 4.0 && e2 < e / 4.0, "worst {w2} N, rms {e2} N");
@@ -491,7 +506,13 @@ mod tests {
             .collect();
         let smooth = rms(&d10, &d);
         eprintln!("σ0 derivative: off the reference by {derr:.3e} (rms) of {dscale:.3e}; 1e-5 vs 1e-6 step {smooth:.3e}");
-        assert!(derr < 3e-2 * dscale, "σ0 derivative off by {derr} of {dscale}");
-        assert!(smooth < 1e-3 * dscale, "σ0 derivative not smooth: {smooth} of {dscale}");
+        assert!(
+            derr < 3e-2 * dscale,
+            "σ0 derivative off by {derr} of {dscale}"
+        );
+        assert!(
+            smooth < 1e-3 * dscale,
+            "σ0 derivative not smooth: {smooth} of {dscale}"
+        );
     }
 }

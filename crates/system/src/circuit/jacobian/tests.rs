@@ -372,12 +372,7 @@ fn the_friction_bench_tangents_equal_central_differences() {
                 .position(|s| s == n)
                 .unwrap_or_else(|| panic!("{n} not in {names:?}"))
         };
-        let (iv, iz, ip1, ip2) = (
-            idx("load.v"),
-            idx("friction.z"),
-            idx("c1.p"),
-            idx("c2.p"),
-        );
+        let (iv, iz, ip1, ip2) = (idx("load.v"), idx("friction.z"), idx("c1.p"), idx("c2.p"));
         let dim = c.dim();
         let scale = c.atol(1.0);
         for (vel, z, p1, p2) in [
@@ -431,8 +426,17 @@ fn the_friction_bench_tangents_equal_central_differences() {
         .collect();
     let c = assemble_inputs(&s, &inputs).unwrap();
     assert!(c.has_jacobian());
-    let force = c.probes().into_iter().find(|p| p.name == "force").unwrap().wire;
-    let iz = c.state_names().iter().position(|n| n == "friction.z").unwrap();
+    let force = c
+        .probes()
+        .into_iter()
+        .find(|p| p.name == "force")
+        .unwrap()
+        .wire;
+    let iz = c
+        .state_names()
+        .iter()
+        .position(|n| n == "friction.z")
+        .unwrap();
     let mut x = c.initial_state();
     x[iz] = 1e-4;
     let dim = c.dim();

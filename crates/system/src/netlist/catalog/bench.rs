@@ -78,10 +78,18 @@ impl Component for ImposedMotion {
     fn evaluate_tangents(&self, t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
         // F = s ((m + Σc) a − ΣF)
         let s = self.force_sign;
-        d.chain(self.force, s * self.acceleration_at(t, w), self.rod.added_mass);
+        d.chain(
+            self.force,
+            s * self.acceleration_at(t, w),
+            self.rod.added_mass,
+        );
         d.chain(self.force, -s, self.rod.force);
         if let Some(a) = self.acceleration {
-            d.chain(self.force, s * (self.mass + w.get(self.rod.added_mass).si()), a);
+            d.chain(
+                self.force,
+                s * (self.mass + w.get(self.rod.added_mass).si()),
+                a,
+            );
         }
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {

@@ -200,8 +200,8 @@ fn steps_land_on_the_output_times() {
     assert_eq!(sol.stats.steps, 12);
     for (k, &t) in t_eval.iter().enumerate() {
         let e = osc.exact(t, [1.0, 0.5]);
-        for i in 0..2 {
-            assert!((sol.state(k)[i] - e[i]).abs() < 1e-14, "t {t}");
+        for (got, want) in sol.state(k).iter().zip(e) {
+            assert!((got - want).abs() < 1e-14, "t {t}");
         }
     }
     // one rhs and one Jacobian a step

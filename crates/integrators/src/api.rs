@@ -86,6 +86,16 @@ pub enum Method {
     Rosenbrock,
     /// Classical Runge–Kutta 4 with a fixed step (`Options::h0`).
     Rk4,
+    /// Exponential Rosenbrock–Euler at the step's mid time,
+    /// `x₁ = x₀ + h φ₁(hJ) f(t + h/2, x₀)` (one right-hand side, one
+    /// Jacobian, one small matrix function a step): fixed steps, each
+    /// interval between two output times split into the fewest equal steps
+    /// no longer than `Options::h0`; second order, exact for linear systems
+    /// with constant coefficients at any step, no stability limit. For a
+    /// stiff mode that is linear over a step (LuGre's bristle at a held
+    /// velocity) and a simulated output that must be smooth in the model's
+    /// parameters (a fit's finite differences).
+    Exponential,
     /// Automatic choice: Dormand–Prince 5(4) while the problem is not stiff,
     /// Rodas4 while it is, switched by the stiffness the run shows (DP45's
     /// step held by its stability region; the Jacobian's spectral radius

@@ -71,7 +71,10 @@ pub(crate) fn check_inputs(
             return bad(format!("Options::h0 = {h0} must be finite and > 0"));
         }
     } else if fixed_step {
-        return bad("RK4 is a fixed-step method: set Options::h0 to the step size".into());
+        return bad(
+            "RK4 and the exponential method are fixed-step methods: set Options::h0 to the step size"
+                .into(),
+        );
     }
     if opts.h_max.is_nan() || opts.h_max <= 0.0 {
         return bad(format!("Options::h_max = {} must be > 0", opts.h_max));

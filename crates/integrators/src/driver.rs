@@ -56,6 +56,13 @@ pub(crate) trait Stepper {
     /// `true` for methods with an error estimate and step-size control.
     fn adaptive(&self) -> bool;
 
+    /// `true` for a fixed-step method whose steps end on every output time
+    /// (each interval between two output times split into the fewest equal
+    /// steps no longer than `Options::h0`) instead of every `h0`.
+    fn lands_on_outputs(&self) -> bool {
+        false
+    }
+
     /// Forgets everything carried over from the previous step (FSAL stage,
     /// Jacobian); called at the start and after every event.
     fn restart(&mut self);
@@ -509,6 +516,23 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
         // Land exactly on the next breakpoint (adaptive methods); the step the
         // controller wanted is kept for after it.
         let mut breakpoint = None;
+        // A method that lands on the output times: the next one (or t_end)
+        // in the fewest equal steps of at most h0.
+        let mut land = None;
+        if !adaptive && stepper.lands_on_outputs() {
+            let h0 = opts.h0.unwrap_or(remaining);
+            let target = t_eval
+                .get(next_out)
+                .copied()
+                .filter(|&tk| tk - t > t_close(t) && tk < t_end)
+                .unwrap_or(t_end);
+            let gap = target - t;
+            let k = (gap / h0 * (1.0 - 1e-9)).ceil().max(1.0);
+            h = gap / k;
+            if k == 1.0 && target < t_end {
+                land = Some(target);
+            }
+        }
         if h * stretch >= remaining {
             h = remaining;
             last = true;
@@ -567,10 +591,11 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
 
         // Accepted.
         stats.steps += 1;
-        let t_new = match (last, breakpoint) {
-            (true, _) => t_end,
-            (false, Some((bp, _))) => bp,
-            (false, None) => t + h,
+        let t_new = match (last, breakpoint, land) {
+            (true, _, _) => t_end,
+            (false, Some((bp, _)), _) => bp,
+            (false, None, Some(tk)) => tk,
+            (false, None, None) => t + h,
         };
         let h_next = match (adaptive, breakpoint) {
             (false, _) => h,

@@ -18,6 +18,12 @@
 //!   differences otherwise;
 //! * [`Method::Rk4`] — classical fixed-step Runge–Kutta 4 (`Options::h0` is
 //!   the step), with a cubic Hermite interpolant, for cross-checks;
+//! * [`Method::Exponential`] — the exponential Rosenbrock–Euler step
+//!   `x₁ = x₀ + h φ₁(hJ) f(t + h/2, x₀)`, fixed steps landing on every
+//!   output time (at most `Options::h0` long), second order, exact on linear
+//!   constant-coefficient systems however stiff: a simulated output smooth
+//!   in the model's parameters, at one right-hand side and one Jacobian a
+//!   step (the friction bench's LuGre fits; [`expo`]);
 //! * [`Method::Auto`] — DP45 while the problem is not stiff, Rodas4 while it
 //!   is: DP45's step held on its stability boundary (Hairer's test,
 //!   `h ‖f(y₇) − f(y₆)‖ / ‖y₇ − y₆‖ > 3.25` for 15 steps) switches to
@@ -157,6 +163,7 @@ pub use api::*;
 mod dopri;
 mod driver;
 pub mod events;
+pub mod expo;
 pub mod linalg;
 pub mod problems;
 mod rk4;

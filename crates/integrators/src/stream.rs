@@ -14,7 +14,7 @@
 
 use crate::api::{Method, OdeSystem, Options, Solution, SolveError};
 use crate::driver::{self, Between, Controller};
-use crate::{auto, dopri, rk4, rodas};
+use crate::{auto, dopri, expo, rk4, rodas};
 use std::borrow::Cow;
 
 /// What a streamed solve's caller does between the steps.
@@ -212,5 +212,10 @@ pub(crate) fn dispatch<S: OdeSystem + ?Sized, B: Between<S>>(
         ),
         Method::Auto => run!(auto::Auto::new(n, quadratures), auto::DP_CONTROLLER, 5.0),
         Method::Rk4 => run!(rk4::Rk4::new(n), Controller::Pi { q: 5.0, beta: 0.0 }, 4.0),
+        Method::Exponential => run!(
+            expo::Exponential::new(n, quadratures),
+            Controller::Pi { q: 2.0, beta: 0.0 },
+            2.0
+        ),
     }
 }

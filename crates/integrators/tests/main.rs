@@ -7,6 +7,7 @@ mod convergence;
 mod dense;
 mod errors;
 mod events;
+mod exponential;
 mod linalg;
 mod stats;
 mod stiff;

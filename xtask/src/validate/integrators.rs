@@ -105,6 +105,7 @@ fn name(method: Method) -> &'static str {
         Method::Rosenbrock => "Rodas4",
         Method::Rk4 => "RK4",
         Method::Auto => "automatic (DP45/Rodas4)",
+        Method::Exponential => "exponential Rosenbrock-Euler",
     }
 }
 

@@ -322,25 +322,6 @@ impl FrictionBench {
         Ok(rig)
     }
 
-    /// A `friction-bench` rig file's bench after `--set`s on its netlist:
-    /// `file` is the file's JSON (its identification fields: refit list,
-    /// column map, steady-state flag, and the declaration's checks), `netlist`
-    /// the file migrated by `hydrocyl_system::rig::load` with any `--set`
-    /// applied under the netlist's paths (`friction.viscous=250`).
-    pub fn from_file_and_netlist(
-        file: &serde_json::Value,
-        netlist: &serde_json::Value,
-    ) -> Result<FrictionBench, String> {
-        let decl = FrictionBench::from_json(&file.to_string())?;
-        let mut b = FrictionBench::from_netlist(netlist, decl.friction.smoothing_velocity)?;
-        b.name = decl.name;
-        b.refit = decl.refit;
-        b.columns = decl.columns;
-        b.steady_state = decl.steady_state;
-        b.validate().map_err(|e| e.to_string())?;
-        Ok(b)
-    }
-
     /// `true` when effect `id` is on.
     pub fn has(&self, id: EffectId) -> bool {
         self.friction.effects.contains_key(&id)
@@ -391,7 +372,6 @@ impl FrictionBench {
     }
 }
 
-mod inverse;
 mod model;
 mod presets;
 mod signals;

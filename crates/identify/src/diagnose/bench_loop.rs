@@ -41,11 +41,6 @@ impl<'a> Bench<'a> {
     /// a force of NaN everywhere: the fit's step is then refused).
     fn simulate(&self, rig: &FrictionBench, k: usize) -> Vec<f64> {
         let s = &self.sigs[k];
-        if rig.has(EffectId::LugreDynamics) {
-            // the bristle's fits stay on the exponential-midpoint evaluator
-            // (bench::inverse's documentation says why)
-            return rig.reference(s);
-        }
         self.runs[k]
             .borrow_mut()
             .force(rig, s, false)

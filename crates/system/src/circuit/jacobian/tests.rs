@@ -322,3 +322,139 @@ fn the_named_rigs_have_an_analytic_jacobian() {
         assert!(circuit(name).has_jacobian(), "{name}");
     }
 }
+
+/// The friction bench's tangents (`friction_bench` with every term and
+/// LuGre's bristle, `piston`, `signal_pressure_source`, `imposed_motion`)
+/// against central differences:
+/// * the law on a free `mass` whose piston's chambers are `volume`s (so the
+///   velocity and the pressures are states and every partial of the law
+///   enters the Jacobian), at states on both sides of v = 0, with and
+///   without the Stribeck hump;
+/// * the bench netlist as a fit runs it (imposed motion, measured
+///   pressures): its Jacobian, and the load cell's tangent row with respect
+///   to the bristle.
+#[test]
+fn the_friction_bench_tangents_equal_central_differences() {
+    use crate::netlist::{assemble_inputs, schematic};
+    use serde_json::json;
+    for stiction in [None, Some(32.0)] {
+        let mut law = json!({
+            "type": "friction_bench", "coulomb": 20.0, "smoothing_velocity": 2e-3,
+            "viscous": 150.0, "asymmetry": 3.0, "external_force": 4.0,
+            "sigma0": 4e4, "sigma1": 30.0,
+            "seal": { "k_pressure": 2e-10, "h_acceleration": 1e8 },
+            "stribeck_velocity": 8e-3, "stribeck_exponent": 1.4
+        });
+        if let Some(fs) = stiction {
+            law["stiction"] = json!(fs);
+        }
+        let v = json!({
+            "kind": "netlist", "name": "t",
+            "components": {
+                "load": { "type": "mass", "mass": 3.0, "initial": { "position": 0.0, "velocity": 0.0 } },
+                "c1": { "type": "volume", "volume": 2e-5, "bulk_modulus": 1.2e9 },
+                "c2": { "type": "volume", "volume": 1e-5, "bulk_modulus": 1.2e9 },
+                "piston": { "type": "piston", "area_1": 1e-3, "area_2": 6e-4 },
+                "friction": law
+            },
+            "connections": [
+                ["load.rod", "piston.rod", "friction.rod"],
+                ["c1.port", "piston.A", "friction.A"],
+                ["c2.port", "piston.B", "friction.B"]
+            ]
+        });
+        let c = crate::netlist::circuit(&v, Signal::Constant { value: 0.0 }).unwrap();
+        assert!(c.has_jacobian());
+        let names = c.state_names();
+        let idx = |n: &str| {
+            names
+                .iter()
+                .position(|s| s == n)
+                .unwrap_or_else(|| panic!("{n} not in {names:?}"))
+        };
+        let (iv, iz, ip1, ip2) = (idx("load.v"), idx("friction.z"), idx("c1.p"), idx("c2.p"));
+        let dim = c.dim();
+        let scale = c.atol(1.0);
+        for (vel, z, p1, p2) in [
+            (0.013, 2e-4, 4e5, 1.5e5),
+            (-0.006, -3e-4, 2e5, 6e5),
+            (0.0004, 1e-5, 3e5, 3e5),
+            (-0.05, 4e-4, 8e5, 1e5),
+        ] {
+            let mut x = c.initial_state();
+            x[iv] = vel;
+            x[iz] = z;
+            x[ip1] = p1;
+            x[ip2] = p2;
+            let mut jac = vec![0.0; dim * dim];
+            assert!(c.jacobian(0.1, &x, &mut jac));
+            for j in [iv, iz, ip1, ip2] {
+                let h = 1e-6 * x[j].abs().max(scale[j]);
+                let col = column(&c, 0.1, &x, j, h);
+                for i in 0..c.n_states() {
+                    let err = (jac[i * dim + j] - col[i]).abs();
+                    assert!(
+                        err <= 1e-6 * jac[i * dim + j].abs().max(col[i].abs()) + 1e-9,
+                        "Fs {stiction:?}, v {vel}: ∂{}/∂{} analytic {} vs FD {}",
+                        names[i],
+                        names[j],
+                        jac[i * dim + j],
+                        col[i]
+                    );
+                }
+            }
+        }
+    }
+    // the bench netlist as a fit runs it: the load cell's row in z
+    let v = crate::netlist::migrate::bench::to_netlist(&json!({
+        "kind": "friction-bench", "name": "b", "area1": 1e-3, "area2": 4e-4,
+        "mass": 2.0, "force_sign": -1.0,
+        "friction": { "coulomb": 20.0, "smoothing_velocity": 1e-3, "effects": {
+            "stribeck": { "Fs": 30.0, "vs": 0.01, "alpha": 1.0 },
+            "lugre_dynamics": { "sigma0": 1e5, "sigma1": 80.0 },
+            "pressure_viscous": { "K": 1e-9 },
+            "acceleration_friction": { "H": 2e7 }
+        } }
+    }))
+    .unwrap();
+    let s = schematic(&v).unwrap();
+    let sig = |x: f64| Signal::Constant { value: x };
+    let inputs: Vec<_> = crate::netlist::migrate::bench::INPUTS
+        .iter()
+        .map(|n| n.to_string())
+        .zip([sig(0.02), sig(0.3), sig(5e5), sig(1e5)])
+        .collect();
+    let c = assemble_inputs(&s, &inputs).unwrap();
+    assert!(c.has_jacobian());
+    let force = c
+        .probes()
+        .into_iter()
+        .find(|p| p.name == "force")
+        .unwrap()
+        .wire;
+    let iz = c
+        .state_names()
+        .iter()
+        .position(|n| n == "friction.z")
+        .unwrap();
+    let mut x = c.initial_state();
+    x[iz] = 1e-4;
+    let dim = c.dim();
+    let mut jac = vec![0.0; dim * dim];
+    assert!(c.jacobian(0.0, &x, &mut jac));
+    let col = column(&c, 0.0, &x, iz, 1e-10);
+    assert!((jac[iz * dim + iz] - col[iz]).abs() <= 1e-7 * col[iz].abs());
+    let read = |z: f64| {
+        let mut y = x.clone();
+        y[iz] = z;
+        let mut out = [0.0];
+        c.read_wires(0.0, &y, &[force], &mut out);
+        out[0]
+    };
+    let fd = (read(1e-4 + 1e-10) - read(1e-4 - 1e-10)) / 2e-10;
+    let analytic = c.tangents.borrow().row(force.0)[iz];
+    assert!(
+        (analytic - fd).abs() <= 1e-6 * fd.abs(),
+        "∂force/∂z analytic {analytic} vs FD {fd}"
+    );
+}

@@ -15,7 +15,8 @@ use super::super::registry::{
 };
 use super::{built, port, HYD, MECH, SIG};
 use crate::circuit::{
-    BuildError, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe, Wire, Wires,
+    BuildError, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe, Tangents,
+    Wire, Wires,
 };
 use crate::signal::Signal;
 use hydrocyl_ports::{Force, Position, Velocity, VolumeFlow};
@@ -67,6 +68,30 @@ impl Component for ImposedMotion {
     fn name(&self) -> &str {
         &self.name
     }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn publish_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        // the velocity is the command's: no state moves it
+        d.state(self.rod.position, 0, 1.0);
+    }
+    fn evaluate_tangents(&self, t: f64, _x: &[f64], w: &Wires, d: &mut Tangents) {
+        // F = s ((m + Σc) a − ΣF)
+        let s = self.force_sign;
+        d.chain(
+            self.force,
+            s * self.acceleration_at(t, w),
+            self.rod.added_mass,
+        );
+        d.chain(self.force, -s, self.rod.force);
+        if let Some(a) = self.acceleration {
+            d.chain(
+                self.force,
+                s * (self.mass + w.get(self.rod.added_mass).si()),
+                a,
+            );
+        }
+    }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.rod = net.own_mechanical(&self.rod_name)?;
         self.acceleration = self.acceleration_name.as_deref().map(|n| net.signal(n));
@@ -97,8 +122,9 @@ impl Component for ImposedMotion {
         let f = self.force_sign * self.drive_force(t, w);
         w.set(self.force, Force::new(f));
     }
-    fn derivatives(&self, t: f64, _x: &[f64], _w: &Wires, dx: &mut [f64]) {
-        dx[0] = self.velocity.value_hinted(t, &self.hint);
+    fn derivatives(&self, _t: f64, _x: &[f64], w: &Wires, dx: &mut [f64]) {
+        // the velocity `publish` set from the command
+        dx[0] = w.get(self.rod.velocity).si();
     }
     fn power(&self, t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         let v = self.velocity.value_hinted(t, &self.hint);
@@ -150,6 +176,18 @@ pub struct Piston {
 impl Component for Piston {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        for (node, area) in [(self.a, self.area_1), (self.b, -self.area_2)] {
+            if let Some(n) = node {
+                d.chain(self.force, area, n.pressure);
+                d.chain(n.inflow, -area, self.rod.velocity);
+            }
+        }
+        d.chain(self.rod.force, 1.0, self.force);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.a = self.a_name.as_deref().map(|n| net.hydraulic(n));

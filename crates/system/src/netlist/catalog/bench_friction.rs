@@ -21,72 +21,13 @@ use super::super::registry::{
 use super::{built, port, HYD, MECH, SIG};
 use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe,
-    Wire, Wires,
+    Tangents, Wire, Wires,
 };
 use hydrocyl_ports::{Force, Mass, Pressure};
+use std::cell::Cell;
 
-/// The coefficients of the bench law \[SI\].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BenchLaw {
-    /// Coulomb level Fc \[N\].
-    pub coulomb: f64,
-    /// Smoothing velocity v_t of the tanh \[m·s⁻¹\].
-    pub smoothing_velocity: f64,
-    /// Stiction level Fs, Stribeck velocity vs \[m·s⁻¹\] and exponent α,
-    /// when the curve has a hump.
-    pub stribeck: Option<(f64, f64, f64)>,
-    /// Bristle stiffness σ0 \[N·m⁻¹\] and damping σ1 \[N·s·m⁻¹\] (LuGre), when on.
-    pub lugre: Option<(f64, f64)>,
-    /// Viscous coefficient b \[N·s·m⁻¹\].
-    pub viscous: f64,
-    /// Seal gain K \[m³·s·N⁻¹\].
-    pub k_pressure: f64,
-    /// Acceleration gain H \[N²·s·m⁻⁴\] (the term is K H a).
-    pub h_acceleration: f64,
-    /// Direction asymmetry dFc \[N\].
-    pub asymmetry: f64,
-    /// Constant force F0 \[N\].
-    pub external_force: f64,
-}
-
-impl BenchLaw {
-    /// g(v): the Coulomb level plus the Stribeck hump if any \[N\].
-    pub fn g(&self, v: f64) -> f64 {
-        match self.stribeck {
-            Some((fs, vs, al)) => {
-                let r = (v / vs.max(1e-12)).abs();
-                let e = if al == 1.0 { r } else { r.powf(al) };
-                self.coulomb + (fs - self.coulomb) * (-e).exp()
-            }
-            None => self.coulomb,
-        }
-    }
-
-    /// The bristle's rate `ż` at deflection `z` \[m·s⁻¹\].
-    pub fn z_rate(&self, v: f64, z: f64) -> f64 {
-        let s0 = self.lugre.map_or(0.0, |(s0, _)| s0);
-        v - s0 * v.abs() * z / self.g(v).max(1e-9)
-    }
-
-    /// The friction force without the acceleration term `K H a` and without
-    /// `F0` \[N\] (+ opposing + motion), at deflection `z`.
-    pub fn force(&self, v: f64, p1: f64, p2: f64, z: f64) -> f64 {
-        let th = (v / self.smoothing_velocity).tanh();
-        let mut f = match self.lugre {
-            Some((s0, s1)) => s0 * z + s1 * self.z_rate(v, z),
-            None => self.g(v) * th,
-        };
-        f += self.viscous * v;
-        f += self.k_pressure * (p1 - p2).powi(2) * v;
-        f += 0.5 * self.asymmetry * th.abs();
-        f
-    }
-
-    /// The acceleration coefficient `K H` \[kg\] (the term's mass side).
-    pub fn added_mass(&self) -> f64 {
-        self.k_pressure * self.h_acceleration
-    }
-}
+mod law;
+pub use law::{BenchLaw, Shape};
 
 /// The bench law on a rod, reading the chamber pressures at `A` and `B`.
 #[derive(Debug)]
@@ -103,9 +44,25 @@ pub struct BenchFriction {
     rod: MechanicalNode,
     p: Option<(Wire<Pressure>, Wire<Pressure>)>,
     force: Wire<Force>,
+    /// The law's [`Shape`] at the last velocity asked (a run evaluates the
+    /// force, the bristle's rate and their tangents at one velocity);
+    /// cleared when a parameter changes.
+    last: Cell<Option<Shape>>,
 }
 
 impl BenchFriction {
+    /// The law's shape at the rod's velocity.
+    fn shape(&self, w: &Wires) -> Shape {
+        let v = w.get(self.rod.velocity).si();
+        match self.last.get() {
+            Some(s) if s.v.to_bits() == v.to_bits() => s,
+            _ => {
+                let s = self.law.shape(v);
+                self.last.set(Some(s));
+                s
+            }
+        }
+    }
     fn pressures(&self, w: &Wires) -> (f64, f64) {
         self.p
             .map_or((0.0, 0.0), |(a, b)| (w.get(a).si(), w.get(b).si()))
@@ -122,6 +79,30 @@ impl BenchFriction {
 impl Component for BenchFriction {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
+        let (p1, p2) = self.pressures(w);
+        let j = self.law.partials_at(&self.shape(w), p1, p2, self.z(x));
+        d.chain(self.force, j.df_dv, self.rod.velocity);
+        if let Some((a, b)) = self.p {
+            d.chain(self.force, j.df_dp1, a);
+            d.chain(self.force, j.df_dp2, b);
+        }
+        if self.law.lugre.is_some() {
+            d.state(self.force, 0, j.df_dz);
+        }
+        d.chain(self.rod.force, -1.0, self.force);
+    }
+    fn derivative_tangents(&self, _t: f64, x: &[f64], w: &Wires, d: &mut Tangents) {
+        if self.law.lugre.is_some() {
+            let (p1, p2) = self.pressures(w);
+            let j = self.law.partials_at(&self.shape(w), p1, p2, x[0]);
+            d.rate_state(0, 0, j.dzdot_dz);
+            d.rate_chain(0, j.dzdot_dv, self.rod.velocity);
+        }
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.rod = net.mechanical(&self.rod_name);
@@ -153,16 +134,15 @@ impl Component for BenchFriction {
         x.fill(self.initial_z);
     }
     fn evaluate(&self, _t: f64, x: &[f64], w: &mut Wires) {
-        let v = w.get(self.rod.velocity).si();
         let (p1, p2) = self.pressures(w);
-        let f = self.law.force(v, p1, p2, self.z(x)) + self.law.external_force;
+        let f = self.law.force_at(&self.shape(w), p1, p2, self.z(x)) + self.law.external_force;
         w.add(self.rod.force, Force::new(-f));
         w.add(self.rod.added_mass, Mass::new(self.law.added_mass()));
         w.set(self.force, Force::new(f));
     }
     fn derivatives(&self, _t: f64, x: &[f64], w: &Wires, dx: &mut [f64]) {
         if self.law.lugre.is_some() {
-            dx[0] = self.law.z_rate(w.get(self.rod.velocity).si(), x[0]);
+            dx[0] = self.law.z_rate_at(&self.shape(w), x[0]);
         }
     }
     fn power(&self, _t: f64, x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
@@ -189,6 +169,7 @@ impl Component for BenchFriction {
     /// the chamber ports; `stiction` switches the Stribeck hump on.
     fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), String> {
         check_param("friction_bench", name, value)?;
+        self.last.set(None);
         let l = &mut self.law;
         match name {
             "coulomb" => l.coulomb = value,
@@ -248,6 +229,12 @@ pub struct SignalPressureSource {
 impl Component for SignalPressureSource {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn has_tangents(&self) -> bool {
+        true
+    }
+    fn evaluate_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.chain(self.node.pressure, 1.0, self.signal);
     }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         self.signal = net.signal(&self.signal_name);
@@ -415,6 +402,7 @@ pub const TYPES: &[ComponentType] = &[
                 rod: MechanicalNode::UNBOUND,
                 p: None,
                 force: Wire::UNBOUND,
+                last: Cell::new(None),
             })
         },
         hints: None,

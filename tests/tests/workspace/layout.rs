@@ -96,9 +96,7 @@ fn workspace_dependencies(manifest: &str) -> Vec<String> {
             continue;
         }
         if let Some(name) = line.strip_prefix("hydrocyl-").filter(|_| in_deps) {
-            let name = name
-                .split(|c: char| c == ' ' || c == '=' || c == '.')
-                .next();
+            let name = name.split([' ', '=', '.']).next();
             deps.push(name.unwrap().to_string());
         }
     }

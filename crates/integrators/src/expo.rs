@@ -247,26 +247,14 @@ impl Exponential {
         if sys.jacobian(t, x, &mut self.jac) {
             return;
         }
-        let na = n - self.quadratures;
-        let sqrt_eps = f64::EPSILON.sqrt();
-        self.y.copy_from_slice(x);
-        for j in 0..n {
-            if j >= na {
-                for i in 0..n {
-                    self.jac[i * n + j] = 0.0;
-                }
-                continue;
-            }
-            let xj = x[j];
-            self.y[j] = xj + sqrt_eps * xj.abs().max(1e-8);
-            sys.rhs(t, &self.y, &mut self.fy);
-            stats.rhs_evals += 1;
-            let dx = self.y[j] - xj;
-            for i in 0..n {
-                self.jac[i * n + j] = (self.fy[i] - self.f[i]) / dx;
-            }
-            self.y[j] = xj;
+        crate::fdjac::ForwardDifference {
+            f0: &self.f,
+            differenced: n - self.quadratures,
+            y: &mut self.y,
+            fy: &mut self.fy,
+            jac: &mut self.jac,
         }
+        .fill(sys, t, x, |_| 1e-8, stats, |_| {});
     }
 }
 

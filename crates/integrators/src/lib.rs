@@ -164,6 +164,7 @@ mod dopri;
 mod driver;
 pub mod events;
 pub mod expo;
+mod fdjac;
 pub mod linalg;
 pub mod problems;
 mod rk4;

@@ -189,26 +189,25 @@ impl Rodas4 {
             self.ft[i] = (self.fy[i] - self.f0[i]) / dt;
         }
         if !analytic {
-            self.y.copy_from_slice(x);
-            // quadrature columns are zero: nothing depends on a quadrature
-            for j in 0..n {
-                if j >= self.na {
-                    for i in 0..n {
-                        self.jac[i * n + j] = 0.0;
-                    }
-                    continue;
-                }
-                let xj = x[j];
-                self.y[j] = xj + sqrt_eps * xj.abs().max(self.scale[j]);
-                sys.rhs(t, &self.y, &mut self.fy);
-                stats.rhs_evals += 1;
-                self.lin_bad = self.lin_bad.or(first_nonfinite(&self.fy));
-                let dx = self.y[j] - xj;
-                for i in 0..n {
-                    self.jac[i * n + j] = (self.fy[i] - self.f0[i]) / dx;
-                }
-                self.y[j] = xj;
+            let scale = &self.scale;
+            let lin_bad = &mut self.lin_bad;
+            crate::fdjac::ForwardDifference {
+                f0: &self.f0,
+                differenced: self.na,
+                y: &mut self.y,
+                fy: &mut self.fy,
+                jac: &mut self.jac,
             }
+            .fill(
+                sys,
+                t,
+                x,
+                |j| scale[j],
+                stats,
+                |fy| {
+                    *lin_bad = lin_bad.or(first_nonfinite(fy));
+                },
+            );
         }
     }
 }

@@ -376,7 +376,8 @@ fn groups(
 }
 
 /// Kahn's order of `items`, stable in the order given; `Err` holds the
-/// items left in a cycle.
+/// items on a cycle (and any between two cycles), without the items that
+/// only depend on one.
 fn kahn<I: Iterator<Item = usize>>(
     items: &[usize],
     deps: impl Fn(usize) -> I,
@@ -390,11 +391,24 @@ fn kahn<I: Iterator<Item = usize>>(
         match next {
             Some(i) => order.push(i),
             None => {
-                return Err(items
+                let mut left: Vec<usize> = items
                     .iter()
                     .copied()
                     .filter(|i| !order.contains(i))
-                    .collect())
+                    .collect();
+                // drop what no item left depends on, until only the cycles
+                // (each of whose items another one left depends on) remain
+                loop {
+                    let needed: Vec<usize> = left
+                        .iter()
+                        .copied()
+                        .filter(|&i| left.iter().any(|&j| deps(j).any(|d| d == i)))
+                        .collect();
+                    if needed.len() == left.len() {
+                        return Err(left);
+                    }
+                    left = needed;
+                }
             }
         }
     }
@@ -463,6 +477,20 @@ pub(crate) fn evaluation_order(net: &Netlist) -> Result<(Vec<Step>, Vec<SeriesGr
 mod tests {
     use super::*;
     use crate::components::{FixedOrifice, PressureSource, Volume};
+
+    #[test]
+    fn a_loop_error_names_the_cycle_and_not_what_hangs_off_it() {
+        // 0 ⇄ 1 is the cycle; 2 reads 0, 3 reads 2: neither is on it
+        let deps: [&[usize]; 4] = [&[1], &[0], &[0], &[2]];
+        let left = kahn(&[0, 1, 2, 3], |i| deps[i].iter().copied()).unwrap_err();
+        assert_eq!(left, vec![0, 1]);
+        // a chain without a cycle orders
+        let chain: [&[usize]; 3] = [&[], &[0], &[1]];
+        assert_eq!(
+            kahn(&[2, 1, 0], |i| chain[i].iter().copied()),
+            Ok(vec![0, 1, 2])
+        );
+    }
     use crate::Circuit;
     use hydrocyl_integrators::{solve, Method, Options};
     use hydrocyl_ports::{Area, Density};

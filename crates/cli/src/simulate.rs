@@ -4,7 +4,7 @@
 //! ```text
 //! hydrocyl simulate --rig leaney-moog --command cmd.csv --out run.csv \
 //!     [--set load.mass=50] [--set cylinder.initial.p1=2e6] \
-//!     [--solver auto|dp45|rosenbrock|rk4] [--rtol 1e-6] [--print-rig] [--fsync]
+//!     [--solver auto|dp45|rosenbrock|rk4|exponential] [--rtol 1e-6] [--print-rig] [--fsync]
 //! ```
 //!
 //! The command file is CSV with a `time` column (`time`, `time [s]` or
@@ -89,18 +89,21 @@ pub struct Args {
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
     /// Integration method: auto (default: dp45 while the run is not stiff,
-    /// rosenbrock while it is), dp45, rosenbrock or rk4.
+    /// rosenbrock while it is), dp45, rosenbrock, rk4 (fixed step, --rk4-step)
+    /// or exponential (exponential Rosenbrock–Euler, fixed steps landing on
+    /// the output times: for a mode stiff but linear over a step, e.g. a
+    /// friction bench's LuGre bristle).
     #[arg(long, default_value = "auto")]
     solver: String,
     /// Relative tolerance of the adaptive methods.
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     rtol: f64,
-    /// Fixed step of rk4 \[s\].
+    /// Fixed step of rk4, and the longest step of exponential \[s\].
     #[arg(
         long,
         default_value_t = 2e-5,
         allow_negative_numbers = true,
-        help = "Fixed step of rk4 [s]"
+        help = "Fixed step of rk4, and the longest step of exponential [s]"
     )]
     rk4_step: f64,
     /// Print the rig (after --set) as JSON and exit.
@@ -341,7 +344,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let solver = Solver::parse(&args.solver).ok_or_else(|| {
         CliError::Input(format!(
-            "--solver: unknown method `{}` (use auto, dp45, rosenbrock or rk4)",
+            "--solver: unknown method `{}` (use auto, dp45, rosenbrock, rk4 or exponential)",
             args.solver
         ))
     })?;

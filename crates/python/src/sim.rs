@@ -22,7 +22,7 @@ pub fn options(
 ) -> Outcome<RunOptions> {
     let solver = Solver::parse(solver).ok_or_else(|| {
         Failure::Input(format!(
-            "solver: unknown method `{solver}` (use dp45, rosenbrock or rk4)"
+            "solver: unknown method `{solver}` (use auto, dp45, rosenbrock, rk4 or exponential)"
         ))
     })?;
     if !(rtol > 0.0 && rtol < 1.0) {

@@ -86,7 +86,7 @@ def test_to_pandas_uses_pandas_when_there_and_says_so_when_not(step, monkeypatch
 @pytest.mark.parametrize(
     "kwargs, message",
     [
-        ({"solver": "euler"}, "solver: unknown method `euler` (use dp45, rosenbrock or rk4)"),
+        ({"solver": "euler"}, "solver: unknown method `euler` (use auto, dp45, rosenbrock, rk4 or exponential)"),
         ({"rtol": 0.0}, "rtol: 0 is not in (0, 1)"),
         ({"rk4_step": -1.0}, "rk4_step: -1 is not positive"),
     ],

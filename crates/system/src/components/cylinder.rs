@@ -56,21 +56,33 @@ pub struct TwoChamberCylinder {
     p_le: Wire<Pressure>,
 }
 
+/// What a [`TwoChamberCylinder`] connects to, by port: named fields, so
+/// that swapping the chambers is a visible edit rather than two positional
+/// strings.
+#[derive(Clone, Copy, Debug)]
+pub struct CylinderNodes<'a> {
+    /// Chamber 1, the cap side (port A, pressure p1).
+    pub a: &'a str,
+    /// Chamber 2, the rod side (port B, pressure p2).
+    pub b: &'a str,
+    /// The body the rod pushes (mechanical node).
+    pub rod: &'a str,
+}
+
 impl TwoChamberCylinder {
-    /// A cylinder owning nodes `a` (chamber 1) and `b` (chamber 2), acting on body `rod`.
+    /// A cylinder owning the chamber nodes `nodes.a` (chamber 1) and
+    /// `nodes.b` (chamber 2), acting on the body `nodes.rod`.
     pub fn new(
         name: &str,
-        a: &str,
-        b: &str,
-        rod: &str,
+        nodes: CylinderNodes<'_>,
         cylinder: Cylinder,
         initial_pressures: (f64, f64),
     ) -> Self {
         Self {
             name: name.into(),
-            a_name: a.into(),
-            b_name: b.into(),
-            rod_name: rod.into(),
+            a_name: nodes.a.into(),
+            b_name: nodes.b.into(),
+            rod_name: nodes.rod.into(),
             cylinder,
             cavitation_pressure: 0.0,
             initial_pressures,

@@ -31,21 +31,35 @@ pub struct FourWayValve {
     ps: Wire<Pressure>,
 }
 
+/// What a [`FourWayValve`] connects to, by port: named fields, so that
+/// swapping A and B is a visible edit rather than two positional strings.
+#[derive(Clone, Copy, Debug)]
+pub struct FourWayNodes<'a> {
+    /// The signal wire holding the spool position \[m\].
+    pub spool: &'a str,
+    /// Supply port P.
+    pub p: &'a str,
+    /// Tank port T.
+    pub t: &'a str,
+    /// Service port A (opened to P for `x_s > 0`).
+    pub a: &'a str,
+    /// Service port B (opened to T for `x_s > 0`).
+    pub b: &'a str,
+}
+
 impl FourWayValve {
-    /// A valve reading signal `spool` \[m\], joining nodes `p`, `t`, `a`, `b`.
-    pub fn new(
-        name: &str,
-        spool: &str,
-        p: &str,
-        t: &str,
-        a: &str,
-        b: &str,
-        metering: Metering,
-    ) -> Self {
+    /// A valve reading the spool position on `nodes.spool`, joining the
+    /// hydraulic nodes `nodes.p`, `nodes.t`, `nodes.a`, `nodes.b`.
+    pub fn new(name: &str, nodes: FourWayNodes<'_>, metering: Metering) -> Self {
         Self {
             name: name.into(),
-            ports: [p.into(), t.into(), a.into(), b.into()],
-            spool_name: spool.into(),
+            ports: [
+                nodes.p.into(),
+                nodes.t.into(),
+                nodes.a.into(),
+                nodes.b.into(),
+            ],
+            spool_name: nodes.spool.into(),
             metering,
             supply_resistance: 0.0,
             supply_probe: None,

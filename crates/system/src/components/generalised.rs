@@ -12,6 +12,7 @@ use hydrocyl_valves::servovalve::Metering;
 use std::cell::Cell;
 
 use super::cylinder::Cavitation;
+use super::four_way::FourWayNodes;
 
 pub use hydrocyl_actuator::generalised::XMethod;
 
@@ -55,15 +56,12 @@ pub struct GeneralisedCylinder {
 }
 
 impl GeneralisedCylinder {
-    /// The generalised actuator reading `spool`, joined to `p`, `t`, owning `a`, `b`, pushing `rod`.
-    #[allow(clippy::too_many_arguments)]
+    /// The generalised actuator reading the spool position on `nodes.spool`,
+    /// joined to `nodes.p`, `nodes.t`, owning `nodes.a`, `nodes.b` (the
+    /// valve's ports and the chambers are one here), pushing the body `rod`.
     pub fn new(
         name: &str,
-        spool: &str,
-        p: &str,
-        t: &str,
-        a: &str,
-        b: &str,
+        nodes: FourWayNodes<'_>,
         rod: &str,
         cylinder: Cylinder,
         metering: Metering,
@@ -72,8 +70,13 @@ impl GeneralisedCylinder {
     ) -> Self {
         Self {
             name: name.into(),
-            ports: [p.into(), t.into(), a.into(), b.into()],
-            spool_name: spool.into(),
+            ports: [
+                nodes.p.into(),
+                nodes.t.into(),
+                nodes.a.into(),
+                nodes.b.into(),
+            ],
+            spool_name: nodes.spool.into(),
             rod_name: rod.into(),
             cylinder,
             metering,

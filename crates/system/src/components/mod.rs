@@ -31,8 +31,8 @@ mod spool;
 mod volume;
 
 pub use controller::{PositionController, PositionLaw};
-pub use cylinder::TwoChamberCylinder;
-pub use four_way::FourWayValve;
+pub use cylinder::{CylinderNodes, TwoChamberCylinder};
+pub use four_way::{FourWayNodes, FourWayValve};
 pub use friction::Friction;
 pub use generalised::{GeneralisedCylinder, XMethod};
 pub use mass::Mass;

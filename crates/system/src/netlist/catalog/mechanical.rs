@@ -9,7 +9,9 @@ use super::hydraulic::{air, AIR};
 use super::servo::{metering, METERING};
 use super::{built, join, port, HYD, MECH, SIG};
 use crate::circuit::Component;
-use crate::components::{GeneralisedCylinder, Mass, TwoChamberCylinder};
+use crate::components::{
+    CylinderNodes, FourWayNodes, GeneralisedCylinder, Mass, TwoChamberCylinder,
+};
 use hydrocyl_actuator::generalised::XMethod;
 use hydrocyl_actuator::{Cylinder, StrokeEnds};
 use hydrocyl_ports::{Area, Position, Pressure};
@@ -159,13 +161,16 @@ fn generalised(i: &Instance) -> Result<Box<dyn Component>, String> {
     } else {
         XMethod::Analytical
     };
+    let nodes = FourWayNodes {
+        spool: i.node("spool"),
+        p: i.node("P"),
+        t: i.node("T"),
+        a: i.node("A"),
+        b: i.node("B"),
+    };
     let mut g = GeneralisedCylinder::new(
         &i.name,
-        i.node("spool"),
-        i.node("P"),
-        i.node("T"),
-        i.node("A"),
-        i.node("B"),
+        nodes,
         i.node("rod"),
         cylinder(i)?,
         metering(i)?,
@@ -198,7 +203,12 @@ pub const TYPES: &[ComponentType] = &[
                 return Err("initial.p1 and initial.p2 are needed".into());
             };
             let p = (p1, p2);
-            let mut c = TwoChamberCylinder::new(&i.name, i.node("A"), i.node("B"), i.node("rod"), cylinder(i)?, p);
+            let nodes = CylinderNodes {
+                a: i.node("A"),
+                b: i.node("B"),
+                rod: i.node("rod"),
+            };
+            let mut c = TwoChamberCylinder::new(&i.name, nodes, cylinder(i)?, p);
             c.cavitation_pressure = i.get("cavitation_pressure");
             c.air = air(i);
             built(c)

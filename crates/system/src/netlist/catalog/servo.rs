@@ -7,7 +7,7 @@ use super::super::registry::{
 use super::hydraulic::orifice_params;
 use super::{built, join, port, HYD, SIG};
 use crate::circuit::Component;
-use crate::components::{CommandInput, FourWayValve, ServoSpool};
+use crate::components::{CommandInput, FourWayNodes, FourWayValve, ServoSpool};
 use hydrocyl_ports::{Density, Position, Pressure};
 use hydrocyl_valves::orifice::Orifice;
 use hydrocyl_valves::servovalve::{Metering, Spool, SpoolDynamics};
@@ -241,15 +241,14 @@ pub const TYPES: &[ComponentType] = &[
         params: &FOUR_WAY,
         states: &[],
         build: |i| {
-            let mut v = FourWayValve::new(
-                &i.name,
-                i.node("spool"),
-                i.node("P"),
-                i.node("T"),
-                i.node("A"),
-                i.node("B"),
-                metering(i)?,
-            );
+            let nodes = FourWayNodes {
+                spool: i.node("spool"),
+                p: i.node("P"),
+                t: i.node("T"),
+                a: i.node("A"),
+                b: i.node("B"),
+            };
+            let mut v = FourWayValve::new(&i.name, nodes, metering(i)?);
             v.supply_resistance = i.get("supply_resistance");
             v.dead_band = i.get("dead_band");
             v.supply_probe = Some("ps".into());

@@ -23,73 +23,20 @@ fn component<T: serde::Serialize>(ty: &str, law: &T) -> Value {
     v
 }
 
-/// The components of the hybrid circuit, in state order.
-const PARTS: [(&str, &str); 17] = [
-    ("command", "command_input"),
-    ("pump", "pump_identified"),
-    ("line_1", "volume"),
-    ("line_2", "volume"),
-    ("cylinder", "cylinder"),
-    ("load", "mass"),
-    ("friction", "friction_*"),
-    ("tank", "pressure_source"),
-    ("relief_1", "relief_valve"),
-    ("relief_2", "relief_valve"),
-    ("relief_3_line_1", "relief_valve"),
-    ("relief_3_line_2", "relief_valve"),
-    ("check_1", "check_valve"),
-    ("check_2", "check_valve"),
-    ("pilot_valve", "pilot_valve"),
-    ("needle_valve", "needle_valve"),
-    ("return_port", "algebraic_node"),
-];
+/// The preset circuit's schematic: the reference [`WangHybrid::from_netlist`]
+/// checks a netlist against (its components by name and type, and which of
+/// their ports are joined), so that the topology is written once, in the file.
+fn reference() -> netlist::Schematic {
+    let v: Value =
+        serde_json::from_str(CIRCUIT).expect("the embedded netlist is valid JSON (tested)");
+    netlist::read(&v).expect("the embedded netlist reads (tested)")
+}
 
-/// Ports the circuit joins: each group shares one node.
-const NODES: [&[(&str, &str)]; 8] = [
-    &[("command", "out"), ("pump", "command")],
-    &[
-        ("pump", "a"),
-        ("line_1", "port"),
-        ("relief_1", "inlet"),
-        ("relief_3_line_1", "inlet"),
-        ("check_1", "outlet"),
-        ("pilot_valve", "pilot_1"),
-    ],
-    &[
-        ("pump", "b"),
-        ("line_2", "port"),
-        ("relief_2", "inlet"),
-        ("relief_3_line_2", "inlet"),
-        ("check_2", "outlet"),
-        ("pilot_valve", "pilot_2"),
-    ],
-    &[
-        ("cylinder", "A"),
-        ("friction", "A"),
-        ("relief_1", "outlet"),
-        ("pilot_valve", "A"),
-    ],
-    &[
-        ("cylinder", "B"),
-        ("friction", "B"),
-        ("relief_2", "outlet"),
-        ("pilot_valve", "B"),
-    ],
-    &[
-        ("tank", "port"),
-        ("relief_3_line_1", "outlet"),
-        ("relief_3_line_2", "outlet"),
-        ("check_1", "inlet"),
-        ("check_2", "inlet"),
-        ("needle_valve", "outlet"),
-    ],
-    &[
-        ("return_port", "node"),
-        ("pilot_valve", "T"),
-        ("needle_valve", "inlet"),
-    ],
-    &[("cylinder", "rod"), ("load", "rod"), ("friction", "rod")],
-];
+/// Whether an instance of type `actual` may stand where the preset has
+/// `wanted`: the same type, or any friction law for the preset's friction.
+fn same_kind(wanted: &str, actual: &str) -> bool {
+    wanted == actual || (wanted.starts_with("friction_") && actual.starts_with("friction_"))
+}
 
 /// A law from an instance's parameters under `prefix`.
 fn typed<T: serde::de::DeserializeOwned>(i: &Instance, prefix: &str) -> Result<T, RigError> {
@@ -183,10 +130,11 @@ impl WangHybrid {
     /// what differs.
     pub fn from_netlist(v: &Value) -> Result<WangHybrid, RigError> {
         let s = netlist::read(v)?;
+        let preset = reference();
         if let Some(extra) = s
             .instances
             .iter()
-            .find(|i| !PARTS.iter().any(|(n, _)| *n == i.name))
+            .find(|i| preset.instance(&i.name).is_none())
         {
             return Err(bad(
                 format!("components.{}", extra.name),
@@ -194,22 +142,14 @@ impl WangHybrid {
             ));
         }
         let get = |name: &str| -> Result<&Instance, RigError> {
-            let ty = PARTS
-                .iter()
-                .find(|(n, _)| *n == name)
-                .map(|(_, t)| *t)
-                .unwrap_or("");
+            let ty = preset.instance(name).map_or("", |i| i.ty.name);
             let i = s.instance(name).ok_or_else(|| {
                 bad(
                     "components",
                     format!("the hybrid circuit has a component `{name}` ({ty})"),
                 )
             })?;
-            let ok = match ty.strip_suffix('*') {
-                Some(prefix) => i.ty.name.starts_with(prefix),
-                None => i.ty.name == ty,
-            };
-            if !ok {
+            if !same_kind(ty, i.ty.name) {
                 return Err(bad(
                     format!("components.{name}.type"),
                     format!("is `{}`; the hybrid circuit needs `{ty}`", i.ty.name),
@@ -217,15 +157,22 @@ impl WangHybrid {
             }
             Ok(i)
         };
-        for (name, _) in PARTS {
-            get(name)?;
+        for i in &preset.instances {
+            get(&i.name)?;
         }
-        for group in NODES {
-            let (c0, p0) = group[0];
-            let n0 = get(c0)?.node(p0);
-            for (c, p) in &group[1..] {
-                if n0.is_empty() || get(c)?.node(p) != n0 {
-                    return Err(bad("connections", format!("`{c0}.{p0}` and `{c}.{p}` must be joined for the hybrid circuit this study works on")));
+        // every pair of ports the preset joins must be joined here: each port
+        // against the first port of its node in the preset
+        let mut first: Vec<(&str, &str, &str)> = Vec::new(); // (node, component, port)
+        for i in &preset.instances {
+            for (port, node) in &i.nodes {
+                match first.iter().find(|(n, _, _)| n == node) {
+                    None => first.push((node, &i.name, port)),
+                    Some(&(_, c0, p0)) => {
+                        let n0 = get(c0)?.node(p0);
+                        if n0.is_empty() || get(&i.name)?.node(port) != n0 {
+                            return Err(bad("connections", format!("`{c0}.{p0}` and `{}.{port}` must be joined for the hybrid circuit this study works on", i.name)));
+                        }
+                    }
                 }
             }
         }

@@ -176,7 +176,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map(|p| outputs.file("--report", p))
         .transpose()?;
     if let Some(dir) = &args.plots {
-        Outputs::check_dir("--plots", dir)?;
+        outputs.check_dir("--plots", dir)?;
     }
     let columns = match &rig {
         Rig::Bench(b) => b.columns.clone(),

@@ -13,6 +13,7 @@
 //! see `docs/fmu.md`.
 
 use crate::error::CliError;
+use crate::output::Outputs;
 use hydrocyl_fmu::package::{find_library, write_fmu};
 use hydrocyl_system::rig;
 use std::path::{Path, PathBuf};
@@ -51,12 +52,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
         return Err(CliError::Input("--rig and --out are required".into()));
     };
     let input = |e: &dyn std::fmt::Display| CliError::Input(e.to_string());
+    let library = find_library(args.library.as_deref()).map_err(|e| input(&e))?;
+    // the FMU must not be written over an input: the rig file or the library
+    let rig_file = (rig::preset(&rig_arg).is_none()).then(|| PathBuf::from(&rig_arg));
+    let mut inputs: Vec<(&str, &Path)> = vec![("--library", library.as_path())];
+    if let Some(f) = &rig_file {
+        inputs.push(("--rig", f.as_path()));
+    }
+    Outputs::new(&inputs).check("--out", &out)?;
     let mut value = rig::load(&rig_arg).map_err(|e| input(&e))?;
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(|e| input(&e))?;
     }
     rig::check(&value).map_err(|e| input(&e))?;
-    let library = find_library(args.library.as_deref()).map_err(|e| input(&e))?;
     let name = if rig::preset(&rig_arg).is_some() {
         rig_arg.clone()
     } else {

@@ -103,7 +103,7 @@ impl Outputs {
 
     /// Checks that output `path` (given as `option`) is not an input or
     /// another output, and that its folder exists and takes a file.
-    fn check(&self, option: &str, path: &Path) -> Result<PathBuf, CliError> {
+    pub fn check(&self, option: &str, path: &Path) -> Result<PathBuf, CliError> {
         let bad = |why: String| CliError::Input(format!("{option} {}: {why}", path.display()));
         if path.file_name().is_none() {
             return Err(bad("not a file name".into()));
@@ -146,10 +146,18 @@ impl Outputs {
     }
 
     /// Checks that folder `dir` (option `option`) exists or can be created
-    /// (its parent exists), and is not a file; the files in it are opened
-    /// later with [`Outputs::file`].
-    pub fn check_dir(option: &str, dir: &Path) -> Result<(), CliError> {
+    /// (its parent exists), and is not a file, an input or another output
+    /// of this command; the files in it are opened later with
+    /// [`Outputs::file`].
+    pub fn check_dir(&self, option: &str, dir: &Path) -> Result<(), CliError> {
         let bad = |why: &str| CliError::Input(format!("{option} {}: {why}", dir.display()));
+        let c = canonical(dir);
+        if let Some((o, _)) = self.inputs.iter().find(|(_, p)| *p == c) {
+            return Err(bad(&format!("is the {o} input file, not a folder")));
+        }
+        if self.files.iter().any(|f| canonical(&f.path) == c) {
+            return Err(bad("is already another output of this command"));
+        }
         if dir.is_dir() {
             return Ok(());
         }

@@ -246,3 +246,28 @@ fn a_valve_record_with_nothing_usable_exits_2_naming_the_problems() {
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(!report.exists());
 }
+
+/// The report and the plots' folder at one path is refused before any fit:
+/// one line, exit code 2, nothing written.
+#[test]
+fn report_and_plots_at_one_path_are_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let same = dir.path().join("same");
+    let out = bin()
+        .args(["diagnose", "--rig", "leaney-moog", "--data"])
+        .arg(fixtures().join("valve-none.csv"))
+        .arg("--report")
+        .arg(&same)
+        .arg("--plots")
+        .arg(&same)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("--plots") && err.contains("another output"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}

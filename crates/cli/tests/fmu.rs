@@ -64,3 +64,34 @@ fn a_file_that_is_not_the_library_and_a_bad_set_are_refused() {
     let err = refused(&out, &["--set", "load.mass=-1"], Some(&fake), None);
     assert!(err.contains("load.mass"), "{err}");
 }
+
+#[test]
+fn the_fmu_is_never_written_over_its_rig_file_or_library() {
+    let dir = tempfile::tempdir().unwrap();
+    let rig = dir.path().join("my-rig.json");
+    let text = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/rigs/leaney-moog.json"
+    ))
+    .unwrap();
+    std::fs::write(&rig, &text).unwrap();
+    let lib = dir.path().join("lib.so");
+    std::fs::write(&lib, b"not a library").unwrap();
+    for (out, what) in [(&rig, "--rig"), (&lib, "--library")] {
+        let o = hydrocyl()
+            .args(["fmu", "--rig"])
+            .arg(&rig)
+            .arg("--library")
+            .arg(&lib)
+            .arg("--out")
+            .arg(out)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2));
+        let err = String::from_utf8(o.stderr).unwrap();
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(what) && err.contains("destroy"), "{err}");
+    }
+    assert_eq!(std::fs::read(&rig).unwrap(), text);
+    assert_eq!(std::fs::read(&lib).unwrap(), b"not a library");
+}

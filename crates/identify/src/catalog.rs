@@ -34,7 +34,72 @@ pub struct ParamSpec {
     pub lower: f64,
     /// Upper bound of a fit.
     pub upper: f64,
+    /// Where it is written in a netlist: a parameter of every component of
+    /// a type (empty for the law edits and the measurement model).
+    pub targets: &'static [Target],
 }
+
+/// One place an effect parameter is written: parameter `param` of every
+/// component of type `ty`, as its [`Scale`] says.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Target {
+    /// Component type.
+    pub ty: &'static str,
+    /// Parameter path within the component.
+    pub param: &'static str,
+    /// How the catalog value becomes the component's value.
+    pub scale: Scale,
+}
+
+/// How a catalog value is written to the components a [`Target`] reaches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scale {
+    /// The catalog value itself.
+    Absolute,
+    /// The catalog value times the component's declared value (a flow gain
+    /// kw = 1.05 on a pump: its gain 5 % up).
+    Factor,
+    /// The catalog value is the effect's first component's (the one it is
+    /// read from); every component keeps its declared ratio to that one (a
+    /// bulk modulus: a line declared with a stiffer oil than the cylinder's
+    /// stays that much stiffer).
+    Ratio,
+}
+
+const fn t(ty: &'static str, param: &'static str) -> Target {
+    Target {
+        ty,
+        param,
+        scale: Scale::Absolute,
+    }
+}
+
+const fn ratio(ty: &'static str, param: &'static str) -> Target {
+    Target {
+        ty,
+        param,
+        scale: Scale::Ratio,
+    }
+}
+
+/// The pressure seal term of every friction type.
+const SEAL_K: [Target; 6] = [
+    t("friction_coulomb_viscous", "seal.k_pressure"),
+    t("friction_stribeck", "seal.k_pressure"),
+    t("friction_karnopp", "seal.k_pressure"),
+    t("friction_dahl", "seal.k_pressure"),
+    t("friction_lugre", "seal.k_pressure"),
+    t("friction_wang", "seal.k_pressure"),
+];
+/// The acceleration seal term of every friction type.
+const SEAL_H: [Target; 6] = [
+    t("friction_coulomb_viscous", "seal.h_acceleration"),
+    t("friction_stribeck", "seal.h_acceleration"),
+    t("friction_karnopp", "seal.h_acceleration"),
+    t("friction_dahl", "seal.h_acceleration"),
+    t("friction_lugre", "seal.h_acceleration"),
+    t("friction_wang", "seal.h_acceleration"),
+];
 
 /// An effect of the catalog.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -78,6 +143,24 @@ const fn p(name: &'static str, unit: &'static str, lower: f64, upper: f64) -> Pa
         unit,
         lower,
         upper,
+        targets: &[],
+    }
+}
+
+/// [`p`] written to `targets` in a netlist.
+const fn pt(
+    name: &'static str,
+    unit: &'static str,
+    lower: f64,
+    upper: f64,
+    targets: &'static [Target],
+) -> ParamSpec {
+    ParamSpec {
+        name,
+        unit,
+        lower,
+        upper,
+        targets,
     }
 }
 
@@ -186,15 +269,29 @@ impl EffectId {
                 P
             }
             EffectId::Viscous => {
-                const P: &[ParamSpec] = &[p("b", "N s/m", 0.0, INF)];
+                const P: &[ParamSpec] = &[pt(
+                    "b",
+                    "N s/m",
+                    0.0,
+                    INF,
+                    &[
+                        t("friction_coulomb_viscous", "viscous"),
+                        t("friction_stribeck", "extending.sigma2"),
+                        t("friction_stribeck", "retracting.sigma2"),
+                        t("friction_lugre", "extending.sigma2"),
+                        t("friction_lugre", "retracting.sigma2"),
+                        t("friction_karnopp", "sigma2"),
+                        t("friction_dahl", "sigma2"),
+                    ],
+                )];
                 P
             }
             EffectId::PressureViscous => {
-                const P: &[ParamSpec] = &[p("K", "m^3 s/N", 0.0, INF)];
+                const P: &[ParamSpec] = &[pt("K", "m^3 s/N", 0.0, INF, &SEAL_K)];
                 P
             }
             EffectId::AccelerationFriction => {
-                const P: &[ParamSpec] = &[p("H", "N^2 s/m^4", -INF, INF)];
+                const P: &[ParamSpec] = &[pt("H", "N^2 s/m^4", -INF, INF, &SEAL_H)];
                 P
             }
             EffectId::LugreDynamics => {
@@ -205,34 +302,102 @@ impl EffectId {
                 P
             }
             EffectId::ExternalForce => {
-                const P: &[ParamSpec] = &[p("F0", "N", -INF, INF)];
+                const P: &[ParamSpec] = &[pt("F0", "N", -INF, INF, &[t("mass", "external_force")])];
                 P
             }
             EffectId::InternalLeakage => {
-                const P: &[ParamSpec] = &[p("Cl", "m^3/(s Pa)", 0.0, 1e-9)];
+                const P: &[ParamSpec] = &[pt(
+                    "Cl",
+                    "m^3/(s Pa)",
+                    0.0,
+                    1e-9,
+                    &[
+                        t("cylinder", "internal_leakage"),
+                        t("generalised_cylinder", "internal_leakage"),
+                    ],
+                )];
                 P
             }
             EffectId::ExternalLeakage => {
                 const P: &[ParamSpec] = &[
-                    p("Ce1", "m^3/(s Pa)", 0.0, 1e-9),
-                    p("Ce2", "m^3/(s Pa)", 0.0, 1e-9),
+                    pt(
+                        "Ce1",
+                        "m^3/(s Pa)",
+                        0.0,
+                        1e-9,
+                        &[
+                            t("cylinder", "external_leakage_1"),
+                            t("generalised_cylinder", "external_leakage_1"),
+                        ],
+                    ),
+                    pt(
+                        "Ce2",
+                        "m^3/(s Pa)",
+                        0.0,
+                        1e-9,
+                        &[
+                            t("cylinder", "external_leakage_2"),
+                            t("generalised_cylinder", "external_leakage_2"),
+                        ],
+                    ),
                 ];
                 P
             }
             EffectId::ValveNullBias => {
-                const P: &[ParamSpec] = &[p("xb", "m", -1e-3, 1e-3)];
+                const P: &[ParamSpec] = &[pt(
+                    "xb",
+                    "m",
+                    -1e-3,
+                    1e-3,
+                    &[
+                        t("four_way_valve", "null_bias"),
+                        t("generalised_cylinder", "null_bias"),
+                    ],
+                )];
                 P
             }
             EffectId::FlowGainError => {
-                const P: &[ParamSpec] = &[p("kw", "-", 0.1, 10.0)];
+                const P: &[ParamSpec] = &[pt(
+                    "kw",
+                    "-",
+                    0.1,
+                    10.0,
+                    &[
+                        t("four_way_valve", "flow_gain"),
+                        t("generalised_cylinder", "flow_gain"),
+                        Target {
+                            ty: "pump_identified",
+                            param: "gain",
+                            scale: Scale::Factor,
+                        },
+                    ],
+                )];
                 P
             }
             EffectId::BulkModulus => {
-                const P: &[ParamSpec] = &[p("B", "Pa", 1e7, 1e10)];
+                const P: &[ParamSpec] = &[pt(
+                    "B",
+                    "Pa",
+                    1e7,
+                    1e10,
+                    // the oil's: the chambers' and every line volume's, each
+                    // scaled with the cylinder's (B is the cylinder's)
+                    &[
+                        ratio("cylinder", "bulk_modulus"),
+                        ratio("generalised_cylinder", "bulk_modulus"),
+                        ratio("volume", "bulk_modulus"),
+                    ],
+                )];
                 P
             }
             EffectId::SupplyDroop => {
-                const P: &[ParamSpec] = &[p("Rs", "Pa s/m^3", 0.0, INF)];
+                const P: &[ParamSpec] = &[pt(
+                    "Rs",
+                    "Pa s/m^3",
+                    0.0,
+                    INF,
+                    &[t("four_way_valve", "supply_resistance")],
+                )];
                 P
             }
             EffectId::SensorLag => {
@@ -240,7 +405,13 @@ impl EffectId {
                 P
             }
             EffectId::ValveDeadBand => {
-                const P: &[ParamSpec] = &[p("xd", "m", 0.0, 1e-3)];
+                const P: &[ParamSpec] = &[pt(
+                    "xd",
+                    "m",
+                    0.0,
+                    1e-3,
+                    &[t("four_way_valve", "dead_band")],
+                )];
                 P
             }
         }

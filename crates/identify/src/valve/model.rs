@@ -23,49 +23,7 @@ use hydrocyl_system::valve_rig::ValveRig;
 use serde_json::{Map, Value};
 
 use crate::catalog::EffectId;
-
-/// One place an effect parameter is written: parameter `param` of every
-/// component of type `ty`, as its [`Scale`] says.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Target {
-    /// Component type.
-    pub ty: &'static str,
-    /// Parameter path within the component.
-    pub param: &'static str,
-    /// How the catalog value becomes the component's value.
-    pub scale: Scale,
-}
-
-/// How a catalog value is written to the components a [`Target`] reaches.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Scale {
-    /// The catalog value itself.
-    Absolute,
-    /// The catalog value times the component's declared value (a flow gain
-    /// kw = 1.05 on a pump: its gain 5 % up).
-    Factor,
-    /// The catalog value is the effect's first component's (the one it is
-    /// read from); every component keeps its declared ratio to that one (a
-    /// bulk modulus: a line declared with a stiffer oil than the cylinder's
-    /// stays that much stiffer).
-    Ratio,
-}
-
-const fn t(ty: &'static str, param: &'static str) -> Target {
-    Target {
-        ty,
-        param,
-        scale: Scale::Absolute,
-    }
-}
-
-const fn ratio(ty: &'static str, param: &'static str) -> Target {
-    Target {
-        ty,
-        param,
-        scale: Scale::Ratio,
-    }
-}
+pub use crate::catalog::{Scale, Target};
 
 /// Every friction component type of the catalog (they all carry the
 /// additive seal terms `seal.k_pressure`, `seal.h_acceleration`).
@@ -85,76 +43,15 @@ pub const SWITCHABLE_FRICTION: [&str; 3] = [
     "friction_lugre",
 ];
 
-const SEAL_K: [Target; 6] = [
-    t("friction_coulomb_viscous", "seal.k_pressure"),
-    t("friction_stribeck", "seal.k_pressure"),
-    t("friction_karnopp", "seal.k_pressure"),
-    t("friction_dahl", "seal.k_pressure"),
-    t("friction_lugre", "seal.k_pressure"),
-    t("friction_wang", "seal.k_pressure"),
-];
-const SEAL_H: [Target; 6] = [
-    t("friction_coulomb_viscous", "seal.h_acceleration"),
-    t("friction_stribeck", "seal.h_acceleration"),
-    t("friction_karnopp", "seal.h_acceleration"),
-    t("friction_dahl", "seal.h_acceleration"),
-    t("friction_lugre", "seal.h_acceleration"),
-    t("friction_wang", "seal.h_acceleration"),
-];
-
-/// The netlist targets of parameter `name` of effect `id` (empty for the
-/// law edits and the measurement model, which [`Model`] handles itself).
+/// The netlist targets of parameter `name` of effect `id`: the targets the
+/// catalog declares for it ([`ParamSpec::targets`](crate::catalog::ParamSpec::targets);
+/// none for the law edits and the measurement model, which [`Model`]
+/// handles itself).
 pub fn targets(id: EffectId, name: &str) -> Vec<Target> {
-    use EffectId as E;
-    match (id, name) {
-        (E::ValveNullBias, "xb") => vec![
-            t("four_way_valve", "null_bias"),
-            t("generalised_cylinder", "null_bias"),
-        ],
-        (E::FlowGainError, "kw") => vec![
-            t("four_way_valve", "flow_gain"),
-            t("generalised_cylinder", "flow_gain"),
-            Target {
-                ty: "pump_identified",
-                param: "gain",
-                scale: Scale::Factor,
-            },
-        ],
-        (E::ValveDeadBand, "xd") => vec![t("four_way_valve", "dead_band")],
-        (E::SupplyDroop, "Rs") => vec![t("four_way_valve", "supply_resistance")],
-        (E::InternalLeakage, "Cl") => vec![
-            t("cylinder", "internal_leakage"),
-            t("generalised_cylinder", "internal_leakage"),
-        ],
-        (E::ExternalLeakage, "Ce1") => vec![
-            t("cylinder", "external_leakage_1"),
-            t("generalised_cylinder", "external_leakage_1"),
-        ],
-        (E::ExternalLeakage, "Ce2") => vec![
-            t("cylinder", "external_leakage_2"),
-            t("generalised_cylinder", "external_leakage_2"),
-        ],
-        // the oil's: the chambers' and every line volume's, each scaled
-        // with the cylinder's (B is the cylinder's)
-        (E::BulkModulus, "B") => vec![
-            ratio("cylinder", "bulk_modulus"),
-            ratio("generalised_cylinder", "bulk_modulus"),
-            ratio("volume", "bulk_modulus"),
-        ],
-        (E::ExternalForce, "F0") => vec![t("mass", "external_force")],
-        (E::PressureViscous, "K") => SEAL_K.to_vec(),
-        (E::AccelerationFriction, "H") => SEAL_H.to_vec(),
-        (E::Viscous, "b") => vec![
-            t("friction_coulomb_viscous", "viscous"),
-            t("friction_stribeck", "extending.sigma2"),
-            t("friction_stribeck", "retracting.sigma2"),
-            t("friction_lugre", "extending.sigma2"),
-            t("friction_lugre", "retracting.sigma2"),
-            t("friction_karnopp", "sigma2"),
-            t("friction_dahl", "sigma2"),
-        ],
-        _ => vec![],
-    }
+    id.params()
+        .iter()
+        .find(|p| p.name == name)
+        .map_or_else(Vec::new, |p| p.targets.to_vec())
 }
 
 /// Whether effect `id` edits the friction law (not one parameter).

@@ -38,12 +38,24 @@ pub fn load(
     }
     let err = |e: rig::RigError| CliError::Input(e.to_string());
     let mut net = rig::load(spec).map_err(err)?;
+    let read = |net: &serde_json::Value| {
+        FrictionBench::from_rig(net).map_err(|e| CliError::Input(format!("{spec}: {e}")))
+    };
+    let as_json = |b: &FrictionBench| serde_json::to_value(b).ok();
     for s in sets {
+        let before = as_json(&read(&net)?);
+        let old = net.clone();
         rig::apply_set(&mut net, s).map_err(err)?;
+        // the bench runs as its standard circuit, read into `FrictionBench`:
+        // a set that changes the file but not the bench would be dropped
+        if net != old && as_json(&read(&net)?) == before {
+            return Err(CliError::Input(format!(
+                "--set {s}: the friction-bench model does not use this parameter (a bench runs as its standard circuit: the drive's mass and load-cell sign, the piston's areas, the friction law; `--print-rig` lists the rest)"
+            )));
+        }
     }
     rig::check(&net).map_err(|e| err(rig::at_line(e, spec)))?;
-    let bench =
-        FrictionBench::from_rig(&net).map_err(|e| CliError::Input(format!("{spec}: {e}")))?;
+    let bench = read(&net)?;
     Ok(Some((bench, net)))
 }
 

@@ -1,7 +1,8 @@
 //! Rig files as `hydrocyl simulate` reads them: a preset or a file
 //! (duplicate keys refused, an older rig kind read as its netlist:
 //! [`rig::load`]), checked once ([`check`]): every error names the JSON path
-//! and, for a file, its line.
+//! and, for a file, its line — those found when the circuit is assembled
+//! (an algebraic loop) too ([`Checked::circuit`]).
 
 use crate::error::CliError;
 use hydrocyl_system::netlist::{self, Schematic};
@@ -17,15 +18,21 @@ pub fn locate(e: RigError, source: &str) -> CliError {
 }
 
 /// A rig read and checked once, ready to be assembled.
-pub enum Checked {
-    /// A netlist: its checked schematic (steady initial pressures filled).
-    Netlist(Box<Schematic>),
+pub struct Checked {
+    /// The netlist's checked schematic (steady initial pressures filled).
+    schematic: Box<Schematic>,
+    /// Where it was read from (`--rig`: a preset name or a file), for the
+    /// lines of the errors found when it is assembled.
+    source: String,
 }
 
 /// Reads and checks a rig value of a kind `simulate` runs (see [`locate`]).
 pub fn check(value: &Value, source: &str) -> Result<Checked, CliError> {
     let checked = match value.get("kind").and_then(Value::as_str) {
-        Some(netlist::KIND) => netlist::schematic(value).map(|s| Checked::Netlist(s.into())),
+        Some(netlist::KIND) => netlist::schematic(value).map(|s| Checked {
+            schematic: s.into(),
+            source: source.to_string(),
+        }),
         // a missing or unknown kind: the error names the kinds there are
         _ => Err(match rig::kind_of(value) {
             Err(e) => e,
@@ -42,30 +49,26 @@ impl Checked {
     /// The unit in which the rig takes its input (the reading port's, see
     /// [`Schematic::input_unit`]).
     pub fn input_unit(&self) -> Option<&'static str> {
-        match self {
-            Checked::Netlist(s) => s.input_unit(),
-        }
+        self.schematic.input_unit()
     }
 
     /// Every numeric parameter as `(path, value, unit)`.
     pub fn parameters(&self) -> Vec<rig::Parameter> {
-        match self {
-            Checked::Netlist(s) => netlist::parameters_of(s)
-                .into_iter()
-                .map(|p| rig::Parameter {
-                    path: p.path,
-                    value: p.value,
-                    unit: Some(p.unit),
-                    doc: Some(p.doc),
-                })
-                .collect(),
-        }
+        netlist::parameters_of(&self.schematic)
+            .into_iter()
+            .map(|p| rig::Parameter {
+                path: p.path,
+                value: p.value,
+                unit: Some(p.unit),
+                doc: Some(p.doc),
+            })
+            .collect()
     }
 
-    /// Assembles the rig's circuit driven by `command`.
+    /// Assembles the rig's circuit driven by `command`; an error found
+    /// only now (an algebraic loop, a component refusing its parameters)
+    /// names its JSON path and, for a file, its line ([`rig::at_line`]).
     pub fn circuit(&self, command: Signal) -> Result<Circuit, RigError> {
-        match self {
-            Checked::Netlist(s) => netlist::assemble(s, command),
-        }
+        netlist::assemble(&self.schematic, command).map_err(|e| rig::at_line(e, &self.source))
     }
 }

@@ -44,9 +44,10 @@ pub enum BuildError {
         /// A component that uses it.
         user: String,
     },
-    /// Algebraic components depend on each other in a cycle.
-    #[error("algebraic loop between components: {0}")]
-    AlgebraicLoop(String),
+    /// Algebraic components depend on each other in a cycle: the components
+    /// on the cycle (and any between two cycles), in circuit order.
+    #[error("algebraic loop between components: {}", .0.join(", "))]
+    AlgebraicLoop(Vec<String>),
     /// Two components use one wire (a signal) as different quantities.
     #[error("`{component}` uses wire `{wire}` in {second}, but it was declared in {first}")]
     UnitMismatch {

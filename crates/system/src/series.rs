@@ -420,7 +420,7 @@ fn loop_error(net: &Netlist, left: &[usize]) -> BuildError {
         .iter()
         .map(|&i| net.component_names[i].clone())
         .collect();
-    BuildError::AlgebraicLoop(names.join(", "))
+    BuildError::AlgebraicLoop(names)
 }
 
 /// The evaluation order of a bound netlist: every read wire has an owner,

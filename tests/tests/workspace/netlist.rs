@@ -415,18 +415,34 @@ fn bad_netlists_are_refused_by_path() {
             &["connections[4][1]", "no port `C`", "A, B, rod"],
         ),
         (
+            // named at the element that brings the hydraulic node in, not
+            // where that node was first used (`connections[4]`)
             "domain mismatch",
             &|v| v["connections"][6][1] = "valve.A".into(),
-            &["connections", "share a domain"],
+            &[
+                "rig `connections[6][1]`:",
+                "`valve.A` is hydraulic but `cylinder.rod` is mechanical",
+                "share a domain",
+            ],
         ),
         (
             "two owners",
             &|v| v["connections"][2][1] = "tank.port".into(),
             &[
-                "connections[2]",
+                "rig `connections[2][1]`:",
                 "owned by both",
                 "supply.port",
                 "tank.port",
+            ],
+        ),
+        (
+            // the second owner comes in a later connection than the node's
+            // first: named there
+            "two owners, the second in a later connection",
+            &|v| v["connections"][4][2] = "supply.port".into(),
+            &[
+                "rig `connections[4][2]`:",
+                "owned by both cylinder.A and supply.port",
             ],
         ),
         (
@@ -437,15 +453,24 @@ fn bad_netlists_are_refused_by_path() {
             &["components.tank", "port `port`", "not connected"],
         ),
         (
+            // an orifice between the supply and the valve: the node between
+            // two resistive ports has no owner
             "no owner",
             &|v| {
-                v["connections"].as_array_mut().unwrap().remove(2);
+                v["components"]["restrictor"] = serde_json::json!(
+                    {"type": "orifice", "area": 1.0e-6, "cd": 0.65, "density": 870.0}
+                );
+                v["connections"][2] = serde_json::json!(["supply.port", "restrictor.a"]);
                 v["connections"]
                     .as_array_mut()
                     .unwrap()
-                    .push(serde_json::json!(["valve.P", "friction.A"]));
+                    .push(serde_json::json!(["restrictor.b", "valve.P"]));
             },
-            &["not connected"],
+            &[
+                "rig `connections[7]`:",
+                "the hydraulic node of restrictor.b, valve.P has no owner",
+                "algebraic_node",
+            ],
         ),
         (
             "out of range",
@@ -518,6 +543,110 @@ fn a_duplicate_key_is_refused_with_its_line() {
         err.contains("components.load.mass") && err.contains("duplicate key at line"),
         "{err}"
     );
+}
+
+/// The error of a rig file as the CLI and the Python package print it: read
+/// (`rig::load`), checked, assembled, and located (`rig::at_line`).
+fn file_error(path: &std::path::Path) -> String {
+    let p = path.to_str().unwrap();
+    let e = rig::load(p)
+        .and_then(|v| rig::check(&v).map(|_| v))
+        .and_then(|v| rig::circuit(&v, square()).map(|_| ()))
+        .expect_err(p);
+    rig::at_line(e, p).to_string()
+}
+
+/// Netlist errors in a rig file name the exact JSON path and its line: an
+/// algebraic loop (found when the circuit is assembled) at the first
+/// component on the cycle, a domain mismatch and a second owner at the
+/// connection element that brings them in (a later connection than the
+/// node's first), a node with no owner at its connection.
+#[test]
+fn netlist_errors_name_the_json_path_and_line() {
+    // (fixture, edits, the edited text whose first line the error names,
+    // the path, words of the message)
+    type FileCase<'a> = (&'a str, &'a [(&'a str, &'a str)], &'a str, &'a str, &'a str);
+    let cases: &[FileCase] = &[
+        (
+            "fixtures/rigs/leaney-moog-closed-loop.json",
+            &[
+                (
+                    "\"reference\": {\n      \"type\": \"command_input\"\n    },",
+                    "\"ctl2\": {\"type\": \"position_controller\", \"gain\": 10.0},",
+                ),
+                (
+                    "\"reference.out\",\n      \"controller.reference\"",
+                    "\"ctl2.command\",\n      \"controller.reference\"",
+                ),
+                (
+                    "\"controller.command\",\n      \"spool.command\"",
+                    "\"controller.command\",\n      \"ctl2.reference\",\n      \"spool.command\"",
+                ),
+                (
+                    "\"controller.rod\"\n",
+                    "\"controller.rod\",\n      \"ctl2.rod\"\n",
+                ),
+                ("\"reference\": \"reference.command\",\n", ""),
+            ],
+            "\"ctl2\": {",
+            "components.ctl2",
+            "algebraic loop between components ctl2, controller: put a volume or a mass between them",
+        ),
+        (
+            "fixtures/rigs/leaney-moog.json",
+            &[(
+                "\"cylinder.rod\",\n      \"load.rod\"",
+                "\"cylinder.rod\",\n      \"valve.A\"",
+            )],
+            "\"valve.A\",\n      \"friction.rod\"",
+            "connections[6][1]",
+            "`valve.A` is hydraulic but `cylinder.rod` is mechanical: connected ports share a domain",
+        ),
+        (
+            "fixtures/rigs/leaney-moog.json",
+            &[(
+                "\"cylinder.A\",\n      \"friction.A\"",
+                "\"cylinder.A\",\n      \"supply.port\"",
+            )],
+            "\"supply.port\"\n",
+            "connections[4][2]",
+            "the hydraulic node is owned by both cylinder.A and supply.port: a node has exactly one owner",
+        ),
+        (
+            "fixtures/rigs/leaney-moog.json",
+            &[
+                (
+                    "\"supply.port\",\n      \"valve.P\"",
+                    "\"supply.port\",\n      \"restrictor.a\"\n    ],\n    [\n      \"restrictor.b\",\n      \"valve.P\"",
+                ),
+                (
+                    "\"components\": {",
+                    "\"components\": {\n    \"restrictor\": {\"type\": \"orifice\", \"area\": 1.0e-6, \"cd\": 0.65, \"density\": 870.0},",
+                ),
+            ],
+            "[\n      \"restrictor.b\"",
+            "connections[3]",
+            "the hydraulic node of restrictor.b, valve.P has no owner",
+        ),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for (k, (fixture, edits, at, path, why)) in cases.iter().enumerate() {
+        let mut text = std::fs::read_to_string(root().join(fixture)).unwrap();
+        for (a, b) in *edits {
+            assert!(text.contains(a), "{fixture} has no `{a}`");
+            text = text.replacen(a, b, 1);
+        }
+        let line = text[..text.find(at).expect(at)].matches('\n').count() + 1;
+        let f = dir.path().join(format!("bad{k}.json"));
+        std::fs::write(&f, &text).unwrap();
+        let err = file_error(&f);
+        let head = format!("rig `{path}`: {why}");
+        let tail = format!("(line {line} of {})", f.display());
+        assert!(
+            err.starts_with(&head) && err.ends_with(&tail) && !err.contains('\n'),
+            "`{err}`: expected `{head} … {tail}`"
+        );
+    }
 }
 
 /// The probes each component type declares are the ones its components

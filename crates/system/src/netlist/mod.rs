@@ -177,10 +177,13 @@ fn assemble_driven(
             path: format!("components.{component}"),
             why: message,
         },
+        // named at the first component on the cycle (in file order), so
+        // that the error has a line in the file
         BuildError::AlgebraicLoop(names) => RigError::Invalid {
-            path: "connections".into(),
+            path: format!("components.{}", names.first().map_or("", String::as_str)),
             why: format!(
-                "algebraic loop between components {names}: put a volume or a mass between them"
+                "algebraic loop between components {}: put a volume or a mass between them",
+                names.join(", ")
             ),
         },
         other => RigError::Build(other),

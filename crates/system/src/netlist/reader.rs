@@ -280,6 +280,117 @@ enum End {
     Named(String),
 }
 
+/// What the endpoints joined so far into one set hold: checked as each
+/// endpoint joins, so that a conflict is named at the connection element
+/// that brings it in (not where the node was first used).
+#[derive(Clone, Debug, Default)]
+struct Part {
+    /// The set's domain and the first port that gave it.
+    domain: Option<(Domain, String)>,
+    /// The owning ports in the set.
+    owners: Vec<String>,
+    /// The set's node name, when a named node is in it.
+    named: Option<String>,
+}
+
+impl Part {
+    fn of(e: &End, instances: &[Instance]) -> Self {
+        match e {
+            End::Named(n) => Part {
+                named: Some(n.clone()),
+                ..Part::default()
+            },
+            End::Port(ci, p) => {
+                let inst = &instances[*ci];
+                let spec = inst.ty.port(p).expect("checked when read");
+                let label = format!("{}.{p}", inst.name);
+                Part {
+                    owners: if spec.role == Role::Owns {
+                        vec![label.clone()]
+                    } else {
+                        Vec::new()
+                    },
+                    domain: Some((spec.domain, label)),
+                    named: None,
+                }
+            }
+        }
+    }
+}
+
+/// Joins `item` (the element `item_label` at JSON path `at`, its endpoint
+/// `e`) to the set
+/// of `to`: a domain, owner or name conflict between the two sets is an
+/// error at `at`, naming the ports (or nodes) on both sides.
+fn join(
+    sets: &mut Sets,
+    parts: &mut [Part],
+    to: usize,
+    item: usize,
+    e: &End,
+    item_label: &str,
+    at: &str,
+) -> Result<(), NetlistError> {
+    let (ra, rb) = (sets.find(to), sets.find(item));
+    if ra == rb {
+        return Ok(());
+    }
+    let (a, b) = (&parts[ra], &parts[rb]);
+    if let (Some(da), Some(db)) = (&a.domain, &b.domain) {
+        if da.0 != db.0 {
+            // the element itself where it is a port, else a port on its node
+            let port = match e {
+                End::Port(..) => format!("`{item_label}`"),
+                End::Named(n) => format!("`{}` (on node `{n}`)", db.1),
+            };
+            return err(
+                at,
+                format!(
+                    "{port} is {} but `{}` is {}: connected ports share a domain",
+                    db.0.name(),
+                    da.1,
+                    da.0.name()
+                ),
+            );
+        }
+    }
+    if let (Some(na), Some(nb)) = (&a.named, &b.named) {
+        if na != nb {
+            return err(
+                at,
+                format!("nodes `{na}` and `{nb}` are joined: a node has one name"),
+            );
+        }
+    }
+    if !a.owners.is_empty() && !b.owners.is_empty() {
+        let domain = a
+            .domain
+            .as_ref()
+            .or(b.domain.as_ref())
+            .expect("owners have ports");
+        return err(
+            at,
+            format!(
+                "the {} node is owned by both {} and {}: a node has exactly one owner",
+                domain.0.name(),
+                a.owners.join(" and "),
+                b.owners.join(" and ")
+            ),
+        );
+    }
+    let b = std::mem::take(&mut parts[rb]);
+    let a = &mut parts[ra];
+    a.domain = a.domain.take().or(b.domain);
+    a.owners.extend(b.owners);
+    a.named = a.named.take().or(b.named);
+    sets.union(ra, rb);
+    let root = sets.find(ra);
+    if root != ra {
+        parts.swap(root, ra);
+    }
+    Ok(())
+}
+
 /// Reads and checks a netlist value.
 pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
     let Value::Object(root) = v else {
@@ -316,18 +427,12 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
         .map(|(n, c)| read_instance(n, c))
         .collect::<Result<Vec<_>, _>>()?;
 
-    // endpoints and their sets
+    // endpoints and their sets, joined connection by connection: a conflict
+    // is named at the element that brings it in
     let mut ends: Vec<End> = Vec::new();
     let mut first_use: Vec<String> = Vec::new();
-    let mut index = |e: End, at: &str, ends: &mut Vec<End>| -> usize {
-        if let Some(i) = ends.iter().position(|x| *x == e) {
-            i
-        } else {
-            ends.push(e);
-            first_use.push(at.to_string());
-            ends.len() - 1
-        }
-    };
+    let mut parts: Vec<Part> = Vec::new();
+    let mut sets = Sets { parent: Vec::new() };
     let conns = match root.get("connections") {
         None => Vec::new(),
         Some(Value::Array(a)) => a.clone(),
@@ -338,7 +443,6 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
             )
         }
     };
-    let mut pairs = Vec::new();
     for (ci, c) in conns.iter().enumerate() {
         let at = format!("connections[{ci}]");
         let Value::Array(items) = c else {
@@ -350,7 +454,7 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
         if items.len() < 2 {
             return err(at, "a connection joins two or more ports");
         }
-        let mut ids = Vec::new();
+        let mut first = None;
         for (k, item) in items.iter().enumerate() {
             let at_k = format!("{at}[{k}]");
             let Value::String(s) = item else {
@@ -381,103 +485,61 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                 None if valid_name(s) => End::Named(s.clone()),
                 None => return err(at_k, "a node name is letters, digits, `_` and `-`"),
             };
-            ids.push(index(e, &at, &mut ends));
+            let id = match ends.iter().position(|x| *x == e) {
+                Some(i) => i,
+                None => {
+                    parts.push(Part::of(&e, &instances));
+                    ends.push(e.clone());
+                    first_use.push(at.clone());
+                    sets.parent.push(ends.len() - 1);
+                    ends.len() - 1
+                }
+            };
+            match first {
+                None => first = Some(id),
+                Some(f) => join(&mut sets, &mut parts, f, id, &e, s, &at_k)?,
+            }
         }
-        for w in ids.windows(2) {
-            pairs.push((w[0], w[1]));
-        }
-    }
-    let mut sets = Sets {
-        parent: (0..ends.len()).collect(),
-    };
-    for (a, b) in pairs {
-        sets.union(a, b);
     }
     let mut groups: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
     for i in 0..ends.len() {
         groups.entry(sets.find(i)).or_default().push(i);
     }
 
-    // each group is a node: one domain, one owner, one name
+    // each group is a node (one domain, at most one owner and one name, as
+    // joined above): it must join a port and have its owner
     let mut nodes = BTreeMap::new();
-    for members in groups.values() {
+    for (root, members) in &groups {
+        // the connection where the node is first used
         let at = &first_use[members[0]];
-        let mut domain: Option<(Domain, String)> = None;
-        let mut owners = Vec::new();
-        let mut named: Option<String> = None;
-        let mut ports = Vec::new();
-        for &m in members {
-            match &ends[m] {
-                End::Named(n) => {
-                    if let Some(prev) = &named {
-                        if prev != n {
-                            return err(
-                                at.clone(),
-                                format!("nodes `{prev}` and `{n}` are joined: a node has one name"),
-                            );
-                        }
-                    }
-                    named = Some(n.clone());
-                }
-                End::Port(ci, p) => {
-                    let inst = &instances[*ci];
-                    let spec = inst.ty.port(p).expect("checked above");
-                    let label = format!("{}.{p}", inst.name);
-                    match &domain {
-                        Some((d, other)) if *d != spec.domain => {
-                            return err(
-                                at.clone(),
-                                format!(
-                                    "`{label}` is {} but `{other}` is {}: connected ports share a domain",
-                                    spec.domain.name(),
-                                    d.name()
-                                ),
-                            )
-                        }
-                        None => domain = Some((spec.domain, label.clone())),
-                        _ => {}
-                    }
-                    if spec.role == Role::Owns {
-                        owners.push(label.clone());
-                    }
-                    ports.push(label);
-                }
-            }
-        }
-        let Some((domain, _)) = domain else {
+        let part = &parts[*root];
+        let ports: Vec<String> = members
+            .iter()
+            .filter_map(|&m| match &ends[m] {
+                End::Port(ci, p) => Some(format!("{}.{p}", instances[*ci].name)),
+                End::Named(_) => None,
+            })
+            .collect();
+        let Some((domain, _)) = part.domain else {
             return err(at.clone(), "this node joins no component port");
         };
-        match owners.len() {
-            1 => {}
-            0 => {
-                return err(
-                    at.clone(),
-                    format!(
-                        "the {} node of {} has no owner: {}",
-                        domain.name(),
-                        ports.join(", "),
-                        match domain {
-                            Domain::Hydraulic =>
-                                "connect a volume, a cylinder chamber or a pressure source to it (or an `algebraic_node` between two resistive components)",
-                            Domain::Mechanical => "connect a mass to it",
-                            Domain::Signal =>
-                                "connect a signal source (command input, spool) to it",
-                        }
-                    ),
-                )
-            }
-            _ => {
-                return err(
-                    at.clone(),
-                    format!(
-                        "the {} node is owned by both {}: a node has exactly one owner",
-                        domain.name(),
-                        owners.join(" and ")
-                    ),
-                )
-            }
-        }
-        let node = named.unwrap_or_else(|| owners[0].clone());
+        let Some(owner) = part.owners.first() else {
+            return err(
+                at.clone(),
+                format!(
+                    "the {} node of {} has no owner: {}",
+                    domain.name(),
+                    ports.join(", "),
+                    match domain {
+                        Domain::Hydraulic =>
+                            "connect a volume, a cylinder chamber or a pressure source to it (or an `algebraic_node` between two resistive components)",
+                        Domain::Mechanical => "connect a mass to it",
+                        Domain::Signal => "connect a signal source (command input, spool) to it",
+                    }
+                ),
+            );
+        };
+        let node = part.named.clone().unwrap_or_else(|| owner.clone());
         for &m in members {
             if let End::Port(ci, p) = &ends[m] {
                 instances[*ci].nodes.insert(p.to_string(), node.clone());

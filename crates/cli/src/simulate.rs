@@ -368,7 +368,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         // are built (on a held command), which runs their own checks
         checked
             .circuit(Signal::Constant { value: 0.0 })
-            .map_err(|e| crate::rigfile::locate(e, &args.rig))?;
+            .map_err(|e| CliError::Input(e.to_string()))?;
         // a netlist is printed with every parameter written out (defaults
         // filled in), under the paths `--set` takes
         let shown = if kind == Some(hydrocyl_system::netlist::KIND) {

@@ -44,7 +44,7 @@ pub use components::{
     CheckComponent, NeedleComponent, PilotNodes, PilotValve, PumpComponent, ReliefComponent,
 };
 
-use crate::circuit::{BuildError, Circuit, Component};
+use crate::circuit::{BuildError, Circuit};
 use crate::rig::RigError;
 use crate::run::{Run, RunOptions};
 use crate::signal::Signal;
@@ -291,21 +291,7 @@ impl WangHybrid {
     /// The assembled circuit driven by `command` \[V\]: the netlist of
     /// [`WangHybrid::to_netlist`].
     pub fn build(&self, command: Signal) -> Result<Circuit, RigError> {
-        self.build_with(command, |_| ())
-    }
-
-    /// [`WangHybrid::build`], with `edit` given the components before they
-    /// are joined (the chapter-8 variants swap valves).
-    pub fn build_with(
-        &self,
-        command: Signal,
-        edit: impl FnOnce(&mut Vec<Box<dyn Component>>),
-    ) -> Result<Circuit, RigError> {
-        crate::netlist::assemble_with(
-            &crate::netlist::schematic(&self.to_netlist()?)?,
-            command,
-            edit,
-        )
+        crate::netlist::assemble(&crate::netlist::schematic(&self.to_netlist()?)?, command)
     }
 }
 

@@ -85,17 +85,6 @@ fn probe_path(component: &str, declared: &[(&str, &str)], probe: &str) -> String
 /// Assembles the circuit of a checked netlist, its command input (one of
 /// [`INPUT_TYPES`]) driven by `command`.
 pub fn assemble(s: &Schematic, command: Signal) -> Result<Circuit, RigError> {
-    assemble_with(s, command, |_| ())
-}
-
-/// [`assemble`], with `edit` given the built components before they are
-/// joined (a study swapping one component for another; the probes of a
-/// component the netlist does not declare keep their own names).
-pub fn assemble_with(
-    s: &Schematic,
-    command: Signal,
-    edit: impl FnOnce(&mut Vec<Box<dyn crate::Component>>),
-) -> Result<Circuit, RigError> {
     command.validate().map_err(|e| RigError::Invalid {
         path: "command".into(),
         why: e.to_string(),
@@ -114,7 +103,7 @@ pub fn assemble_with(
         .iter()
         .map(|n| (n.to_string(), command.clone()))
         .collect();
-    assemble_driven(s, &drive, edit)
+    assemble_driven(s, &drive)
 }
 
 /// Assembles a netlist with several inputs: each input component
@@ -134,14 +123,10 @@ pub fn assemble_inputs(s: &Schematic, inputs: &[(String, Signal)]) -> Result<Cir
             why: e.to_string(),
         })?;
     }
-    assemble_driven(s, inputs, |_| ())
+    assemble_driven(s, inputs)
 }
 
-fn assemble_driven(
-    s: &Schematic,
-    drive: &[(String, Signal)],
-    edit: impl FnOnce(&mut Vec<Box<dyn crate::Component>>),
-) -> Result<Circuit, RigError> {
+fn assemble_driven(s: &Schematic, drive: &[(String, Signal)]) -> Result<Circuit, RigError> {
     let names: Vec<&str> = s.inputs().map(|i| i.name.as_str()).collect();
     if let Some((n, _)) = drive.iter().find(|(n, _)| !names.contains(&n.as_str())) {
         return Err(RigError::Invalid {
@@ -171,7 +156,6 @@ fn assemble_driven(
         })?;
         comps.push(c);
     }
-    edit(&mut comps);
     let mut c = Circuit::build(comps).map_err(|e| match e {
         BuildError::Component { component, message } => RigError::Invalid {
             path: format!("components.{component}"),

@@ -29,8 +29,8 @@
 
 use crate::circuit::Circuit;
 use crate::rig::{self, RigError};
-use crate::run::{run, Run, RunOptions, SimError};
-use crate::signal::Signal;
+use crate::run::{self as runner, CommandSource, Run, RunOptions, SimError, StateSink};
+use crate::signal::{Signal, StreamedTable};
 use crate::wires::AnyWire;
 use hydrocyl_integrators::{solve, OdeSystem};
 use serde_json::Value;
@@ -107,10 +107,99 @@ impl Simulation {
     /// at least two). A solver failure is [`RigError::Sim`] with the method,
     /// time and reason; bad settings name the setting.
     pub fn run(&mut self, t_eval: &[f64]) -> Result<Run, RigError> {
-        run(&mut self.circuit, &self.initial, t_eval, &self.options).map_err(|e| match e {
-            SimError::Build(b) => RigError::from(b),
-            other => RigError::Sim(other.to_string()),
-        })
+        self.try_run(t_eval).map_err(rig_error)
+    }
+
+    /// [`Simulation::run`] with the run's own error, not mapped to a
+    /// [`RigError`]: a solver failure stays [`SimError::Solve`], whose
+    /// [`hydrocyl_integrators::SolveError`] holds the time it failed at (what
+    /// a caller that locates the failure reads).
+    pub fn try_run(&mut self, t_eval: &[f64]) -> Result<Run, SimError> {
+        runner::run(&mut self.circuit, &self.initial, t_eval, &self.options)
+    }
+
+    /// [`Simulation::run`] for long records: the outputs go to `sink` in
+    /// blocks of about `block` output times (a block ends at a step's end,
+    /// so it may hold a few more) as soon as each is computed, so the memory
+    /// grows with the block, not the record. It is one solve: the
+    /// integrator's step size, controller and stages carry over from block
+    /// to block, and the outputs are [`Simulation::run`]'s, bit for bit. An
+    /// `Err` from the sink stops the run (its message in the error).
+    /// Returns the totals: the stats, the diagnostics at the end, the wall
+    /// time of the solve (the sink's excluded); its `time`, `channels` and
+    /// `states` are empty.
+    pub fn run_streaming(
+        &mut self,
+        t_eval: &[f64],
+        block: usize,
+        sink: &mut dyn FnMut(&Run) -> Result<(), String>,
+    ) -> Result<Run, RigError> {
+        runner::run_streaming(
+            &mut self.circuit,
+            &self.initial,
+            t_eval,
+            &self.options,
+            block,
+            sink,
+        )
+        .map_err(rig_error)
+    }
+
+    /// [`Simulation::run_streaming`] without the channels: `sink` receives
+    /// each block's output times and full states (row-major,
+    /// `x.len() / t.len()` each) as the integrator wrote them, and reads the
+    /// probes itself where it likes, e.g. a [`crate::run::ProbeReader`] on
+    /// another thread (the solve's thread then only solves). The buffers
+    /// are the solve's, reused block after block: copy what is kept.
+    pub fn run_streaming_states(
+        &mut self,
+        t_eval: &[f64],
+        block: usize,
+        sink: &mut StateSink<'_>,
+    ) -> Result<Run, RigError> {
+        runner::run_streaming_states(
+            &mut self.circuit,
+            &self.initial,
+            t_eval,
+            &self.options,
+            block,
+            sink,
+        )
+        .map_err(rig_error)
+    }
+
+    /// [`Simulation::run_streaming`] on a command record too long to hold:
+    /// the circuit reads its command from `table` (the simulation built with
+    /// [`Signal::Streamed`] of a clone of it), which is filled from `source`
+    /// ahead of the integration and emptied behind it; the output times are
+    /// the record's sample times, from the first (the initial state's time)
+    /// to `t_end`, the last. Memory grows with `block` and the window, not
+    /// the record; the outputs are those of [`Simulation::run`] on the whole
+    /// record as a [`Signal::Table`].
+    pub fn run_command_stream(
+        &mut self,
+        table: &StreamedTable,
+        source: &mut dyn CommandSource,
+        t_end: f64,
+        block: usize,
+        sink: &mut dyn FnMut(&Run) -> Result<(), String>,
+    ) -> Result<Run, RigError> {
+        runner::run_command_stream(
+            &mut self.circuit,
+            &self.initial,
+            table,
+            source,
+            t_end,
+            &self.options,
+            block,
+            sink,
+        )
+        .map_err(rig_error)
+    }
+
+    /// The initial state of the runs ([`Circuit::state_names`] order).
+    pub fn initial(&self) -> &[f64] {
+        &self.initial
     }
 
     /// Sets parameter `path` (`<component>.<parameter>`) of the assembled
@@ -304,6 +393,15 @@ impl Simulation {
     /// The circuit, consumed (for callers that keep it after the runs).
     pub fn into_circuit(self) -> Circuit {
         self.circuit
+    }
+}
+
+/// A run's error as a rig's: an assembly error as such, any other (the
+/// solver's, bad settings, a sink's) as [`RigError::Sim`] with its message.
+fn rig_error(e: SimError) -> RigError {
+    match e {
+        SimError::Build(b) => RigError::from(b),
+        other => RigError::Sim(other.to_string()),
     }
 }
 

@@ -2,12 +2,29 @@
 //! options → a [`Run`] (channels, statistics, diagnostics and, when asked,
 //! the energy ledger's quadratures).
 //!
-//! Every caller that simulates a rig goes through [`Simulation`]:
-//! [`rig::simulate`], the CLI's `simulate`, the studies
-//! (chapter 3, 7 and 8), identification, the Python package and the benches.
-//! A rig value is read, checked and assembled once, in [`Simulation::new`];
-//! [`Simulation::run`] then integrates it and maps every failure to one
-//! [`RigError`].
+//! Every caller that simulates a rig or a circuit goes through
+//! [`Simulation`]: [`rig::simulate`] (and so the typed rigs' `simulate`),
+//! `hydrocyl simulate`, `diagnose` and identification, the energy matrix and
+//! the studies (chapter 3, 7, 8 and 9), the Python package, xtask and the
+//! benches. A rig value is read, checked and assembled once, in
+//! [`Simulation::new`] (a circuit assembled by hand enters by
+//! [`Simulation::of_circuit`]); then one of its run methods integrates it
+//! from its initial state, each delegating to the crate's run machinery
+//! ([`crate::run`], whose integrating functions are private to this crate):
+//!
+//! - [`Simulation::run`]: every output time kept, a failure mapped to one
+//!   [`RigError`]; [`Simulation::try_run`] the same with the run's own
+//!   [`SimError`] (a solver failure's time, for a caller that locates it);
+//! - [`Simulation::run_streaming`]: the channels handed to a sink in blocks
+//!   (one solve, bit for bit [`Simulation::run`]'s outputs);
+//! - [`Simulation::run_streaming_states`]: the raw states handed to a
+//!   [`StateSink`] in blocks, the probes read by the sink (the CLI's writer
+//!   thread, a [`crate::run::ProbeReader`]);
+//! - [`Simulation::run_command_stream`]: the command read from a
+//!   [`CommandSource`] into a [`StreamedTable`] while the run goes (a
+//!   command file too long to hold);
+//! - [`Simulation::run_wires`] and [`Simulation::sample_state_free`]: chosen
+//!   wires only (a fit's residuals).
 //!
 //! A co-simulation slave (the FMU) steps the same simulation between
 //! communication points instead: [`Simulation::start`], then

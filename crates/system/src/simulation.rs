@@ -457,6 +457,46 @@ mod tests {
         assert!(sim.step_to(0.1).is_err(), "no step backwards");
     }
 
+    /// The streamed entry points give [`Simulation::run`]'s outputs bit for
+    /// bit (states and channels, in blocks), and [`Simulation::try_run`]
+    /// keeps the solver's error where [`Simulation::run`] maps it.
+    #[test]
+    fn the_streamed_runs_are_the_run() {
+        let rig = rig::load("leaney-moog").unwrap();
+        let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-3).collect();
+        let u: Vec<f64> = t
+            .iter()
+            .map(|&t| if t < 0.15 { 0.2 } else { -0.2 })
+            .collect();
+        let cmd = Signal::table(t.clone(), u).unwrap();
+        let mut sim = Simulation::new(&rig, cmd).unwrap();
+        let whole = sim.run(&t).unwrap();
+        let (mut times, mut states) = (Vec::new(), Vec::new());
+        let total = sim
+            .run_streaming_states(&t, 64, &mut |tb, xb| {
+                times.extend_from_slice(tb);
+                states.extend_from_slice(xb);
+                Ok(())
+            })
+            .unwrap();
+        assert_eq!(times, whole.time);
+        assert_eq!(states, whole.states);
+        assert_eq!(total.stats, whole.stats);
+        let mut velocity = Vec::new();
+        sim.run_streaming(&t, 64, &mut |b| {
+            velocity.extend_from_slice(b.channel("velocity").unwrap());
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(velocity, whole.channel("velocity").unwrap());
+        let e = sim.run_streaming(&t, 64, &mut |_| Err("sink full".into()));
+        assert!(e.unwrap_err().to_string().contains("sink full"));
+        let mut opts = RunOptions::dp45();
+        opts.max_steps = 5;
+        sim.set_options(opts);
+        assert!(matches!(sim.try_run(&t), Err(SimError::Solve { .. })));
+    }
+
     /// The step budget is the options': a run that needs more steps fails.
     #[test]
     fn the_step_budget_is_kept() {

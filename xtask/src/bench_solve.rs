@@ -9,8 +9,9 @@ use hydrocyl_identify::plaincsv::{
 };
 use hydrocyl_integrators::Method;
 use hydrocyl_studies::chapter7::{Chapter7Test, Load, Shape};
-use hydrocyl_system::run::{nrmse, run_streaming_states, Run, RunOptions, Solver};
+use hydrocyl_system::run::{nrmse, Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
+use hydrocyl_system::simulation::Simulation;
 use hydrocyl_system::valve_rig::ValveRig;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -231,7 +232,7 @@ fn first_touch_us() -> f64 {
 /// 1000 s), so every row does the same work; the ratio to the 1 s cost says
 /// whether anything grows with the record. Two paths, each its own 1 s
 /// reference:
-/// - **streamed** (`run_streaming_states` in 256-row blocks, the path of
+/// - **streamed** (`Simulation::run_streaming_states` in 256-row blocks, the path of
 ///   `hydrocyl simulate`'s solve thread): the outputs go to a sink block by
 ///   block in reused buffers (here one reused copy, as the CLI's writer
 ///   queue), so the memory does not grow with the record; this is the row
@@ -264,13 +265,13 @@ fn cost_per_step() -> Result<(), String> {
         |case: &SquareCase, streamed: bool| -> Result<(f64, usize, Option<u64>), String> {
             let f0;
             let r = if streamed {
-                let mut c = case
+                let c = case
                     .rig
                     .circuit(case.command.clone())
                     .map_err(|e| e.to_string())?;
-                let x0 = c.initial_state();
+                let mut sim = Simulation::of_circuit(c).options(opts.clone());
                 f0 = minor_faults();
-                run_streaming_states(&mut c, &x0, &case.times, &opts, 256, &mut |t, x| {
+                sim.run_streaming_states(&case.times, 256, &mut |t, x| {
                     kept.clear();
                     kept.extend_from_slice(t);
                     kept.extend_from_slice(x);
@@ -292,7 +293,7 @@ fn cost_per_step() -> Result<(), String> {
         println!(
             "  {}",
             if streamed {
-                "streamed (run_streaming_states, 256-row blocks in reused buffers: hydrocyl simulate's solve thread):"
+                "streamed (Simulation::run_streaming_states, 256-row blocks in reused buffers: hydrocyl simulate's solve thread):"
             } else {
                 "in memory (run: all outputs kept, the states grow with the record):"
             }

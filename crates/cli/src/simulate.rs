@@ -31,12 +31,14 @@
 //!
 //! Every input is checked and the output's temporary file created before the
 //! run ([`crate::output`]); the command file is read meanwhile on a thread of
-//! its own ([`crate::command::Ahead`]). The run is streamed in blocks
-//! ([`hydrocyl_system::run::run_streaming`]); each block's text is made by
-//! the writer thread while the solve computes the next, and by both threads
-//! once the solve has ended, and written in order ([`crate::writer`]); a
-//! history-free rig's probes are read there too, on a circuit of each
-//! thread's own ([`hydrocyl_system::run::run_streaming_states`],
+//! its own ([`crate::command::Ahead`]). The run is one
+//! [`Simulation`] of the checked rig's circuit, streamed in blocks
+//! ([`Simulation::run_streaming`]; a command file too long to hold is read
+//! while the run goes, [`Simulation::run_command_stream`]); each block's
+//! text is made by the writer thread while the solve computes the next, and
+//! by both threads once the solve has ended, and written in order
+//! ([`crate::writer`]); a history-free rig's probes are read there too, on a
+//! circuit of each thread's own ([`Simulation::run_streaming_states`],
 //! [`hydrocyl_system::run::ProbeReader`]). The temporary is put in place at
 //! the end, so a failed or interrupted run leaves no file and the old one as
 //! it was (`--fsync` also flushes it to the disk first; without it the
@@ -50,8 +52,9 @@ use crate::progress::Progress;
 use crate::writer::{Block, Maker, Rows, Writer};
 use hydrocyl_identify::bench::FrictionBench;
 use hydrocyl_system::rig;
-use hydrocyl_system::run::{self as runner, ProbeReader, Run, RunOptions, Solver};
+use hydrocyl_system::run::{ProbeReader, Run, RunOptions, Solver};
 use hydrocyl_system::signal::{Signal, StreamedTable};
+use hydrocyl_system::simulation::Simulation;
 use std::path::{Path, PathBuf};
 
 /// The output columns, for `hydrocyl simulate --help`.
@@ -465,7 +468,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // own to read the probes on while this thread builds the solving one
     let checked = std::sync::Arc::new(checked);
     let o = outputs;
-    let (mut c, w, table) = match &input {
+    let (c, w, table) = match &input {
         Input::Table(times) => {
             let t0 = times[0];
             let signal = std::sync::Arc::new(signal);
@@ -505,7 +508,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
             (c, w, None)
         }
     };
-    let x0 = c.initial_state();
+    // the run: the circuit from its own initial state, with the options
+    let mut sim = Simulation::of_circuit(c).options(opts.clone());
+    let x0 = sim.initial().to_vec();
     crate::progress::mark("circuit built");
     let mut bar = Progress::new("simulate", rows as u64, args.progress, args.quiet);
     let mut failed: Option<CliError> = None;
@@ -515,7 +520,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // (the writer far behind) on a third circuit, after it on the solving one
     let mut own: Option<Maker> = None;
     let (streamed, written) = match (table, &input) {
-        (Some((reader, t0)), Input::Table(times)) if c.history_free() => {
+        (Some((reader, t0)), Input::Table(times)) if sim.circuit().history_free() => {
             w.rows(Rows::States {
                 unit,
                 solver,
@@ -541,12 +546,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
                     let m = own.as_mut().ok_or("no maker")?;
                     w.make_here(m, fill).map_err(|e| e.to_string())
                 };
-                runner::run_streaming_states(&mut c, &x0, times, &opts, BLOCK, &mut sink)
+                sim.run_streaming_states(times, BLOCK, &mut sink)
             };
             crate::progress::mark("solve done");
             // the solving circuit is free now: it reads the probes of the
             // solve's share of what is left (history-free: the same values)
-            let mut solving = Some(c);
+            let mut solving = Some(sim.into_circuit());
             let mut after = || match solving.take() {
                 Some(c) => ProbeReader::new(c, &x0, t0, &opts)
                     .map(Maker::states)
@@ -588,12 +593,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
                     })
                 };
                 match &mut input {
-                    Input::Table(times) => {
-                        runner::run_streaming(&mut c, &x0, times, &opts, BLOCK, &mut sink)
+                    Input::Table(times) => sim.run_streaming(times, BLOCK, &mut sink),
+                    Input::Stream(table, chunks) => {
+                        sim.run_command_stream(table, chunks, t1, BLOCK, &mut sink)
                     }
-                    Input::Stream(table, chunks) => runner::run_command_stream(
-                        &mut c, &x0, table, chunks, t1, &opts, BLOCK, &mut sink,
-                    ),
                 }
             };
             crate::progress::mark("solve done");
@@ -606,7 +609,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // solve's is its echo
     let (outputs, run) = match (streamed, failed, written) {
         (_, _, Err(e)) | (_, Some(e), _) => return Err(e),
-        (Err(e), None, _) => return Err(solver_hint(rig::RigError::Sim(e.to_string()))),
+        (Err(e), None, _) => return Err(solver_hint(e)),
         (Ok(r), None, Ok((o, p))) => {
             min_p = min_p.min(p);
             (o, r)

@@ -39,13 +39,14 @@
 //! use hydrocyl_energy::ledger::{ledger, RodSide};
 //! use hydrocyl_ports::{Area, Density, Pressure};
 //! use hydrocyl_system::components::{FixedOrifice, PressureSource, Volume};
-//! use hydrocyl_system::run::{run, RunOptions};
+//! use hydrocyl_system::run::RunOptions;
+//! use hydrocyl_system::simulation::Simulation;
 //! use hydrocyl_system::Circuit;
 //! use hydrocyl_valves::orifice::Orifice;
 //!
 //! let (ps, v, b) = (7.0e6, 1.0e-4, 7.0e8);
 //! let oil = Orifice { cd: 0.65, density: Density::new(900.0), dp_transition: Pressure::new(1000.0) };
-//! let mut c = Circuit::build(vec![
+//! let c = Circuit::build(vec![
 //!     Box::new(PressureSource::new("supply", "P", Pressure::new(ps), None)),
 //!     Box::new(FixedOrifice::new("orifice", "P", "V", Area::new(1e-6), oil)),
 //!     Box::new(Volume::new("volume", "V", v, b, 0.0, Some("pv"))),
@@ -53,10 +54,10 @@
 //! .unwrap();
 //! let t: Vec<f64> = (0..=100).map(|k| k as f64 * 1e-2).collect();
 //! let opts = RunOptions { ledger: true, rtol: 1e-8, ..RunOptions::dp45() };
-//! let x0 = c.initial_state();
-//! let r = run(&mut c, &x0, &t, &opts).unwrap();
+//! let mut sim = Simulation::of_circuit(c).options(opts);
+//! let r = sim.run(&t).unwrap();
 //! let rod = RodSide { node: "none".into(), components: vec![] };
-//! let l = ledger(&c, &r, 0, t.len() - 1, &rod).unwrap();
+//! let l = ledger(sim.circuit(), &r, 0, t.len() - 1, &rod).unwrap();
 //! let e_in = v * ps * ps / b; // V Ps² / B
 //! assert!((l.loss("orifice") / e_in - 0.5).abs() < 1e-4);
 //! assert!(l.error.abs() < 1e-3); // the ledger closes

@@ -4,7 +4,8 @@
 use hydrocyl_energy::ledger::{ledger, RodSide};
 use hydrocyl_ports::{Area, Density, Pressure};
 use hydrocyl_system::components::{FixedOrifice, PressureSource, Volume};
-use hydrocyl_system::run::{run, RunOptions};
+use hydrocyl_system::run::RunOptions;
+use hydrocyl_system::simulation::Simulation;
 use hydrocyl_system::{Circuit, Component};
 use hydrocyl_valves::orifice::Orifice;
 use std::path::{Path, PathBuf};
@@ -44,22 +45,23 @@ mod closed_forms {
         let (ps, v, b) = (7.0e6, 1.0e-4, 7.0e8);
         for area in [1e-7, 1e-6] {
             let orifice = FixedOrifice::new("orifice", "P", "V", Area::new(area), oil());
-            let mut c = charging_circuit(ps, v, b, Box::new(orifice));
+            let c = charging_circuit(ps, v, b, Box::new(orifice));
             let t: Vec<f64> = (0..=200).map(|k| k as f64 * 5e-3).collect();
             let opts = RunOptions {
                 ledger: true,
                 rtol: 1e-8,
                 ..RunOptions::dp45()
             };
-            let x0 = c.initial_state();
-            let r = run(&mut c, &x0, &t, &opts).unwrap();
+            let mut sim = Simulation::of_circuit(c).options(opts);
+            let r = sim.run(&t).unwrap();
+            let c = sim.circuit();
             let pv = *r.channel("pv").unwrap().last().unwrap();
             assert!((pv - ps).abs() < 1e-6 * ps, "not charged: {pv}");
             let rod = RodSide {
                 node: "none".into(),
                 components: vec![],
             };
-            let l = ledger(&c, &r, 0, t.len() - 1, &rod).unwrap();
+            let l = ledger(c, &r, 0, t.len() - 1, &rod).unwrap();
             let e_in = v * ps * ps / b;
             assert!((l.energy_in_j - e_in).abs() < 1e-5 * e_in, "{l:?}");
             assert!(
@@ -81,11 +83,11 @@ mod bad_input {
     #[test]
     fn a_run_without_the_ledger_is_refused() {
         let orifice = FixedOrifice::new("orifice", "P", "V", Area::new(1e-7), oil());
-        let mut c = charging_circuit(1e6, 1e-4, 7e8, Box::new(orifice));
+        let c = charging_circuit(1e6, 1e-4, 7e8, Box::new(orifice));
         let t = [0.0, 0.01, 0.02];
-        let x0 = c.initial_state();
-        let r = run(&mut c, &x0, &t, &RunOptions::dp45()).unwrap();
-        let e = ledger(&c, &r, 0, 2, &RodSide::default()).unwrap_err();
+        let mut sim = Simulation::of_circuit(c).options(RunOptions::dp45());
+        let r = sim.run(&t).unwrap();
+        let e = ledger(sim.circuit(), &r, 0, 2, &RodSide::default()).unwrap_err();
         assert!(e.to_string().contains("ledger: true"), "{e}");
     }
 

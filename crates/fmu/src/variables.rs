@@ -91,8 +91,8 @@ pub struct Variables {
 
 /// The circuit's output channels in the order of a run's channels
 /// (command, position, velocity, p1, p2, then the others in component order, as
-/// `hydrocyl_system::run::run` orders them), without the command (it is the
-/// FMU's input, named `input`).
+/// `hydrocyl_system::simulation::Simulation::run` orders them), without the
+/// command (it is the FMU's input, named `input`).
 pub fn output_channels(circuit: &Circuit, input: &str) -> Vec<Probe> {
     // a closed-loop rig's `command` (its controller's output) comes first,
     // as in a run

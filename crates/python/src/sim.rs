@@ -7,8 +7,9 @@ use crate::errors::{Failure, Outcome};
 use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
 use hydrocyl_integrators::SolveError;
 use hydrocyl_system::rig::{self, RigError};
-use hydrocyl_system::run::{self as runner, Run, RunOptions, SimError, Solver};
+use hydrocyl_system::run::{Run, RunOptions, SimError, Solver};
 use hydrocyl_system::signal::Signal;
+use hydrocyl_system::simulation::Simulation;
 use serde_json::Value;
 
 /// The run settings `simulate` and `simulate_batch` take, checked with the
@@ -106,9 +107,11 @@ fn failure_time(e: &SolveError) -> Option<f64> {
 }
 
 /// Turns a failed run into a [`Failure::Solver`]: the rig's run is repeated
-/// on its circuit to get the solver's time, then integrated up to that time
-/// for the state there (or up to the last point before it a run reaches,
-/// when the failing step ends at that time). The message is the CLI's, with the state appended.
+/// (a fresh [`Simulation`], [`Simulation::try_run`] for the solver's own
+/// error) to get the solver's time, then integrated up to that time for the
+/// state there (or up to the last point before it a run reaches, when the
+/// failing step ends at that time). The message is the CLI's, with the state
+/// appended.
 fn locate_failure(
     value: &Value,
     command: &Signal,
@@ -117,11 +120,16 @@ fn locate_failure(
     message: String,
 ) -> Failure {
     let located = (|| {
-        let mut c = rig::circuit(value, command.clone()).ok()?;
-        let x0 = c.initial_state();
-        let n = c.n_states();
-        let names = c.state_names();
-        let time = match runner::run(&mut c, &x0, t, opts) {
+        let sim = || {
+            Simulation::new(value, command.clone())
+                .ok()
+                .map(|s| s.options(opts.clone()))
+        };
+        let mut first = sim()?;
+        let x0 = first.initial().to_vec();
+        let n = first.circuit().n_states();
+        let names = first.circuit().state_names();
+        let time = match first.try_run(t) {
             Err(SimError::Solve { source, .. }) => failure_time(&source)?,
             _ => return None,
         };
@@ -130,7 +138,7 @@ fn locate_failure(
         // before it that a run reaches: one fixed step back, else the last
         // output sample before it
         let mut candidates = vec![time];
-        if opts.solver == runner::Solver::Rk4 {
+        if opts.solver == Solver::Rk4 {
             candidates.push(time - opts.rk4_step);
         }
         candidates.extend(t.iter().rev().find(|&&s| s < time));
@@ -140,8 +148,7 @@ fn locate_failure(
                 reached = Some((at, x0[..n].to_vec()));
                 break;
             }
-            let mut c = rig::circuit(value, command.clone()).ok()?;
-            if let Ok(r) = runner::run(&mut c, &x0, &[t[0], at], opts) {
+            if let Ok(r) = sim()?.try_run(&[t[0], at]) {
                 reached = Some((at, r.state(1)[..n].to_vec()));
                 break;
             }

@@ -6,7 +6,8 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use hydrocyl_studies::chapter7::{Chapter7Test, Load, Shape};
-use hydrocyl_system::run::{run, RunOptions, Solver};
+use hydrocyl_system::run::{RunOptions, Solver};
+use hydrocyl_system::simulation::Simulation;
 use std::hint::black_box;
 
 fn square_period(c: &mut Criterion) {
@@ -32,11 +33,10 @@ fn square_period(c: &mut Criterion) {
         };
         g.bench_function(name, |b| {
             b.iter(|| {
-                let mut circ = rig.build(test.command(&rig)).expect("rig");
-                circ.set_analytic_jacobian(analytic);
-                let x0 = circ.initial_state();
-                circ.reset(0.0, &x0);
-                black_box(run(&mut circ, &x0, &t, &opts).expect("run").stats.steps)
+                let mut sim = Simulation::of_circuit(rig.build(test.command(&rig)).expect("rig"))
+                    .options(opts.clone());
+                sim.circuit_mut().set_analytic_jacobian(analytic);
+                black_box(sim.run(&t).expect("run").stats.steps)
             })
         });
     }

@@ -6,7 +6,8 @@
 //! `cargo run --release -p hydrocyl-studies --example hybrid_square -- [reps]`
 
 use hydrocyl_studies::chapter7::{Chapter7Test, Load, Shape};
-use hydrocyl_system::run::{run, RunOptions, Solver};
+use hydrocyl_system::run::{RunOptions, Solver};
+use hydrocyl_system::simulation::Simulation;
 
 fn main() {
     let reps: usize = std::env::args()
@@ -28,10 +29,11 @@ fn main() {
     };
     for _ in 0..reps {
         let start = std::time::Instant::now();
-        let mut circ = rig.build(test.command(&rig)).expect("rig");
-        let x0 = circ.initial_state();
-        circ.reset(0.0, &x0);
-        let r = run(&mut circ, &x0, &t, &opts).expect("run");
+        let circ = rig.build(test.command(&rig)).expect("rig");
+        let r = Simulation::of_circuit(circ)
+            .options(opts.clone())
+            .run(&t)
+            .expect("run");
         best = best.min(start.elapsed().as_secs_f64());
         if last_run(reps) {
             let s = &r.stats;

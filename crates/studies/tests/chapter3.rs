@@ -3,8 +3,9 @@
 //! end stop.
 
 use hydrocyl_studies::chapter3;
-use hydrocyl_system::run::{run, RunOptions, Solver};
+use hydrocyl_system::run::{RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
+use hydrocyl_system::simulation::Simulation;
 
 #[test]
 fn open_loop_bias_gives_symmetric_velocity() {
@@ -35,13 +36,14 @@ fn open_loop_bias_gives_symmetric_velocity() {
 #[test]
 fn chamber_mass_balance_closes() {
     let case = chapter3::square_wave().unwrap();
-    let mut c = case.rig.circuit(case.command.clone()).unwrap();
-    let x0 = c.initial_state();
     let opts = RunOptions {
         quadratures: true,
         ..RunOptions::dp45()
     };
-    let r = run(&mut c, &x0, &case.times, &opts).unwrap();
+    let mut sim =
+        Simulation::of_circuit(case.rig.circuit(case.command.clone()).unwrap()).options(opts);
+    let r = sim.run(&case.times).unwrap();
+    let c = sim.circuit();
     let cyl = case.rig.cylinder_model();
     let (q, st) = (
         c.quadrature_range(c.component_index("cylinder").unwrap()),

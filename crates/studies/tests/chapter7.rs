@@ -165,19 +165,20 @@ fn bias_makes_the_command_implied_velocity_symmetric() {
 /// member evaluations and never falls back to Brent.
 #[test]
 fn the_return_port_solve_is_cheap_on_the_rig() {
-    use hydrocyl_system::run::{run, RunOptions, Solver};
+    use hydrocyl_system::run::{RunOptions, Solver};
+    use hydrocyl_system::simulation::Simulation;
     let test = Chapter7Test::new(Shape::Square, Load::None);
     let rig = test.rig();
-    let mut c = rig.build(test.command(&rig)).unwrap();
-    let x0 = c.initial_state();
-    c.reset(0.0, &x0);
     let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-2).collect();
     let opts = RunOptions {
         solver: Solver::Rosenbrock,
         ..RunOptions::default()
     };
-    run(&mut c, &x0, &t, &opts).unwrap();
-    let d = c.diagnostics();
+    let d = Simulation::of_circuit(rig.build(test.command(&rig)).unwrap())
+        .options(opts)
+        .run(&t)
+        .unwrap()
+        .diagnostics;
     let get = |k: &str| d.iter().find(|(n, _)| n == k).unwrap().1;
     let (solves, evals) = (
         get("return_port.solves"),

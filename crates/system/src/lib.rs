@@ -82,12 +82,14 @@
 //!   [`Circuit::set_ledger`] appends four quadratures per component to the
 //!   state vector (loosely weighted in the error norm by [`Circuit::atol`]).
 //!
-//! A circuit from components, by hand (what a rig kind's builder does):
+//! A circuit from components, by hand (what a rig kind's builder does), run as
+//! every circuit is, by a [`simulation::Simulation`]:
 //!
 //! ```
-//! use hydrocyl_integrators::{solve, Method, OdeSystem, Options};
 //! use hydrocyl_ports::{Area, Density, Pressure};
 //! use hydrocyl_system::components::{FixedOrifice, PressureSource, Volume};
+//! use hydrocyl_system::run::{RunOptions, Solver};
+//! use hydrocyl_system::simulation::Simulation;
 //! use hydrocyl_system::{Circuit, Component};
 //! use hydrocyl_valves::orifice::Orifice;
 //!
@@ -98,11 +100,10 @@
 //!                                Orifice::new(0.65, Density::new(870.0)))),
 //!     Box::new(Volume::new("line", "L", 1e-4, 7e8, 0.0, Some("pl"))),
 //! ];
-//! let mut c = Circuit::build(parts).unwrap();
-//! let x0 = c.initial_state();
-//! let opts = Options { atol: c.atol(1e-8), rtol: 1e-8, ..Options::default() };
-//! let sol = solve(Method::DormandPrince45, &mut c, 0.0, &x0, 2.0, &opts).unwrap();
-//! assert!((sol.last().unwrap()[0] - 7.0e6).abs() < 1e3); // the line fills to supply pressure
+//! let c = Circuit::build(parts).unwrap();
+//! let opts = RunOptions { rtol: 1e-8, solver: Solver::Dp45, ..RunOptions::default() };
+//! let run = Simulation::of_circuit(c).options(opts).run(&[0.0, 2.0]).unwrap();
+//! assert!((run.channel("pl").unwrap()[1] - 7.0e6).abs() < 1e3); // the line fills to supply pressure
 //! ```
 //!
 //! ## Thesis equations

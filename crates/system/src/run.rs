@@ -1,5 +1,19 @@
-//! Running an assembled circuit: solver choice, output sampling at given
-//! times, probes turned into named channels, cavitation and stop reports.
+//! The machinery under [`Simulation`](crate::simulation::Simulation):
+//! running an assembled circuit, with the solver chosen ([`Solver`],
+//! [`RunOptions`]), the outputs sampled at given times, the probes turned
+//! into named channels ([`ProbeSet`], or [`ProbeReader`] on a circuit of its
+//! own), cavitation and stop reports ([`Run`]).
+//!
+//! The functions that integrate are this crate's own: `run` (one solve,
+//! every output kept), `run_streaming` (the outputs' channels handed to a
+//! sink in blocks), `run_streaming_states` (the raw states handed to a
+//! [`StateSink`]) and `run_command_stream` (the command read from a
+//! [`CommandSource`] while the run goes), the last three one streamed solve
+//! ([`hydrocyl_integrators::solve_streaming`]). Outside this crate a circuit
+//! is run only through [`Simulation`](crate::simulation::Simulation), whose
+//! methods of the same names delegate to them; what is public here is what
+//! those methods take and give: the options, the run and its channels, the
+//! errors, the sink and source types, the probe readers, and [`nrmse`].
 
 use crate::circuit::{BuildError, Circuit};
 use crate::signal::StreamedTable;
@@ -246,8 +260,9 @@ impl Run {
 const ORDER: [&str; 5] = ["command", "position", "velocity", "p1", "p2"];
 
 /// Integrates `circuit` from `x0` at `t_eval[0]` to the last of `t_eval`,
-/// sampling at every `t_eval` time (sorted, strictly increasing, ≥ 2 points).
-pub fn run(
+/// sampling at every `t_eval` time (sorted, strictly increasing, ≥ 2 points):
+/// [`crate::simulation::Simulation::run`].
+pub(crate) fn run(
     circuit: &mut Circuit,
     x0: &[f64],
     t_eval: &[f64],
@@ -339,7 +354,7 @@ fn solver_options(circuit: &Circuit, opts: &RunOptions) -> Options {
 /// to block, and the outputs are [`run`]'s, bit for bit. Returns the totals:
 /// the stats, the diagnostics at the end, the wall time of the solve (the
 /// sink's excluded); its `time`, `channels` and `states` are empty.
-pub fn run_streaming(
+pub(crate) fn run_streaming(
     circuit: &mut Circuit,
     x0: &[f64],
     t_eval: &[f64],
@@ -350,8 +365,10 @@ pub fn run_streaming(
     stream_slice(circuit, x0, t_eval, opts, block, Output::Channels(sink))
 }
 
-/// The sink of [`run_streaming_states`]: a block's output times and
-/// states (row-major); an `Err` stops the run.
+/// The sink of [`Simulation::run_streaming_states`]: a block's output times
+/// and states (row-major); an `Err` stops the run.
+///
+/// [`Simulation::run_streaming_states`]: crate::simulation::Simulation::run_streaming_states
 pub type StateSink<'a> = dyn FnMut(&[f64], &[f64]) -> Result<(), String> + 'a;
 
 /// [`run_streaming`] without the channels: `sink` receives each block's
@@ -360,7 +377,7 @@ pub type StateSink<'a> = dyn FnMut(&[f64], &[f64]) -> Result<(), String> + 'a;
 /// e.g. a [`ProbeReader`] on another thread (the solve's thread then only
 /// solves). The buffers are the solve's, reused block after block: copy
 /// what is kept.
-pub fn run_streaming_states(
+pub(crate) fn run_streaming_states(
     circuit: &mut Circuit,
     x0: &[f64],
     t_eval: &[f64],
@@ -390,7 +407,9 @@ fn stream_slice(
 }
 
 /// The samples of a command record, read while the run goes (a source for
-/// [`run_command_stream`]).
+/// [`Simulation::run_command_stream`]).
+///
+/// [`Simulation::run_command_stream`]: crate::simulation::Simulation::run_command_stream
 pub trait CommandSource {
     /// Appends the next samples' times \[s\] and values to `t` and `u`
     /// (both the same length; times strictly increasing across calls);
@@ -406,7 +425,7 @@ pub trait CommandSource {
 /// grows with `block` and the window, not the record; the outputs are those
 /// of [`run`] on the whole record as a [`crate::signal::Signal::Table`].
 #[allow(clippy::too_many_arguments)]
-pub fn run_command_stream(
+pub(crate) fn run_command_stream(
     circuit: &mut Circuit,
     x0: &[f64],
     table: &StreamedTable,

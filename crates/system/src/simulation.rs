@@ -2,12 +2,29 @@
 //! options → a [`Run`] (channels, statistics, diagnostics and, when asked,
 //! the energy ledger's quadratures).
 //!
-//! Every caller that simulates a rig goes through [`Simulation`]:
-//! [`rig::simulate`], the CLI's `simulate`, the studies
-//! (chapter 3, 7 and 8), identification, the Python package and the benches.
-//! A rig value is read, checked and assembled once, in [`Simulation::new`];
-//! [`Simulation::run`] then integrates it and maps every failure to one
-//! [`RigError`].
+//! Every caller that simulates a rig or a circuit goes through
+//! [`Simulation`]: [`rig::simulate`] (and so the typed rigs' `simulate`),
+//! `hydrocyl simulate`, `diagnose` and identification, the energy matrix and
+//! the studies (chapter 3, 7, 8 and 9), the Python package, xtask and the
+//! benches. A rig value is read, checked and assembled once, in
+//! [`Simulation::new`] (a circuit assembled by hand enters by
+//! [`Simulation::of_circuit`]); then one of its run methods integrates it
+//! from its initial state, each delegating to the crate's run machinery
+//! ([`crate::run`], whose integrating functions are private to this crate):
+//!
+//! - [`Simulation::run`]: every output time kept, a failure mapped to one
+//!   [`RigError`]; [`Simulation::try_run`] the same with the run's own
+//!   [`SimError`] (a solver failure's time, for a caller that locates it);
+//! - [`Simulation::run_streaming`]: the channels handed to a sink in blocks
+//!   (one solve, bit for bit [`Simulation::run`]'s outputs);
+//! - [`Simulation::run_streaming_states`]: the raw states handed to a
+//!   [`StateSink`] in blocks, the probes read by the sink (the CLI's writer
+//!   thread, a [`crate::run::ProbeReader`]);
+//! - [`Simulation::run_command_stream`]: the command read from a
+//!   [`CommandSource`] into a [`StreamedTable`] while the run goes (a
+//!   command file too long to hold);
+//! - [`Simulation::run_wires`] and [`Simulation::sample_state_free`]: chosen
+//!   wires only (a fit's residuals).
 //!
 //! A co-simulation slave (the FMU) steps the same simulation between
 //! communication points instead: [`Simulation::start`], then
@@ -29,8 +46,8 @@
 
 use crate::circuit::Circuit;
 use crate::rig::{self, RigError};
-use crate::run::{run, Run, RunOptions, SimError};
-use crate::signal::Signal;
+use crate::run::{self as runner, CommandSource, Run, RunOptions, SimError, StateSink};
+use crate::signal::{Signal, StreamedTable};
 use crate::wires::AnyWire;
 use hydrocyl_integrators::{solve, OdeSystem};
 use serde_json::Value;
@@ -107,10 +124,99 @@ impl Simulation {
     /// at least two). A solver failure is [`RigError::Sim`] with the method,
     /// time and reason; bad settings name the setting.
     pub fn run(&mut self, t_eval: &[f64]) -> Result<Run, RigError> {
-        run(&mut self.circuit, &self.initial, t_eval, &self.options).map_err(|e| match e {
-            SimError::Build(b) => RigError::from(b),
-            other => RigError::Sim(other.to_string()),
-        })
+        self.try_run(t_eval).map_err(rig_error)
+    }
+
+    /// [`Simulation::run`] with the run's own error, not mapped to a
+    /// [`RigError`]: a solver failure stays [`SimError::Solve`], whose
+    /// [`hydrocyl_integrators::SolveError`] holds the time it failed at (what
+    /// a caller that locates the failure reads).
+    pub fn try_run(&mut self, t_eval: &[f64]) -> Result<Run, SimError> {
+        runner::run(&mut self.circuit, &self.initial, t_eval, &self.options)
+    }
+
+    /// [`Simulation::run`] for long records: the outputs go to `sink` in
+    /// blocks of about `block` output times (a block ends at a step's end,
+    /// so it may hold a few more) as soon as each is computed, so the memory
+    /// grows with the block, not the record. It is one solve: the
+    /// integrator's step size, controller and stages carry over from block
+    /// to block, and the outputs are [`Simulation::run`]'s, bit for bit. An
+    /// `Err` from the sink stops the run (its message in the error).
+    /// Returns the totals: the stats, the diagnostics at the end, the wall
+    /// time of the solve (the sink's excluded); its `time`, `channels` and
+    /// `states` are empty.
+    pub fn run_streaming(
+        &mut self,
+        t_eval: &[f64],
+        block: usize,
+        sink: &mut dyn FnMut(&Run) -> Result<(), String>,
+    ) -> Result<Run, RigError> {
+        runner::run_streaming(
+            &mut self.circuit,
+            &self.initial,
+            t_eval,
+            &self.options,
+            block,
+            sink,
+        )
+        .map_err(rig_error)
+    }
+
+    /// [`Simulation::run_streaming`] without the channels: `sink` receives
+    /// each block's output times and full states (row-major,
+    /// `x.len() / t.len()` each) as the integrator wrote them, and reads the
+    /// probes itself where it likes, e.g. a [`crate::run::ProbeReader`] on
+    /// another thread (the solve's thread then only solves). The buffers
+    /// are the solve's, reused block after block: copy what is kept.
+    pub fn run_streaming_states(
+        &mut self,
+        t_eval: &[f64],
+        block: usize,
+        sink: &mut StateSink<'_>,
+    ) -> Result<Run, RigError> {
+        runner::run_streaming_states(
+            &mut self.circuit,
+            &self.initial,
+            t_eval,
+            &self.options,
+            block,
+            sink,
+        )
+        .map_err(rig_error)
+    }
+
+    /// [`Simulation::run_streaming`] on a command record too long to hold:
+    /// the circuit reads its command from `table` (the simulation built with
+    /// [`Signal::Streamed`] of a clone of it), which is filled from `source`
+    /// ahead of the integration and emptied behind it; the output times are
+    /// the record's sample times, from the first (the initial state's time)
+    /// to `t_end`, the last. Memory grows with `block` and the window, not
+    /// the record; the outputs are those of [`Simulation::run`] on the whole
+    /// record as a [`Signal::Table`].
+    pub fn run_command_stream(
+        &mut self,
+        table: &StreamedTable,
+        source: &mut dyn CommandSource,
+        t_end: f64,
+        block: usize,
+        sink: &mut dyn FnMut(&Run) -> Result<(), String>,
+    ) -> Result<Run, RigError> {
+        runner::run_command_stream(
+            &mut self.circuit,
+            &self.initial,
+            table,
+            source,
+            t_end,
+            &self.options,
+            block,
+            sink,
+        )
+        .map_err(rig_error)
+    }
+
+    /// The initial state of the runs ([`Circuit::state_names`] order).
+    pub fn initial(&self) -> &[f64] {
+        &self.initial
     }
 
     /// Sets parameter `path` (`<component>.<parameter>`) of the assembled
@@ -307,6 +413,15 @@ impl Simulation {
     }
 }
 
+/// A run's error as a rig's: an assembly error as such, any other (the
+/// solver's, bad settings, a sink's) as [`RigError::Sim`] with its message.
+fn rig_error(e: SimError) -> RigError {
+    match e {
+        SimError::Build(b) => RigError::from(b),
+        other => RigError::Sim(other.to_string()),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -340,6 +455,46 @@ mod tests {
             assert!((a - b).abs() < 1e-6 * scale, "state {i}: {a} vs {b}");
         }
         assert!(sim.step_to(0.1).is_err(), "no step backwards");
+    }
+
+    /// The streamed entry points give [`Simulation::run`]'s outputs bit for
+    /// bit (states and channels, in blocks), and [`Simulation::try_run`]
+    /// keeps the solver's error where [`Simulation::run`] maps it.
+    #[test]
+    fn the_streamed_runs_are_the_run() {
+        let rig = rig::load("leaney-moog").unwrap();
+        let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-3).collect();
+        let u: Vec<f64> = t
+            .iter()
+            .map(|&t| if t < 0.15 { 0.2 } else { -0.2 })
+            .collect();
+        let cmd = Signal::table(t.clone(), u).unwrap();
+        let mut sim = Simulation::new(&rig, cmd).unwrap();
+        let whole = sim.run(&t).unwrap();
+        let (mut times, mut states) = (Vec::new(), Vec::new());
+        let total = sim
+            .run_streaming_states(&t, 64, &mut |tb, xb| {
+                times.extend_from_slice(tb);
+                states.extend_from_slice(xb);
+                Ok(())
+            })
+            .unwrap();
+        assert_eq!(times, whole.time);
+        assert_eq!(states, whole.states);
+        assert_eq!(total.stats, whole.stats);
+        let mut velocity = Vec::new();
+        sim.run_streaming(&t, 64, &mut |b| {
+            velocity.extend_from_slice(b.channel("velocity").unwrap());
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(velocity, whole.channel("velocity").unwrap());
+        let e = sim.run_streaming(&t, 64, &mut |_| Err("sink full".into()));
+        assert!(e.unwrap_err().to_string().contains("sink full"));
+        let mut opts = RunOptions::dp45();
+        opts.max_steps = 5;
+        sim.set_options(opts);
+        assert!(matches!(sim.try_run(&t), Err(SimError::Solve { .. })));
     }
 
     /// The step budget is the options': a run that needs more steps fails.

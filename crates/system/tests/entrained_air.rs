@@ -3,9 +3,11 @@
 //! in a shut chamber), mass conservation, the floor at absolute zero, energy,
 //! the limit of no air, and the analytic Jacobian against differences.
 
-use hydrocyl_integrators::{solve, Method, OdeSystem, Options, Solution};
+use hydrocyl_integrators::OdeSystem;
 use hydrocyl_system::rig;
+use hydrocyl_system::run::{Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
+use hydrocyl_system::simulation::Simulation;
 use hydrocyl_system::Circuit;
 use serde_json::{json, Value};
 
@@ -30,23 +32,46 @@ fn pumped_volume(alpha: f64, b: f64, p0: f64) -> Value {
     })
 }
 
-fn build(v: &Value, u: f64) -> Circuit {
-    let mut c = rig::circuit(v, Signal::Constant { value: u }).expect("circuit");
-    let x0 = c.initial_state();
-    c.reset(0.0, &x0);
-    c
+/// Rosenbrock at rtol 1e-10, no step bound, the energy ledger on or off.
+fn options(ledger: bool) -> RunOptions {
+    RunOptions {
+        solver: Solver::Rosenbrock,
+        rtol: 1e-10,
+        h_max: f64::INFINITY,
+        max_steps: 1_000_000,
+        ledger,
+        ..RunOptions::default()
+    }
 }
 
-fn run(c: &mut Circuit, t_end: f64, t_eval: Vec<f64>) -> Solution {
-    let x0 = c.initial_state();
-    let opts = Options {
-        rtol: 1e-10,
-        atol: c.atol(1e-10),
-        t_eval: Some(t_eval),
-        max_steps: 1_000_000,
-        ..Options::default()
-    };
-    solve(Method::Rosenbrock, c, 0.0, &x0, t_end, &opts).expect("solve")
+fn simulation(v: &Value, command: Signal) -> Simulation {
+    Simulation::new(v, command)
+        .expect("circuit")
+        .options(options(false))
+}
+
+fn build(v: &Value, u: f64) -> Simulation {
+    simulation(v, Signal::Constant { value: u })
+}
+
+/// A run from t = 0 sampled at `t_eval` (after 0): `state(k)` and `t[k]`
+/// are at `t_eval[k]`.
+struct Sol {
+    run: Run,
+    t: Vec<f64>,
+}
+
+impl Sol {
+    fn state(&self, k: usize) -> &[f64] {
+        self.run.state(k + 1)
+    }
+}
+
+fn run(sim: &mut Simulation, t_eval: Vec<f64>) -> Sol {
+    let mut t = vec![0.0];
+    t.extend_from_slice(&t_eval);
+    let run = sim.run(&t).expect("solve");
+    Sol { run, t: t_eval }
 }
 
 fn state_of(c: &Circuit, comp: &str, k: usize) -> usize {
@@ -65,10 +90,10 @@ fn an_evacuated_volume_fills_in_the_closed_form_time() {
     let v0 = (1.0 - alpha) + alpha * PA / (p0 + PA);
     let delay = 2.0 * 1.0 / 2000.0;
     let t_fill = v / q * v0.ln() + delay;
-    let mut c = build(&pumped_volume(alpha, RIGID, p0), q / 1e-5);
+    let mut sim = build(&pumped_volume(alpha, RIGID, p0), q / 1e-5);
     let times: Vec<f64> = vec![0.5, 1.0, 2.0, 4.0, t_fill];
-    let sol = run(&mut c, t_fill, times.clone());
-    let ip = state_of(&c, "vol", 0);
+    let sol = run(&mut sim, times.clone());
+    let ip = state_of(sim.circuit(), "vol", 0);
     for (k, &t) in times.iter().enumerate() {
         let vt = v0 * (-q * (t - delay) / v).exp();
         let want = alpha * PA / (vt - (1.0 - alpha)) - PA;
@@ -96,9 +121,9 @@ fn an_evacuated_volume_fills_in_the_closed_form_time() {
 fn no_outflow_takes_a_volume_below_absolute_zero() {
     let (alpha, v, q) = (0.01, 1e-4, 1e-5);
     let times: Vec<f64> = (1..=40).map(|k| 0.5 * k as f64).collect();
-    let mut c = build(&pumped_volume(alpha, RIGID, 0.0), -1.0);
-    let sol = run(&mut c, 20.0, times.clone());
-    let ip = state_of(&c, "vol", 0);
+    let mut sim = build(&pumped_volume(alpha, RIGID, 0.0), -1.0);
+    let sol = run(&mut sim, times.clone());
+    let ip = state_of(sim.circuit(), "vol", 0);
     for (k, &t) in times.iter().enumerate() {
         let p = sol.state(k)[ip];
         assert!(p > -PA, "t = {t}: {p} Pa gauge is below absolute zero");
@@ -114,9 +139,9 @@ fn no_outflow_takes_a_volume_below_absolute_zero() {
         );
     }
     // the constant-B liquid has no floor: it goes far below absolute zero
-    let mut c = build(&pumped_volume(0.0, 7e8, 0.0), -1.0);
-    let sol = run(&mut c, 0.05, vec![0.05]);
-    assert!(sol.state(0)[state_of(&c, "vol", 0)] < -10.0 * PA);
+    let mut sim = build(&pumped_volume(0.0, 7e8, 0.0), -1.0);
+    let sol = run(&mut sim, vec![0.05]);
+    assert!(sol.state(0)[state_of(sim.circuit(), "vol", 0)] < -10.0 * PA);
 }
 
 /// Energy into the volume (the pump's `(p_a − p_b) Q`) equals the compression
@@ -125,9 +150,9 @@ fn no_outflow_takes_a_volume_below_absolute_zero() {
 #[test]
 fn the_ledger_closes_and_the_stored_energy_is_the_compression_work() {
     let v = pumped_volume(0.005, 7e8, -0.9e5);
-    let mut c = build(&v, 1.0);
-    c.set_ledger(true);
-    let sol = run(&mut c, 3.0, vec![3.0]);
+    let mut sim = build(&v, 1.0).options(options(true));
+    let sol = run(&mut sim, vec![3.0]);
+    let c = sim.circuit();
     let last = sol.state(0);
     let o = c.ledger_offset();
     let pump = c.component_index("pump").unwrap();
@@ -138,7 +163,7 @@ fn the_ledger_closes_and_the_stored_energy_is_the_compression_work() {
         (source - storage).abs() < 1e-8 * source.abs(),
         "{source} vs {storage}"
     );
-    let p = last[state_of(&c, "vol", 0)];
+    let p = last[state_of(c, "vol", 0)];
     assert!(p > 1e6, "filled to {p} Pa");
     let air = hydrocyl_actuator::EntrainedAir::isothermal(0.005);
     let stored = air.stored_energy(7e8, p, 1e-4) - air.stored_energy(7e8, -0.9e5, 1e-4);
@@ -170,11 +195,12 @@ fn a_shut_chamber_is_a_boyle_gas_spring() {
         },
         "connections": [["cylinder.rod", "load.rod"], ["cylinder.A", "gauge_1.port"], ["cylinder.B", "gauge_2.port"]]
     });
-    let mut c = build(&net, 0.0);
+    let mut sim = build(&net, 0.0);
     let times: Vec<f64> = (1..=50).map(|k| 2e-3 * k as f64).collect();
-    let sol = run(&mut c, 0.1, times.clone());
-    let (ip1, ip2) = (state_of(&c, "cylinder", 0), state_of(&c, "cylinder", 1));
-    let (ix, iv) = (state_of(&c, "load", 0), state_of(&c, "load", 1));
+    let sol = run(&mut sim, times.clone());
+    let c = sim.circuit();
+    let (ip1, ip2) = (state_of(c, "cylinder", 0), state_of(c, "cylinder", 1));
+    let (ix, iv) = (state_of(c, "load", 0), state_of(c, "load", 1));
     let (m1, m2) = (a1 * l, a2 * l);
     let eps = |p: f64| alpha * PA * (((p + PA) / PA).ln() + PA / (p + PA) - 1.0);
     let energy = |x: &[f64]| 0.5 * 20.0 * x[iv] * x[iv] + m1 * eps(x[ip1]) + m2 * eps(x[ip2]);
@@ -221,11 +247,10 @@ fn a_vanishing_air_fraction_is_the_liquid_model() {
     let times: Vec<f64> = (1..=40).map(|k| 0.01 * k as f64).collect();
     let mut runs = Vec::new();
     for alpha in [0.0, 1e-9] {
-        let mut c = rig::circuit(&net(alpha), sine.clone()).unwrap();
-        let x0 = c.initial_state();
-        c.reset(0.0, &x0);
-        let sol = run(&mut c, 0.4, times.clone());
-        let (ix, ip) = (state_of(&c, "load", 0), state_of(&c, "cylinder", 0));
+        let mut sim = simulation(&net(alpha), sine.clone());
+        let sol = run(&mut sim, times.clone());
+        let c = sim.circuit();
+        let (ix, ip) = (state_of(c, "load", 0), state_of(c, "cylinder", 0));
         let lowest = (0..times.len())
             .map(|k| sol.state(k)[ip])
             .fold(f64::INFINITY, f64::min);
@@ -256,9 +281,10 @@ fn the_analytic_jacobian_with_air_equals_differences() {
         (pumped_volume(0.005, 7e8, -0.95e5), 1.0),
         (pumped_volume(0.01, 7e8, 2e5), -1.0),
     ] {
-        let mut c = build(&net, u);
-        assert!(c.has_jacobian());
-        let sol = run(&mut c, 0.02, vec![0.005, 0.01, 0.02]);
+        let mut sim = build(&net, u);
+        assert!(sim.circuit().has_jacobian());
+        let sol = run(&mut sim, vec![0.005, 0.01, 0.02]);
+        let c = sim.circuit();
         let n = c.dim();
         let mut jac = vec![0.0; n * n];
         for k in 0..3 {

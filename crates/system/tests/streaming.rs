@@ -1,49 +1,44 @@
-//! `run::run_streaming`: one block is `run` bit for bit; many blocks (the
+//! `Simulation::run_streaming`: one block is `Simulation::run` bit for bit; many blocks (the
 //! integrator restarted at each block's first time) agree with `run` to the
 //! tolerance and emit every output time once, in order.
 
 use hydrocyl_system::rig;
-use hydrocyl_system::run::{run, run_streaming, Run, RunOptions};
+use hydrocyl_system::run::{Run, RunOptions};
 use hydrocyl_system::signal::Signal;
+use hydrocyl_system::simulation::Simulation;
 
-fn setup() -> (hydrocyl_system::Circuit, Vec<f64>, Vec<f64>) {
+fn setup() -> (Simulation, Vec<f64>) {
     let t: Vec<f64> = (0..400).map(|k| k as f64 * 0.005).collect();
     let u: Vec<f64> = t
         .iter()
         .map(|&t| if t % 1.0 < 0.5 { 0.15 } else { -0.2 })
         .collect();
     let v = rig::preset("leaney-moog").unwrap();
-    let c = rig::circuit(&v, Signal::table(t.clone(), u).unwrap()).unwrap();
-    let x0 = c.initial_state();
-    (c, x0, t)
+    let sim = Simulation::new(&v, Signal::table(t.clone(), u).unwrap()).unwrap();
+    (sim, t)
 }
 
 fn streamed(block: usize) -> (Vec<f64>, Vec<Vec<f64>>, Run) {
-    let (mut c, x0, t) = setup();
+    let (sim, t) = setup();
     let (mut time, mut cols) = (Vec::new(), Vec::<Vec<f64>>::new());
-    let total = run_streaming(
-        &mut c,
-        &x0,
-        &t,
-        &RunOptions::default(),
-        block,
-        &mut |b: &Run| {
+    let total = sim
+        .options(RunOptions::default())
+        .run_streaming(&t, block, &mut |b: &Run| {
             time.extend_from_slice(&b.time);
             cols.resize(b.channels.len(), Vec::new());
             for (c, ch) in cols.iter_mut().zip(&b.channels) {
                 c.extend_from_slice(&ch.values);
             }
             Ok(())
-        },
-    )
-    .unwrap();
+        })
+        .unwrap();
     (time, cols, total)
 }
 
 #[test]
 fn one_block_is_run_and_many_blocks_agree_to_the_tolerance() {
-    let (mut c, x0, t) = setup();
-    let whole = run(&mut c, &x0, &t, &RunOptions::default()).unwrap();
+    let (sim, t) = setup();
+    let whole = sim.options(RunOptions::default()).run(&t).unwrap();
     let (time, cols, total) = streamed(t.len());
     assert_eq!(time, whole.time);
     for (c, ch) in cols.iter().zip(&whole.channels) {

@@ -5,8 +5,9 @@
 use hydrocyl_friction::{CoulombViscous, FrictionLaw, LuGre};
 use hydrocyl_integrators::OdeSystem;
 use hydrocyl_system::rig::{self, RigError};
-use hydrocyl_system::run::{nrmse, run, RunOptions};
+use hydrocyl_system::run::{nrmse, RunOptions};
 use hydrocyl_system::signal::Signal;
+use hydrocyl_system::simulation::Simulation;
 use hydrocyl_system::valve_rig::{Formulation, ValveRig};
 use hydrocyl_valves::servovalve::SpoolDynamics;
 
@@ -195,9 +196,10 @@ fn power_terms_balance_at_every_state_of_a_run() {
         phase_rad: 0.0,
     };
     let t = times(2.0, 0.05);
-    let mut c = rig.circuit(cmd.clone()).unwrap();
-    let x0 = c.initial_state();
-    let r = run(&mut c, &x0, &t, &RunOptions::dp45()).unwrap();
+    let mut sim =
+        Simulation::of_circuit(rig.circuit(cmd.clone()).unwrap()).options(RunOptions::dp45());
+    let r = sim.run(&t).unwrap();
+    let c = sim.circuit();
     for k in 0..r.time.len() {
         let p = c.power_terms(r.time[k], r.state(k));
         let src: f64 = p.iter().map(|p| p.source).sum();
@@ -324,10 +326,13 @@ fn bad_run_inputs_are_errors_not_panics() {
         )
         .unwrap_err();
     assert!(e.to_string().contains("command"), "{e}");
-    let mut c = rig.circuit(cmd).unwrap();
+    let c = rig.circuit(cmd).unwrap();
     assert_eq!(c.dim(), c.n_states());
     let x0 = vec![0.0; 2];
-    assert!(run(&mut c, &x0, &[0.0, 1.0], &RunOptions::dp45()).is_err());
+    let mut sim = Simulation::of_circuit(c)
+        .options(RunOptions::dp45())
+        .initial_state(x0);
+    assert!(sim.run(&[0.0, 1.0]).is_err());
 }
 
 mod invariants {
@@ -468,9 +473,9 @@ fn power_terms_balance_with_supply_droop() {
         phase_rad: 0.0,
     };
     let t = times(1.0, 0.05);
-    let mut c = rig.circuit(cmd).unwrap();
-    let x0 = c.initial_state();
-    let r = run(&mut c, &x0, &t, &RunOptions::dp45()).unwrap();
+    let mut sim = Simulation::of_circuit(rig.circuit(cmd).unwrap()).options(RunOptions::dp45());
+    let r = sim.run(&t).unwrap();
+    let c = sim.circuit();
     for k in 0..r.time.len() {
         let p = c.power_terms(r.time[k], r.state(k));
         let src: f64 = p.iter().map(|p| p.source).sum();

@@ -7,6 +7,7 @@ use hydrocyl_ports::{Area, Density, Pressure};
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
+use hydrocyl_system::simulation::Simulation;
 use hydrocyl_valves::check::CheckValve;
 use hydrocyl_valves::orifice::Orifice;
 use serde_json::Value;
@@ -711,16 +712,17 @@ fn every_netlist_ledger_closes() {
             period_s: 0.5,
             bias: 0.0,
         };
-        let mut c = rig::circuit(&v, cmd).unwrap();
-        let x0 = c.initial_state();
         let opts = RunOptions {
             solver: Solver::Rosenbrock,
             rtol: 1e-8,
             ledger: true,
             ..RunOptions::default()
         };
-        let run = hydrocyl_system::run::run(&mut c, &x0, &times(1.0, 0.01), &opts)
+        let mut sim = Simulation::new(&v, cmd).unwrap().options(opts);
+        let run = sim
+            .run(&times(1.0, 0.01))
             .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        let c = sim.circuit();
         let last = run.state(run.time.len() - 1);
         let off = c.ledger_offset();
         let (mut e_in, mut residual) = (0.0, 0.0);

@@ -14,7 +14,8 @@ use crate::report::Section;
 use hydrocyl_friction::FrictionInput;
 use hydrocyl_ports::{Force, Pressure, Velocity};
 use hydrocyl_studies::chapter3::{self, Case, Comparison, COMPARED};
-use hydrocyl_system::run::{nrmse, run, Run, RunOptions, Solver};
+use hydrocyl_system::run::{nrmse, Run, RunOptions, Solver};
+use hydrocyl_system::simulation::Simulation;
 use hydrocyl_system::valve_rig::ValveRig;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -378,28 +379,29 @@ fn balances(s: &mut Section) {
         }
     };
     let rig = &case.rig;
-    let mut c = match rig.circuit(case.command.clone()) {
+    let c = match rig.circuit(case.command.clone()) {
         Ok(c) => c,
         Err(e) => {
             s.check("balances: build", e.to_string(), "".into(), false);
             return;
         }
     };
-    let x0 = c.initial_state();
     let opts = RunOptions {
         rtol: RTOL,
         quadratures: true,
         ledger: true,
         ..RunOptions::dp45()
     };
-    let r = match run(&mut c, &x0, &case.times, &opts) {
+    let mut sim = Simulation::of_circuit(c).options(opts);
+    let r = match sim.run(&case.times) {
         Ok(r) => r,
         Err(e) => {
             s.check("balances: run", e.to_string(), "".into(), false);
             return;
         }
     };
-    let (res1, res2, swept) = mass_balance(rig, &c, &r);
+    let c = sim.circuit();
+    let (res1, res2, swept) = mass_balance(rig, c, &r);
     for (i, res) in [(1, res1), (2, res2)] {
         s.check(
             &format!("square: chamber {i} mass balance |∫(Q{i} - A{i} v - V{i}/B dp{i}/dt) dt| / swept volume"),

@@ -1,6 +1,7 @@
 //! A circuit's probes read into a run's channels at its output points, on
 //! the solving circuit ([`ProbeSet`]) or on a second circuit of its own on
-//! another thread ([`ProbeReader`], fed by [`super::run_streaming_states`]).
+//! another thread ([`ProbeReader`], fed by
+//! [`Simulation::run_streaming_states`](crate::simulation::Simulation::run_streaming_states)).
 
 use super::{initial, Channel, Run, RunOptions, SimError, ORDER};
 use crate::circuit::{AnyWire, Circuit};
@@ -89,7 +90,7 @@ impl ProbeSet {
 /// A run's probes read on a circuit of their own: built like the solving
 /// circuit (the same rig, the same command) and set up from the same initial
 /// state, it reads the same channels, bit for bit, from the raw outputs of
-/// [`super::run_streaming_states`], so that the solve's thread does not
+/// [`Simulation::run_streaming_states`](crate::simulation::Simulation::run_streaming_states), so that the solve's thread does not
 /// evaluate the circuit once more per output row. Only for a circuit whose
 /// wires do not depend on what ran before ([`Circuit::history_free`]).
 pub struct ProbeReader {
@@ -98,7 +99,7 @@ pub struct ProbeReader {
 }
 
 impl ProbeReader {
-    /// Sets `circuit` up as [`super::run_streaming_states`] sets up the
+    /// Sets `circuit` up as [`Simulation::run_streaming_states`](crate::simulation::Simulation::run_streaming_states) sets up the
     /// solving one (from `x0` at `t0`, with `opts`' quadratures and ledger).
     ///
     /// # Errors

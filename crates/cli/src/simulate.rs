@@ -635,11 +635,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         run.stats.rhs_evals,
         if cav > 0 {
             let lowest = if min_p.is_finite() {
-                format!("lowest sampled chamber pressure {min_p:.0} Pa")
+                format!("lowest sampled cylinder chamber pressure {min_p:.0} Pa")
             } else {
                 "no chamber pressure among the outputs".to_string()
             };
-            format!("CAVITATION: a chamber entered cavitation {cav} times between the output samples ({lowest})")
+            format!("CAVITATION: a cylinder chamber fell below its cavitation pressure, or a line volume below absolute vacuum, {cav} times between the output samples ({lowest}; the components' cavitation_entries say which)")
         } else {
             "no cavitation".to_string()
         }

@@ -138,10 +138,13 @@ fn no_outflow_takes_a_volume_below_absolute_zero() {
             p + PA
         );
     }
-    // the constant-B liquid has no floor: it goes far below absolute zero
+    assert_eq!(sol.run.cavitation_entries(), 0, "air: never below vacuum");
+    // the constant-B liquid has no floor: it goes far below absolute zero,
+    // and the volume reports it (one entry below absolute vacuum)
     let mut sim = build(&pumped_volume(0.0, 7e8, 0.0), -1.0);
     let sol = run(&mut sim, vec![0.05]);
     assert!(sol.state(0)[state_of(sim.circuit(), "vol", 0)] < -10.0 * PA);
+    assert_eq!(sol.run.cavitation_entries(), 1, "{:?}", sol.run.diagnostics);
 }
 
 /// Energy into the volume (the pump's `(p_a − p_b) Q`) equals the compression

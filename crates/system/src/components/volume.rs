@@ -4,11 +4,18 @@ use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, Netlist, PowerTerms, Probe, Tangents, Wires,
 };
 use hydrocyl_actuator::EntrainedAir;
+use hydrocyl_integrators::{Crossing, EventAction};
 use hydrocyl_ports::{HydraulicPort, Pressure};
 
 /// A constant hydraulic volume (a pipeline, a hose, a pump line):
 /// `dp/dt = B_eff(p)/V ΣQ_in`, `B_eff` the liquid's `B` without entrained
 /// air ([`hydrocyl_actuator::fluid`]).
+///
+/// A pressure below absolute vacuum is **reported**, not hidden: a switching
+/// function crosses zero there and the entries are counted
+/// ([`Component::diagnostics`] `cavitation_entries`, which the run summary
+/// reads as it reads a cylinder chamber's); the constant-B liquid has left
+/// its range there (with entrained air the pressure stays above it).
 #[derive(Debug)]
 pub struct Volume {
     name: String,
@@ -23,6 +30,8 @@ pub struct Volume {
     pub initial_pressure: f64,
     probe: Option<String>,
     node: HydraulicNode,
+    /// Entries below absolute vacuum in this run.
+    below_vacuum: usize,
 }
 
 impl Volume {
@@ -44,6 +53,7 @@ impl Volume {
             initial_pressure,
             probe: probe.map(str::to_string),
             node: HydraulicNode::UNBOUND,
+            below_vacuum: 0,
         }
     }
 }
@@ -107,6 +117,35 @@ impl Component for Volume {
         let port = HydraulicPort::new(Pressure::new(x[0]), w.get(self.node.inflow));
         p.storage = port.power().si();
         p.stored = self.air.stored_energy(self.bulk_modulus, x[0], self.volume);
+    }
+    fn n_events(&self) -> usize {
+        1
+    }
+    fn events(&self, _t: f64, x: &[f64], _w: &Wires, g: &mut [f64]) {
+        g[0] = x[0] - crate::rig::ABSOLUTE_VACUUM_GAUGE_PA;
+    }
+    fn on_event(
+        &mut self,
+        _t: f64,
+        _x: &mut [f64],
+        _w: &Wires,
+        _which: usize,
+        dir: Crossing,
+    ) -> EventAction {
+        if dir == Crossing::Falling {
+            self.below_vacuum += 1;
+        }
+        EventAction::Continue
+    }
+    /// Its event only counts entries below vacuum.
+    fn events_change_evaluation(&self) -> bool {
+        false
+    }
+    fn reset(&mut self, _t: f64, _x: &[f64], _w: &Wires) {
+        self.below_vacuum = 0;
+    }
+    fn diagnostics(&self) -> Vec<(String, f64)> {
+        vec![("cavitation_entries".into(), self.below_vacuum as f64)]
     }
     fn probes(&self) -> Vec<Probe> {
         self.probe

@@ -165,9 +165,9 @@ fn assemble_driven(
                 .find(|(n, _)| *n == inst.name)
                 .map(|(_, sig)| sig.clone());
         }
-        let c = (inst.ty.build)(&inst).map_err(|why| RigError::Invalid {
-            path: format!("components.{}", inst.name),
-            why,
+        let c = (inst.ty.build)(&inst).map_err(|message| {
+            let (path, why) = registry::error_path(&inst.name, message);
+            RigError::Invalid { path, why }
         })?;
         comps.push(c);
     }
@@ -209,6 +209,19 @@ fn assemble_driven(
         }
     });
     Ok(c)
+}
+
+/// Reads and checks a netlist value completely: [`schematic`], then its
+/// circuit assembled with every input held at zero, so that what only the
+/// assembly finds (an algebraic loop, a component refusing its parameters,
+/// a circuit with no state) is refused where a rig is loaded or checked too.
+pub fn check(v: &Value) -> Result<(), RigError> {
+    let s = schematic(v)?;
+    let drive: Vec<(String, Signal)> = s
+        .inputs()
+        .map(|i| (i.name.clone(), Signal::Constant { value: 0.0 }))
+        .collect();
+    assemble_driven(&s, &drive, |_| ()).map(|_| ())
 }
 
 /// Reads a netlist value and assembles its circuit.

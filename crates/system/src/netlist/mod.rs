@@ -395,6 +395,35 @@ pub fn expanded(v: &Value) -> Result<Value, RigError> {
 
 #[cfg(test)]
 mod tests {
+    use serde_json::json;
+
+    /// What only the assembly finds is refused where a rig is checked:
+    /// a controller reading its own command is an algebraic loop of one.
+    #[test]
+    fn check_refuses_a_signal_self_loop_and_a_parameter_given_twice() {
+        let mut v = crate::rig::preset("leaney-moog-closed-loop").unwrap();
+        let conns = v["connections"].as_array_mut().unwrap();
+        conns[0] = json!(["reference.out", "spare"]);
+        conns[1] = json!([
+            "controller.command",
+            "spool.command",
+            "controller.reference"
+        ]);
+        let e = crate::rig::check(&v).unwrap_err().to_string();
+        assert!(
+            e.contains("components.controller") && e.contains("algebraic loop"),
+            "{e}"
+        );
+
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        v["components"]["valve"]["orifice.cd"] = json!(0.3);
+        let e = crate::rig::check(&v).unwrap_err().to_string();
+        assert!(
+            e.contains("components.valve.orifice.cd") && e.contains("given twice"),
+            "{e}"
+        );
+    }
+
     /// `--set cylinder.…`/`load.…` on a friction bench (no cylinder, no
     /// load) names the drive's paths that hold the mass and the position.
     #[test]

@@ -98,9 +98,9 @@ pub fn columns_of<'a>(
     unit: CommandUnit,
 ) -> Result<Columns, CliError> {
     let headers: Vec<&str> = headers.collect();
-    if headers.len() == 1 && headers[0].contains(';') {
+    if let Some(why) = hydrocyl_identify::data::foreign_separator(&headers) {
         return Err(CliError::Input(format!(
-            "{file}: row 1: the file is semicolon-delimited (`;`); hydrocyl reads comma-separated CSV (`time,command`)"
+            "{file}: row 1: {why} (`time,command`)"
         )));
     }
     let mut time: Option<(usize, f64)> = None;
@@ -399,8 +399,39 @@ impl Ahead {
     }
 }
 
-/// The command CSV `bytes` of file `file` as `(time [s], command [unit])`.
+/// The longest run a command file may span \[s\] (about 11.6 days): a
+/// longer span is a time column in the wrong unit or a typo (`1e300`),
+/// which would otherwise run until the solver's step limit.
+pub const MAX_SPAN_S: f64 = 1.0e6;
+
+/// Refuses sample `t` (at CSV row `row` of `file`) lying more than
+/// [`MAX_SPAN_S`] after the first sample `t0`.
+pub fn check_span(file: &str, row: usize, t0: f64, t: f64) -> Result<(), CliError> {
+    if t - t0 > MAX_SPAN_S {
+        return Err(CliError::Input(format!(
+            "{file}: row {row}, column `time`: {t:e} s is {:e} s after the first sample: a run spans at most {MAX_SPAN_S:e} s (about 11.6 days); is the time column in seconds?",
+            t - t0
+        )));
+    }
+    Ok(())
+}
+
+/// The command CSV `bytes` of file `file` as `(time [s], command [unit])`;
+/// a span longer than [`MAX_SPAN_S`] is refused.
 pub fn parse_command(
+    file: &str,
+    bytes: &[u8],
+    unit: CommandUnit,
+) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+    let (t, u) = parse_samples(file, bytes, unit)?;
+    if let Some(k) = t.iter().position(|&tk| tk - t[0] > MAX_SPAN_S) {
+        check_span(file, k + 2, t[0], t[k])?;
+    }
+    Ok((t, u))
+}
+
+/// [`parse_command`] without the span check.
+fn parse_samples(
     file: &str,
     bytes: &[u8],
     unit: CommandUnit,

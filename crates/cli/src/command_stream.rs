@@ -226,6 +226,12 @@ pub fn scan(path: &Path, unit: CommandUnit) -> Result<Option<(Scan, Chunks)>, Cl
         if s.rows == 0 {
             s.t0 = t[0];
         }
+        if let Some(k) = t
+            .iter()
+            .position(|&tk| tk - s.t0 > crate::command::MAX_SPAN_S)
+        {
+            crate::command::check_span(&path.display().to_string(), s.rows + k + 2, s.t0, t[k])?;
+        }
         s.rows += t.len();
         s.t1 = t[t.len() - 1];
         for (&tk, &uk) in t.iter().zip(u) {

@@ -119,6 +119,10 @@ fn load_rig(spec: &str) -> Result<Rig, CliError> {
     match v.get("kind").and_then(|k| k.as_str()).unwrap_or("") {
         // an older rig kind (`valve-cylinder`) is read as its netlist (rig::load)
         k if k == hydrocyl_system::netlist::KIND => {
+            // a netlist that does not check (an algebraic loop, a bad
+            // parameter) is named as such, with its file and line
+            hydrocyl_system::rig::check(&v)
+                .map_err(|e| CliError::Input(hydrocyl_system::rig::at_line(e, spec).to_string()))?;
             net_rig_with_columns(&v).map_err(|e| unsupported(&e))
         }
         k => Err(unsupported(&format!(

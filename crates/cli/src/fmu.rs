@@ -64,7 +64,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(|e| input(&e))?;
     }
-    rig::check(&value).map_err(|e| input(&e))?;
+    // errors name the file and line of their JSON path
+    rig::check(&value).map_err(|e| input(&rig::at_line(e, &rig_arg)))?;
     let name = if rig::preset(&rig_arg).is_some() {
         rig_arg.clone()
     } else {

@@ -331,15 +331,22 @@ enum Input {
     Stream(StreamedTable, command_stream::Chunks),
 }
 
-/// Adds the remedy to a step-limit failure of an explicit method.
-fn solver_hint(e: rig::RigError) -> CliError {
+/// Adds the remedy to a step-limit failure: an explicit method is told to
+/// use rosenbrock; `auto` (which switches to it itself) and rosenbrock are
+/// told that the run is too long or too stiff for the step limit.
+fn solver_hint(e: rig::RigError, solver: &str) -> CliError {
     let m = e.to_string();
-    if m.contains("steps before t") {
+    if !m.contains("steps before t") {
+        return CliError::Input(m);
+    }
+    if matches!(solver, "auto" | "rosenbrock") {
+        CliError::Input(format!(
+            "{m}: the run is too long or too stiff for the step limit (--solver {solver}); shorten the command file, or check that its time column is in seconds"
+        ))
+    } else {
         CliError::Input(format!(
             "{m}: the run is stiff for an explicit method; use --solver rosenbrock"
         ))
-    } else {
-        CliError::Input(m)
     }
 }
 
@@ -609,7 +616,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // solve's is its echo
     let (outputs, run) = match (streamed, failed, written) {
         (_, _, Err(e)) | (_, Some(e), _) => return Err(e),
-        (Err(e), None, _) => return Err(solver_hint(e)),
+        (Err(e), None, _) => return Err(solver_hint(e, &args.solver)),
         (Ok(r), None, Ok((o, p))) => {
             min_p = min_p.min(p);
             (o, r)

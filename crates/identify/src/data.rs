@@ -274,8 +274,35 @@ struct Columns {
     ignored: Vec<String>,
 }
 
+/// Why a header of one cell is not comma-separated CSV, when the cell
+/// shows another separator (`;` or a tab): "the file is separated by `;`;
+/// hydrocyl reads comma-separated CSV". Every CSV reader of hydrocyl
+/// (records, command files) gives this message for row 1.
+pub fn foreign_separator(headers: &[&str]) -> Option<String> {
+    let [cell] = headers else {
+        return None;
+    };
+    let sep = if cell.contains(';') {
+        "`;`"
+    } else if cell.contains('\t') {
+        "tabs"
+    } else {
+        return None;
+    };
+    Some(format!(
+        "the file is separated by {sep}; hydrocyl reads comma-separated CSV"
+    ))
+}
+
 /// Finds the signals among `headers` (trimmed), directly or through `map`.
 fn map_columns(file: &str, headers: &[&str], map: &ColumnMap) -> Result<Columns, DataError> {
+    if let Some(reason) = foreign_separator(headers) {
+        return Err(DataError::Malformed {
+            file: file.to_string(),
+            row: 1,
+            reason,
+        });
+    }
     let mut cols: Vec<Option<(Signal, f64)>> = vec![None; headers.len()];
     let mut seen: BTreeMap<Signal, usize> = BTreeMap::new();
     let mut ignored = Vec::new();
@@ -622,6 +649,20 @@ mod tests {
         assert!((r.get(Signal::P2).unwrap()[0] - 6894.757293168361).abs() < 1e-9);
         assert!((r.get(Signal::Force).unwrap()[0] - 2000.0).abs() < 1e-12);
         assert_eq!(r.ignored, vec!["other".to_string()]);
+    }
+
+    #[test]
+    fn a_semicolon_or_tab_file_is_named_as_such() {
+        for (text, sep) in [
+            ("time [s];command;position [mm]\n0;0;0\n1;0;0\n", "`;`"),
+            ("time\tcommand\tposition\n0\t0\t0\n1\t0\t0\n", "tabs"),
+        ] {
+            let e = parse(text).unwrap_err().to_string();
+            assert!(
+                e.contains("row 1") && e.contains(&format!("separated by {sep}")),
+                "{e}"
+            );
+        }
     }
 
     #[test]

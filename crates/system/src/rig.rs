@@ -151,7 +151,7 @@ pub struct RigKind {
 /// are read as netlists ([`crate::netlist::migrate`]).
 pub const RIG_KINDS: &[RigKind] = &[RigKind {
     kind: crate::netlist::KIND,
-    check: |v| crate::netlist::read(v).map(|_| ()).map_err(RigError::from),
+    check: crate::netlist::check,
     circuit: crate::netlist::circuit,
 }];
 
@@ -232,23 +232,28 @@ pub fn at_line(e: RigError, source: &str) -> RigError {
     let Ok(text) = std::fs::read_to_string(source) else {
         return e;
     };
+    // an error about the file itself (it does not read, a duplicate key)
+    // names it already
+    if let RigError::Invalid { path, .. } = &e {
+        if path == source || path.starts_with(&format!("{source}: ")) {
+            return e;
+        }
+    }
     let located = crate::netlist::locate::scan(&text);
-    let line = |path: &str| located.line_of(path).filter(|_| !path.is_empty());
+    // the file is named always, with the line where the path has one
+    let place = |path: &str| match located.line_of(path).filter(|_| !path.is_empty()) {
+        Some(l) => format!("(line {l} of {source})"),
+        None => format!("(in {source})"),
+    };
     match e {
-        RigError::Invalid { path, why } => match line(&path) {
-            Some(l) => RigError::Invalid {
-                why: format!("{why} (line {l} of {source})"),
-                path,
-            },
-            None => RigError::Invalid { path, why },
+        RigError::Invalid { path, why } => RigError::Invalid {
+            why: format!("{why} {}", place(&path)),
+            path,
         },
-        RigError::OutOfRange { path, value, why } => match line(&path) {
-            Some(l) => RigError::OutOfRange {
-                why: format!("{why} (line {l} of {source})"),
-                path,
-                value,
-            },
-            None => RigError::OutOfRange { path, value, why },
+        RigError::OutOfRange { path, value, why } => RigError::OutOfRange {
+            why: format!("{why} {}", place(&path)),
+            path,
+            value,
         },
         other => other,
     }

@@ -440,6 +440,11 @@ pub(crate) fn evaluation_order(net: &Netlist) -> Result<(Vec<Step>, Vec<SeriesGr
             }
             Some(o) => {
                 let solved = net.solved.iter().any(|(_, h, _)| h.pressure.0 == *w);
+                // a component reading its own algebraic output (a signal
+                // joined back to its own input) is a loop of one
+                if o.causality == crate::Causality::Algebraic && !solved && o.owner == *reader {
+                    return Err(loop_error(net, &[*reader]));
+                }
                 if o.causality == crate::Causality::Algebraic
                     && !solved
                     && o.owner != *reader

@@ -17,15 +17,18 @@ pub struct Located {
 
 impl Located {
     /// The 1-based line of `path`, or of its longest prefix that is in the
-    /// text (a missing parameter is reported at its component).
+    /// text (a missing parameter is reported at its component, a missing
+    /// top-level key at the object's opening line).
     pub fn line_of(&self, path: &str) -> Option<usize> {
         let mut p = path.to_string();
         loop {
             if let Some(l) = self.lines.get(&p) {
                 return Some(*l);
             }
-            let cut = p.rfind(['.', '['])?;
-            p.truncate(cut);
+            match p.rfind(['.', '[']) {
+                Some(cut) => p.truncate(cut),
+                None => return self.lines.get("").copied(),
+            }
         }
     }
 }
@@ -104,10 +107,13 @@ impl Scanner<'_> {
                     } else {
                         format!("{path}.{key}")
                     };
-                    if !seen.insert(key) && self.out.duplicate.is_none() {
+                    if seen.insert(key) {
+                        // the later of a key given flat and nested (`"a.b"`,
+                        // `"a": {"b"}`) is where the reader refuses it
+                        self.out.lines.insert(child.clone(), line);
+                    } else if self.out.duplicate.is_none() {
                         self.out.duplicate = Some((child.clone(), line));
                     }
-                    self.out.lines.entry(child.clone()).or_insert(line);
                     self.ws();
                     if *self.s.get(self.i)? != b':' {
                         return None;
@@ -177,5 +183,9 @@ mod tests {
         assert_eq!(l.line_of("a.missing.deep"), Some(2));
         assert_eq!(l.duplicate, Some(("a".to_string(), 9)));
         assert!(scan("{\"k\": \"a\\\"b\", \"q\": 1}").duplicate.is_none());
+        // a parameter given flat and nested: the later key's line
+        let l = scan("{\"o\": {\"cd\": 1},\n \"o.cd\": 2}");
+        assert_eq!(l.line_of("o.cd"), Some(2));
+        assert_eq!(l.line_of("missing"), Some(1));
     }
 }

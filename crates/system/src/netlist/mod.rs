@@ -150,9 +150,9 @@ fn assemble_driven(s: &Schematic, drive: &[(String, Signal)]) -> Result<Circuit,
                 .find(|(n, _)| *n == inst.name)
                 .map(|(_, sig)| sig.clone());
         }
-        let c = (inst.ty.build)(&inst).map_err(|why| RigError::Invalid {
-            path: format!("components.{}", inst.name),
-            why,
+        let c = (inst.ty.build)(&inst).map_err(|message| {
+            let (path, why) = registry::error_path(&inst.name, message);
+            RigError::Invalid { path, why }
         })?;
         comps.push(c);
     }
@@ -193,6 +193,19 @@ fn assemble_driven(s: &Schematic, drive: &[(String, Signal)]) -> Result<Circuit,
         }
     });
     Ok(c)
+}
+
+/// Reads and checks a netlist value completely: [`schematic`], then its
+/// circuit assembled with every input held at zero, so that what only the
+/// assembly finds (an algebraic loop, a component refusing its parameters,
+/// a circuit with no state) is refused where a rig is loaded or checked too.
+pub fn check(v: &Value) -> Result<(), RigError> {
+    let s = schematic(v)?;
+    let drive: Vec<(String, Signal)> = s
+        .inputs()
+        .map(|i| (i.name.clone(), Signal::Constant { value: 0.0 }))
+        .collect();
+    assemble_driven(&s, &drive).map(|_| ())
 }
 
 /// Reads a netlist value and assembles its circuit.
@@ -366,6 +379,35 @@ pub fn expanded(v: &Value) -> Result<Value, RigError> {
 
 #[cfg(test)]
 mod tests {
+    use serde_json::json;
+
+    /// What only the assembly finds is refused where a rig is checked:
+    /// a controller reading its own command is an algebraic loop of one.
+    #[test]
+    fn check_refuses_a_signal_self_loop_and_a_parameter_given_twice() {
+        let mut v = crate::rig::preset("leaney-moog-closed-loop").unwrap();
+        let conns = v["connections"].as_array_mut().unwrap();
+        conns[0] = json!(["reference.out", "spare"]);
+        conns[1] = json!([
+            "controller.command",
+            "spool.command",
+            "controller.reference"
+        ]);
+        let e = crate::rig::check(&v).unwrap_err().to_string();
+        assert!(
+            e.contains("components.controller") && e.contains("algebraic loop"),
+            "{e}"
+        );
+
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        v["components"]["valve"]["orifice.cd"] = json!(0.3);
+        let e = crate::rig::check(&v).unwrap_err().to_string();
+        assert!(
+            e.contains("components.valve.orifice.cd") && e.contains("given twice"),
+            "{e}"
+        );
+    }
+
     /// `--set cylinder.…`/`load.…` on a friction bench (no cylinder, no
     /// load) names the drive's paths that hold the mass and the position.
     #[test]

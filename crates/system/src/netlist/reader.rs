@@ -53,11 +53,15 @@ fn valid_name(s: &str) -> bool {
 
 /// Flattens a component's parameter object into dotted names; `null`
 /// leaves are left out (absent).
+/// A parameter given twice, flat (`"orifice.cd"`) and nested (`"orifice":
+/// {"cd": …}`), is refused at the later key: `given` holds how each dotted
+/// name was spelled.
 fn flatten(
     m: &Map<String, Value>,
     prefix: &str,
     path: &str,
     out: &mut BTreeMap<String, f64>,
+    given: &mut BTreeMap<String, String>,
 ) -> Result<(), NetlistError> {
     for (k, v) in m {
         let name = if prefix.is_empty() {
@@ -66,13 +70,26 @@ fn flatten(
             format!("{prefix}.{k}")
         };
         let at = format!("{path}.{k}");
+        let spelled = if prefix.is_empty() {
+            format!("as `{k}`")
+        } else {
+            format!("inside `{prefix}`")
+        };
+        if !matches!(v, Value::Object(_)) {
+            if let Some(first) = given.insert(name.clone(), spelled.clone()) {
+                return err(
+                    at,
+                    format!("`{name}` is given twice: {first} and {spelled} (give it once)"),
+                );
+            }
+        }
         match v {
             Value::Number(n) => {
                 let x = n.as_f64().unwrap_or(f64::NAN);
                 out.insert(name, x);
             }
             Value::Null => {}
-            Value::Object(o) => flatten(o, &name, &at, out)?,
+            Value::Object(o) => flatten(o, &name, &at, out, given)?,
             other => {
                 return err(
                     at,
@@ -143,7 +160,7 @@ fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistError> {
         .filter(|(k, _)| !RESERVED.contains(&k.as_str()))
         .map(|(k, v)| (k.clone(), v.clone()))
         .collect();
-    flatten(&rest, "", &path, &mut given)?;
+    flatten(&rest, "", &path, &mut given, &mut BTreeMap::new())?;
     for k in given.keys() {
         if ty.param(k).is_none() {
             return err(
@@ -224,6 +241,15 @@ fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistError> {
                 if !x.is_finite() {
                     return err(at, "must be finite");
                 }
+                // a gauge pressure of a chamber or a volume (not a
+                // difference, such as the load pressure) below vacuum
+                let vacuum = crate::rig::ABSOLUTE_VACUUM_GAUGE_PA;
+                if s.unit == "Pa" && matches!(s.name, "p1" | "p2" | "pressure") && x < vacuum {
+                    return err(
+                        at,
+                        format!("{x} Pa is below absolute vacuum ({vacuum} Pa gauge)"),
+                    );
+                }
                 Some(x)
             }
             Some(Value::Null) | None => match s.default {
@@ -242,6 +268,7 @@ fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistError> {
         initial,
         nodes: BTreeMap::new(),
         hints: BTreeMap::new(),
+        hint_from: BTreeMap::new(),
         input: None,
     })
 }
@@ -391,6 +418,51 @@ fn join(
     Ok(())
 }
 
+/// Why `col` cannot be an output column beside `before` (the columns
+/// named so far): a CSV header cell holds a name and a `[unit]`, and the
+/// first column is `time`.
+fn check_column(col: &str, before: &[(String, String)]) -> Result<(), String> {
+    if col.trim().is_empty() {
+        return Err("an output name is blank".into());
+    }
+    if col.trim() != col {
+        return Err(format!(
+            "the output name `{col}` starts or ends with a space"
+        ));
+    }
+    if let Some(c) = col
+        .chars()
+        .find(|c| matches!(c, ',' | '[' | ']' | '"' | ';') || c.is_control())
+    {
+        return Err(format!(
+            "the output name `{col}` holds `{}`: a column name has no `,`, `;`, `\"`, `[` or `]` (the unit is added as ` [unit]`)",
+            c.escape_default()
+        ));
+    }
+    if col.eq_ignore_ascii_case("time") {
+        return Err("`time` is the first column of every run: name the output otherwise".into());
+    }
+    if let Some((other, _)) = before.iter().find(|(o, _)| o.eq_ignore_ascii_case(col)) {
+        return Err(format!(
+            "the output names `{other}` and `{col}` are one column"
+        ));
+    }
+    Ok(())
+}
+
+/// Whether two connections join the same endpoints (in any order).
+fn same_connection(a: &Value, b: &Value) -> bool {
+    let set = |v: &Value| {
+        let mut s: Vec<String> = v
+            .as_array()
+            .map(|a| a.iter().map(Value::to_string).collect())
+            .unwrap_or_default();
+        s.sort();
+        s
+    };
+    set(a) == set(b)
+}
+
 /// Reads and checks a netlist value.
 pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
     let Value::Object(root) = v else {
@@ -422,6 +494,12 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
     let Some(Value::Object(comps)) = root.get("components") else {
         return err("components", "missing: an object of named components");
     };
+    if comps.is_empty() {
+        return err(
+            "components",
+            "no components: a netlist names at least its components and their connections",
+        );
+    }
     let mut instances = comps
         .iter()
         .map(|(n, c)| read_instance(n, c))
@@ -433,6 +511,8 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
     let mut first_use: Vec<String> = Vec::new();
     let mut parts: Vec<Part> = Vec::new();
     let mut sets = Sets { parent: Vec::new() };
+    // where each node name is first used
+    let mut named_at: BTreeMap<String, String> = BTreeMap::new();
     let conns = match root.get("connections") {
         None => Vec::new(),
         Some(Value::Array(a)) => a.clone(),
@@ -454,7 +534,14 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
         if items.len() < 2 {
             return err(at, "a connection joins two or more ports");
         }
+        if let Some(j) = conns[..ci].iter().position(|d| same_connection(c, d)) {
+            return err(
+                at,
+                format!("repeats `connections[{j}]`: list a connection once"),
+            );
+        }
         let mut first = None;
+        let mut here: Vec<End> = Vec::new();
         for (k, item) in items.iter().enumerate() {
             let at_k = format!("{at}[{k}]");
             let Value::String(s) = item else {
@@ -482,9 +569,19 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                     };
                     End::Port(ci, ps.name)
                 }
-                None if valid_name(s) => End::Named(s.clone()),
+                None if valid_name(s) => {
+                    named_at.entry(s.clone()).or_insert_with(|| at_k.clone());
+                    End::Named(s.clone())
+                }
                 None => return err(at_k, "a node name is letters, digits, `_` and `-`"),
             };
+            if here.contains(&e) {
+                return err(
+                    at_k,
+                    format!("`{s}` is named twice in this connection: name each port once"),
+                );
+            }
+            here.push(e.clone());
             let id = match ends.iter().position(|x| *x == e) {
                 Some(i) => i,
                 None => {
@@ -520,6 +617,26 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                 End::Named(_) => None,
             })
             .collect();
+        // a node named after a component (`"tank"` beside `"tank.port"`) must
+        // hold one of its ports: else the name was meant as a port
+        if let Some(n) = &part.named {
+            if let Some(inst) = instances.iter().find(|i| i.name == *n) {
+                if !ports
+                    .iter()
+                    .any(|p| p.split_once('.').is_some_and(|(c, _)| c == n))
+                {
+                    let names: Vec<&str> = inst.ty.ports.iter().map(|p| p.name).collect();
+                    return err(
+                        named_at[n].clone(),
+                        format!(
+                            "`{n}` is a component: name one of its ports ({}), e.g. `{n}.{}`",
+                            names.join(", "),
+                            names.first().copied().unwrap_or("port")
+                        ),
+                    );
+                }
+            }
+        }
         let Some((domain, _)) = part.domain else {
             return err(at.clone(), "this node joins no component port");
         };
@@ -571,12 +688,12 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
         if let Some(h) = inst.ty.hints {
             for (port, key, value) in h(inst) {
                 if let Some(node) = inst.nodes.get(port) {
-                    hints.push((node.clone(), key, value));
+                    hints.push((node.clone(), key, value, inst.name.clone()));
                 }
             }
         }
     }
-    for (node, key, value) in hints {
+    for (node, key, value, from) in hints {
         for inst in instances.iter_mut() {
             let owned: Vec<String> = inst
                 .nodes
@@ -587,6 +704,8 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                 .map(|(p, _)| p.clone())
                 .collect();
             for p in owned {
+                inst.hint_from
+                    .insert((p.clone(), key.to_string()), from.clone());
                 inst.hints.insert((p, key.to_string()), value);
             }
         }
@@ -599,6 +718,7 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
         Some(Value::Object(m)) => {
             for (col, probe) in m {
                 let at = format!("outputs.{col}");
+                check_column(col, &outputs).or_else(|why| err(at.clone(), why))?;
                 let Value::String(p) = probe else {
                     return err(at, "an output names a probe `component.probe`");
                 };
@@ -621,6 +741,12 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                                 .collect::<Vec<_>>()
                                 .join(", ")
                         ),
+                    );
+                }
+                if let Some((first, _)) = outputs.iter().find(|(_, q)| q == p) {
+                    return err(
+                        at,
+                        format!("`{p}` is already the output `{first}`: a probe is written once, under one name"),
                     );
                 }
                 outputs.push((col.clone(), p.clone()));

@@ -260,6 +260,27 @@ impl ComponentType {
     }
 }
 
+/// Marks the two ends of the path in an [`error_at`] message.
+const PATH_MARK: char = '\u{1f}';
+
+/// A [`Builder`] error about the value at JSON `path` of the netlist (one
+/// another component gave it as a hint) rather than the building component:
+/// the error is named at `path`.
+pub fn error_at(path: &str, why: &str) -> String {
+    format!("{PATH_MARK}{path}{PATH_MARK}{why}")
+}
+
+/// A [`Builder`] error of component `component` as `(path, why)`: the path
+/// [`error_at`] gave, else `components.<component>`.
+pub(crate) fn error_path(component: &str, message: String) -> (String, String) {
+    if let Some(rest) = message.strip_prefix(PATH_MARK) {
+        if let Some((path, why)) = rest.split_once(PATH_MARK) {
+            return (path.to_string(), why.to_string());
+        }
+    }
+    (format!("components.{component}"), message)
+}
+
 /// A checked component instance: what a [`Builder`] works from.
 #[derive(Clone, Debug)]
 pub struct Instance {
@@ -276,6 +297,8 @@ pub struct Instance {
     pub nodes: BTreeMap<String, String>,
     /// Hints from the components at the nodes it owns, by `(port, key)`.
     pub hints: BTreeMap<(String, String), f64>,
+    /// The component that gave each hint, by `(port, key)`.
+    pub hint_from: BTreeMap<(String, String), String>,
     /// The run's command, for an input component (`command_input`).
     pub input: Option<crate::signal::Signal>,
 }
@@ -307,6 +330,14 @@ impl Instance {
         self.hints
             .get(&(port.to_string(), key.to_string()))
             .copied()
+    }
+    /// The JSON path of the value behind a hint (`key` of the component that
+    /// gave it: `components.cylinder.initial.position`), for errors about
+    /// it ([`error_at`]).
+    pub fn hint_path(&self, port: &str, key: &str) -> Option<String> {
+        self.hint_from
+            .get(&(port.to_string(), key.to_string()))
+            .map(|c| format!("components.{c}.{key}"))
     }
     /// The parameters under `prefix` (all with `""`) as a nested JSON
     /// object, deserialised into a law's serde struct: the parameter names

@@ -275,7 +275,17 @@ pub const TYPES: &[ComponentType] = &[
             let x0 = (pick("position")?, pick("velocity")?);
             if let Some(s) = stops {
                 if !(s.min.si()..=s.max.si()).contains(&x0.0) {
-                    return Err(format!("initial position {} m is outside the end stops", x0.0));
+                    let why = format!(
+                        "initial position {} m is outside the end stops [{}, {}] m",
+                        x0.0,
+                        s.min.si(),
+                        s.max.si()
+                    );
+                    // named where it was given: on the cylinder at the rod
+                    return Err(match (i.initial("position"), i.hint_path("rod", "initial.position")) {
+                        (None, Some(path)) => crate::netlist::registry::error_at(&path, &why),
+                        _ => why,
+                    });
                 }
             }
             built(Mass::new(&i.name, i.node("rod"), i.get("mass"), i.get("external_force"), stops, x0))

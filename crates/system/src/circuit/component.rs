@@ -51,7 +51,7 @@ impl Probe {
 }
 
 /// A component of a circuit. Implement this to add a new component type: it
-/// lives in its own file, and [`Circuit::build`] joins it to the others
+/// lives in its own file, and [`Circuit::build`](super::Circuit::build) joins it to the others
 /// through named nodes — no change to the assembler.
 ///
 /// The assembler calls, for each evaluation of `rhs(t, x)`:
@@ -154,7 +154,7 @@ pub trait Component {
     }
 
     /// The first time after `t` where an input of this component has a
-    /// kink (see [`OdeSystem::next_breakpoint`]), or `+∞`.
+    /// kink (see [`OdeSystem::next_breakpoint`](hydrocyl_integrators::OdeSystem::next_breakpoint)), or `+∞`.
     fn next_breakpoint(&self, _t: f64) -> f64 {
         f64::INFINITY
     }
@@ -185,7 +185,7 @@ pub trait Component {
     /// compute at a given `(t, x)` (a mode: stick/slip, at a stop). `true`
     /// for every component with events unless it says otherwise (one that
     /// only counts its events, e.g. cavitation entries); see
-    /// [`Circuit::history_free`].
+    /// [`Circuit::history_free`](super::Circuit::history_free).
     fn events_change_evaluation(&self) -> bool {
         self.n_events() > 0
     }
@@ -199,7 +199,7 @@ pub trait Component {
     fn power(&self, _t: f64, _x: &[f64], _w: &Wires, _dx: &[f64], _p: &mut PowerTerms) {}
 
     /// Number of extra quadratures this component asks for (integrated
-    /// alongside the states when [`Circuit::set_quadratures`] is on).
+    /// alongside the states when [`Circuit::set_quadratures`](super::Circuit::set_quadratures) is on).
     fn n_quadratures(&self) -> usize {
         0
     }

@@ -9,9 +9,7 @@ use super::hydraulic::{air, AIR};
 use super::servo::{metering, METERING};
 use super::{built, join, port, HYD, MECH, SIG};
 use crate::circuit::Component;
-use crate::components::{
-    CylinderNodes, FourWayNodes, GeneralisedCylinder, Mass, TwoChamberCylinder,
-};
+use crate::components::{CylinderNodes, GeneralisedCylinder, Mass, TwoChamberCylinder};
 use hydrocyl_actuator::generalised::XMethod;
 use hydrocyl_actuator::{Cylinder, StrokeEnds};
 use hydrocyl_ports::{Area, Position, Pressure};
@@ -161,16 +159,9 @@ fn generalised(i: &Instance) -> Result<Box<dyn Component>, String> {
     } else {
         XMethod::Analytical
     };
-    let nodes = FourWayNodes {
-        spool: i.node("spool"),
-        p: i.node("P"),
-        t: i.node("T"),
-        a: i.node("A"),
-        b: i.node("B"),
-    };
     let mut g = GeneralisedCylinder::new(
         &i.name,
-        nodes,
+        super::servo::four_way_nodes(i),
         i.node("rod"),
         cylinder(i)?,
         metering(i)?,

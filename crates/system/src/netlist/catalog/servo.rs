@@ -50,6 +50,18 @@ pub(super) const METERING: [ParamSpec; 7] = {
     ]
 };
 
+/// The nodes of a four-way metering's ports `spool`, `P`, `T`, `A`, `B`
+/// (the servovalve's and the generalised cylinder's).
+pub(crate) fn four_way_nodes(i: &Instance) -> FourWayNodes<'_> {
+    FourWayNodes {
+        spool: i.node("spool"),
+        p: i.node("P"),
+        t: i.node("T"),
+        a: i.node("A"),
+        b: i.node("B"),
+    }
+}
+
 /// The [`Metering`] of an instance with [`METERING`] parameters.
 pub(crate) fn metering(i: &Instance) -> Result<Metering, String> {
     let m = Metering {
@@ -241,14 +253,7 @@ pub const TYPES: &[ComponentType] = &[
         params: &FOUR_WAY,
         states: &[],
         build: |i| {
-            let nodes = FourWayNodes {
-                spool: i.node("spool"),
-                p: i.node("P"),
-                t: i.node("T"),
-                a: i.node("A"),
-                b: i.node("B"),
-            };
-            let mut v = FourWayValve::new(&i.name, nodes, metering(i)?);
+            let mut v = FourWayValve::new(&i.name, four_way_nodes(i), metering(i)?);
             v.supply_resistance = i.get("supply_resistance");
             v.dead_band = i.get("dead_band");
             v.supply_probe = Some("ps".into());

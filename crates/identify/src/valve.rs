@@ -663,9 +663,10 @@ pub fn diagnose_rig_traced(
         warnings,
         noise_share: (noise_ss / rss_after.max(1e-300)).min(1.0),
         selection: format!(
-            "output-error tracing: add the effect removing the largest share of the noise-weighted output-error SS if share >= {:.0} %, held-out share >= {:.1} % and BIC falls; refit all added parameters on the output error",
+            "output-error tracing: add the effect removing the largest share of the noise-weighted output-error SS if share >= {:.0} %, held-out share >= {:.1} % and BIC falls; refit all added parameters on the output error; keep it only if no compared channel's NRMSE rises by more than {:.0} % of its noise floor and the held-out part improves",
             100.0 * opts.min_share,
-            50.0 * opts.min_share
+            50.0 * opts.min_share,
+            100.0 * accept::WORSEN_TOL
         ),
         wall_times_s: clock.finish(),
         elapsed_s: start.elapsed().as_secs_f64(),

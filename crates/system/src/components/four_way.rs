@@ -47,18 +47,20 @@ pub struct FourWayNodes<'a> {
     pub b: &'a str,
 }
 
+impl FourWayNodes<'_> {
+    /// The hydraulic node names `[P, T, A, B]`, owned.
+    pub fn hydraulic(&self) -> [String; 4] {
+        [self.p, self.t, self.a, self.b].map(String::from)
+    }
+}
+
 impl FourWayValve {
     /// A valve reading the spool position on `nodes.spool`, joining the
     /// hydraulic nodes `nodes.p`, `nodes.t`, `nodes.a`, `nodes.b`.
     pub fn new(name: &str, nodes: FourWayNodes<'_>, metering: Metering) -> Self {
         Self {
             name: name.into(),
-            ports: [
-                nodes.p.into(),
-                nodes.t.into(),
-                nodes.a.into(),
-                nodes.b.into(),
-            ],
+            ports: nodes.hydraulic(),
             spool_name: nodes.spool.into(),
             metering,
             supply_resistance: 0.0,

@@ -70,12 +70,7 @@ impl GeneralisedCylinder {
     ) -> Self {
         Self {
             name: name.into(),
-            ports: [
-                nodes.p.into(),
-                nodes.t.into(),
-                nodes.a.into(),
-                nodes.b.into(),
-            ],
+            ports: nodes.hydraulic(),
             spool_name: nodes.spool.into(),
             rod_name: rod.into(),
             cylinder,

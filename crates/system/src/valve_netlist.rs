@@ -23,67 +23,12 @@ pub const GENERALISED: &str = include_str!("../../../fixtures/rigs/leaney-moog-g
 /// preset): a `position_controller` between the reference input and the spool.
 pub const CLOSED_LOOP: &str = include_str!("../../../fixtures/rigs/leaney-moog-closed-loop.json");
 
-/// Closes the loop of a valve-cylinder netlist: the input `command` becomes
-/// the position reference `reference`, and a `controller` reads it and the
-/// rod and drives the spool (the wiring of [`CLOSED_LOOP`]).
-fn close_loop(v: &mut Value, c: &ControllerSpec) {
-    let comps = v["components"]
-        .as_object_mut()
-        .expect("a template has components");
-    let mut out = serde_json::Map::new();
-    for (k, x) in std::mem::take(comps) {
-        if k == "command" {
-            out.insert("reference".into(), json!({ "type": "command_input" }));
-            out.insert(
-                "controller".into(),
-                json!({
-                    "type": "position_controller",
-                    "gain": c.gain_per_m,
-                    "integral_time": c.integral_time_s,
-                    "bias": c.bias,
-                    "output_min": c.output_min,
-                    "output_max": c.output_max
-                }),
-            );
-        } else {
-            out.insert(k, x);
-        }
-    }
-    *comps = out;
-    let conns = v["connections"]
-        .as_array_mut()
-        .expect("a template has connections");
-    let mut next = Vec::new();
-    for c in conns.drain(..) {
-        let ends: Vec<&str> = c
-            .as_array()
-            .map(|a| a.iter().filter_map(Value::as_str).collect())
-            .unwrap_or_default();
-        if ends == ["command.out", "spool.command"] {
-            next.push(json!(["reference.out", "controller.reference"]));
-            next.push(json!(["controller.command", "spool.command"]));
-        } else if ends.contains(&"cylinder.rod") {
-            let mut e = c.as_array().cloned().unwrap_or_default();
-            e.push(Value::from("controller.rod"));
-            next.push(Value::Array(e));
-        } else {
-            next.push(c);
-        }
-    }
-    *conns = next;
-    let outs = v["outputs"]
-        .as_object_mut()
-        .expect("a template has outputs");
-    let mut o = serde_json::Map::new();
-    o.insert("reference".into(), Value::from("reference.command"));
-    o.insert("command".into(), Value::from("controller.command"));
-    for (k, x) in std::mem::take(outs) {
-        if k != "command" {
-            o.insert(k, x);
-        }
-    }
-    *outs = o;
-}
+/// Pressure sensors on a valve-cylinder circuit's chambers, as an overlay
+/// ([`netlist::overlay`]): `sensor_A`, `sensor_B` read `cylinder.A`,
+/// `cylinder.B`; the outputs `p1`, `p2` become their readings and the
+/// chamber pressures `p1_chamber`, `p2_chamber`.
+pub const CHAMBER_SENSORS: &str =
+    include_str!("../../../fixtures/legacy/circuits/chamber-sensors.json");
 
 fn template(text: &str) -> Value {
     serde_json::from_str(text).expect("the embedded netlist is valid JSON (tested)")
@@ -246,25 +191,27 @@ impl ValveRig {
         }
         let tau = self.sensors.pressure_lag_s;
         if tau > 0.0 {
-            // the sensors read the chambers; `p1`, `p2` become their
-            // readings and the chamber pressures `p1_chamber`, `p2_chamber`
-            for (port, k, p0) in [("A", "p1", p1), ("B", "p2", p2)] {
-                let name = format!("sensor_{port}");
-                v["components"][&name] = json!({
-                    "type": "pressure_sensor",
-                    "time_constant": tau,
-                    "initial": { "reading": p0 }
-                });
-                v["connections"]
-                    .as_array_mut()
-                    .expect("a template has connections")
-                    .push(json!([format!("cylinder.{port}"), format!("{name}.port")]));
-                v["outputs"][k] = Value::from(format!("{name}.reading"));
-                v["outputs"][format!("{k}_chamber")] = Value::from(format!("cylinder.{k}"));
+            netlist::overlay::overlay(&mut v, &template(CHAMBER_SENSORS))?;
+            for (name, p0) in [("sensor_A", p1), ("sensor_B", p2)] {
+                netlist::set(&mut v, &format!("{name}.time_constant"), Value::from(tau))?;
+                netlist::set(&mut v, &format!("{name}.initial.reading"), Value::from(p0))?;
             }
         }
         if let Some(c) = &self.controller {
-            close_loop(&mut v, c);
+            // the loop the `leaney-moog-closed-loop` preset closes around
+            // `leaney-moog`, closed here around this rig's circuit
+            let closing =
+                netlist::overlay::difference(&template(FUNDAMENTAL), &template(CLOSED_LOOP));
+            netlist::overlay::overlay(&mut v, &closing)?;
+            for (k, x) in [
+                ("gain", c.gain_per_m),
+                ("integral_time", c.integral_time_s),
+                ("bias", c.bias),
+                ("output_min", c.output_min),
+                ("output_max", c.output_max),
+            ] {
+                netlist::set(&mut v, &format!("controller.{k}"), Value::from(x))?;
+            }
         }
         Ok(v)
     }

@@ -320,6 +320,9 @@ mod tests {
         let mut seen = 0;
         for entry in std::fs::read_dir(fixtures().join("legacy")).unwrap() {
             let path = entry.unwrap().path();
+            if path.is_dir() {
+                continue; // `circuits/`: what the older kinds become
+            }
             let old = json(&path);
             if old.get("kind").and_then(|k| k.as_str()) != Some(KIND) {
                 continue;

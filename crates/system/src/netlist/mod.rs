@@ -42,6 +42,7 @@ pub mod identify;
 mod inputs;
 pub mod locate;
 pub mod migrate;
+pub mod overlay;
 pub mod reader;
 pub mod registry;
 
@@ -293,8 +294,8 @@ pub fn set(v: &mut Value, path: &str, value: Value) -> Result<(), RigError> {
         .and_then(Value::as_object_mut)
         .ok_or_else(|| unknown(" (the netlist has no components)".into()))?;
     let names: Vec<String> = comps.keys().cloned().collect();
-    // a friction bench has no cylinder and no load: its drive carries the
-    // moving mass and the rod's position
+    // a friction bench has no load (and emps no cylinder): its drive carries
+    // the moving mass and the rod's position
     let drive = comps
         .iter()
         .find(|(_, c)| c.get("type").and_then(Value::as_str) == Some("imposed_motion"))
@@ -305,7 +306,7 @@ pub fn set(v: &mut Value, path: &str, value: Value) -> Result<(), RigError> {
         .and_then(Value::as_object_mut)
         .ok_or_else(|| {
             let bench = drive.map_or(String::new(), |d| {
-                format!("; a bench's drive `{d}` carries the moving mass and the rod's position: `{d}.mass`, `{d}.initial.position`")
+                format!("; this bench's drive `{d}` carries the moving mass and the rod's position: `{d}.mass`, `{d}.initial.position`")
             });
             unknown(format!(
                 " (no component `{comp}`; components: {}{bench})",
@@ -408,13 +409,18 @@ mod tests {
         );
     }
 
-    /// `--set cylinder.…`/`load.…` on a friction bench (no cylinder, no
-    /// load) names the drive's paths that hold the mass and the position.
+    /// `--set cylinder.…`/`load.…` on a friction bench without that
+    /// component (emps has no cylinder; no bench has a load) names the
+    /// drive's paths that hold the mass and the position; the seal benches'
+    /// cylinder under test takes `cylinder.initial.position`.
     #[test]
     fn a_bench_set_names_the_drives_paths() {
-        for preset in ["emps", "tudelft-seal-25"] {
+        for (preset, missing) in [
+            ("emps", &["cylinder.initial.position", "load.mass"][..]),
+            ("tudelft-seal-25", &["load.mass"][..]),
+        ] {
             let mut v = crate::rig::preset(preset).unwrap();
-            for path in ["cylinder.initial.position", "load.mass"] {
+            for path in missing {
                 let e = super::set(&mut v, path, 0.01.into())
                     .unwrap_err()
                     .to_string();
@@ -424,6 +430,9 @@ mod tests {
                 );
             }
             super::set(&mut v, "drive.initial.position", 0.01.into()).unwrap();
+            if preset != "emps" {
+                super::set(&mut v, "cylinder.initial.position", 0.02.into()).unwrap();
+            }
             let e = super::set(&mut v, "pump.speed", 1.0.into())
                 .unwrap_err()
                 .to_string();

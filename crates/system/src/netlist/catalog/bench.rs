@@ -157,6 +157,11 @@ impl Component for ImposedMotion {
 /// A rigid piston: pushes the rod with `p1 A1 − p2 A2` and displaces
 /// `A1 v` out of port A's node into the chamber (and `A2 v` back out of the
 /// rod side); lossless, no chamber volume. An unconnected port is at 0 Pa.
+///
+/// Its one state is the piston's position in its bore, the integral of the
+/// rod's velocity from `initial.position`: the stroke coordinate of the
+/// cylinder under test, whose datum need not be the drive's (a bench drive
+/// keeps its own, `drive.initial.position`). No force depends on it.
 #[derive(Debug)]
 pub struct Piston {
     name: String,
@@ -167,10 +172,13 @@ pub struct Piston {
     pub area_1: f64,
     /// Area on which p2 pushes in − direction \[m²\].
     pub area_2: f64,
+    /// Initial position of the piston in its bore \[m\].
+    pub initial_position: f64,
     a: Option<HydraulicNode>,
     b: Option<HydraulicNode>,
     rod: MechanicalNode,
     force: Wire<Force>,
+    position: Wire<Position>,
 }
 
 impl Component for Piston {
@@ -179,6 +187,9 @@ impl Component for Piston {
     }
     fn has_tangents(&self) -> bool {
         true
+    }
+    fn derivative_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.rate_chain(0, 1.0, self.rod.velocity);
     }
     fn evaluate_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
         for (node, area) in [(self.a, self.area_1), (self.b, -self.area_2)] {
@@ -194,7 +205,29 @@ impl Component for Piston {
         self.b = self.b_name.as_deref().map(|n| net.hydraulic(n));
         self.rod = net.mechanical(&self.rod_name);
         self.force = net.private("force");
+        self.position = net.private("position");
         Ok(())
+    }
+    fn n_states(&self) -> usize {
+        1
+    }
+    fn state_names(&self) -> Vec<String> {
+        vec![format!("{}.x", self.name)]
+    }
+    fn state_scales(&self, s: &mut [f64]) {
+        s[0] = 0.1;
+    }
+    fn initial_state(&self, x: &mut [f64]) {
+        x[0] = self.initial_position;
+    }
+    fn publish(&self, _t: f64, x: &[f64], w: &mut Wires) {
+        w.set(self.position, Position::new(x[0]));
+    }
+    fn publish_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, d: &mut Tangents) {
+        d.state(self.position, 0, 1.0);
+    }
+    fn derivatives(&self, _t: f64, _x: &[f64], w: &Wires, dx: &mut [f64]) {
+        dx[0] = w.get(self.rod.velocity).si();
     }
     fn evaluate(&self, _t: f64, _x: &[f64], w: &mut Wires) {
         let v = w.get(self.rod.velocity).si();
@@ -222,7 +255,11 @@ impl Component for Piston {
         Ok(())
     }
     fn probes(&self) -> Vec<Probe> {
-        vec![Probe::of(format!("{}_force", self.name), self.force)]
+        vec![
+            Probe::of("position", self.position),
+            Probe::of("velocity", self.rod.velocity),
+            Probe::of(format!("{}_force", self.name), self.force),
+        ]
     }
 }
 
@@ -272,7 +309,7 @@ pub const TYPES: &[ComponentType] = &[
     },
     ComponentType {
         name: "piston",
-        summary: "a rigid piston: force p1 A1 − p2 A2 on the rod, displaced flows A1 v and A2 v, no chamber volume (a bench chamber held by a pressure source)",
+        summary: "a rigid piston: force p1 A1 − p2 A2 on the rod, displaced flows A1 v and A2 v, no chamber volume (a bench chamber held by a pressure source); its state is its position in the bore",
         ports: &[
             port("A", HYD, Role::Reads, true, "cap-side chamber (p1 pushes +)"),
             port("B", HYD, Role::Reads, true, "rod-side chamber (p2 pushes −)"),
@@ -282,7 +319,12 @@ pub const TYPES: &[ComponentType] = &[
             param("area_1", "m^2", Value(0.0), Range::NON_NEGATIVE, "area A1 on which p1 pushes in + direction"),
             param("area_2", "m^2", Value(0.0), Range::NON_NEGATIVE, "area A2 on which p2 pushes in − direction"),
         ],
-        states: &[],
+        states: &[StateSpec {
+            name: "position",
+            unit: "m",
+            default: Value(0.0),
+            doc: "initial position of the piston in its bore (its own datum, not the drive's)",
+        }],
         build: |i| {
             let a = i.connected("A").then(|| i.node("A").to_string());
             let b = i.connected("B").then(|| i.node("B").to_string());
@@ -296,14 +338,16 @@ pub const TYPES: &[ComponentType] = &[
                 rod_name: i.node("rod").into(),
                 area_1: i.get("area_1"),
                 area_2: i.get("area_2"),
+                initial_position: i.initial("position").unwrap_or(0.0),
                 a: None,
                 b: None,
                 rod: MechanicalNode::UNBOUND,
                 force: Wire::UNBOUND,
+                position: Wire::UNBOUND,
             })
         },
         hints: None,
-        probes: &[("force", "N")],
+        probes: &[("position", "m"), ("velocity", "m/s"), ("force", "N")],
     },
 ];
 

@@ -1,8 +1,10 @@
-//! The `friction-bench` kind read as a netlist: a drive imposing the
-//! record's velocity and acceleration (`imposed_motion` fed by the inputs
-//! `drive` and `acceleration`), the record's chamber pressures on
-//! `signal_pressure_source`s (inputs `p1`, `p2`), a rigid `piston` and the
-//! `friction_bench` law with the file's Coulomb level and catalog effects.
+//! The `friction-bench` kind read as a netlist: the circuit of
+//! `fixtures/legacy/circuits/friction-bench.json` ([`CIRCUIT`]: a drive
+//! imposing the record's velocity and acceleration, `imposed_motion` fed by
+//! the inputs `drive` and `acceleration`; the record's chamber pressures on
+//! `signal_pressure_source`s, inputs `p1`, `p2`; a rigid `piston` and the
+//! `friction_bench` law), with the file's values set by netlist path: its
+//! mass, force sign, areas, Coulomb level and catalog effects.
 //!
 //! The file's identification fields (`refit`, `columns`, `steady_state`)
 //! become the netlist's identification section ([`crate::netlist::identify`],
@@ -16,6 +18,11 @@ use crate::rig::RigError;
 use serde::Deserialize;
 use serde_json::{json, Map, Value};
 use std::collections::BTreeMap;
+
+/// The circuit a friction-bench file becomes (its values filled in by
+/// netlist path): `fixtures/legacy/circuits/friction-bench.json`.
+pub const CIRCUIT: &str =
+    include_str!("../../../../../fixtures/legacy/circuits/friction-bench.json");
 
 /// The `kind` of a friction-bench rig file.
 pub const KIND: &str = "friction-bench";
@@ -143,19 +150,25 @@ pub fn to_netlist(v: &Value) -> Result<Value, RigError> {
         "smoothing_velocity",
         f.friction.smoothing_velocity,
     )?;
-    let mut law = Map::new();
-    law.insert("type".into(), json!("friction_bench"));
-    law.insert("coulomb".into(), json!(f.friction.coulomb));
-    law.insert(
-        "smoothing_velocity".into(),
-        json!(f.friction.smoothing_velocity),
-    );
+    let mut v: Value =
+        serde_json::from_str(CIRCUIT).expect("the embedded bench circuit is valid JSON (tested)");
+    v["name"] = Value::from(f.name.clone());
+    let mut sets: Vec<(String, f64)> = vec![
+        (format!("{DRIVE}.mass"), f.mass),
+        (format!("{DRIVE}.force_sign"), f.force_sign),
+        ("piston.area_1".into(), f.area1),
+        ("piston.area_2".into(), f.area2),
+        (format!("{FRICTION}.coulomb"), f.friction.coulomb),
+        (
+            format!("{FRICTION}.smoothing_velocity"),
+            f.friction.smoothing_velocity,
+        ),
+    ];
     for (id, params) in &f.friction.effects {
         let here = format!("friction.effects.{id}");
         let of_effect: Vec<_> = EFFECT_PARAMS.iter().filter(|(e, _, _)| e == id).collect();
         if of_effect.is_empty() {
-            let known: Vec<&str> = EFFECT_PARAMS.iter().map(|(e, _, _)| *e).collect();
-            let mut known = known;
+            let mut known: Vec<&str> = EFFECT_PARAMS.iter().map(|(e, _, _)| *e).collect();
             known.dedup();
             return Err(RigError::Invalid {
                 path: here,
@@ -184,20 +197,11 @@ pub fn to_netlist(v: &Value) -> Result<Value, RigError> {
             if *target == "sigma0" && x <= 0.0 {
                 return Err(out_of_range(&path, x, "must be > 0"));
             }
-            let mut node = &mut law;
-            let mut parts = target.split('.').peekable();
-            while let Some(part) = parts.next() {
-                if parts.peek().is_none() {
-                    node.insert(part.into(), json!(x));
-                } else {
-                    node = node
-                        .entry(part)
-                        .or_insert_with(|| json!({}))
-                        .as_object_mut()
-                        .expect("an object");
-                }
-            }
+            sets.push((format!("{FRICTION}.{target}"), x));
         }
+    }
+    for (path, x) in sets {
+        crate::netlist::set(&mut v, &path, Value::from(x))?;
     }
     let mut identify = Map::new();
     identify.insert(
@@ -224,43 +228,8 @@ pub fn to_netlist(v: &Value) -> Result<Value, RigError> {
     if f.steady_state {
         identify.insert("steady_state".into(), json!(true));
     }
-    let n = json!({
-        "kind": crate::netlist::KIND,
-        "name": f.name,
-        "description": "a friction bench: the drive imposes the record's velocity (input `drive`) and acceleration (input `acceleration`); the chambers hold the record's pressures (inputs `p1`, `p2`); the load cell reads `drive.force`",
-        "components": {
-            DRIVE: {
-                "type": "imposed_motion",
-                "mass": f.mass,
-                "force_sign": f.force_sign,
-                "initial": { "position": 0.0 }
-            },
-            "acceleration": { "type": "command_input" },
-            "p1": { "type": "command_input" },
-            "p2": { "type": "command_input" },
-            "chamber_1": { "type": "signal_pressure_source" },
-            "chamber_2": { "type": "signal_pressure_source" },
-            "piston": { "type": "piston", "area_1": f.area1, "area_2": f.area2 },
-            FRICTION: Value::Object(law)
-        },
-        "connections": [
-            ["drive.rod", "piston.rod", "friction.rod"],
-            ["acceleration.out", "drive.acceleration"],
-            ["p1.out", "chamber_1.pressure"],
-            ["p2.out", "chamber_2.pressure"],
-            ["chamber_1.port", "piston.A", "friction.A"],
-            ["chamber_2.port", "piston.B", "friction.B"]
-        ],
-        "outputs": {
-            "position": "drive.position",
-            "velocity": "drive.velocity",
-            "p1": "chamber_1.p",
-            "p2": "chamber_2.p",
-            "force": "drive.force",
-            "friction_force": "friction.force"
-        },
-        "identify": Value::Object(identify)
-    });
+    v["identify"] = Value::Object(identify);
+    let n = v;
     // the identification section checked here, so that its errors name the
     // file's own keys (`columns.torque`, `refit[1]`)
     crate::netlist::read(&n).map_err(|e| RigError::Invalid {

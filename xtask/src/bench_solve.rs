@@ -390,18 +390,68 @@ fn hybrid_solver_choice() -> Result<(), String> {
     Ok(())
 }
 
-/// Median of `f`'s per-call time \[ns\] over 7 repetitions after a warm-up.
-fn median_ns(mut f: impl FnMut() -> usize) -> f64 {
-    std::hint::black_box(f());
-    let mut v: Vec<f64> = (0..7)
-        .map(|_| {
+/// Rounds of the CSV section's interleaved timing.
+const CSV_ROUNDS: usize = 41;
+
+/// The fastest and the median time \[ns\] of one call of each of `fs`,
+/// timed **interleaved**: after a warm-up of each, `rounds` rounds in which
+/// every variant runs once (the order rotated from round to round), so that
+/// a disturbance of the shared machine (another build, a noisy neighbour)
+/// falls on every variant alike instead of on one block of one variant's
+/// runs. The fastest of a variant is its least disturbed run; the ratios
+/// are taken between fastests, the medians printed beside them.
+fn interleaved_ns<const N: usize>(
+    rounds: usize,
+    mut fs: [&mut dyn FnMut() -> usize; N],
+) -> [Timing; N] {
+    for f in fs.iter_mut() {
+        std::hint::black_box(f());
+    }
+    let mut samples = [(); N].map(|_| Vec::with_capacity(rounds));
+    for r in 0..rounds {
+        for i in 0..N {
+            let k = (i + r) % N;
             let t0 = Instant::now();
-            std::hint::black_box(f());
-            t0.elapsed().as_secs_f64() * 1e9
-        })
-        .collect();
-    v.sort_by(f64::total_cmp);
-    v[3]
+            std::hint::black_box(fs[k]());
+            samples[k].push(t0.elapsed().as_secs_f64() * 1e9);
+        }
+    }
+    samples.map(|mut v| {
+        v.sort_by(f64::total_cmp);
+        Timing {
+            min: v[0],
+            median: v[v.len() / 2],
+        }
+    })
+}
+
+/// One variant's time per call (or, scaled, per row) \[ns\]: its fastest
+/// (least disturbed) run and its median run.
+#[derive(Clone, Copy)]
+struct Timing {
+    min: f64,
+    median: f64,
+}
+
+impl Timing {
+    fn per(self, n: f64) -> Timing {
+        Timing {
+            min: self.min / n,
+            median: self.median / n,
+        }
+    }
+    /// "`old`/`self` x (median `...`x)": how many times faster than `old`.
+    fn speedup(self, old: Timing) -> String {
+        format!(
+            "{:.1}x (medians {:.1}x)",
+            old.min / self.min,
+            old.median / self.median
+        )
+    }
+    /// "fastest ns (median ns)"
+    fn show(self) -> String {
+        format!("{:.0} ns/row (median {:.0})", self.min, self.median)
+    }
 }
 
 /// CSV per row: the plain-CSV path against the previous implementation
@@ -411,32 +461,50 @@ fn median_ns(mut f: impl FnMut() -> usize) -> f64 {
 /// (`write_columns_in_parts` with `write_parts`; `PlainCsv::columns`, which
 /// `hydrocyl` reads with; the CLI formats on one writer thread beside the
 /// solve), with the floor of each: the number conversions alone on every
-/// cell (no splitting, no columns, no copying, no repeat skipped).
+/// cell (no splitting, no columns, no copying, no repeat skipped). The
+/// previous and the new implementations of each row are timed interleaved
+/// ([`interleaved_ns`], [`CSV_ROUNDS`] rounds): the ratios are between the
+/// fastest runs of each, the medians' ratio beside them.
 fn csv_per_row() -> Result<(), String> {
     let case = square_case(10.0)?;
     let run = case.run(Solver::Dp45, 1e-5)?;
     let (names, columns) = run_columns(&run);
     let rows = run.time.len() as f64;
     let parts = write_parts(run.time.len(), columns.len());
-    let write_new = median_ns(|| write_columns(&names, &columns).len()) / rows;
-    let write_par = median_ns(|| {
-        write_columns_in_parts(&names, &columns, parts)
-            .iter()
-            .map(Vec::len)
-            .sum()
-    }) / rows;
-    let write_old = median_ns(|| {
-        let mut s = names.join(",");
-        s.push('\n');
-        for k in 0..run.time.len() {
-            s.push_str(&format!("{:?}", columns[0][k]));
-            for c in &columns[1..] {
-                s.push_str(&format!(",{:?}", c[k]));
-            }
-            s.push('\n');
-        }
-        s.len()
-    }) / rows;
+    let [write_new, write_par, write_old, write_floor] = interleaved_ns(
+        CSV_ROUNDS,
+        [
+            &mut || write_columns(&names, &columns).len(),
+            &mut || {
+                write_columns_in_parts(&names, &columns, parts)
+                    .iter()
+                    .map(Vec::len)
+                    .sum()
+            },
+            &mut || {
+                let mut s = names.join(",");
+                s.push('\n');
+                for k in 0..run.time.len() {
+                    s.push_str(&format!("{:?}", columns[0][k]));
+                    for c in &columns[1..] {
+                        s.push_str(&format!(",{:?}", c[k]));
+                    }
+                    s.push('\n');
+                }
+                s.len()
+            },
+            // the floor: zmij alone on the same values
+            &mut || {
+                let mut buf = zmij::Buffer::new();
+                columns
+                    .iter()
+                    .flat_map(|c| c.iter())
+                    .map(|&v| buf.format(v).len())
+                    .sum()
+            },
+        ],
+    )
+    .map(|t| t.per(rows));
     let text = String::from_utf8(write_columns(&names, &columns)).map_err(|e| e.to_string())?;
     let wanted: Vec<usize> = (0..names.len()).collect();
     let threads = |text: &str| {
@@ -444,27 +512,49 @@ fn csv_per_row() -> Result<(), String> {
             .map(|p| p.threads())
             .ok_or("not plain CSV")
     };
+    fn cells_of(text: &str) -> Vec<Vec<&[u8]>> {
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').map(str::as_bytes).collect())
+            .collect()
+    }
+    // the floor: fast-float2 alone on the same cells (no splitting, no
+    // columns, no copying)
+    let floor_of = |cells: &[&[u8]]| -> usize {
+        cells
+            .iter()
+            .map(|c| fast_float2::parse::<f64, _>(c).map_or(0, |v: f64| v.is_finite() as usize))
+            .sum()
+    };
     let read_threads = threads(&text)?;
-    let read_par = median_ns(|| {
-        PlainCsv::new(&text)
-            .and_then(|p| p.columns(&wanted))
-            .map_or(0, |c| c.len())
-    }) / rows;
-    let read_new = median_ns(|| {
-        PlainCsv::new(&text)
-            .and_then(|p| p.columns_on(&wanted, 1))
-            .map_or(0, |c| c.len())
-    }) / rows;
-    let read_old = median_ns(|| {
-        let mut rdr = csv_reader(&text);
-        let mut cols = vec![Vec::new(); wanted.len()];
-        for rec in rdr.records().flatten() {
-            for (j, c) in cols.iter_mut().enumerate() {
-                c.push(rec[j].parse::<f64>().unwrap_or(f64::NAN));
-            }
-        }
-        cols.len()
-    }) / rows;
+    let text_cells: Vec<&[u8]> = cells_of(&text).into_iter().flatten().collect();
+    let [read_par, read_new, read_old, read_floor] = interleaved_ns(
+        CSV_ROUNDS,
+        [
+            &mut || {
+                PlainCsv::new(&text)
+                    .and_then(|p| p.columns(&wanted))
+                    .map_or(0, |c| c.len())
+            },
+            &mut || {
+                PlainCsv::new(&text)
+                    .and_then(|p| p.columns_on(&wanted, 1))
+                    .map_or(0, |c| c.len())
+            },
+            &mut || {
+                let mut rdr = csv_reader(&text);
+                let mut cols = vec![Vec::new(); wanted.len()];
+                for rec in rdr.records().flatten() {
+                    for (j, c) in cols.iter_mut().enumerate() {
+                        c.push(rec[j].parse::<f64>().unwrap_or(f64::NAN));
+                    }
+                }
+                cols.len()
+            },
+            &mut || floor_of(&text_cells),
+        ],
+    )
+    .map(|t| t.per(rows));
     let Signal::Table { time_s, value } = &case.command else {
         return Err("not a table".into());
     };
@@ -472,50 +562,33 @@ fn csv_per_row() -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let cmd_rows = time_s.len() as f64;
     let cmd_threads = threads(&cmd)?;
-    let cmd_par = median_ns(|| {
-        PlainCsv::new(&cmd)
-            .and_then(|p| p.columns(&[0, 1]))
-            .map_or(0, |c| c.len())
-    }) / cmd_rows;
-    let cmd_new = median_ns(|| {
-        PlainCsv::new(&cmd)
-            .and_then(|p| p.columns_on(&[0, 1], 1))
-            .map_or(0, |c| c.len())
-    }) / cmd_rows;
-    let cmd_old = median_ns(|| {
-        let mut rdr = csv_reader(&cmd);
-        let (mut t, mut u) = (Vec::new(), Vec::new());
-        for rec in rdr.records().flatten() {
-            t.push(rec[0].parse::<f64>().unwrap_or(f64::NAN));
-            u.push(rec[1].parse::<f64>().unwrap_or(f64::NAN));
-        }
-        t.len() + u.len()
-    }) / cmd_rows;
-    // the floors: the number conversions alone on the same values and cells
-    // (no splitting, no columns, no copying)
-    let write_floor = median_ns(|| {
-        let mut buf = zmij::Buffer::new();
-        columns
-            .iter()
-            .flat_map(|c| c.iter())
-            .map(|&v| buf.format(v).len())
-            .sum()
-    }) / rows;
-    fn cells_of(text: &str) -> Vec<Vec<&[u8]>> {
-        text.lines()
-            .skip(1)
-            .map(|l| l.split(',').map(str::as_bytes).collect())
-            .collect()
-    }
-    let floor_of = |text: &str| {
-        let cells: Vec<&[u8]> = cells_of(text).into_iter().flatten().collect();
-        median_ns(|| {
-            cells
-                .iter()
-                .map(|c| fast_float2::parse::<f64, _>(c).map_or(0, |v: f64| v.is_finite() as usize))
-                .sum()
-        })
-    };
+    let cmd_cells: Vec<&[u8]> = cells_of(&cmd).into_iter().flatten().collect();
+    let [cmd_par, cmd_new, cmd_old, cmd_floor] = interleaved_ns(
+        CSV_ROUNDS,
+        [
+            &mut || {
+                PlainCsv::new(&cmd)
+                    .and_then(|p| p.columns(&[0, 1]))
+                    .map_or(0, |c| c.len())
+            },
+            &mut || {
+                PlainCsv::new(&cmd)
+                    .and_then(|p| p.columns_on(&[0, 1], 1))
+                    .map_or(0, |c| c.len())
+            },
+            &mut || {
+                let mut rdr = csv_reader(&cmd);
+                let (mut t, mut u) = (Vec::new(), Vec::new());
+                for rec in rdr.records().flatten() {
+                    t.push(rec[0].parse::<f64>().unwrap_or(f64::NAN));
+                    u.push(rec[1].parse::<f64>().unwrap_or(f64::NAN));
+                }
+                t.len() + u.len()
+            },
+            &mut || floor_of(&cmd_cells),
+        ],
+    )
+    .map(|t| t.per(cmd_rows));
     // the share of the cells whose text is the text above (read: its value
     // is taken, not parsed again)
     let text_repeats = |text: &str| {
@@ -526,13 +599,18 @@ fn csv_per_row() -> Result<(), String> {
             .sum();
         100.0 * same as f64 / lines.iter().map(Vec::len).sum::<usize>().max(1) as f64
     };
-    let read_floor = floor_of(&text) / rows;
-    let cmd_floor = floor_of(&cmd) / cmd_rows;
     println!(
-        "CSV, 1 kHz command file (time, command), read: one thread {cmd_new:.0} ns/row (previous {cmd_old:.0}, {:.1}x faster; fast-float2 alone {cmd_floor:.0}; {:.0} % of the cells repeat the text above), {cmd_threads} threads {cmd_par:.0} ns/row ({:.1}x); goal >= 10x",
-        cmd_old / cmd_new,
+        "CSV per row: fastest of {CSV_ROUNDS} interleaved rounds (median beside); ratios of the fastests against the previous implementation"
+    );
+    println!(
+        "CSV, 1 kHz command file (time, command), read: one thread {} (previous {}, {} faster; fast-float2 alone {:.0}; {:.0} % of the cells repeat the text above), {cmd_threads} threads {} ({}); goal >= 10x",
+        cmd_new.show(),
+        cmd_old.show(),
+        cmd_new.speedup(cmd_old),
+        cmd_floor.min,
         text_repeats(&cmd),
-        cmd_old / cmd_par
+        cmd_par.show(),
+        cmd_par.speedup(cmd_old),
     );
     // a value equal to the one above it is copied, not formatted again
     let repeats = columns
@@ -545,18 +623,26 @@ fn csv_per_row() -> Result<(), String> {
         .sum::<usize>() as f64
         / (rows * columns.len() as f64);
     println!(
-        "CSV, {} columns, write: one thread {write_new:.0} ns/row (previous {write_old:.0}, {:.1}x faster; zmij alone on every cell {write_floor:.0}; {:.0} % of the cells repeat the value above and are copied, not formatted), {parts} threads {write_par:.0} ns/row ({:.1}x); goal >= 10x",
+        "CSV, {} columns, write: one thread {} (previous {}, {} faster; zmij alone on every cell {:.0}; {:.0} % of the cells repeat the value above and are copied, not formatted), {parts} threads {} ({}); goal >= 10x",
         names.len(),
-        write_old / write_new,
+        write_new.show(),
+        write_old.show(),
+        write_new.speedup(write_old),
+        write_floor.min,
         100.0 * repeats,
-        write_old / write_par
+        write_par.show(),
+        write_par.speedup(write_old),
     );
     println!(
-        "CSV, {} columns, read: one thread {read_new:.0} ns/row (previous {read_old:.0}, {:.1}x faster; fast-float2 alone on every cell {read_floor:.0}; {:.0} % of the cells repeat the text above and take its value, not parsed), {read_threads} threads {read_par:.0} ns/row ({:.1}x); goal >= 10x",
+        "CSV, {} columns, read: one thread {} (previous {}, {} faster; fast-float2 alone on every cell {:.0}; {:.0} % of the cells repeat the text above and take its value, not parsed), {read_threads} threads {} ({}); goal >= 10x",
         names.len(),
-        read_old / read_new,
+        read_new.show(),
+        read_old.show(),
+        read_new.speedup(read_old),
+        read_floor.min,
         text_repeats(&text),
-        read_old / read_par
+        read_par.show(),
+        read_par.speedup(read_old),
     );
     Ok(())
 }
@@ -567,13 +653,23 @@ fn csv_reader(text: &str) -> csv::Reader<&[u8]> {
         .from_reader(text.as_bytes())
 }
 
-/// The `hydrocyl` binary and the profile it was built with:
-/// `$HYDROCYL_BIN` ("given"), else the release build, brought up to date now
-/// (`cargo build --release -p hydrocyl-cli`; a no-op when it is): a user
-/// runs a release build (`cargo install`), so the whole process is timed on one.
-fn hydrocyl_binary() -> Result<(PathBuf, &'static str), String> {
+/// The `hydrocyl` binaries to time and the profile they were built with:
+/// `$HYDROCYL_BIN` ("given"; several paths separated by `:` are timed
+/// interleaved, run by run, to compare builds in one run), else the release
+/// build, brought up to date now (`cargo build --release -p hydrocyl-cli`; a
+/// no-op when it is): a user runs a release build (`cargo install`), so the
+/// whole process is timed on one.
+fn hydrocyl_binaries() -> Result<(Vec<PathBuf>, &'static str), String> {
     if let Ok(p) = std::env::var("HYDROCYL_BIN") {
-        return Ok((PathBuf::from(p), "given by HYDROCYL_BIN"));
+        let bins: Vec<PathBuf> = p
+            .split(':')
+            .filter(|s| !s.is_empty())
+            .map(PathBuf::from)
+            .collect();
+        if bins.is_empty() {
+            return Err("HYDROCYL_BIN names no binary".into());
+        }
+        return Ok((bins, "given by HYDROCYL_BIN"));
     }
     let root = Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
@@ -598,12 +694,21 @@ fn hydrocyl_binary() -> Result<(PathBuf, &'static str), String> {
     let target = std::env::var("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|_| root.join("target"));
-    Ok((target.join("release").join("hydrocyl"), "release profile"))
+    Ok((
+        vec![target.join("release").join("hydrocyl")],
+        "release profile",
+    ))
 }
+
+/// Runs of each binary per row of [`whole_process`].
+const PROCESS_RUNS: usize = 21;
 
 /// The whole `hydrocyl simulate` process on the 1 kHz 10 s and 100 s
 /// command files (1 kHz output), against the process doing nothing
-/// (`hydrocyl --version`): median and fastest of 21 runs. Each run replaces
+/// (`hydrocyl --version`): median and fastest of [`PROCESS_RUNS`] runs.
+/// Several binaries ([`hydrocyl_binaries`]) are timed interleaved, run by
+/// run (each run's order rotated), so that the machine's load falls on each
+/// alike. Each run replaces
 /// the output of the one before (still in the page cache); the 10 s default
 /// is also timed over an output already on the disk (synced before each
 /// run), as a rerun long after the last finds it: replacing it then frees
@@ -611,7 +716,7 @@ fn hydrocyl_binary() -> Result<(PathBuf, &'static str), String> {
 /// go to `keep` and stay there when it is given (to profile the process on
 /// them), else to a temporary folder removed at the end.
 fn whole_process(keep: Option<&Path>) -> Result<(), String> {
-    let (bin, profile) = hydrocyl_binary()?;
+    let (bins, profile) = hydrocyl_binaries()?;
     let dir = keep.map_or_else(
         || std::env::temp_dir().join(format!("hydrocyl-bench-{}", std::process::id())),
         Path::to_path_buf,
@@ -619,34 +724,51 @@ fn whole_process(keep: Option<&Path>) -> Result<(), String> {
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     // `synced`: the output the run replaces is on the disk first (a rerun
     // long after the last: deleting it frees its blocks), not only in the
-    // page cache as after the run before
-    let time_with = |args: &[&str], synced: Option<&Path>| -> Result<(f64, f64), String> {
-        let mut v = Vec::new();
-        for _ in 0..21 {
-            if let Some(p) = synced {
-                if let Ok(f) = std::fs::File::open(p) {
-                    f.sync_all().map_err(|e| e.to_string())?;
+    // page cache as after the run before; per binary, (median, fastest)
+    let time_with = |args: &[&str], synced: Option<&Path>| -> Result<Vec<(f64, f64)>, String> {
+        let mut v = vec![Vec::with_capacity(PROCESS_RUNS); bins.len()];
+        for r in 0..PROCESS_RUNS {
+            for i in 0..bins.len() {
+                let b = (i + r) % bins.len();
+                if let Some(p) = synced {
+                    if let Ok(f) = std::fs::File::open(p) {
+                        f.sync_all().map_err(|e| e.to_string())?;
+                    }
+                }
+                let t0 = Instant::now();
+                let out = Command::new(&bins[b])
+                    .args(args)
+                    .output()
+                    .map_err(|e| e.to_string())?;
+                v[b].push(t0.elapsed().as_secs_f64() * 1e3);
+                if !out.status.success() {
+                    return Err(String::from_utf8_lossy(&out.stderr).into_owned());
                 }
             }
-            let t0 = Instant::now();
-            let out = Command::new(&bin)
-                .args(args)
-                .output()
-                .map_err(|e| e.to_string())?;
-            v.push(t0.elapsed().as_secs_f64() * 1e3);
-            if !out.status.success() {
-                return Err(String::from_utf8_lossy(&out.stderr).into_owned());
-            }
         }
-        v.sort_by(f64::total_cmp);
-        Ok((v[10], v[0]))
+        Ok(v.into_iter()
+            .map(|mut v| {
+                v.sort_by(f64::total_cmp);
+                (v[v.len() / 2], v[0])
+            })
+            .collect())
     };
     let time = |args: &[&str]| time_with(args, None);
-    let (idle, idle_min) = time(&["--version"])?;
-    println!(
-        "hydrocyl simulate, whole process ({}, {profile}): process start {idle:.2} ms (fastest {idle_min:.2})",
-        bin.display()
-    );
+    // the binary's label on its rows when several are compared
+    let label = |b: usize| {
+        if bins.len() > 1 {
+            format!(" [{}]", bins[b].display())
+        } else {
+            String::new()
+        }
+    };
+    println!("hydrocyl simulate, whole process ({profile}):");
+    for (b, (idle, idle_min)) in time(&["--version"])?.into_iter().enumerate() {
+        println!(
+            "  {}: process start {idle:.2} ms (fastest {idle_min:.2})",
+            bins[b].display()
+        );
+    }
     for t_end in [10.0, 100.0] {
         let case = square_case(t_end)?;
         let Signal::Table { time_s, value } = &case.command else {
@@ -657,7 +779,7 @@ fn whole_process(keep: Option<&Path>) -> Result<(), String> {
             .map_err(|e| e.to_string())?;
         let out = dir.join("out.csv");
         let (cmd_s, out_s) = (cmd.display().to_string(), out.display().to_string());
-        for (label, extra) in [
+        for (name, extra) in [
             ("default (auto, rtol 1e-6)", None),
             (
                 "dp45 rtol 1e-5",
@@ -676,17 +798,21 @@ fn whole_process(keep: Option<&Path>) -> Result<(), String> {
             if let Some(e) = extra {
                 args.extend(e);
             }
-            let (med, min) = time(&args)?;
-            println!(
-                "  {t_end:>4.0} s, 1 kHz in and out, {label:<26}: median {med:7.2} ms, fastest {min:7.2} ms{}",
-                if t_end == 10.0 { " (goal < 6 ms)" } else { "" }
-            );
-            if t_end == 10.0 && extra.is_none() {
-                let (med, min) = time_with(&args, Some(&out))?;
+            for (b, (med, min)) in time(&args)?.into_iter().enumerate() {
                 println!(
-                    "  {t_end:>4.0} s, 1 kHz in and out, {:<26}: median {med:7.2} ms, fastest {min:7.2} ms",
-                    "default, output on disk"
+                    "  {t_end:>4.0} s, 1 kHz in and out, {name:<26}: median {med:7.2} ms, fastest {min:7.2} ms{}{}",
+                    if t_end == 10.0 { " (goal < 6 ms)" } else { "" },
+                    label(b)
                 );
+            }
+            if t_end == 10.0 && extra.is_none() {
+                for (b, (med, min)) in time_with(&args, Some(&out))?.into_iter().enumerate() {
+                    println!(
+                        "  {t_end:>4.0} s, 1 kHz in and out, {:<26}: median {med:7.2} ms, fastest {min:7.2} ms{}",
+                        "default, output on disk",
+                        label(b)
+                    );
+                }
             }
         }
     }

@@ -118,7 +118,7 @@ fn work_precision() -> Result<(), String> {
     let mut rows: Vec<(Solver, f64, f64, f64)> = Vec::new();
     for solver in [Solver::Auto, Solver::Dp45, Solver::Rosenbrock] {
         for rtol in WORK_PRECISION_RTOLS {
-            let reps = if rtol >= 1e-7 { 5 } else { 2 };
+            let reps = if rtol >= 1e-7 { 15 } else { 3 };
             let r = case.best(solver, rtol, reps)?;
             let ms = r.wall.as_secs_f64() * 1e3;
             let mut line = format!(
@@ -391,7 +391,7 @@ fn hybrid_solver_choice() -> Result<(), String> {
 }
 
 /// Rounds of the CSV section's interleaved timing.
-const CSV_ROUNDS: usize = 41;
+const CSV_ROUNDS: usize = 60;
 
 /// The fastest and the median time \[ns\] of one call of each of `fs`,
 /// timed **interleaved**: after a warm-up of each, `rounds` rounds in which

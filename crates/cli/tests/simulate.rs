@@ -394,7 +394,7 @@ fn friction_bench_is_simulated_from_its_motion() {
     let rig: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(fx.join("bench-none.rig.json")).unwrap())
             .unwrap();
-    let area = rig["components"]["piston"]["area_2"].as_f64().unwrap();
+    let area = rig["components"]["cylinder"]["area_2"].as_f64().unwrap();
     let floor = (0.5f64.powi(2) + (2e3 * area).powi(2)).sqrt();
     let truth = rms("bench-none.rig.json", "bench-none.csv");
     assert!(

@@ -72,6 +72,34 @@ impl ValveRig {
         v["name"] = Value::from(self.name.clone());
         v["description"] = Value::from(self.description.clone());
         let (p1, p2) = self.initial_pressures()?;
+        // the optional parts first, so that the rig's values set below
+        // hold whatever the overlays bring
+        let tau = self.sensors.pressure_lag_s;
+        if tau > 0.0 {
+            netlist::overlay::overlay(&mut v, &template(CHAMBER_SENSORS))?;
+            for (name, p0) in [("sensor_A", p1), ("sensor_B", p2)] {
+                netlist::set(&mut v, &format!("{name}.time_constant"), Value::from(tau))?;
+                netlist::set(&mut v, &format!("{name}.initial.reading"), Value::from(p0))?;
+            }
+        }
+        if let Some(c) = &self.controller {
+            // the loop the `leaney-moog-closed-loop` preset closes around
+            // `leaney-moog`, closed here around this rig's circuit (before
+            // the rig's values are set: tested to touch only the command,
+            // the reference and the controller)
+            let closing =
+                netlist::overlay::difference(&template(FUNDAMENTAL), &template(CLOSED_LOOP))?;
+            netlist::overlay::overlay(&mut v, &closing)?;
+            for (k, x) in [
+                ("gain", c.gain_per_m),
+                ("integral_time", c.integral_time_s),
+                ("bias", c.bias),
+                ("output_min", c.output_min),
+                ("output_max", c.output_max),
+            ] {
+                netlist::set(&mut v, &format!("controller.{k}"), Value::from(x))?;
+            }
+        }
         let (va, c, s, i) = (&self.valve, &self.cylinder, &self.supply, &self.initial);
         let metering = if fundamental { "valve" } else { "cylinder" };
         let mut sets: Vec<(String, f64)> = vec![
@@ -188,30 +216,6 @@ impl ValveRig {
         }
         for (path, x) in sets {
             netlist::set(&mut v, &path, Value::from(x))?;
-        }
-        let tau = self.sensors.pressure_lag_s;
-        if tau > 0.0 {
-            netlist::overlay::overlay(&mut v, &template(CHAMBER_SENSORS))?;
-            for (name, p0) in [("sensor_A", p1), ("sensor_B", p2)] {
-                netlist::set(&mut v, &format!("{name}.time_constant"), Value::from(tau))?;
-                netlist::set(&mut v, &format!("{name}.initial.reading"), Value::from(p0))?;
-            }
-        }
-        if let Some(c) = &self.controller {
-            // the loop the `leaney-moog-closed-loop` preset closes around
-            // `leaney-moog`, closed here around this rig's circuit
-            let closing =
-                netlist::overlay::difference(&template(FUNDAMENTAL), &template(CLOSED_LOOP));
-            netlist::overlay::overlay(&mut v, &closing)?;
-            for (k, x) in [
-                ("gain", c.gain_per_m),
-                ("integral_time", c.integral_time_s),
-                ("bias", c.bias),
-                ("output_min", c.output_min),
-                ("output_max", c.output_max),
-            ] {
-                netlist::set(&mut v, &format!("controller.{k}"), Value::from(x))?;
-            }
         }
         Ok(v)
     }

@@ -139,8 +139,8 @@ impl FrictionBench {
 /// built circuit by their netlist paths (no reassembly): the one run path
 /// ([`Simulation`]) as a fit uses it.
 ///
-/// * A static law has no state the force depends on (the drive's position
-///   feeds no force): the load cell is read at the sample times with no
+/// * A static law has no state the force depends on (the drive's and the
+///   piston's positions feed no force): the load cell is read at the sample times with no
 ///   integration ([`Simulation::sample_state_free`], which checks that).
 /// * LuGre's bristle is integrated ([`Simulation::run_wires`], reading only
 ///   the load cell) with [`run_options`]: the exponential Rosenbrock–Euler

@@ -295,7 +295,7 @@ pub fn set(v: &mut Value, path: &str, value: Value) -> Result<(), RigError> {
         .ok_or_else(|| unknown(" (the netlist has no components)".into()))?;
     let names: Vec<String> = comps.keys().cloned().collect();
     // a friction bench has no load (and emps no cylinder): its drive carries
-    // the moving mass and the rod's position
+    // the moving mass, and where there is no cylinder the rod's position
     let drive = comps
         .iter()
         .find(|(_, c)| c.get("type").and_then(Value::as_str) == Some("imposed_motion"))
@@ -306,7 +306,11 @@ pub fn set(v: &mut Value, path: &str, value: Value) -> Result<(), RigError> {
         .and_then(Value::as_object_mut)
         .ok_or_else(|| {
             let bench = drive.map_or(String::new(), |d| {
-                format!("; this bench's drive `{d}` carries the moving mass and the rod's position: `{d}.mass`, `{d}.initial.position`")
+                if comp == "load" {
+                    format!("; this bench's drive `{d}` carries the moving mass: `{d}.mass`")
+                } else {
+                    format!("; this bench has no cylinder: its drive `{d}` carries the moving mass and the rod's position, `{d}.mass`, `{d}.initial.position`")
+                }
             });
             unknown(format!(
                 " (no component `{comp}`; components: {}{bench})",
@@ -424,8 +428,10 @@ mod tests {
                 let e = super::set(&mut v, path, 0.01.into())
                     .unwrap_err()
                     .to_string();
-                assert!(
-                    e.contains("`drive.initial.position`") && e.contains("`drive.mass`"),
+                assert!(e.contains("`drive.mass`"), "{e}");
+                assert_eq!(
+                    e.contains("`drive.initial.position`"),
+                    path.starts_with("cylinder."),
                     "{e}"
                 );
             }

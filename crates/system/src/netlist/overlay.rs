@@ -70,10 +70,68 @@ fn component_of(endpoint: &str) -> &str {
     endpoint.split_once('.').map_or(endpoint, |(c, _)| c)
 }
 
-/// Applies `part` to the netlist `base` (see the module's rules). Errors
-/// name the overlay's JSON path (`overlay.components.x`); the result is
-/// checked when it is read, as any netlist.
+/// Connections joined into nodes: connections that share an endpoint
+/// become one (at the first one's place, its endpoints first), as the
+/// reader joins them.
+fn nodes(conns: Vec<Vec<String>>) -> Vec<Vec<String>> {
+    let mut out: Vec<Vec<String>> = Vec::new();
+    for c in conns {
+        let mut node = c;
+        let mut at = None;
+        let mut i = 0;
+        while i < out.len() {
+            if out[i].iter().any(|p| node.contains(p)) {
+                let mut first = std::mem::take(&mut out[i]);
+                for p in node {
+                    if !first.contains(&p) {
+                        first.push(p);
+                    }
+                }
+                node = first;
+                at.get_or_insert(i);
+            }
+            i += 1;
+        }
+        match at {
+            Some(i) => out[i] = node,
+            None => out.push(node),
+        }
+        out.retain(|e| !e.is_empty());
+    }
+    out
+}
+
+/// Applies `part` to the netlist `base` (see the module's rules); on an
+/// error `base` is left as it was. Errors name the overlay's JSON path
+/// (`overlay.components.x`); the result is checked when it is read, as any
+/// netlist.
 pub fn overlay(base: &mut Value, part: &Value) -> Result<(), RigError> {
+    if !base.is_object() {
+        return Err(invalid("rig", "a netlist is an object"));
+    }
+    let mut v = base.clone();
+    apply(&mut v, part)?;
+    // an output may not read a component the overlay removed
+    let removed = |c: &str| {
+        part.pointer("/components")
+            .and_then(|m| m.get(c))
+            .is_some_and(Value::is_null)
+    };
+    if let Some((k, probe)) = v.get("outputs").and_then(Value::as_object).and_then(|o| {
+        o.iter()
+            .filter_map(|(k, p)| p.as_str().map(|p| (k, p)))
+            .find(|(_, p)| removed(component_of(p)))
+    }) {
+        return Err(invalid(
+            &format!("overlay.components.{}", component_of(probe)),
+            format!("removes the component the output `{k}` reads (`{probe}`): set or drop that output in the overlay's `outputs`"),
+        ));
+    }
+    *base = v;
+    Ok(())
+}
+
+fn apply(base: &mut Value, part: &Value) -> Result<(), RigError> {
     let part = part
         .as_object()
         .ok_or_else(|| invalid("overlay", "an overlay is an object"))?;
@@ -86,11 +144,13 @@ pub fn overlay(base: &mut Value, part: &Value) -> Result<(), RigError> {
             "unknown key (an overlay has components, connections, outputs)",
         ));
     }
-    let mut conns: Vec<Vec<String>> = base
-        .get("connections")
-        .and_then(Value::as_array)
-        .map(|a| a.iter().map(endpoints).collect())
-        .unwrap_or_default();
+    // as nodes, so that removing a component never parts what it joined
+    let mut conns: Vec<Vec<String>> = nodes(
+        base.get("connections")
+            .and_then(Value::as_array)
+            .map(|a| a.iter().map(endpoints).collect())
+            .unwrap_or_default(),
+    );
     if let Some(comps) = part.get("components") {
         let comps = comps
             .as_object()
@@ -206,8 +266,17 @@ pub fn overlay(base: &mut Value, part: &Value) -> Result<(), RigError> {
         let outs = outs
             .as_object()
             .ok_or_else(|| invalid("overlay.outputs", "must be an object"))?;
-        if base.get("outputs").is_none() {
-            base["outputs"] = Value::Object(Map::new());
+        if base
+            .get("outputs")
+            .and_then(Value::as_object)
+            .is_none_or(Map::is_empty)
+        {
+            // without outputs every probe is one: the overlay's columns
+            // alone would drop the rest
+            return Err(invalid(
+                "overlay.outputs",
+                "the circuit lists no outputs (every probe is one): list them before an overlay sets some",
+            ));
         }
         let target = base["outputs"]
             .as_object_mut()
@@ -251,8 +320,10 @@ pub fn overlay(base: &mut Value, part: &Value) -> Result<(), RigError> {
 
 /// The overlay that turns netlist `from` into netlist `to`: the components
 /// `to` adds or changes and those it removes, the connections of `to` that
-/// `from` does not have, the outputs it adds, changes or drops.
-pub fn difference(from: &Value, to: &Value) -> Value {
+/// `from` does not have, the outputs it adds, changes or drops. An error
+/// where `to` parts endpoints that `from` joins among the components it
+/// keeps (an overlay joins and removes, it does not rewire).
+pub fn difference(from: &Value, to: &Value) -> Result<Value, RigError> {
     let obj = |v: &Value, k: &str| {
         v.get(k)
             .and_then(Value::as_object)
@@ -271,37 +342,46 @@ pub fn difference(from: &Value, to: &Value) -> Value {
         }
         d
     };
-    let sorted = |c: &Value| {
-        let mut e = endpoints(c);
+    let conns = |v: &Value| -> Vec<Vec<String>> {
+        v.get("connections")
+            .and_then(Value::as_array)
+            .map(|a| a.iter().map(endpoints).collect())
+            .unwrap_or_default()
+    };
+    let comps = diff(&obj(from, "components"), &obj(to, "components"));
+    let kept = |p: &String| !comps.get(component_of(p)).is_some_and(Value::is_null);
+    let to_nodes = nodes(conns(to));
+    for node in nodes(conns(from)) {
+        let node: Vec<&String> = node.iter().filter(|p| kept(p)).collect();
+        if node.len() > 1 && !to_nodes.iter().any(|n| node.iter().all(|p| n.contains(p))) {
+            return Err(invalid(
+                "connections",
+                format!(
+                    "the second netlist parts endpoints the first joins ({}): an overlay cannot rewire",
+                    node.iter().map(|p| p.as_str()).collect::<Vec<_>>().join(", ")
+                ),
+            ));
+        }
+    }
+    let sorted = |e: &[String]| {
+        let mut e = e.to_vec();
         e.sort();
         e
     };
-    let old: Vec<Vec<String>> = from
-        .get("connections")
-        .and_then(Value::as_array)
-        .map(|a| a.iter().map(sorted).collect())
-        .unwrap_or_default();
-    let conns: Vec<Value> = to
-        .get("connections")
-        .and_then(Value::as_array)
-        .map(|a| {
-            a.iter()
-                .filter(|c| !old.contains(&sorted(c)))
-                .cloned()
-                .collect()
-        })
-        .unwrap_or_default();
+    let old: Vec<Vec<String>> = conns(from).iter().map(|e| sorted(e)).collect();
+    let added: Vec<Value> = conns(to)
+        .into_iter()
+        .filter(|e| !old.contains(&sorted(e)))
+        .map(|e| Value::Array(e.into_iter().map(Value::from).collect()))
+        .collect();
     let mut d = Map::new();
-    d.insert(
-        "components".into(),
-        Value::Object(diff(&obj(from, "components"), &obj(to, "components"))),
-    );
-    d.insert("connections".into(), Value::Array(conns));
+    d.insert("components".into(), Value::Object(comps));
+    d.insert("connections".into(), Value::Array(added));
     d.insert(
         "outputs".into(),
         Value::Object(diff(&obj(from, "outputs"), &obj(to, "outputs"))),
     );
-    Value::Object(d)
+    Ok(Value::Object(d))
 }
 
 #[cfg(test)]
@@ -338,7 +418,7 @@ mod tests {
     #[test]
     fn the_difference_applied_gives_the_other_netlist() {
         let (open, closed) = (preset("leaney-moog"), preset("leaney-moog-closed-loop"));
-        let d = difference(&open, &closed);
+        let d = difference(&open, &closed).unwrap();
         assert_eq!(d["components"]["command"], Value::Null);
         assert_eq!(d["components"]["controller"]["type"], "position_controller");
         let mut v = open.clone();
@@ -357,10 +437,19 @@ mod tests {
                 .collect()
         };
         assert_eq!(order(&v), order(&closed), "the state vector's order");
+        let columns = |v: &Value| -> Vec<String> {
+            v["outputs"].as_object().unwrap().keys().cloned().collect()
+        };
+        assert_eq!(columns(&v), columns(&closed), "the columns' order");
         crate::netlist::read(&v).unwrap();
+        // the closed loop touches only the command, the reference and the
+        // controller (so `ValveRig::to_netlist` may close it around the
+        // generalised circuit and set every other value after)
+        let touched: Vec<&String> = d["components"].as_object().unwrap().keys().collect();
+        assert_eq!(touched, ["command", "reference", "controller"]);
         // and nothing from a netlist to itself
         let mut w = open.clone();
-        overlay(&mut w, &difference(&open, &open)).unwrap();
+        overlay(&mut w, &difference(&open, &open).unwrap()).unwrap();
         assert!(same_circuit(&w, &open));
     }
 
@@ -401,6 +490,60 @@ mod tests {
             "first"
         );
         assert!(!keys.iter().any(|k| *k == "p_le"));
+    }
+
+    /// Removing a component keeps the node it joined whole, however the
+    /// base spells it (one connection or two sharing the endpoint).
+    #[test]
+    fn removing_a_component_keeps_its_node_whole() {
+        let base = json!({
+            "kind": "netlist", "name": "n",
+            "components": { "a": {}, "b": {}, "c": {} },
+            "connections": [["a.x", "b.y"], ["b.y", "c.z"]]
+        });
+        let mut v = base.clone();
+        overlay(&mut v, &json!({ "components": { "b": null } })).unwrap();
+        assert_eq!(v["connections"], json!([["a.x", "c.z"]]));
+    }
+
+    /// What an overlay cannot say is refused: a difference that rewires
+    /// (a sensor moved from one chamber to the other), an output left on a
+    /// removed component, outputs on a circuit that lists none; and a
+    /// refused overlay leaves the circuit as it was.
+    #[test]
+    fn what_an_overlay_cannot_say_is_refused() {
+        let open = preset("leaney-moog");
+        let sensor = |port: &str| {
+            let mut v = open.clone();
+            overlay(
+                &mut v,
+                &json!({
+                    "components": { "gauge": { "type": "pressure_sensor", "time_constant": 1e-3 } },
+                    "connections": [[format!("cylinder.{port}"), "gauge.port"]]
+                }),
+            )
+            .unwrap();
+            v
+        };
+        let e = difference(&sensor("A"), &sensor("B"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("rewire") && e.contains("gauge.port"), "{e}");
+        let mut v = open.clone();
+        let e = overlay(&mut v, &json!({ "components": { "command": null } }))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("`overlay.components.command`") && e.contains("`command`"),
+            "{e}"
+        );
+        assert_eq!(v, open);
+        let mut bare = open.clone();
+        bare.as_object_mut().unwrap().shift_remove("outputs");
+        let e = overlay(&mut bare, &json!({ "outputs": { "x": "load.position" } }))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`overlay.outputs`"), "{e}");
     }
 
     #[test]

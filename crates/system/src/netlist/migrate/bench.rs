@@ -2,7 +2,8 @@
 //! `fixtures/legacy/circuits/friction-bench.json` ([`CIRCUIT`]: a drive
 //! imposing the record's velocity and acceleration, `imposed_motion` fed by
 //! the inputs `drive` and `acceleration`; the record's chamber pressures on
-//! `signal_pressure_source`s, inputs `p1`, `p2`; a rigid `piston` and the
+//! `signal_pressure_source`s, inputs `p1`, `p2`; the cylinder under test
+//! `cylinder`, a rigid `piston` keeping its position in the bore; and the
 //! `friction_bench` law), with the file's values set by netlist path: its
 //! mass, force sign, areas, Coulomb level and catalog effects.
 //!
@@ -156,8 +157,8 @@ pub fn to_netlist(v: &Value) -> Result<Value, RigError> {
     let mut sets: Vec<(String, f64)> = vec![
         (format!("{DRIVE}.mass"), f.mass),
         (format!("{DRIVE}.force_sign"), f.force_sign),
-        ("piston.area_1".into(), f.area1),
-        ("piston.area_2".into(), f.area2),
+        ("cylinder.area_1".into(), f.area1),
+        ("cylinder.area_2".into(), f.area2),
         (format!("{FRICTION}.coulomb"), f.friction.coulomb),
         (
             format!("{FRICTION}.smoothing_velocity"),

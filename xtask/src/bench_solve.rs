@@ -1,12 +1,9 @@
 //! `cargo xtask bench`, the user-facing speed of issue 19: the valve rig's
 //! work-precision table, the cost per step against the simulated time, the
-//! automatic solver choice on the hybrid rig, CSV reading and writing against
-//! the previous per-row implementation, and the whole `hydrocyl simulate`
-//! process. Every ratio is against a reference run in the same run.
+//! automatic solver choice on the hybrid rig and the whole `hydrocyl
+//! simulate` process (CSV reading and writing: [`crate::bench_csv`]). Every ratio is against a reference run in the same run.
 
-use hydrocyl_identify::plaincsv::{
-    run_columns, write_columns, write_columns_in_parts, write_parts, PlainCsv,
-};
+use hydrocyl_identify::plaincsv::write_columns;
 use hydrocyl_integrators::Method;
 use hydrocyl_studies::chapter7::{Chapter7Test, Load, Shape};
 use hydrocyl_system::run::{nrmse, Run, RunOptions, Solver};
@@ -19,13 +16,13 @@ use std::time::Instant;
 
 /// The issue's case: `leaney-moog`, open-loop square ±90 mm/s (period 2 s)
 /// as a 1 kHz command table, output at the same 1 kHz times.
-struct SquareCase {
+pub(crate) struct SquareCase {
     rig: ValveRig,
     times: Vec<f64>,
-    command: Signal,
+    pub(crate) command: Signal,
 }
 
-fn square_case(t_end: f64) -> Result<SquareCase, String> {
+pub(crate) fn square_case(t_end: f64) -> Result<SquareCase, String> {
     let rig = ValveRig::leaney_moog();
     let (bias, amplitude) = rig.open_loop_square(0.09).map_err(|e| e.to_string())?;
     let n = (t_end * 1e3).round() as usize;
@@ -49,7 +46,7 @@ fn square_case(t_end: f64) -> Result<SquareCase, String> {
 }
 
 impl SquareCase {
-    fn run(&self, solver: Solver, rtol: f64) -> Result<Run, String> {
+    pub(crate) fn run(&self, solver: Solver, rtol: f64) -> Result<Run, String> {
         let opts = RunOptions {
             solver,
             rtol,
@@ -390,269 +387,6 @@ fn hybrid_solver_choice() -> Result<(), String> {
     Ok(())
 }
 
-/// Rounds of the CSV section's interleaved timing.
-const CSV_ROUNDS: usize = 60;
-
-/// The fastest and the median time \[ns\] of one call of each of `fs`,
-/// timed **interleaved**: after a warm-up of each, `rounds` rounds in which
-/// every variant runs once (the order rotated from round to round), so that
-/// a disturbance of the shared machine (another build, a noisy neighbour)
-/// falls on every variant alike instead of on one block of one variant's
-/// runs. The fastest of a variant is its least disturbed run; the ratios
-/// are taken between fastests, the medians printed beside them.
-fn interleaved_ns<const N: usize>(
-    rounds: usize,
-    mut fs: [&mut dyn FnMut() -> usize; N],
-) -> [Timing; N] {
-    for f in fs.iter_mut() {
-        std::hint::black_box(f());
-    }
-    let mut samples = [(); N].map(|_| Vec::with_capacity(rounds));
-    for r in 0..rounds {
-        for i in 0..N {
-            let k = (i + r) % N;
-            let t0 = Instant::now();
-            std::hint::black_box(fs[k]());
-            samples[k].push(t0.elapsed().as_secs_f64() * 1e9);
-        }
-    }
-    samples.map(|mut v| {
-        v.sort_by(f64::total_cmp);
-        Timing {
-            min: v[0],
-            median: v[v.len() / 2],
-        }
-    })
-}
-
-/// One variant's time per call (or, scaled, per row) \[ns\]: its fastest
-/// (least disturbed) run and its median run.
-#[derive(Clone, Copy)]
-struct Timing {
-    min: f64,
-    median: f64,
-}
-
-impl Timing {
-    fn per(self, n: f64) -> Timing {
-        Timing {
-            min: self.min / n,
-            median: self.median / n,
-        }
-    }
-    /// "`old`/`self` x (median `...`x)": how many times faster than `old`.
-    fn speedup(self, old: Timing) -> String {
-        format!(
-            "{:.1}x (medians {:.1}x)",
-            old.min / self.min,
-            old.median / self.median
-        )
-    }
-    /// "fastest ns (median ns)"
-    fn show(self) -> String {
-        format!("{:.0} ns/row (median {:.0})", self.min, self.median)
-    }
-}
-
-/// CSV per row: the plain-CSV path against the previous implementation
-/// (the `csv` crate's records with `str::parse`; `format!("{:?}")` per cell,
-/// one thread), on one thread (`write_columns`; `PlainCsv::columns_on(_, 1)`)
-/// and as the library splits a long table over the cores
-/// (`write_columns_in_parts` with `write_parts`; `PlainCsv::columns`, which
-/// `hydrocyl` reads with; the CLI formats on one writer thread beside the
-/// solve), with the floor of each: the number conversions alone on every
-/// cell (no splitting, no columns, no copying, no repeat skipped). The
-/// previous and the new implementations of each row are timed interleaved
-/// ([`interleaved_ns`], [`CSV_ROUNDS`] rounds): the ratios are between the
-/// fastest runs of each, the medians' ratio beside them.
-fn csv_per_row() -> Result<(), String> {
-    let case = square_case(10.0)?;
-    let run = case.run(Solver::Dp45, 1e-5)?;
-    let (names, columns) = run_columns(&run);
-    let rows = run.time.len() as f64;
-    let parts = write_parts(run.time.len(), columns.len());
-    let [write_new, write_par, write_old, write_floor] = interleaved_ns(
-        CSV_ROUNDS,
-        [
-            &mut || write_columns(&names, &columns).len(),
-            &mut || {
-                write_columns_in_parts(&names, &columns, parts)
-                    .iter()
-                    .map(Vec::len)
-                    .sum()
-            },
-            &mut || {
-                let mut s = names.join(",");
-                s.push('\n');
-                for k in 0..run.time.len() {
-                    s.push_str(&format!("{:?}", columns[0][k]));
-                    for c in &columns[1..] {
-                        s.push_str(&format!(",{:?}", c[k]));
-                    }
-                    s.push('\n');
-                }
-                s.len()
-            },
-            // the floor: zmij alone on the same values
-            &mut || {
-                let mut buf = zmij::Buffer::new();
-                columns
-                    .iter()
-                    .flat_map(|c| c.iter())
-                    .map(|&v| buf.format(v).len())
-                    .sum()
-            },
-        ],
-    )
-    .map(|t| t.per(rows));
-    let text = String::from_utf8(write_columns(&names, &columns)).map_err(|e| e.to_string())?;
-    let wanted: Vec<usize> = (0..names.len()).collect();
-    let threads = |text: &str| {
-        PlainCsv::new(text)
-            .map(|p| p.threads())
-            .ok_or("not plain CSV")
-    };
-    fn cells_of(text: &str) -> Vec<Vec<&[u8]>> {
-        text.lines()
-            .skip(1)
-            .map(|l| l.split(',').map(str::as_bytes).collect())
-            .collect()
-    }
-    // the floor: fast-float2 alone on the same cells (no splitting, no
-    // columns, no copying)
-    let floor_of = |cells: &[&[u8]]| -> usize {
-        cells
-            .iter()
-            .map(|c| fast_float2::parse::<f64, _>(c).map_or(0, |v: f64| v.is_finite() as usize))
-            .sum()
-    };
-    let read_threads = threads(&text)?;
-    let text_cells: Vec<&[u8]> = cells_of(&text).into_iter().flatten().collect();
-    let [read_par, read_new, read_old, read_floor] = interleaved_ns(
-        CSV_ROUNDS,
-        [
-            &mut || {
-                PlainCsv::new(&text)
-                    .and_then(|p| p.columns(&wanted))
-                    .map_or(0, |c| c.len())
-            },
-            &mut || {
-                PlainCsv::new(&text)
-                    .and_then(|p| p.columns_on(&wanted, 1))
-                    .map_or(0, |c| c.len())
-            },
-            &mut || {
-                let mut rdr = csv_reader(&text);
-                let mut cols = vec![Vec::new(); wanted.len()];
-                for rec in rdr.records().flatten() {
-                    for (j, c) in cols.iter_mut().enumerate() {
-                        c.push(rec[j].parse::<f64>().unwrap_or(f64::NAN));
-                    }
-                }
-                cols.len()
-            },
-            &mut || floor_of(&text_cells),
-        ],
-    )
-    .map(|t| t.per(rows));
-    let Signal::Table { time_s, value } = &case.command else {
-        return Err("not a table".into());
-    };
-    let cmd = String::from_utf8(write_columns(&["time", "command"], &[time_s, value]))
-        .map_err(|e| e.to_string())?;
-    let cmd_rows = time_s.len() as f64;
-    let cmd_threads = threads(&cmd)?;
-    let cmd_cells: Vec<&[u8]> = cells_of(&cmd).into_iter().flatten().collect();
-    let [cmd_par, cmd_new, cmd_old, cmd_floor] = interleaved_ns(
-        CSV_ROUNDS,
-        [
-            &mut || {
-                PlainCsv::new(&cmd)
-                    .and_then(|p| p.columns(&[0, 1]))
-                    .map_or(0, |c| c.len())
-            },
-            &mut || {
-                PlainCsv::new(&cmd)
-                    .and_then(|p| p.columns_on(&[0, 1], 1))
-                    .map_or(0, |c| c.len())
-            },
-            &mut || {
-                let mut rdr = csv_reader(&cmd);
-                let (mut t, mut u) = (Vec::new(), Vec::new());
-                for rec in rdr.records().flatten() {
-                    t.push(rec[0].parse::<f64>().unwrap_or(f64::NAN));
-                    u.push(rec[1].parse::<f64>().unwrap_or(f64::NAN));
-                }
-                t.len() + u.len()
-            },
-            &mut || floor_of(&cmd_cells),
-        ],
-    )
-    .map(|t| t.per(cmd_rows));
-    // the share of the cells whose text is the text above (read: its value
-    // is taken, not parsed again)
-    let text_repeats = |text: &str| {
-        let lines = cells_of(text);
-        let same: usize = lines
-            .windows(2)
-            .map(|w| w[0].iter().zip(&w[1]).filter(|(a, b)| a == b).count())
-            .sum();
-        100.0 * same as f64 / lines.iter().map(Vec::len).sum::<usize>().max(1) as f64
-    };
-    println!(
-        "CSV per row: fastest of {CSV_ROUNDS} interleaved rounds (median beside); ratios of the fastests against the previous implementation"
-    );
-    println!(
-        "CSV, 1 kHz command file (time, command), read: one thread {} (previous {}, {} faster; fast-float2 alone {:.0}; {:.0} % of the cells repeat the text above), {cmd_threads} threads {} ({}); goal >= 10x",
-        cmd_new.show(),
-        cmd_old.show(),
-        cmd_new.speedup(cmd_old),
-        cmd_floor.min,
-        text_repeats(&cmd),
-        cmd_par.show(),
-        cmd_par.speedup(cmd_old),
-    );
-    // a value equal to the one above it is copied, not formatted again
-    let repeats = columns
-        .iter()
-        .map(|c| {
-            c.windows(2)
-                .filter(|w| w[0].to_bits() == w[1].to_bits())
-                .count()
-        })
-        .sum::<usize>() as f64
-        / (rows * columns.len() as f64);
-    println!(
-        "CSV, {} columns, write: one thread {} (previous {}, {} faster; zmij alone on every cell {:.0}; {:.0} % of the cells repeat the value above and are copied, not formatted), {parts} threads {} ({}); goal >= 10x",
-        names.len(),
-        write_new.show(),
-        write_old.show(),
-        write_new.speedup(write_old),
-        write_floor.min,
-        100.0 * repeats,
-        write_par.show(),
-        write_par.speedup(write_old),
-    );
-    println!(
-        "CSV, {} columns, read: one thread {} (previous {}, {} faster; fast-float2 alone on every cell {:.0}; {:.0} % of the cells repeat the text above and take its value, not parsed), {read_threads} threads {} ({}); goal >= 10x",
-        names.len(),
-        read_new.show(),
-        read_old.show(),
-        read_new.speedup(read_old),
-        read_floor.min,
-        text_repeats(&text),
-        read_par.show(),
-        read_par.speedup(read_old),
-    );
-    Ok(())
-}
-
-fn csv_reader(text: &str) -> csv::Reader<&[u8]> {
-    csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes())
-}
-
 /// The `hydrocyl` binaries to time and the profile they were built with:
 /// `$HYDROCYL_BIN` ("given"; several paths separated by `:` are timed
 /// interleaved, run by run, to compare builds in one run), else the release
@@ -827,7 +561,7 @@ fn whole_process(keep: Option<&Path>) -> Result<(), String> {
 pub fn run(wanted: &dyn Fn(&str) -> bool, keep: Option<&Path>) -> bool {
     let mut ok = true;
     let sections: [(&str, crate::bench::Section); 4] = [
-        ("csv", csv_per_row),
+        ("csv", crate::bench_csv::csv_per_row),
         ("cost per step", cost_per_step),
         ("work-precision", work_precision),
         ("hybrid solver choice", hybrid_solver_choice),

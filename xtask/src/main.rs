@@ -11,6 +11,7 @@
 //! Every section prints only what it measured in this run.
 
 mod bench;
+mod bench_csv;
 mod bench_solve;
 mod energy;
 mod energy_ch9;

@@ -40,6 +40,10 @@ pub const FRICTION: &str = "friction";
 /// moving mass and the load cell).
 pub const DRIVE: &str = "drive";
 
+/// The cylinder under test's name in a bench netlist (the `piston` with
+/// the chamber areas and its position in the bore).
+pub const CYLINDER: &str = "cylinder";
+
 /// The catalog effects a friction bench carries, each parameter with the
 /// `friction_bench` parameter it is.
 pub const EFFECT_PARAMS: &[(&str, &str, &str)] = &[
@@ -157,8 +161,8 @@ pub fn to_netlist(v: &Value) -> Result<Value, RigError> {
     let mut sets: Vec<(String, f64)> = vec![
         (format!("{DRIVE}.mass"), f.mass),
         (format!("{DRIVE}.force_sign"), f.force_sign),
-        ("cylinder.area_1".into(), f.area1),
-        ("cylinder.area_2".into(), f.area2),
+        (format!("{CYLINDER}.area_1"), f.area1),
+        (format!("{CYLINDER}.area_2"), f.area2),
         (format!("{FRICTION}.coulomb"), f.friction.coulomb),
         (
             format!("{FRICTION}.smoothing_velocity"),
@@ -230,10 +234,9 @@ pub fn to_netlist(v: &Value) -> Result<Value, RigError> {
         identify.insert("steady_state".into(), json!(true));
     }
     v["identify"] = Value::Object(identify);
-    let n = v;
     // the identification section checked here, so that its errors name the
     // file's own keys (`columns.torque`, `refit[1]`)
-    crate::netlist::read(&n).map_err(|e| RigError::Invalid {
+    crate::netlist::read(&v).map_err(|e| RigError::Invalid {
         path: e
             .path
             .strip_prefix("identify.")
@@ -241,7 +244,7 @@ pub fn to_netlist(v: &Value) -> Result<Value, RigError> {
             .to_string(),
         why: e.why,
     })?;
-    Ok(n)
+    Ok(v)
 }
 
 #[cfg(test)]

@@ -234,6 +234,7 @@ fn newton(
     let mut p = p0;
     let mut last_step = f64::INFINITY;
     let mut prev: Option<(f64, f64)> = None;
+    let mut prev2: Option<(f64, f64)> = None;
     let mut last_slope = warm;
     for k in 0..NEWTON_ITERATIONS {
         let r = f(p, w);
@@ -258,6 +259,16 @@ fn newton(
             None => slope(w)?,
         };
         let mut step = if s < 0.0 { -r / s } else { f64::NAN };
+        // with three trials, inverse quadratic interpolation: it follows the
+        // curvature the secant misses (a sharply bent law far from the root)
+        if let (Some((p1, r1)), Some((p0, r0))) = (prev, prev2) {
+            let x = p0 * r1 * r / ((r0 - r1) * (r0 - r))
+                + p1 * r0 * r / ((r1 - r0) * (r1 - r))
+                + p * r0 * r1 / ((r - r0) * (r - r1));
+            if x > a && x < b {
+                step = x - p;
+            }
+        }
         let mut confirmed = true;
         if warm_step && step.abs() <= tol {
             // the warm slope is the last solve's: a stale, steeper one would
@@ -281,6 +292,7 @@ fn newton(
         }
         last_step = step.abs();
         last_slope = s;
+        prev2 = prev;
         prev = Some((p, r));
         let next = p + step;
         p = if next > a && next < b {
@@ -617,6 +629,29 @@ mod tests {
         };
         let (p, _) = newton(&mut g, &slope, &mut w, 1.0 + 1e-13, (0.0, 2.0), tol, -1e-3).unwrap();
         assert!((p - 1.0).abs() <= tol && calls == 1, "{p} {calls}");
+    }
+
+    #[test]
+    fn a_sharply_bent_law_converges_in_few_residuals() {
+        // two square-root laws in series, bent sharply near the root: it is
+        // the closed form p = (k1² p1 + k2² p2)/(k1² + k2²); the start is
+        // 40 % too high, the warm slope the one at the root (stale where the
+        // solve starts), no analytic slope: secant and quadratic
+        // interpolation steps alone, inside the bracket
+        let (k1, k2, p1, p2) = (1.0e-8_f64, 2.0e-8_f64, 2.0e4_f64, 0.0_f64);
+        let root = (k1 * k1 * p1 + k2 * k2 * p2) / (k1 * k1 + k2 * k2);
+        let calls = Cell::new(0);
+        let mut f = |p: f64, _: &mut Wires| {
+            calls.set(calls.get() + 1);
+            k1 * (p1 - p).sqrt() - k2 * (p - p2).sqrt()
+        };
+        let slope = |_: &Wires| None;
+        let warm = -0.5 * k1 / (p1 - root).sqrt() - 0.5 * k2 / (root - p2).sqrt();
+        let tol = SERIES_RTOL * 1e5;
+        let mut w = Wires::default();
+        let (p, _) = newton(&mut f, &slope, &mut w, 1.4 * root, (p2, p1), tol, warm).unwrap();
+        assert!((p - root).abs() <= 1e3 * tol, "{p} {root}");
+        assert!(calls.get() <= 6, "{} residuals", calls.get());
     }
 
     #[test]

@@ -199,15 +199,34 @@ impl PilotFourWay {
     #[inline]
     pub fn open_fraction(&self, s: Position) -> f64 {
         let r = self.hole_radius.si();
-        segment_area(s.si().abs(), r) / segment_area(self.stroke.si(), r)
+        segment_area(s.si().abs(), r) / self.full_open_area()
+    }
+
+    /// The ports' open area at full stroke (the circle segment the fraction
+    /// is taken of) \[m²\].
+    #[inline]
+    pub fn full_open_area(&self) -> f64 {
+        segment_area(self.stroke.si(), self.hole_radius.si())
     }
 
     /// Signed opening in `[-1, 1]` from the pilot pressures: + extending state
     /// (P→A, B→T), − retracting state (P→B, A→T), 0 centred.
     #[inline]
     pub fn opening(&self, pp1: Pressure, pp2: Pressure) -> f64 {
-        let s = self.spool_travel(pp1, pp2);
-        self.open_fraction(s) * s.signum() * f64::from(s.si() != 0.0)
+        self.opening_given_full_area(pp1, pp2, self.full_open_area())
+    }
+
+    /// [`PilotFourWay::opening`] with [`PilotFourWay::full_open_area`]
+    /// given (a caller that asks often computes it once): the same value, bit
+    /// for bit, when `full` is `self.full_open_area()`.
+    #[inline]
+    pub fn opening_given_full_area(&self, pp1: Pressure, pp2: Pressure, full: f64) -> f64 {
+        let s = self.spool_travel(pp1, pp2).si();
+        if s == 0.0 {
+            // centred: no segment to compute (the signed zero as below)
+            return 0.0 * s.signum();
+        }
+        segment_area(s.abs(), self.hole_radius.si()) / full * s.signum()
     }
 
     /// The four port flows at pilot pressures `pp1`, `pp2` and port pressures `p`.
@@ -361,6 +380,19 @@ mod tests {
     }
 
     proptest! {
+        #[test]
+        fn opening_is_the_signed_open_fraction_bit_for_bit(d in -6.0e6f64..6.0e6, centred in any::<bool>(), neg in any::<bool>()) {
+            // the centred spool (no segment computed) keeps the zero's sign
+            let v = PilotFourWay::dddc();
+            let d = if centred { if neg { -1.0 } else { 1.0 } } else { d };
+            let s = v.spool_travel(Pressure::new(d), Pressure::ZERO);
+            let by_fraction = v.open_fraction(s) * s.signum() * f64::from(s.si() != 0.0);
+            let y = v.opening(Pressure::new(d), Pressure::ZERO);
+            prop_assert_eq!(y.to_bits(), by_fraction.to_bits());
+            let given = v.opening_given_full_area(Pressure::new(d), Pressure::ZERO, v.full_open_area());
+            prop_assert_eq!(given.to_bits(), y.to_bits());
+        }
+
         #[test]
         fn opening_is_continuous_odd_and_bounded(d in -6.0e6f64..6.0e6) {
             let v = PilotFourWay::dddc();

@@ -457,6 +457,8 @@ pub struct PilotValve {
     /// computed once per pilot pressures, not once per trial of the T
     /// port's Newton solve.
     last_opening: std::cell::Cell<[f64; 3]>,
+    /// [`PilotFourWay::full_open_area`], computed when bound.
+    full_open_area: f64,
 }
 
 impl PilotValve {
@@ -482,6 +484,7 @@ impl PilotValve {
             flow_b: Wire::UNBOUND,
             counts: [0; 3],
             last_opening: std::cell::Cell::new([f64::NAN; 3]),
+            full_open_area: f64::NAN,
         }
     }
 
@@ -492,7 +495,9 @@ impl PilotValve {
         if a == pp1.si() && b == pp2.si() {
             return y;
         }
-        let y = self.four_way.opening(pp1, pp2);
+        let y = self
+            .four_way
+            .opening_given_full_area(pp1, pp2, self.full_open_area);
         self.last_opening.set([pp1.si(), pp2.si(), y]);
         y
     }
@@ -563,6 +568,7 @@ impl Component for PilotValve {
                 component: self.name.clone(),
                 message: e.to_string(),
             })?;
+        self.full_open_area = self.four_way.full_open_area();
         self.pp1 = net.hydraulic(&self.nodes[0]);
         self.pp2 = net.hydraulic(&self.nodes[1]);
         self.a = net.hydraulic(&self.nodes[2]);

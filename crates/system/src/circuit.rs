@@ -480,7 +480,7 @@ impl Circuit {
                             Some(s + self.comps[i].inflow_slope(t, xs(i), w, g.node.pressure)?)
                         })
                     };
-                    g.solve(&mut w, &mut self.scratch.borrow_mut(), eval, slope);
+                    g.solve(t, &mut w, &mut self.scratch.borrow_mut(), eval, slope);
                 }
             }
         }

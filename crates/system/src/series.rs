@@ -17,16 +17,20 @@
 //! components that connect to the node (its *members*) and evaluates them as
 //! one unit in the dependency order. Each evaluation solves `ΣQ_in(p) = 0`
 //! by Newton's method on the members' analytic slopes
-//! ([`Component::inflow_slope`]), started from the previous solution and
-//! kept inside the bracket given by the lowest and highest pressure the
-//! members read elsewhere (each resistive flow into the node falls
-//! monotonically with `p`, so the root is bracketed and unique): a step that
-//! leaves the bracket, or a member without a slope, falls back to bisection
-//! and Brent's method. Converged when the Newton step is below
-//! [`SERIES_RTOL`] of the pressure scale; only a converged evaluation is
-//! kept (every trial starts from the wire table as it was before the members
-//! ran). The result depends on the starting point only within that
-//! tolerance; [`Circuit::reset`](crate::Circuit::reset) forgets it.
+//! ([`Component::inflow_slope`]), then secants, then inverse quadratic
+//! interpolation through the last three trials (which follows the bend of a
+//! square-root law near a small pressure drop). It starts from the previous
+//! solution, or from the line through the last two extended to its time when
+//! it comes after both, and is kept inside the bracket given by the lowest
+//! and highest pressure the members read elsewhere (each resistive flow into
+//! the node falls monotonically with `p`, so the root is bracketed and
+//! unique): a step that leaves the bracket, or a member without a slope,
+//! falls back to bisection and Brent's method. Converged when the step is
+//! below [`SERIES_RTOL`] of the pressure scale; only a converged evaluation
+//! is kept (every trial starts from the accumulators as they were before the
+//! members added to them; each member writes all the wires it owns anew).
+//! The result depends on the starting point only within that tolerance;
+//! [`Circuit::reset`](crate::Circuit::reset) forgets it.
 
 use crate::circuit::{BuildError, Component, Probe};
 use crate::wires::{HydraulicNode, Wires};
@@ -106,8 +110,11 @@ pub(crate) struct SeriesGroup {
     /// Pressure wires (table indices) the members read elsewhere: the bracket.
     bracket: Vec<usize>,
     /// Every wire a member may write (their accumulators and owned wires,
-    /// the node's pressure among them): what a trial restores.
+    /// the node's pressure among them).
     writes: Vec<usize>,
+    /// The accumulators among them: what a trial restores (a member writes
+    /// every wire it owns whenever it is evaluated, so those need not be).
+    accumulators: Vec<usize>,
     /// `∂ΣQ_in/∂p` at the last solution: the first Newton step of the next
     /// solve uses it (NaN: ask the members).
     slope: Cell<f64>,
@@ -116,6 +123,11 @@ pub(crate) struct SeriesGroup {
     pub(crate) fallbacks: Cell<u64>,
     /// The last solution: the next solve starts from it.
     pub(crate) guess: Cell<f64>,
+    /// `[t₀, p₀, t₁, p₁]`: the times and solutions of the last two solves.
+    /// A solve later than both, which were in time order (an output row
+    /// after the last, an integrator stage ahead of the last two), starts
+    /// from their straight line extended to its time.
+    history: Cell<[f64; 4]>,
 }
 
 impl SeriesGroup {
@@ -129,20 +141,23 @@ impl SeriesGroup {
     pub(crate) fn forget(&self) {
         self.guess.set(f64::NAN);
         self.slope.set(f64::NAN);
+        self.history.set([f64::NAN; 4]);
     }
 
-    /// Solves the node: `eval(w)` runs the members on `w`, `slope(w)` sums
-    /// their [`Component::inflow_slope`] (None if one has none); `snap` is
-    /// scratch. Each trial restores only the wires the members write.
+    /// Solves the node at time `t`: `eval(w)` runs the members on `w`,
+    /// `slope(w)` sums their [`Component::inflow_slope`] (None if one has
+    /// none); `snap` is scratch. Each trial restores only the accumulators
+    /// the members add into.
     pub(crate) fn solve(
         &self,
+        t: f64,
         w: &mut Wires,
         snap: &mut Vec<f64>,
         mut eval: impl FnMut(&mut Wires),
         slope: impl Fn(&Wires) -> Option<f64>,
     ) {
         snap.clear();
-        snap.extend(self.writes.iter().map(|&i| w.v[i]));
+        snap.extend(self.accumulators.iter().map(|&i| w.v[i]));
         #[cfg(debug_assertions)]
         let before = w.v.clone();
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -152,7 +167,7 @@ impl SeriesGroup {
         }
         let (last, n) = (Cell::new(f64::NAN), Cell::new(0u64));
         let mut f = |p: f64, w: &mut Wires| {
-            for (&i, &v) in self.writes.iter().zip(snap.iter()) {
+            for (&i, &v) in self.accumulators.iter().zip(snap.iter()) {
                 w.v[i] = v;
             }
             w.set(self.node.pressure, Pressure::new(p));
@@ -166,12 +181,17 @@ impl SeriesGroup {
         let p = if lo >= hi {
             lo
         } else {
-            let guess = self.guess.get();
-            let p0 = if guess > lo && guess < hi {
-                guess
+            let [t0, p0, t1, p1] = self.history.get();
+            let extended = if t > t1 && t1 > t0 {
+                p1 + (p1 - p0) * ((t - t1) / (t1 - t0))
             } else {
-                0.5 * (lo + hi)
+                f64::NAN
             };
+            let inside = |p: f64| p > lo && p < hi;
+            let p0 = [extended, self.guess.get()]
+                .into_iter()
+                .find(|&p| inside(p))
+                .unwrap_or(0.5 * (lo + hi));
             match newton(&mut f, &slope, w, p0, (lo, hi), tol, self.slope.get()) {
                 Some((p, s)) => {
                     self.slope.set(s);
@@ -194,6 +214,8 @@ impl SeriesGroup {
             }
         };
         self.guess.set(p);
+        let [_, _, t1, p1] = self.history.get();
+        self.history.set([t1, p1, t, p]);
         if last.get() != p {
             f(p, w);
         }
@@ -366,6 +388,11 @@ fn groups(
             .collect();
         writes.sort_unstable();
         writes.dedup();
+        let accumulators: Vec<usize> = writes
+            .iter()
+            .copied()
+            .filter(|w| net.accumulators.contains(w))
+            .collect();
         if bracket.is_empty() {
             return Err(err(format!(
                 "algebraic node `{name}` is connected to no other hydraulic node"
@@ -377,11 +404,13 @@ fn groups(
             members: order,
             bracket,
             writes,
+            accumulators,
             slope: Cell::new(f64::NAN),
             solves: Cell::new(0),
             evaluations: Cell::new(0),
             fallbacks: Cell::new(0),
             guess: Cell::new(f64::NAN),
+            history: Cell::new([f64::NAN; 4]),
         });
     }
     Ok((out, of))

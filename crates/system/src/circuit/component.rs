@@ -99,10 +99,11 @@ pub trait Component {
     fn publish(&self, _t: f64, _x: &[f64], _w: &mut Wires) {}
 
     /// Computes flows and forces from the efforts at its ports and adds them
-    /// to the node accumulators; writes [`Causality::Algebraic`](super::Causality::Algebraic) wires,
-    /// every one it owns on every call (the Newton solve of an algebraic
-    /// node, [`crate::series`], evaluates its members repeatedly and restores
-    /// only the accumulators between trials).
+    /// to the node accumulators; writes [`Causality::Algebraic`](super::Causality::Algebraic) wires.
+    /// Every wire other than an accumulator that it writes here it writes on
+    /// every call, never as a function of its previous value: the Newton
+    /// solve of an algebraic node ([`crate::series`]) evaluates its members
+    /// repeatedly and restores only the accumulators between trials.
     fn evaluate(&self, _t: f64, _x: &[f64], _w: &mut Wires) {}
 
     /// `∂Q/∂p` of the flow this component adds into hydraulic node `node`

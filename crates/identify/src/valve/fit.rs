@@ -489,11 +489,12 @@ pub(super) fn delay_probe(rig: &Model, p: &Prepared, holdout: f64, rss0: f64) ->
     const TAUS: [f64; 8] = [0.002, 0.005, 0.01, 0.015, 0.02, 0.03, 0.045, 0.06];
     let shifted = |tau: &f64| {
         let mut q = p.clone();
-        q.input =
+        let mut input: Vec<f64> =
             p.t.iter()
                 .map(|&t| crate::data::interp_linear(&p.t, &p.input, t - tau))
                 .collect();
-        q.input[0] = p.input[0];
+        input[0] = p.input[0];
+        q.input = input.into();
         rss(rig, &q, holdout, Part::All)
     };
     let scores = trace_parallel(&TAUS, &shifted);

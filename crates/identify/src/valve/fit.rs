@@ -307,7 +307,11 @@ impl FirstStep {
 /// properly afterwards.
 ///
 /// The first step takes what `first` has of it (see [`FirstStep`]); each
-/// later step starts from the residual its backtracking accepted.
+/// later step starts from the residual its backtracking accepted, with new
+/// columns for the candidate's parameters and the first step's for the
+/// initial position and velocity (how the record answers a shift of the
+/// start barely depends on the effect's size: new ones cost two
+/// simulations a step and moved no ranking in the tests).
 ///
 /// Screening: where the first step's linearised sum of squares
 /// `rss₀ + gᵀδ` (δ the Gauss–Newton step, g = Jᵀr) removes less than
@@ -341,14 +345,19 @@ pub(super) fn gauss_newton_trace(
             r0
         }
     };
+    // the first step's initial-position and -velocity columns, kept for
+    // the later steps
+    let mut nuisance: Vec<(Column, Vec<f64>)> = Vec::new();
     for step in 0..3 {
         let m = r0.len();
         let mut jac = nalgebra::DMatrix::<f64>::zeros(m, k);
         for (j, c) in cols.iter().enumerate() {
-            let shared = first
-                .filter(|_| step == 0)
-                .and_then(|f| f.cols.iter().find(|(fc, _)| fc == c));
-            if let Some((_, col)) = shared {
+            let known = if step == 0 {
+                first.and_then(|f| f.cols.iter().find(|(fc, _)| fc == c))
+            } else {
+                nuisance.iter().find(|(fc, _)| fc == c)
+            };
+            if let Some((_, col)) = known {
                 jac.set_column(j, &nalgebra::DVector::from_column_slice(col));
                 continue;
             }
@@ -357,6 +366,13 @@ pub(super) fn gauss_newton_trace(
             residual(&t, p, holdout, part, &mut r1)?;
             for i in 0..m {
                 jac[(i, j)] = (r1[i] - r0[i]) / h;
+            }
+        }
+        if step == 0 {
+            for (j, c) in cols.iter().enumerate() {
+                if matches!(c, Column::X0 | Column::V0) {
+                    nuisance.push((*c, jac.column(j).iter().copied().collect()));
+                }
             }
         }
         let rhs = jac.transpose() * nalgebra::DVector::from_column_slice(&r0);

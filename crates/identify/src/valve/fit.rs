@@ -253,7 +253,8 @@ fn perturbed(rig: &Model, c: Column) -> (Model, f64) {
 /// nuisance parameters. A candidate that starts from this model (every one
 /// but the friction-law starts of `trace_starts`) reuses them and simulates
 /// only its own parameters' columns; the numbers are the ones it would have
-/// computed itself.
+/// computed itself. The friction-law starts take the two nuisance columns
+/// (see [`gauss_newton_trace`]).
 pub(super) struct FirstStep {
     /// The round's model.
     model: Model,
@@ -306,12 +307,14 @@ impl FirstStep {
 /// of a full Levenberg–Marquardt fit; the effect that is added is refitted
 /// properly afterwards.
 ///
-/// The first step takes what `first` has of it (see [`FirstStep`]); each
-/// later step starts from the residual its backtracking accepted, with new
-/// columns for the candidate's parameters and the first step's for the
-/// initial position and velocity (how the record answers a shift of the
-/// start barely depends on the effect's size: new ones cost two
-/// simulations a step and moved no ranking in the tests).
+/// The first step takes what `first` has of it (see [`FirstStep`]; a
+/// start of its own, a friction-law edit of `trace_starts`, only its
+/// initial-position and -velocity columns); each later step starts from the
+/// residual its backtracking accepted, with new columns for the
+/// candidate's parameters and the first step's for the initial position
+/// and velocity (how the record answers a shift of the start barely
+/// depends on the effect: new ones cost two simulations a step and moved
+/// no ranking in the tests).
 ///
 /// Screening: where the first step's linearised sum of squares
 /// `rss₀ + gᵀδ` (δ the Gauss–Newton step, g = Jᵀr) removes less than
@@ -336,6 +339,9 @@ pub(super) fn gauss_newton_trace(
 ) -> Result<TraceEnd, String> {
     let cols = columns(params);
     let k = cols.len();
+    // a start of its own (a friction-law edit) takes only the round
+    // model's initial-position and -velocity columns
+    let lent = first;
     let first = first.filter(|f| f.applies_to(rig));
     let mut r0 = match first {
         Some(f) => f.r0.clone(),
@@ -353,7 +359,9 @@ pub(super) fn gauss_newton_trace(
         let mut jac = nalgebra::DMatrix::<f64>::zeros(m, k);
         for (j, c) in cols.iter().enumerate() {
             let known = if step == 0 {
-                first.and_then(|f| f.cols.iter().find(|(fc, _)| fc == c))
+                first
+                    .or(lent.filter(|_| matches!(c, Column::X0 | Column::V0)))
+                    .and_then(|f| f.cols.iter().find(|(fc, _)| fc == c))
             } else {
                 nuisance.iter().find(|(fc, _)| fc == c)
             };

@@ -147,10 +147,33 @@ pub fn fit_parallel<F>(
 where
     F: Fn(&[f64], &mut Vec<f64>) -> Result<(), String> + Sync,
 {
+    fit_parallel_from(resid, x0, None, lower, upper, typical, opts)
+}
+
+/// [`fit_parallel`] given the residual at `x0` (`r0`; `None`: evaluated
+/// there).
+pub fn fit_parallel_from<F>(
+    resid: F,
+    x0: &[f64],
+    r0: Option<Vec<f64>>,
+    lower: &[f64],
+    upper: &[f64],
+    typical: &[f64],
+    opts: &LmOptions,
+) -> Result<LmResult, LmError>
+where
+    F: Fn(&[f64], &mut Vec<f64>) -> Result<(), String> + Sync,
+{
     check_setup(x0, lower, upper, typical)?;
     let u0 = scaled(x0, typical);
-    let mut r0 = Vec::new();
-    resid(&unscaled(&u0, typical), &mut r0).map_err(LmError::Start)?;
+    let r0 = match r0 {
+        Some(r0) => r0,
+        None => {
+            let mut r0 = Vec::new();
+            resid(&unscaled(&u0, typical), &mut r0).map_err(LmError::Start)?;
+            r0
+        }
+    };
     let model = Parallel {
         resid,
         typical,

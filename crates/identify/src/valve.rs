@@ -482,8 +482,17 @@ pub fn diagnose_rig_traced(
             last.insert(id, rep);
         }
         eligible.sort_by(|a, b| b.2.explained_share.total_cmp(&a.2.explained_share));
-        if let Some(pr) = delay_probe(&model, &pt, opts.holdout, rss0) {
-            let top = eligible.first().map(|(id, _, r)| (*id, r.explained_share));
+        let top = eligible.first().map(|(id, _, r)| (*id, r.explained_share));
+        // The probe's share is at most 1 (a sum of squares is not negative):
+        // it is not run where it could not win.
+        let probe_can_win =
+            opts.min_share <= 1.0 && top.is_none_or(|(_, share)| share + opts.min_share < 1.0);
+        let probe = if probe_can_win {
+            delay_probe(&model, &pt, opts.holdout, rss0)
+        } else {
+            None
+        };
+        if let Some(pr) = probe {
             if pr.explained_share >= opts.min_share
                 && top.is_none_or(|(_, share)| pr.explained_share > share + opts.min_share)
             {

@@ -21,7 +21,7 @@ pub(super) fn fit(
     holdout: f64,
     part: Part,
 ) -> Result<lm::LmResult, lm::LmError> {
-    fit_with(rig, params, p, holdout, part, Stop::LOOSE)
+    fit_with(rig, params, p, holdout, part, Stop::LOOSE, None)
 }
 
 /// Every valve-rig fit stops after this many rejected steps in a row: the
@@ -109,11 +109,12 @@ pub(super) fn refit_polished(
             *rig = smoothed;
         }
     }
-    fit_with(rig, params, &coarse, holdout, Part::All, Stop::LOOSE)?;
+    fit_with(rig, params, &coarse, holdout, Part::All, Stop::LOOSE, None)?;
     let q = Prepared {
         rtol: POLISH_RTOL,
         ..p.clone()
     };
+    let start = warm_step(rig, params, &q, holdout);
     fit_with(
         rig,
         params,
@@ -128,18 +129,15 @@ pub(super) fn refit_polished(
             fd_floor: Some(FD_FLOOR),
             max_rejections: MAX_REJECTIONS,
         },
+        start,
     )
 }
 
-/// [`fit`] with its stopping rule `stop`.
-fn fit_with(
-    rig: &mut Model,
-    params: &ParamList,
-    p: &Prepared,
-    holdout: f64,
-    part: Part,
-    stop: Stop,
-) -> Result<lm::LmResult, lm::LmError> {
+/// The values a fit of `params` on `rig` starts from, with the initial
+/// position and velocity last, their bounds and their typical sizes (the
+/// solver's scales).
+#[allow(clippy::type_complexity)]
+fn start_of(rig: &Model, params: &ParamList) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
     let mut x0: Vec<f64> = params
         .iter()
         .map(|(id, n)| get(rig, *id, n).unwrap_or(0.0))
@@ -164,18 +162,105 @@ fn fit_with(
     lo.push(vi - 0.2);
     hi.push(vi + 0.2);
     typ.push(1e-2);
+    (x0, lo, hi, typ)
+}
+
+/// `rig` with `params`, then the initial position and velocity, set to `x`.
+fn at(rig: &Model, params: &ParamList, x: &[f64]) -> Model {
     let k = params.len();
-    let res = lm::fit_parallel(
-        |x, r| {
-            let mut work = rig.clone();
-            for ((id, n), v) in params.iter().zip(x) {
-                set(&mut work, *id, n, *v);
+    let mut work = rig.clone();
+    for ((id, n), v) in params.iter().zip(x) {
+        set(&mut work, *id, n, *v);
+    }
+    work.set_x0(x[k]);
+    work.set_v0(x[k + 1]);
+    work
+}
+
+/// The polish's first step, with a one-sided finite-difference Jacobian
+/// (the polish's own is central: twice the simulations at its tight
+/// tolerance `q`): the Gauss–Newton step from `rig`, projected on the fit's
+/// bounds, where it lowers the sum of squares at `q` (else `rig` stays).
+/// Returns the residual at `q` where `rig` ends, for the polish to start
+/// from (`None` where a simulation fails: the polish then starts as
+/// before). The polish's stop (its own Jacobian at its end point, the step
+/// below [`POLISH_STEP_SE`] standard errors) and the intervals it gives
+/// are unchanged; the step saves the polish's first central Jacobian where
+/// it lands as close as the polish's own first step would.
+fn warm_step(rig: &mut Model, params: &ParamList, q: &Prepared, holdout: f64) -> Option<Vec<f64>> {
+    let (x, lo, hi, typ) = start_of(rig, params);
+    let mut r0 = Vec::new();
+    residual(rig, q, holdout, Part::All, &mut r0).ok()?;
+    let k = x.len();
+    // the solver's steps (`fd_step` 1e-3 of max(|x|, FD_FLOOR typical sizes))
+    let cols: Vec<Option<Vec<f64>>> = (0..k)
+        .into_par_iter()
+        .map(|j| {
+            let mut h = 1e-3 * (x[j] / typ[j]).abs().max(FD_FLOOR) * typ[j];
+            if x[j] + h > hi[j] {
+                h = -h;
             }
-            work.set_x0(x[k]);
-            work.set_v0(x[k + 1]);
-            residual(&work, p, holdout, part, r)
-        },
+            let mut xj = x.clone();
+            xj[j] += h;
+            let mut r1 = Vec::new();
+            residual(&at(rig, params, &xj), q, holdout, Part::All, &mut r1).ok()?;
+            Some(
+                r1.iter()
+                    .zip(&r0)
+                    .map(|(a, b)| (a - b) / h * typ[j])
+                    .collect(),
+            )
+        })
+        .collect();
+    let Some(cols) = cols.into_iter().collect::<Option<Vec<Vec<f64>>>>() else {
+        return Some(r0);
+    };
+    // normal equations in scaled parameters
+    let mut a = nalgebra::DMatrix::<f64>::zeros(k, k);
+    let mut g = nalgebra::DVector::<f64>::zeros(k);
+    for i in 0..k {
+        g[i] = -cols[i].iter().zip(&r0).map(|(j, r)| j * r).sum::<f64>();
+        for j in 0..=i {
+            let v: f64 = cols[i].iter().zip(&cols[j]).map(|(a, b)| a * b).sum();
+            a[(i, j)] = v;
+            a[(j, i)] = v;
+        }
+    }
+    let Some(d) = a.cholesky().map(|c| c.solve(&g)) else {
+        return Some(r0);
+    };
+    let x1: Vec<f64> = (0..k)
+        .map(|i| (x[i] + d[i] * typ[i]).clamp(lo[i], hi[i]))
+        .collect();
+    if x1.iter().any(|v| !v.is_finite()) {
+        return Some(r0);
+    }
+    let t = at(rig, params, &x1);
+    let mut r1 = Vec::new();
+    if residual(&t, q, holdout, Part::All, &mut r1).is_ok() && sum_sq(&r1) < sum_sq(&r0) {
+        *rig = t;
+        return Some(r1);
+    }
+    Some(r0)
+}
+
+/// [`fit`] with its stopping rule `stop`, given the residual `start` at
+/// `rig` where it is known.
+fn fit_with(
+    rig: &mut Model,
+    params: &ParamList,
+    p: &Prepared,
+    holdout: f64,
+    part: Part,
+    stop: Stop,
+    start: Option<Vec<f64>>,
+) -> Result<lm::LmResult, lm::LmError> {
+    let (x0, lo, hi, typ) = start_of(rig, params);
+    let k = params.len();
+    let res = lm::fit_parallel_from(
+        |x, r| residual(&at(rig, params, x), p, holdout, part, r),
         &x0,
+        start,
         &lo,
         &hi,
         &typ,
@@ -253,7 +338,8 @@ fn perturbed(rig: &Model, c: Column) -> (Model, f64) {
 /// nuisance parameters. A candidate that starts from this model (every one
 /// but the friction-law starts of `trace_starts`) reuses them and simulates
 /// only its own parameters' columns; the numbers are the ones it would have
-/// computed itself.
+/// computed itself. The friction-law starts take the two nuisance columns
+/// (see [`gauss_newton_trace`]).
 pub(super) struct FirstStep {
     /// The round's model.
     model: Model,
@@ -306,8 +392,15 @@ impl FirstStep {
 /// of a full Levenberg–Marquardt fit; the effect that is added is refitted
 /// properly afterwards.
 ///
-/// The first step takes what `first` has of it (see [`FirstStep`]); each
-/// later step starts from the residual its backtracking accepted.
+/// The first step takes what `first` has of it (see [`FirstStep`]; a
+/// start of its own, a friction-law edit of `trace_starts`, only its
+/// initial-position and -velocity columns); each later step starts from the
+/// residual its backtracking accepted, with the Jacobian of the step before
+/// updated by Broyden's rank-one formula from the step taken and the change
+/// of the residual (in parameters scaled by their finite-difference steps),
+/// not by new finite differences: those cost a simulation a column a step,
+/// about a third of a round's traces, and every planted effect and
+/// fixture is found the same without them.
 ///
 /// Screening: where the first step's linearised sum of squares
 /// `rss₀ + gᵀδ` (δ the Gauss–Newton step, g = Jᵀr) removes less than
@@ -332,6 +425,9 @@ pub(super) fn gauss_newton_trace(
 ) -> Result<TraceEnd, String> {
     let cols = columns(params);
     let k = cols.len();
+    // a start of its own (a friction-law edit) takes only the round
+    // model's initial-position and -velocity columns
+    let lent = first;
     let first = first.filter(|f| f.applies_to(rig));
     let mut r0 = match first {
         Some(f) => f.r0.clone(),
@@ -341,24 +437,27 @@ pub(super) fn gauss_newton_trace(
             r0
         }
     };
-    for step in 0..3 {
-        let m = r0.len();
-        let mut jac = nalgebra::DMatrix::<f64>::zeros(m, k);
-        for (j, c) in cols.iter().enumerate() {
-            let shared = first
-                .filter(|_| step == 0)
-                .and_then(|f| f.cols.iter().find(|(fc, _)| fc == c));
-            if let Some((_, col)) = shared {
-                jac.set_column(j, &nalgebra::DVector::from_column_slice(col));
-                continue;
-            }
-            let (t, h) = perturbed(rig, *c);
-            let mut r1 = Vec::new();
-            residual(&t, p, holdout, part, &mut r1)?;
-            for i in 0..m {
-                jac[(i, j)] = (r1[i] - r0[i]) / h;
-            }
+    let m = r0.len();
+    let mut jac = nalgebra::DMatrix::<f64>::zeros(m, k);
+    // each column's finite-difference step (the scale of the updates)
+    let mut steps = vec![1.0; k];
+    for (j, c) in cols.iter().enumerate() {
+        let (t, h) = perturbed(rig, *c);
+        steps[j] = h;
+        let known = first
+            .or(lent.filter(|_| matches!(c, Column::X0 | Column::V0)))
+            .and_then(|f| f.cols.iter().find(|(fc, _)| fc == c));
+        if let Some((_, col)) = known {
+            jac.set_column(j, &nalgebra::DVector::from_column_slice(col));
+            continue;
         }
+        let mut r1 = Vec::new();
+        residual(&t, p, holdout, part, &mut r1)?;
+        for i in 0..m {
+            jac[(i, j)] = (r1[i] - r0[i]) / h;
+        }
+    }
+    for step in 0..3 {
         let rhs = jac.transpose() * nalgebra::DVector::from_column_slice(&r0);
         let mut a = jac.transpose() * &jac;
         for j in 0..k {
@@ -397,6 +496,7 @@ pub(super) fn gauss_newton_trace(
         }
         match accepted {
             Some((t, r1)) => {
+                broyden(&mut jac, &steps, &moved(rig, &t, params), &r0, &r1);
                 *rig = t;
                 r0 = r1;
             }
@@ -404,6 +504,37 @@ pub(super) fn gauss_newton_trace(
         }
     }
     Ok(TraceEnd::Traced(r0))
+}
+
+/// How far each column of a trace of `params` moved from `from` to `to`.
+fn moved(from: &Model, to: &Model, params: &ParamList) -> Vec<f64> {
+    params
+        .iter()
+        .map(|(id, n)| get(to, *id, n).unwrap_or(0.0) - get(from, *id, n).unwrap_or(0.0))
+        .chain([to.x0() - from.x0(), to.v0() - from.v0()])
+        .collect()
+}
+
+/// Broyden's rank-one update of a Jacobian `jac` after a step `s` that
+/// took the residual from `r0` to `r1`, in parameters scaled by `scale`:
+/// the least change of the scaled Jacobian that maps the step onto the
+/// residual's change.
+fn broyden(jac: &mut nalgebra::DMatrix<f64>, scale: &[f64], s: &[f64], r0: &[f64], r1: &[f64]) {
+    let sigma: Vec<f64> = s.iter().zip(scale).map(|(a, w)| a / w).collect();
+    let ss: f64 = sigma.iter().map(|v| v * v).sum();
+    if !(ss > 0.0 && ss.is_finite()) {
+        return;
+    }
+    let js = &*jac * nalgebra::DVector::from_column_slice(s);
+    for (j, (sj, w)) in sigma.iter().zip(scale).enumerate() {
+        let f = sj / (w * ss);
+        if f == 0.0 {
+            continue;
+        }
+        for i in 0..r0.len() {
+            jac[(i, j)] += (r1[i] - r0[i] - js[i]) * f;
+        }
+    }
 }
 
 /// What a trace's shortcuts are judged against (see [`gauss_newton_trace`]).
@@ -489,11 +620,12 @@ pub(super) fn delay_probe(rig: &Model, p: &Prepared, holdout: f64, rss0: f64) ->
     const TAUS: [f64; 8] = [0.002, 0.005, 0.01, 0.015, 0.02, 0.03, 0.045, 0.06];
     let shifted = |tau: &f64| {
         let mut q = p.clone();
-        q.input =
+        let mut input: Vec<f64> =
             p.t.iter()
                 .map(|&t| crate::data::interp_linear(&p.t, &p.input, t - tau))
                 .collect();
-        q.input[0] = p.input[0];
+        input[0] = p.input[0];
+        q.input = input.into();
         rss(rig, &q, holdout, Part::All)
     };
     let scores = trace_parallel(&TAUS, &shifted);

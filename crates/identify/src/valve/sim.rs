@@ -6,6 +6,7 @@ use super::*;
 use hydrocyl_system::rig;
 use hydrocyl_system::simulation::Simulation;
 use serde_json::Value;
+use std::sync::Arc;
 /// The channels compared, in report order.
 pub(super) const CHANNELS: [Signal; 4] =
     [Signal::Position, Signal::Velocity, Signal::P1, Signal::P2];
@@ -18,7 +19,7 @@ pub(super) struct Prepared {
     /// The run's input: the measured command (open loop) or the position
     /// reference (a closed-loop record, whose rig's controller computes the
     /// command).
-    pub(super) input: Vec<f64>,
+    pub(super) input: Arc<[f64]>,
     /// Whether the record is closed loop (it has a `reference` column).
     pub(super) closed: bool,
     /// The measured command at the first sample (the initial spool demand;
@@ -40,7 +41,89 @@ pub(super) struct Prepared {
     /// Restarts of the simulation where the measured piston leaves a stop.
     pub(super) restarts: Vec<stops::Restart>,
     /// Simulations run so far (shared by every copy).
-    pub(super) count: std::sync::Arc<std::sync::atomic::AtomicUsize>,
+    pub(super) count: Arc<std::sync::atomic::AtomicUsize>,
+    /// The latest simulations, to answer a repeated one (shared by every
+    /// copy; a copy may change `rtol` and `input`, which the runs are kept
+    /// by, but anything else it changes needs a fresh one).
+    pub(super) recent: Arc<Recent>,
+}
+
+/// How many simulated samples [`Recent`] keeps, all runs and channels
+/// together (64 MB; ~160 runs of four channels of a 12 s, 1 kHz record).
+const RECENT_SAMPLES: usize = 8 << 20;
+
+/// The latest simulations of a prepared record, each by what determines it
+/// (the netlist and the roles of its components, the tolerance, the input
+/// and the samples simulated), with
+/// the simulated channels before the sensor lag (which acts on the samples,
+/// see [`simulate`]). A repeated simulation — the diagnosis asks for some
+/// twice: the round model's, a trace that ends where it started, a
+/// `sensor_lag` column that changes only the lag — is answered from here
+/// with the numbers a new run would give (a run is a deterministic function
+/// of these).
+#[derive(Default)]
+pub(super) struct Recent {
+    runs: std::sync::Mutex<std::collections::VecDeque<Kept>>,
+}
+
+/// One simulation kept by [`Recent`].
+struct Kept {
+    /// A hash of `net`'s text (compared first).
+    hash: u64,
+    net: Value,
+    roles: Arc<model::Roles>,
+    rtol: u64,
+    input: Arc<[f64]>,
+    n: usize,
+    out: Arc<Vec<Vec<f64>>>,
+}
+
+/// A hash of a netlist's text.
+fn net_hash(net: &Value) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    net.to_string().hash(&mut h);
+    h.finish()
+}
+
+impl Recent {
+    fn find(&self, hash: u64, rig: &Model, p: &Prepared, n: usize) -> Option<Arc<Vec<Vec<f64>>>> {
+        let runs = self.runs.lock().ok()?;
+        runs.iter()
+            .rev()
+            .find(|k| {
+                k.hash == hash
+                    && k.n == n
+                    && k.rtol == p.rtol.to_bits()
+                    && Arc::ptr_eq(&k.input, &p.input)
+                    && Arc::ptr_eq(&k.roles, &rig.roles)
+                    && k.net == rig.net
+            })
+            .map(|k| Arc::clone(&k.out))
+    }
+
+    fn keep(&self, hash: u64, rig: &Model, p: &Prepared, n: usize, out: Arc<Vec<Vec<f64>>>) {
+        let size = |k: &Kept| k.out.iter().map(Vec::len).sum::<usize>();
+        if let Ok(mut runs) = self.runs.lock() {
+            let mut kept: usize = runs.iter().map(size).sum();
+            kept += out.iter().map(Vec::len).sum::<usize>();
+            while kept > RECENT_SAMPLES {
+                match runs.pop_front() {
+                    Some(k) => kept -= size(&k),
+                    None => return,
+                }
+            }
+            runs.push_back(Kept {
+                hash,
+                net: rig.net.clone(),
+                roles: Arc::clone(&rig.roles),
+                rtol: p.rtol.to_bits(),
+                input: Arc::clone(&p.input),
+                n,
+                out,
+            });
+        }
+    }
 }
 
 pub(super) fn prepare(
@@ -124,8 +207,9 @@ pub(super) fn prepare(
             p20,
             restarts,
             count: Default::default(),
+            recent: Default::default(),
             t,
-            input,
+            input: input.into(),
             closed,
             command0,
             meas,
@@ -211,18 +295,44 @@ pub(super) fn simulate_prefix(
     n: usize,
 ) -> Result<Vec<Vec<f64>>, String> {
     let n = n.clamp(2.min(p.t.len()), p.t.len());
-    let t = &p.t[..n];
-    let cmd = CmdSignal::table(p.t.clone(), p.input.clone()).map_err(|e| e.to_string())?;
-    let opts = RunOptions {
-        rtol: p.rtol,
-        ..RunOptions::default()
-    };
     let tau = rig.lag;
     if !(tau.is_finite() && tau >= 0.0) {
         return Err(format!(
             "the sensor lag must be finite and non-negative, got {tau}"
         ));
     }
+    let hash = net_hash(&rig.net);
+    let out = match p.recent.find(hash, rig, p, n) {
+        Some(out) => out,
+        None => {
+            let out = Arc::new(run_prefix(rig, p, n)?);
+            p.recent.keep(hash, rig, p, n, Arc::clone(&out));
+            out
+        }
+    };
+    let t = &p.t[..n];
+    Ok(out
+        .iter()
+        .zip(&p.meas)
+        .map(|(o, (ch, _))| {
+            if tau > 0.0 && matches!(ch, Signal::P1 | Signal::P2) {
+                lag_samples(t, o, tau)
+            } else {
+                o.clone()
+            }
+        })
+        .collect())
+}
+
+/// The run behind [`simulate_prefix`]: the compared channels of `rig` over
+/// the first `n` samples, before the sensor lag.
+fn run_prefix(rig: &Model, p: &Prepared, n: usize) -> Result<Vec<Vec<f64>>, String> {
+    let t = &p.t[..n];
+    let cmd = CmdSignal::table(p.t.clone(), p.input.to_vec()).map_err(|e| e.to_string())?;
+    let opts = RunOptions {
+        rtol: p.rtol,
+        ..RunOptions::default()
+    };
     p.count.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let circuit = rig::circuit(&rig.net, cmd).map_err(|e| e.to_string())?;
     let names = circuit.state_names();
@@ -268,13 +378,6 @@ pub(super) fn simulate_prefix(
         }
         sim = sim.initial_state(x);
         a = b;
-    }
-    if tau > 0.0 {
-        for (o, (ch, _)) in out.iter_mut().zip(&p.meas) {
-            if matches!(ch, Signal::P1 | Signal::P2) {
-                *o = lag_samples(t, o, tau);
-            }
-        }
     }
     Ok(out)
 }
@@ -443,7 +546,7 @@ mod tests {
         let half = 0.5 * m.stroke();
         let p = Prepared {
             rtol: 1e-6,
-            input: vec![0.0; t.len()],
+            input: vec![0.0; t.len()].into(),
             closed: false,
             command0: Some(0.0),
             meas: vec![(Signal::Position, vec![0.0; t.len()])],
@@ -458,6 +561,7 @@ mod tests {
                 position: half,
             }],
             count: Default::default(),
+            recent: Default::default(),
             t,
         };
         assert!(simulate(&m, &p).is_ok(), "the mass has x and v");
@@ -553,7 +657,7 @@ mod tests {
         x0[ki] = 0.0;
         let circuit = rig::circuit(
             &m.net,
-            CmdSignal::table(t.clone(), p.input.clone()).unwrap(),
+            CmdSignal::table(t.clone(), p.input.to_vec()).unwrap(),
         )
         .unwrap();
         let run = Simulation::of_circuit(circuit)

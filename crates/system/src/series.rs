@@ -21,10 +21,10 @@
 //! interpolation through the last three trials (which follows the bend of a
 //! square-root law near a small pressure drop). It starts from the previous
 //! solution, or from the line through the last two extended to its time when
-//! it comes shortly after both, and is kept inside the bracket given by the lowest
-//! and highest pressure the members read elsewhere (each resistive flow into
-//! the node falls monotonically with `p`, so the root is bracketed and
-//! unique): a step that leaves the bracket, or a member without a slope,
+//! it comes shortly after both, and is kept inside the bracket given by the
+//! lowest and highest pressure the members read elsewhere (each resistive
+//! flow into the node falls monotonically with `p`, so the root is bracketed
+//! and unique): a step that leaves the bracket, or a member without a slope,
 //! falls back to bisection and Brent's method. Converged when the step is
 //! below [`SERIES_RTOL`] of the pressure scale; only a converged evaluation
 //! is kept (every trial starts from the accumulators as they were before the
@@ -123,13 +123,11 @@ pub(crate) struct SeriesGroup {
     pub(crate) solves: Cell<u64>,
     pub(crate) evaluations: Cell<u64>,
     pub(crate) fallbacks: Cell<u64>,
-    /// The last solution: the next solve starts from it.
-    pub(crate) guess: Cell<f64>,
     /// `[t₀, p₀, t₁, p₁]`: the times and solutions of the last two solves.
-    /// A solve later than both, which were in time order (an output row
-    /// after the last, an integrator stage ahead of the last two), by at most
-    /// twice their interval, starts from their straight line extended to its
-    /// time.
+    /// The next solve starts from the last solution `p₁`, or, later than
+    /// both, which were in time order (an output row after the last, an
+    /// integrator stage ahead of the last two), by at most twice their
+    /// interval, from their straight line extended to its time.
     history: Cell<[f64; 4]>,
 }
 
@@ -142,7 +140,6 @@ impl SeriesGroup {
     /// Forgets the last solution and slope (a run from a given state solves
     /// the same way whatever ran before).
     pub(crate) fn forget(&self) {
-        self.guess.set(f64::NAN);
         self.slope.set(f64::NAN);
         self.history.set([f64::NAN; 4]);
     }
@@ -193,7 +190,7 @@ impl SeriesGroup {
                 f64::NAN
             };
             let inside = |p: f64| p > lo && p < hi;
-            let start = [extended, self.guess.get()]
+            let start = [extended, p1]
                 .into_iter()
                 .find(|&p| inside(p))
                 .unwrap_or(0.5 * (lo + hi));
@@ -218,7 +215,6 @@ impl SeriesGroup {
                 }
             }
         };
-        self.guess.set(p);
         let [_, _, t1, p1] = self.history.get();
         self.history.set([t1, p1, t, p]);
         if last.get() != p {
@@ -438,7 +434,6 @@ fn groups(
             solves: Cell::new(0),
             evaluations: Cell::new(0),
             fallbacks: Cell::new(0),
-            guess: Cell::new(f64::NAN),
             history: Cell::new([f64::NAN; 4]),
         });
     }

@@ -128,88 +128,13 @@ pub(crate) fn csv_per_row() -> Result<(), String> {
     .map(|t| t.per(rows));
     let text = String::from_utf8(write_columns(&names, &columns)).map_err(|e| e.to_string())?;
     let wanted: Vec<usize> = (0..names.len()).collect();
-    let threads = |text: &str| {
-        PlainCsv::new(text)
-            .map(|p| p.threads())
-            .ok_or("not plain CSV")
-    };
-    fn cells_of(text: &str) -> Vec<Vec<&[u8]>> {
-        text.lines()
-            .skip(1)
-            .map(|l| l.split(',').map(str::as_bytes).collect())
-            .collect()
-    }
-    // the floor: fast-float2 alone on the same cells (no splitting, no
-    // columns, no copying)
-    let floor_of = |cells: &[&[u8]]| -> usize {
-        cells
-            .iter()
-            .map(|c| fast_float2::parse::<f64, _>(c).map_or(0, |v: f64| v.is_finite() as usize))
-            .sum()
-    };
-    let read_threads = threads(&text)?;
-    let text_cells: Vec<&[u8]> = cells_of(&text).into_iter().flatten().collect();
-    let [read_par, read_new, read_old, read_floor] = interleaved_ns(
-        CSV_ROUNDS,
-        [
-            &mut || {
-                PlainCsv::new(&text)
-                    .and_then(|p| p.columns(&wanted))
-                    .map_or(0, |c| c.len())
-            },
-            &mut || {
-                PlainCsv::new(&text)
-                    .and_then(|p| p.columns_on(&wanted, 1))
-                    .map_or(0, |c| c.len())
-            },
-            &mut || {
-                let mut rdr = csv_reader(&text);
-                let mut cols = vec![Vec::new(); wanted.len()];
-                for rec in rdr.records().flatten() {
-                    for (j, c) in cols.iter_mut().enumerate() {
-                        c.push(rec[j].parse::<f64>().unwrap_or(f64::NAN));
-                    }
-                }
-                cols.len()
-            },
-            &mut || floor_of(&text_cells),
-        ],
-    )
-    .map(|t| t.per(rows));
+    let (read_threads, [read_par, read_new, read_old, read_floor]) = read_per_row(&text, &wanted)?;
     let Signal::Table { time_s, value } = &case.command else {
         return Err("not a table".into());
     };
     let cmd = String::from_utf8(write_columns(&["time", "command"], &[time_s, value]))
         .map_err(|e| e.to_string())?;
-    let cmd_rows = time_s.len() as f64;
-    let cmd_threads = threads(&cmd)?;
-    let cmd_cells: Vec<&[u8]> = cells_of(&cmd).into_iter().flatten().collect();
-    let [cmd_par, cmd_new, cmd_old, cmd_floor] = interleaved_ns(
-        CSV_ROUNDS,
-        [
-            &mut || {
-                PlainCsv::new(&cmd)
-                    .and_then(|p| p.columns(&[0, 1]))
-                    .map_or(0, |c| c.len())
-            },
-            &mut || {
-                PlainCsv::new(&cmd)
-                    .and_then(|p| p.columns_on(&[0, 1], 1))
-                    .map_or(0, |c| c.len())
-            },
-            &mut || {
-                let mut rdr = csv_reader(&cmd);
-                let (mut t, mut u) = (Vec::new(), Vec::new());
-                for rec in rdr.records().flatten() {
-                    t.push(rec[0].parse::<f64>().unwrap_or(f64::NAN));
-                    u.push(rec[1].parse::<f64>().unwrap_or(f64::NAN));
-                }
-                t.len() + u.len()
-            },
-            &mut || floor_of(&cmd_cells),
-        ],
-    )
-    .map(|t| t.per(cmd_rows));
+    let (cmd_threads, [cmd_par, cmd_new, cmd_old, cmd_floor]) = read_per_row(&cmd, &[0, 1])?;
     // the share of the cells whose text is the text above (read: its value
     // is taken, not parsed again)
     let text_repeats = |text: &str| {
@@ -266,6 +191,62 @@ pub(crate) fn csv_per_row() -> Result<(), String> {
         read_par.speedup(read_old),
     );
     Ok(())
+}
+
+/// The cells of each data line of `text` (the header skipped).
+fn cells_of(text: &str) -> Vec<Vec<&[u8]>> {
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::as_bytes).collect())
+        .collect()
+}
+
+/// Reading the `wanted` columns of plain CSV `text`, ns per data line,
+/// interleaved: on the threads `PlainCsv` takes (returned beside), on one
+/// thread, by the previous per-record reader, and the floor (fast-float2
+/// alone on the same cells: no splitting, no columns, no copying).
+fn read_per_row(text: &str, wanted: &[usize]) -> Result<(usize, [Timing; 4]), String> {
+    let threads = PlainCsv::new(text)
+        .map(|p| p.threads())
+        .ok_or("not plain CSV")?;
+    let lines = cells_of(text);
+    let rows = lines.len() as f64;
+    let cells: Vec<&[u8]> = lines.into_iter().flatten().collect();
+    let timings = interleaved_ns(
+        CSV_ROUNDS,
+        [
+            &mut || {
+                PlainCsv::new(text)
+                    .and_then(|p| p.columns(wanted))
+                    .map_or(0, |c| c.len())
+            },
+            &mut || {
+                PlainCsv::new(text)
+                    .and_then(|p| p.columns_on(wanted, 1))
+                    .map_or(0, |c| c.len())
+            },
+            &mut || {
+                let mut rdr = csv_reader(text);
+                let mut cols = vec![Vec::new(); wanted.len()];
+                for rec in rdr.records().flatten() {
+                    for (c, &j) in cols.iter_mut().zip(wanted) {
+                        c.push(rec[j].parse::<f64>().unwrap_or(f64::NAN));
+                    }
+                }
+                cols.len()
+            },
+            &mut || {
+                cells
+                    .iter()
+                    .map(|c| {
+                        fast_float2::parse::<f64, _>(c).map_or(0, |v: f64| v.is_finite() as usize)
+                    })
+                    .sum()
+            },
+        ],
+    )
+    .map(|t| t.per(rows));
+    Ok((threads, timings))
 }
 
 fn csv_reader(text: &str) -> csv::Reader<&[u8]> {

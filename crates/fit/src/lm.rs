@@ -101,6 +101,15 @@ pub struct Options {
     /// where it stops (in a flat valley a damped step may lower the cost by
     /// less than `ftol` while still several standard errors away).
     pub step_se: f64,
+    /// The last this many parameters are nuisance parameters (an initial
+    /// state the fit needs but whose value is not the answer): the
+    /// `step_se` test leaves them out, so it says how far the answer's
+    /// parameters are from the joint minimum — the Gauss–Newton step is the
+    /// joint one, so a nuisance parameter still far from its own optimum
+    /// moves the others' steps by what it takes with it. A fit whose free
+    /// parameters are all nuisance tests them all. 0 (the default): every
+    /// parameter is tested.
+    pub step_se_nuisance: usize,
     /// Stop ([`Termination::NoReduction`]) after this many trial steps in a
     /// row fail to lower the cost (0 = no limit: until λ overflows or the
     /// step falls below `xtol`). With integration noise in the residual a
@@ -122,6 +131,7 @@ impl Default for Options {
             forward_differences: false,
             confidence_level: 0.95,
             step_se: 0.0,
+            step_se_nuisance: 0,
             max_rejections: 0,
         }
     }
@@ -338,7 +348,9 @@ impl<R: Residuals> Problem<R> {
                 break;
             }
             let k = free.len();
-            if o.step_se > 0.0 && gauss_newton_within_se(&a, &g, &free, cost, n, o.step_se) {
+            let answer = m.saturating_sub(o.step_se_nuisance);
+            if o.step_se > 0.0 && gauss_newton_within_se(&a, &g, &free, answer, cost, n, o.step_se)
+            {
                 termination = Termination::StandardError;
                 break;
             }
@@ -438,13 +450,15 @@ impl<R: Residuals> Problem<R> {
 }
 
 /// Whether the undamped Gauss–Newton step `−A⁻¹g` on the `free` parameters
-/// (`A = JᵀJ`, `g = Jᵀr`) is below `tol` standard errors in every one:
+/// (`A = JᵀJ`, `g = Jᵀr`) is below `tol` standard errors in every free one
+/// below index `answer` (in every free one where none is):
 /// `|d_j| ≤ tol √(s² (A⁻¹)_jj)` with `s² = 2 cost / (n − k)`. `false` where
 /// the free block is singular or there are no degrees of freedom left.
 fn gauss_newton_within_se(
     a: &DMatrix<f64>,
     g: &DVector<f64>,
     free: &[usize],
+    answer: usize,
     cost: f64,
     n: usize,
     tol: f64,
@@ -461,7 +475,8 @@ fn gauss_newton_within_se(
     let d = chol.solve(&rhs);
     let inv = chol.inverse();
     let s2 = 2.0 * cost / (n - k) as f64;
-    (0..k).all(|i| {
+    let all = !free.iter().any(|&j| j < answer);
+    (0..k).filter(|&i| all || free[i] < answer).all(|i| {
         let se = (s2 * inv[(i, i)]).sqrt();
         se.is_finite() && d[i].abs() <= tol * se
     })
@@ -480,4 +495,28 @@ fn check_finite(jac: &DMatrix<f64>, iteration: usize) -> Result<(), FitError> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_step_test_leaves_the_nuisance_parameters_out_unless_they_are_all_there_is() {
+        // Uncorrelated parameters, unit standard errors (A = I·(n−k)/(2
+        // cost) makes s²(A⁻¹)_jj = 1): the Gauss–Newton step is −g, 0.01
+        // standard errors in the answer, 0.5 in the nuisance.
+        let (n, cost) = (12, 5.0);
+        let a = DMatrix::<f64>::identity(2, 2) * ((n - 2) as f64 / (2.0 * cost));
+        let g = DVector::from_vec(vec![0.01, -0.5]).component_mul(&a.diagonal());
+        let within =
+            |free: &[usize], answer| gauss_newton_within_se(&a, &g, free, answer, cost, n, 0.05);
+        // every parameter tested: the nuisance's step is too long
+        assert!(!within(&[0, 1], 2));
+        // the answer alone: within
+        assert!(within(&[0, 1], 1));
+        // all nuisance (or no free answer parameter): all are tested
+        assert!(!within(&[0, 1], 0));
+        assert!(!within(&[1], 1));
+    }
 }

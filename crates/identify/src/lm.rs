@@ -43,6 +43,9 @@ pub struct LmOptions {
     /// standard errors in every free parameter (0 = off; see
     /// `hydrocyl_fit::Options::step_se`).
     pub step_se: f64,
+    /// The last this many parameters are nuisance parameters, left out of
+    /// the `step_se` test (see `hydrocyl_fit::Options::step_se_nuisance`).
+    pub step_se_nuisance: usize,
     /// Stop after this many rejected steps in a row (0 = no limit; see
     /// `hydrocyl_fit::Options::max_rejections`).
     pub max_rejections: usize,
@@ -58,6 +61,7 @@ impl Default for LmOptions {
             fd_floor: None,
             forward_differences: false,
             step_se: 0.0,
+            step_se_nuisance: 0,
             max_rejections: 0,
         }
     }
@@ -266,6 +270,7 @@ fn solve<M: Residuals>(
             gtol: 1e-8,
             fd_step: opts.fd_step,
             step_se: opts.step_se,
+            step_se_nuisance: opts.step_se_nuisance,
             fd_floor: opts.fd_floor,
             forward_differences: opts.forward_differences,
             max_rejections: opts.max_rejections,

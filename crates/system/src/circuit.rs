@@ -88,6 +88,9 @@ pub struct Circuit {
     q_offsets: Vec<usize>,
     n_quad: usize,
     wire_names: Vec<String>,
+    /// The component whose `publish` sets each wire (a stored effort), by
+    /// wire index.
+    publisher: Vec<Option<usize>>,
     probe_names: Option<Vec<Option<String>>>,
     /// Every component has tangents and the analytic Jacobian is wanted.
     analytic: bool,
@@ -170,6 +173,12 @@ impl Circuit {
         ev_offsets.push(e);
         q_offsets.push(q);
         let analytic = comps.iter().all(|c| c.has_tangents());
+        let mut publisher = vec![None; net.names.len()];
+        for (&w, o) in &net.owners {
+            if o.causality == crate::Causality::Stored {
+                publisher[w] = Some(o.owner);
+            }
+        }
         Ok(Self {
             comps,
             offsets,
@@ -188,6 +197,7 @@ impl Circuit {
             q_offsets,
             n_quad: q,
             wire_names: net.names,
+            publisher,
             probe_names: None,
             analytic,
             tangents: RefCell::new(Tangents::default()),
@@ -383,6 +393,37 @@ impl Circuit {
     pub fn read_wires(&self, t: f64, x: &[f64], wires: &[AnyWire], out: &mut [f64]) {
         self.fill(t, x);
         let w = self.wires.borrow();
+        for (o, wire) in out.iter_mut().zip(wires) {
+            *o = w.get(*wire);
+        }
+    }
+
+    /// The component whose [`Component::publish`] sets wire `w` from its
+    /// own state and the time (an effort it owns with
+    /// [`Causality::Stored`](crate::Causality::Stored)), if one does.
+    pub fn publisher_of(&self, w: AnyWire) -> Option<usize> {
+        self.publisher.get(w.0).copied().flatten()
+    }
+
+    /// Copies `wires` at `(t, x)` into `out` with only the components
+    /// `publishers` publishing, the circuit not evaluated: the values
+    /// [`Circuit::read_wires`] reads, for wires that are each set by one of
+    /// `publishers` ([`Circuit::publisher_of`]) — a stored effort depends
+    /// on its owner's state and the time alone.
+    pub fn read_published(
+        &self,
+        t: f64,
+        x: &[f64],
+        publishers: &[usize],
+        wires: &[AnyWire],
+        out: &mut [f64],
+    ) {
+        // the table is no evaluation at any point now
+        self.filled.borrow_mut().valid = false;
+        let mut w = self.wires.borrow_mut();
+        for &i in publishers {
+            self.comps[i].publish(t, &x[self.offsets[i]..self.offsets[i + 1]], &mut w);
+        }
         for (o, wire) in out.iter_mut().zip(wires) {
             *o = w.get(*wire);
         }

@@ -137,6 +137,12 @@ pub struct RunOptions {
     /// run keeps only its raw [`Run::states`] (for a caller that reads the
     /// circuit itself, e.g. the chapter-7 measurements).
     pub channels: bool,
+    /// Read only the channels named here (e.g. `["position", "p1",
+    /// "p2"]`: what a fit compares with a record), in the order of the
+    /// full set; `None` (the default): every probe. When each named
+    /// channel is a stored effort (a state's: a position, a chamber
+    /// pressure), they are read without evaluating the circuit.
+    pub only_channels: Option<Vec<String>>,
 }
 
 impl Default for RunOptions {
@@ -150,6 +156,7 @@ impl Default for RunOptions {
             ledger: false,
             max_steps: Options::default().max_steps,
             channels: true,
+            only_channels: None,
         }
     }
 }
@@ -271,6 +278,7 @@ pub(crate) fn run(
     check_times(t_eval)?;
     check_options(opts)?;
     let x = initial(circuit, x0, t_eval[0], opts)?;
+    let mut probes = ProbeSet::selected(circuit, opts.only_channels.as_deref())?;
     let (t0, t_end) = (t_eval[0], t_eval[t_eval.len() - 1]);
     let sopts = opts.solver_options(circuit, t_eval.to_vec());
     let start = Instant::now();
@@ -284,7 +292,7 @@ pub(crate) fn run(
     // probes → channels
     let mut channels = Vec::new();
     if opts.channels {
-        ProbeSet::of(circuit).read_channels(circuit, &sol.t, &sol.x, &mut channels);
+        probes.read_channels(circuit, &sol.t, &sol.x, &mut channels);
     }
     Ok(Run {
         time: sol.t,
@@ -697,7 +705,7 @@ fn stream(
         }) * 1.05,
         block: block.max(2),
         sink,
-        probes: ProbeSet::of(circuit),
+        probes: ProbeSet::selected(circuit, opts.only_channels.as_deref())?,
         out: Run::default(),
         in_sink: Duration::ZERO,
         covered: f64::NEG_INFINITY,

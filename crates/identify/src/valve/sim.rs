@@ -329,8 +329,11 @@ pub(super) fn simulate_prefix(
 fn run_prefix(rig: &Model, p: &Prepared, n: usize) -> Result<Vec<Vec<f64>>, String> {
     let t = &p.t[..n];
     let cmd = CmdSignal::table(p.t.clone(), p.input.to_vec()).map_err(|e| e.to_string())?;
+    // only the compared channels: position and pressures are states,
+    // read without evaluating the circuit at each sample
     let opts = RunOptions {
         rtol: p.rtol,
+        only_channels: Some(p.meas.iter().map(|(ch, _)| ch.name().to_string()).collect()),
         ..RunOptions::default()
     };
     p.count.fetch_add(1, std::sync::atomic::Ordering::Relaxed);

@@ -4,7 +4,7 @@
 //! [`Simulation::run_streaming_states`](crate::simulation::Simulation::run_streaming_states)).
 
 use super::{initial, Channel, Run, RunOptions, SimError, ORDER};
-use crate::circuit::{AnyWire, Circuit};
+use crate::circuit::{AnyWire, Circuit, Probe};
 
 /// The probes of a circuit as a run's channels, in the measured-data order
 /// (command, position, velocity, p1, p2, then the others in component
@@ -17,12 +17,54 @@ pub struct ProbeSet {
     /// The wire of each channel, in channel order.
     order: Vec<usize>,
     row: Vec<f64>,
+    /// The components whose `publish` sets every probed wire, when each is
+    /// a stored effort: the probes are then read without evaluating the
+    /// circuit ([`Circuit::read_published`]).
+    publishers: Option<Vec<usize>>,
 }
 
 impl ProbeSet {
     /// The probes of `circuit`.
     pub fn of(circuit: &Circuit) -> Self {
-        let probes = circuit.probes();
+        Self::of_probes(circuit, circuit.probes())
+    }
+
+    /// The probes of `circuit` named in `names` (every probe for `None`),
+    /// in the channel order of [`ProbeSet::of`].
+    ///
+    /// # Errors
+    /// [`SimError::Settings`] naming a channel the circuit has no probe for.
+    pub fn selected(circuit: &Circuit, names: Option<&[String]>) -> Result<Self, SimError> {
+        let all = circuit.probes();
+        let Some(names) = names else {
+            return Ok(Self::of_probes(circuit, all));
+        };
+        if let Some(n) = names.iter().find(|n| !all.iter().any(|p| p.name == **n)) {
+            return Err(SimError::Settings(format!(
+                "channel `{n}`: the circuit has no such output (it has {})",
+                all.iter()
+                    .map(|p| p.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )));
+        }
+        let chosen = all
+            .into_iter()
+            .filter(|p| names.contains(&p.name))
+            .collect();
+        Ok(Self::of_probes(circuit, chosen))
+    }
+
+    fn of_probes(circuit: &Circuit, probes: Vec<Probe>) -> Self {
+        let publishers = probes
+            .iter()
+            .map(|p| circuit.publisher_of(p.wire))
+            .collect::<Option<Vec<usize>>>()
+            .map(|mut v| {
+                v.sort_unstable();
+                v.dedup();
+                v
+            });
         let mut order: Vec<usize> = (0..probes.len()).collect();
         // stable: probes outside ORDER keep their component order
         order.sort_by_key(|&i| {
@@ -39,6 +81,7 @@ impl ProbeSet {
                 .collect(),
             order,
             row: vec![0.0; probes.len()],
+            publishers,
         }
     }
 
@@ -79,7 +122,11 @@ impl ProbeSet {
             return;
         }
         for (k, &tk) in t.iter().enumerate() {
-            c.read_wires(tk, &x[k * dim..(k + 1) * dim], &self.wires, &mut self.row);
+            let xk = &x[k * dim..(k + 1) * dim];
+            match &self.publishers {
+                Some(p) => c.read_published(tk, xk, p, &self.wires, &mut self.row),
+                None => c.read_wires(tk, xk, &self.wires, &mut self.row),
+            }
             for (ch, &i) in out.iter_mut().zip(&self.order) {
                 ch.values.push(self.row[i]);
             }

@@ -180,6 +180,58 @@ fn probes_read_on_a_second_circuit_are_the_runs() {
 }
 
 #[test]
+fn stored_channels_read_alone_are_the_full_runs_on_every_preset() {
+    // Every preset: the channels whose wires a component publishes from its
+    // state, read alone (without evaluating the circuit), equal the full
+    // run's, bit for bit; the valve rig's compared channels are such.
+    let (t, u) = square(0.3);
+    let table = Signal::table(t.clone(), u).unwrap();
+    let opts = RunOptions::default();
+    for preset in rig::PRESETS {
+        let value = (preset.json)();
+        let mut c = rig::circuit(&value, table.clone()).unwrap();
+        let x0 = c.initial_state();
+        let whole = run(&mut c, &x0, &t, &opts).unwrap();
+        let stored: Vec<String> = c
+            .probes()
+            .into_iter()
+            .filter(|p| c.publisher_of(p.wire).is_some())
+            .map(|p| p.name)
+            .collect();
+        if preset.name == "leaney-moog" {
+            for n in ["position", "velocity", "p1", "p2"] {
+                assert!(stored.iter().any(|s| s == n), "{n} is not stored");
+            }
+        }
+        let alone = RunOptions {
+            only_channels: Some(stored.clone()),
+            ..opts.clone()
+        };
+        let mut c = rig::circuit(&value, table.clone()).unwrap();
+        let part = run(&mut c, &x0, &t, &alone).unwrap();
+        assert_eq!(part.channels.len(), stored.len(), "{}", preset.name);
+        for ch in &part.channels {
+            assert_eq!(
+                Some(&ch.values),
+                whole.channel(&ch.name).map(|v| v.to_vec()).as_ref(),
+                "{}: {}",
+                preset.name,
+                ch.name
+            );
+        }
+    }
+    let value = rig::load("leaney-moog").unwrap();
+    let mut c = rig::circuit(&value, table).unwrap();
+    let x0 = c.initial_state();
+    let wrong = RunOptions {
+        only_channels: Some(vec!["position".into(), "p3".into()]),
+        ..opts
+    };
+    let e = run(&mut c, &x0, &t, &wrong).unwrap_err().to_string();
+    assert!(e.contains("channel `p3`") && e.contains("p1"), "{e}");
+}
+
+#[test]
 fn min_chamber_pressure_reads_every_cylinders_chambers_and_nothing_else() {
     let channel = |name: &str, values: Vec<f64>| Channel {
         name: name.into(),

@@ -112,7 +112,11 @@ pub(super) fn refit_polished(
         let mut smoothed = rig.clone();
         smoothed.set_x0(x0.clamp(-half, half));
         smoothed.set_v0(v0);
-        if rss(&smoothed, &coarse, holdout, Part::All) < rss(rig, &coarse, holdout, Part::All) {
+        let (from_smoothed, from_trace) = rayon::join(
+            || rss(&smoothed, &coarse, holdout, Part::All),
+            || rss(rig, &coarse, holdout, Part::All),
+        );
+        if from_smoothed < from_trace {
             *rig = smoothed;
         }
     }
@@ -196,30 +200,47 @@ fn at(rig: &Model, params: &ParamList, x: &[f64]) -> Model {
 /// it lands as close as the polish's own first step would.
 fn warm_step(rig: &mut Model, params: &ParamList, q: &Prepared, holdout: f64) -> Option<Vec<f64>> {
     let (x, lo, hi, typ) = start_of(rig, params);
-    let mut r0 = Vec::new();
-    residual(rig, q, holdout, Part::All, &mut r0).ok()?;
     let k = x.len();
     // the solver's steps (`fd_step` 1e-3 of max(|x|, FD_FLOOR typical sizes))
-    let cols: Vec<Option<Vec<f64>>> = (0..k)
+    let steps: Vec<f64> = (0..k)
+        .map(|j| {
+            let h = 1e-3 * (x[j] / typ[j]).abs().max(FD_FLOOR) * typ[j];
+            if x[j] + h > hi[j] {
+                -h
+            } else {
+                h
+            }
+        })
+        .collect();
+    // the residual at `rig` (the last) and at each stepped point, all at
+    // once: none waits for another
+    let mut runs: Vec<Option<Vec<f64>>> = (0..=k)
         .into_par_iter()
         .map(|j| {
-            let mut h = 1e-3 * (x[j] / typ[j]).abs().max(FD_FLOOR) * typ[j];
-            if x[j] + h > hi[j] {
-                h = -h;
-            }
             let mut xj = x.clone();
-            xj[j] += h;
-            let mut r1 = Vec::new();
-            residual(&at(rig, params, &xj), q, holdout, Part::All, &mut r1).ok()?;
+            if j < k {
+                xj[j] += steps[j];
+            }
+            let mut r = Vec::new();
+            residual(&at(rig, params, &xj), q, holdout, Part::All, &mut r).ok()?;
+            Some(r)
+        })
+        .collect();
+    let r0 = runs.pop().flatten()?;
+    let cols: Option<Vec<Vec<f64>>> = runs
+        .into_iter()
+        .zip(&steps)
+        .enumerate()
+        .map(|(j, (r1, h))| {
             Some(
-                r1.iter()
+                r1?.iter()
                     .zip(&r0)
                     .map(|(a, b)| (a - b) / h * typ[j])
                     .collect(),
             )
         })
         .collect();
-    let Some(cols) = cols.into_iter().collect::<Option<Vec<Vec<f64>>>>() else {
+    let Some(cols) = cols else {
         return Some(r0);
     };
     // normal equations in scaled parameters

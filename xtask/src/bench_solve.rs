@@ -393,7 +393,7 @@ fn hybrid_solver_choice() -> Result<(), String> {
 /// build, brought up to date now (`cargo build --release -p hydrocyl-cli`; a
 /// no-op when it is): a user runs a release build (`cargo install`), so the
 /// whole process is timed on one.
-fn hydrocyl_binaries() -> Result<(Vec<PathBuf>, &'static str), String> {
+pub(crate) fn hydrocyl_binaries() -> Result<(Vec<PathBuf>, &'static str), String> {
     if let Ok(p) = std::env::var("HYDROCYL_BIN") {
         let bins: Vec<PathBuf> = p
             .split(':')

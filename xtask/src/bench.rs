@@ -243,6 +243,45 @@ fn diagnose_process(rec: &hydrocyl_identify::data::Record) -> Result<(), String>
     Ok(())
 }
 
+/// Runs this bench again in the release build (`cargo run --release -p
+/// xtask -- bench` with this run's arguments): what users run is timed, not
+/// the dev build with its debug assertions. `false` when it could not run
+/// or failed.
+pub fn in_release() -> bool {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap_or_else(|| std::path::Path::new("."));
+    // everything after `bench`
+    let args: Vec<String> = std::env::args()
+        .skip_while(|a| a != "bench")
+        .skip(1)
+        .collect();
+    eprintln!("cargo xtask bench: timing the release build (`--dev` times the dev build)");
+    match std::process::Command::new(cargo)
+        .args([
+            "run",
+            "--release",
+            "--quiet",
+            "-p",
+            "xtask",
+            "--bin",
+            "xtask",
+            "--",
+            "bench",
+        ])
+        .args(&args)
+        .current_dir(root)
+        .status()
+    {
+        Ok(s) => s.success(),
+        Err(e) => {
+            eprintln!("cargo xtask bench: cannot run the release build: {e}");
+            false
+        }
+    }
+}
+
 /// Runs the benchmarks; returns `false` only when a benchmark could not run
 /// (a benchmark has no pass/fail threshold).
 /// A section of the bench: prints its rows, or says why it could not run.

@@ -46,8 +46,14 @@ enum Task {
     Xfactor,
     /// The chapter-8 energy-efficiency matrix of the valve and hybrid drives.
     Energy,
-    /// Speed ratios against reference runs on this machine, in the same run.
+    /// Speed ratios against reference runs on this machine, in the same run,
+    /// timed on the release build (the one users run: `cargo xtask bench`
+    /// builds and runs it; `--dev` times the dev build instead).
     Bench {
+        /// Time this build (the dev profile: opt-level 2, debug assertions)
+        /// instead of the release one.
+        #[arg(long)]
+        dev: bool,
         /// Run only the sections whose name contains this text (e.g. `csv`,
         /// `process`, `cost`).
         #[arg(long)]
@@ -85,7 +91,17 @@ fn main() {
         Task::Validate { only } => validate::run(only.as_deref()),
         Task::Xfactor => xfactor::run(),
         Task::Energy => energy::run(),
-        Task::Bench { only, keep_files } => bench::run(only.as_deref(), keep_files.as_deref()),
+        Task::Bench {
+            dev,
+            only,
+            keep_files,
+        } => {
+            if cfg!(debug_assertions) && !dev {
+                bench::in_release()
+            } else {
+                bench::run(only.as_deref(), keep_files.as_deref())
+            }
+        }
         Task::Test {
             python_only,
             rust_only,

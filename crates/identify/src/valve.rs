@@ -252,9 +252,6 @@ pub fn diagnose_rig_traced(
         });
     }
     let mut rig0 = with_initial(declared, &p);
-    let sims_declared = simulate(&rig0, &p)
-        .map_err(|e| DiagnoseError::Rig(format!("declared model does not simulate: {e}")))?;
-    let nrmse_declared = nrmse_of(&p, &sims_declared);
     let mut warnings: Vec<String> = data_problems
         .iter()
         .map(|p| format!("{} left out of the fit: {}", p.channel, p.message))
@@ -271,14 +268,23 @@ pub fn diagnose_rig_traced(
     // The declared model's own refit: the initial position and velocity
     // only (the nuisance parameters of every later fit), so that what the
     // effects are scored against is not an initial transient.
-    {
+    // (the declared model's own run alongside: it waits for nothing)
+    let (sims_declared, initial_fit) = {
         let mut r = rig0.clone();
-        match fit(&mut r, &Vec::new(), &pt, opts.holdout, Part::All) {
-            Ok(_) => rig0 = r,
-            Err(e) => warnings.push(format!(
-                "initial-state fit: {e}; the smoother's initial position and velocity are kept"
-            )),
-        }
+        let (declared_run, fitted) = rayon::join(
+            || simulate(&rig0, &p),
+            || fit(&mut r, &Vec::new(), &pt, opts.holdout, Part::All),
+        );
+        (declared_run, fitted.map(|_| r))
+    };
+    let sims_declared = sims_declared
+        .map_err(|e| DiagnoseError::Rig(format!("declared model does not simulate: {e}")))?;
+    let nrmse_declared = nrmse_of(&p, &sims_declared);
+    match initial_fit {
+        Ok(r) => rig0 = r,
+        Err(e) => warnings.push(format!(
+            "initial-state fit: {e}; the smoother's initial position and velocity are kept"
+        )),
     }
     clock.lap("checks, smoothing and initial-state fit");
     let sims_before = simulate(&rig0, &p).unwrap_or_default();
@@ -512,20 +518,10 @@ pub fn diagnose_rig_traced(
         // The acceptance rule (`accept`): refit each candidate in turn with
         // the effects already added; the first that earns its place is added.
         clock.lap("tracing");
-        // (simulated only where a candidate is to be refitted)
-        let (nrmse, held) = if eligible.is_empty() {
-            (BTreeMap::new(), f64::INFINITY)
-        } else {
-            nrmse_and_held(&model, &p, opts.holdout)
-        };
-        let base = accept::Baseline {
-            declared,
-            nrmse,
-            held,
-            floors: floors.clone(),
-            p: &p,
-            holdout: opts.holdout,
-        };
+        // The round model's scores the verdicts compare with: simulated
+        // (only where a candidate is to be refitted) alongside the first
+        // refit, which does not need them.
+        let mut scores: Option<(BTreeMap<String, f64>, f64)> = None;
         let mut accepted: Option<(EffectId, Model, EffectReport, ParamList, lm::LmResult)> = None;
         for (id, _, _) in eligible.iter().skip(MAX_REFITS_PER_ROUND) {
             if let Some(r) = last.get_mut(id) {
@@ -542,7 +538,27 @@ pub fn diagnose_rig_traced(
                 .chain(id.params().iter().map(|q| (id, q.name)))
                 .collect();
             let mut refit = trial;
-            let verdict = match refit_polished(&mut refit, &joint, &p, opts.holdout) {
+            let polished = match scores {
+                Some(_) => refit_polished(&mut refit, &joint, &p, opts.holdout),
+                None => {
+                    let (polished, round_scores) = rayon::join(
+                        || refit_polished(&mut refit, &joint, &p, opts.holdout),
+                        || nrmse_and_held(&model, &p, opts.holdout),
+                    );
+                    scores = Some(round_scores);
+                    polished
+                }
+            };
+            let (nrmse, held) = scores.clone().unwrap_or((BTreeMap::new(), f64::INFINITY));
+            let base = accept::Baseline {
+                declared,
+                nrmse,
+                held,
+                floors: floors.clone(),
+                p: &p,
+                holdout: opts.holdout,
+            };
+            let verdict = match polished {
                 Ok(res) => accept::verdict(id, &joint, &res, &refit, &base).map(|()| res),
                 Err(e) => Err(format!("refit failed: {e}")),
             };

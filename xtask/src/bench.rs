@@ -177,7 +177,7 @@ fn valve_diagnose_time() -> Result<(), String> {
         .to_string();
     println!(
         "diagnose, valve rig, 12 s at 1 kHz:                   {diagnose:7.2} s wall in-process ({}) = {:.0} record simulations ({:.0} ms each); found {found}",
-        if cfg!(debug_assertions) { "dev profile" } else { "release profile" },
+        crate::bench_solve::profile(),
         diagnose / simulate,
         simulate * 1e3
     );

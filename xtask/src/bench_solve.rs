@@ -71,9 +71,9 @@ impl SquareCase {
 }
 
 /// The build profile this binary was compiled in, for the bench headers
-/// (`cargo xtask bench` runs the dev profile; `cargo run --release -p xtask
-/// -- bench` the release one users run).
-fn profile() -> &'static str {
+/// (`cargo xtask bench` runs the release build, the one users run;
+/// `cargo xtask bench --dev` this dev build).
+pub(crate) fn profile() -> &'static str {
     if cfg!(debug_assertions) {
         "dev profile"
     } else {

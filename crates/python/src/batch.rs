@@ -178,10 +178,22 @@ pub fn simulate_batch(
     }
     let base = &rig.value;
     let keep = channels.as_deref();
+    // the channels asked for are checked once, before any run, and only
+    // they are read in each (a stored one, e.g. a position or a chamber
+    // pressure, without evaluating the circuit)
+    if let Some(k) = keep {
+        let names = channel_names(base, &t, &u).map_err(|e| e.into_pyerr(py))?;
+        if let Some(missing) = k.iter().find(|c| !names.contains(c)) {
+            return Err(no_channel(missing, &names));
+        }
+    }
     let sets = &sets;
     let (rows, interval): (Vec<Outcome<Row>>, (f64, f64)) = detached(py, || {
         let start = unix_now();
-        let opts = sim::options(solver, rtol, rk4_step, h_max, false)?;
+        let opts = hydrocyl_system::run::RunOptions {
+            only_channels: channels.clone(),
+            ..sim::options(solver, rtol, rk4_step, h_max, false)?
+        };
         let cmd = sim::command(&t, &u)?;
         let work = || {
             (0..sets.n)
@@ -202,6 +214,13 @@ pub fn simulate_batch(
     let mut b = stack(py, t, rows, sets, keep, raise)?;
     b.interval = interval;
     Ok(b)
+}
+
+/// The channels a run of the rig `value` on the command `(t, u)` has.
+fn channel_names(value: &Value, t: &[f64], u: &[f64]) -> Outcome<Vec<String>> {
+    let circuit = rig::circuit(value, sim::command(t, u)?)
+        .map_err(|e| Failure::Input(e.to_string()))?;
+    Ok(circuit.probes().into_iter().map(|p| p.name).collect())
 }
 
 /// Stacks the rows into `(N, T)` arrays (failed rows NaN), or raises the

@@ -54,8 +54,12 @@ def test_batch_does_not_depend_on_the_thread_count(step, sets):
 def test_channel_selection(step, sets):
     t, u = step
     rig, params = sets
-    batch = hydrocyl.simulate_batch(rig, t, u, params, channels=["position", "p1"])
+    batch = hydrocyl.simulate_batch(rig, t, u, params, channels=["p1", "position"])
     assert batch.names == ["position", "p1"] and batch["p1"].shape == (12, len(t))
+    # only the channels asked for are read, and they are the full runs'
+    full = hydrocyl.simulate_batch(rig, t, u, params)
+    for name in batch.names:
+        np.testing.assert_array_equal(batch[name], full[name])
     with pytest.raises(KeyError, match="no channel `nope`"):
         hydrocyl.simulate_batch(rig, t, u, params, channels=["nope"])
 

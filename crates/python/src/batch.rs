@@ -218,8 +218,8 @@ pub fn simulate_batch(
 
 /// The channels a run of the rig `value` on the command `(t, u)` has.
 fn channel_names(value: &Value, t: &[f64], u: &[f64]) -> Outcome<Vec<String>> {
-    let circuit = rig::circuit(value, sim::command(t, u)?)
-        .map_err(|e| Failure::Input(e.to_string()))?;
+    let circuit =
+        rig::circuit(value, sim::command(t, u)?).map_err(|e| Failure::Input(e.to_string()))?;
     Ok(circuit.probes().into_iter().map(|p| p.name).collect())
 }
 

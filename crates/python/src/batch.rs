@@ -180,11 +180,13 @@ pub fn simulate_batch(
     let keep = channels.as_deref();
     // the channels asked for are checked once, before any run, and only
     // they are read in each (a stored one, e.g. a position or a chamber
-    // pressure, without evaluating the circuit)
+    // pressure, without evaluating the circuit); on the first set's rig:
+    // where it does not build, its run says why
     if let Some(k) = keep {
-        let names = channel_names(base, &t, &u).map_err(|e| e.into_pyerr(py))?;
-        if let Some(missing) = k.iter().find(|c| !names.contains(c)) {
-            return Err(no_channel(missing, &names));
+        if let Some(names) = channel_names(base, &sets, &t, &u) {
+            if let Some(missing) = k.iter().find(|c| !names.contains(c)) {
+                return Err(no_channel(missing, &names));
+            }
         }
     }
     let sets = &sets;
@@ -216,11 +218,16 @@ pub fn simulate_batch(
     Ok(b)
 }
 
-/// The channels a run of the rig `value` on the command `(t, u)` has.
-fn channel_names(value: &Value, t: &[f64], u: &[f64]) -> Outcome<Vec<String>> {
-    let circuit =
-        rig::circuit(value, sim::command(t, u)?).map_err(|e| Failure::Input(e.to_string()))?;
-    Ok(circuit.probes().into_iter().map(|p| p.name).collect())
+/// The channels a run of the rig `value` with the first parameter set on
+/// the command `(t, u)` has (every set has the same: a set changes
+/// parameters, not components); `None` where that rig does not build.
+fn channel_names(value: &Value, sets: &Sets, t: &[f64], u: &[f64]) -> Option<Vec<String>> {
+    let mut v = value.clone();
+    for a in sets.assignments(0) {
+        rig::apply_set(&mut v, &a).ok()?;
+    }
+    let circuit = rig::circuit(&v, sim::command(t, u).ok()?).ok()?;
+    Some(circuit.probes().into_iter().map(|p| p.name).collect())
 }
 
 /// Stacks the rows into `(N, T)` arrays (failed rows NaN), or raises the

@@ -442,8 +442,9 @@ pub struct PilotNodes<'a> {
 pub struct PilotValve {
     name: String,
     nodes: [String; 5],
-    /// The pilot four-way valve.
-    pub four_way: PilotFourWay,
+    /// The pilot four-way valve (private: the opening caches below are
+    /// computed from it when bound).
+    four_way: PilotFourWay,
     pp1: HydraulicNode,
     pp2: HydraulicNode,
     a: HydraulicNode,
@@ -462,6 +463,11 @@ pub struct PilotValve {
 }
 
 impl PilotValve {
+    /// The pilot four-way valve.
+    pub fn four_way(&self) -> &PilotFourWay {
+        &self.four_way
+    }
+
     /// The valve `name` joined to `nodes`.
     pub fn new(name: &str, four_way: PilotFourWay, nodes: PilotNodes<'_>) -> Self {
         Self {

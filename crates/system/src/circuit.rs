@@ -400,7 +400,7 @@ impl Circuit {
 
     /// The component whose [`Component::publish`] sets wire `w` from its
     /// own state and the time (an effort it owns with
-    /// [`Causality::Stored`](crate::Causality::Stored)), if one does.
+    /// [`Causality::Stored`]), if one does.
     pub fn publisher_of(&self, w: AnyWire) -> Option<usize> {
         self.publisher.get(w.0).copied().flatten()
     }

@@ -156,7 +156,8 @@ def simulate_batch(
 ) -> BatchRun:
     """Runs ``rig`` once per parameter set (``params``: path -> N values,
     SI) in parallel with the GIL released; results in set order,
-    independent of ``threads``."""
+    independent of ``threads``. ``channels`` (default: all) names the
+    channels kept, and only they are read in each run."""
 
 def xfactor(gamma: float, travel: ArrayLike) -> npt.NDArray[np.float64]:
     """Leaney's X factor (dimensionless) for area ratio ``gamma`` = A1/A2

@@ -215,29 +215,12 @@ fn diagnose_process(rec: &hydrocyl_identify::data::Record) -> Result<(), String>
         &report_s,
         "--quiet",
     ];
-    let mut walls = vec![Vec::with_capacity(DIAGNOSE_RUNS); bins.len()];
-    for r in 0..DIAGNOSE_RUNS {
-        for i in 0..bins.len() {
-            let b = (i + r) % bins.len();
-            let t0 = Instant::now();
-            let out = std::process::Command::new(&bins[b])
-                .args(args)
-                .output()
-                .map_err(|e| e.to_string())?;
-            walls[b].push(t0.elapsed().as_secs_f64());
-            if !out.status.success() {
-                return Err(String::from_utf8_lossy(&out.stderr).into_owned());
-            }
-        }
-    }
+    let walls = crate::bench_solve::time_processes(&bins, &args, DIAGNOSE_RUNS, None);
     let _ = std::fs::remove_dir_all(&dir);
-    for (b, mut w) in walls.into_iter().enumerate() {
-        w.sort_by(f64::total_cmp);
+    for (b, (median, fastest)) in walls?.into_iter().enumerate() {
         println!(
-            "diagnose, whole process ({profile}{}): median {:.2} s, fastest {:.2} s of {DIAGNOSE_RUNS} (goal <= 2 s)",
+            "diagnose, whole process ({profile}{}): median {median:.2} s, fastest {fastest:.2} s of {DIAGNOSE_RUNS} (goal <= 2 s)",
             if bins.len() > 1 { format!(", {}", bins[b].display()) } else { String::new() },
-            w[w.len() / 2],
-            w[0]
         );
     }
     Ok(())

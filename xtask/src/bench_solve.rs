@@ -434,6 +434,46 @@ pub(crate) fn hydrocyl_binaries() -> Result<(Vec<PathBuf>, &'static str), String
     ))
 }
 
+/// Wall times of `runs` runs of each of `bins` with `args` \[s\], the
+/// binaries interleaved run by run (each run's order rotated, so that the
+/// machine's load falls on each alike): per binary, (median, fastest).
+/// `synced`: a file flushed to the disk before each run (the output a run
+/// replaces, as a rerun long after the last finds it: deleting it then
+/// frees its blocks), not only in the page cache as after the run before.
+pub(crate) fn time_processes(
+    bins: &[PathBuf],
+    args: &[&str],
+    runs: usize,
+    synced: Option<&Path>,
+) -> Result<Vec<(f64, f64)>, String> {
+    let mut v = vec![Vec::with_capacity(runs); bins.len()];
+    for r in 0..runs {
+        for i in 0..bins.len() {
+            let b = (i + r) % bins.len();
+            if let Some(p) = synced {
+                if let Ok(f) = std::fs::File::open(p) {
+                    f.sync_all().map_err(|e| e.to_string())?;
+                }
+            }
+            let t0 = Instant::now();
+            let out = Command::new(&bins[b])
+                .args(args)
+                .output()
+                .map_err(|e| e.to_string())?;
+            v[b].push(t0.elapsed().as_secs_f64());
+            if !out.status.success() {
+                return Err(String::from_utf8_lossy(&out.stderr).into_owned());
+            }
+        }
+    }
+    Ok(v.into_iter()
+        .map(|mut v| {
+            v.sort_by(f64::total_cmp);
+            (v[v.len() / 2], v[0])
+        })
+        .collect())
+}
+
 /// Runs of each binary per row of [`whole_process`].
 const PROCESS_RUNS: usize = 21;
 
@@ -456,36 +496,13 @@ fn whole_process(keep: Option<&Path>) -> Result<(), String> {
         Path::to_path_buf,
     );
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    // `synced`: the output the run replaces is on the disk first (a rerun
-    // long after the last: deleting it frees its blocks), not only in the
-    // page cache as after the run before; per binary, (median, fastest)
-    let time_with = |args: &[&str], synced: Option<&Path>| -> Result<Vec<(f64, f64)>, String> {
-        let mut v = vec![Vec::with_capacity(PROCESS_RUNS); bins.len()];
-        for r in 0..PROCESS_RUNS {
-            for i in 0..bins.len() {
-                let b = (i + r) % bins.len();
-                if let Some(p) = synced {
-                    if let Ok(f) = std::fs::File::open(p) {
-                        f.sync_all().map_err(|e| e.to_string())?;
-                    }
-                }
-                let t0 = Instant::now();
-                let out = Command::new(&bins[b])
-                    .args(args)
-                    .output()
-                    .map_err(|e| e.to_string())?;
-                v[b].push(t0.elapsed().as_secs_f64() * 1e3);
-                if !out.status.success() {
-                    return Err(String::from_utf8_lossy(&out.stderr).into_owned());
-                }
-            }
-        }
-        Ok(v.into_iter()
-            .map(|mut v| {
-                v.sort_by(f64::total_cmp);
-                (v[v.len() / 2], v[0])
-            })
-            .collect())
+    // `synced`: see `time_processes`
+    let time_with = |args: &[&str], synced: Option<&Path>| {
+        time_processes(&bins, args, PROCESS_RUNS, synced).map(|v| {
+            v.into_iter()
+                .map(|(m, f)| (m * 1e3, f * 1e3))
+                .collect::<Vec<_>>()
+        })
     };
     let time = |args: &[&str]| time_with(args, None);
     // the binary's label on its rows when several are compared

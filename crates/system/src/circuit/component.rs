@@ -95,7 +95,11 @@ pub trait Component {
     /// The component's default initial state.
     fn initial_state(&self, _x: &mut [f64]) {}
 
-    /// Writes the efforts this component owns with [`Causality::Stored`](super::Causality::Stored).
+    /// Writes the efforts this component owns with
+    /// [`Causality::Stored`](super::Causality::Stored), from its own state and
+    /// the time; it may also add what depends on them alone into node
+    /// accumulators (a chamber's pressure force on the rod, a pump's flow).
+    /// The circuit zeroes the accumulators before the first `publish`.
     fn publish(&self, _t: f64, _x: &[f64], _w: &mut Wires) {}
 
     /// Computes flows and forces from the efforts at its ports and adds them

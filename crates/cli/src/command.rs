@@ -195,7 +195,7 @@ pub fn read_bytes(path: &Path) -> Result<Vec<u8>, CliError> {
 /// A command file read whole, as a run takes it.
 pub struct Table {
     /// The sample times \[s\] (the output times).
-    pub times: Vec<f64>,
+    pub times: std::sync::Arc<[f64]>,
     /// The command as a signal of time.
     pub signal: Signal,
     /// Samples outside ±1 (a normalised command; else 0).
@@ -230,8 +230,12 @@ fn table_of(file: &str, t: Vec<f64>, u: Vec<f64>, unit: CommandUnit) -> Result<T
     } else {
         (0, (0.0, f64::NAN))
     };
-    let times = t.clone();
     let signal = Signal::table(t, u).map_err(|e| CliError::Input(format!("{file}: {e}")))?;
+    // the output times are the table's own (shared, not copied)
+    let Signal::Table { time_s: times, .. } = &signal else {
+        return Err(CliError::Input(format!("{file}: not a table")));
+    };
+    let times = times.clone();
     Ok(Table {
         times,
         signal,

@@ -327,7 +327,7 @@ fn warn_clamped(file: &Path, outside: usize, peak: (f64, f64)) {
 /// The command of a run: a table read whole (and its times, the output
 /// times), or a long file streamed into a window.
 enum Input {
-    Table(Vec<f64>),
+    Table(std::sync::Arc<[f64]>),
     Stream(StreamedTable, command_stream::Chunks),
 }
 

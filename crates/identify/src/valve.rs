@@ -187,7 +187,7 @@ fn traces(rec: &Record, p: &Prepared, before: &[Vec<f64>], after: &[Vec<f64>]) -
         .zip(before.iter().zip(after))
         .map(|((ch, m), (b, a))| RecordTrace {
             source: rec.source.clone(),
-            t: p.t.clone(),
+            t: p.t.to_vec(),
             velocity: velocity.clone(),
             channel: ch.name().to_string(),
             measured: m.clone(),

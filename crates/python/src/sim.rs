@@ -58,7 +58,7 @@ pub fn command(t: &[f64], u: &[f64]) -> Outcome<Signal> {
             t.len()
         )));
     }
-    Signal::table(t.to_vec(), u.to_vec())
+    Signal::shared_table(t.into(), u.into())
         .map_err(|e| Failure::Input(format!("command (t, u): {e}")))
 }
 

@@ -5,6 +5,7 @@
 use crate::external::ExternalInput;
 use serde::{Deserialize, Serialize};
 use std::cell::Cell;
+use std::sync::Arc;
 pub use streamed::StreamedTable;
 use thiserror::Error;
 
@@ -94,12 +95,14 @@ pub enum Signal {
         t1_s: f64,
     },
     /// Samples with first-order hold (linear between samples), held constant
-    /// outside the sampled range.
+    /// outside the sampled range. The samples are shared, not copied, when
+    /// the signal is cloned (a circuit per thread, per parameter set or per
+    /// record simulation reads the same table).
     Table {
         /// Sample times, strictly increasing \[s\].
-        time_s: Vec<f64>,
+        time_s: Arc<[f64]>,
         /// Sample values.
-        value: Vec<f64>,
+        value: Arc<[f64]>,
     },
     /// A value the host sets between solver calls (an FMU's input), linear
     /// inside a step; see [`ExternalInput`]. Not part of rig or command
@@ -115,8 +118,16 @@ pub enum Signal {
 
 impl Signal {
     /// A table signal, checked: equal lengths, at least one sample, finite
-    /// values, strictly increasing times.
+    /// values, strictly increasing times. The samples are moved into shared
+    /// storage (one copy); [`Signal::shared_table`] takes samples already
+    /// shared.
     pub fn table(time_s: Vec<f64>, value: Vec<f64>) -> Result<Self, SignalError> {
+        Self::shared_table(time_s.into(), value.into())
+    }
+
+    /// [`Signal::table`] on samples already shared (another table's, a
+    /// record's column): no copy, the same checks.
+    pub fn shared_table(time_s: Arc<[f64]>, value: Arc<[f64]>) -> Result<Self, SignalError> {
         let s = Signal::Table { time_s, value };
         s.validate()?;
         Ok(s)
@@ -215,7 +226,7 @@ impl Signal {
                         why: "no samples".into(),
                     });
                 }
-                for (i, (t, v)) in time_s.iter().zip(value).enumerate() {
+                for (i, (t, v)) in time_s.iter().zip(value.iter()).enumerate() {
                     if !t.is_finite() || !v.is_finite() {
                         return Err(SignalError::Table {
                             row: i,
@@ -442,6 +453,35 @@ fn table_interval(time_s: &[f64], t: f64, from: usize) -> usize {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn a_cloned_table_shares_its_samples_and_a_shared_one_is_checked() {
+        let t: Arc<[f64]> = vec![0.0, 1.0, 2.0].into();
+        let u: Arc<[f64]> = vec![0.0, 1.0, 0.5].into();
+        let a = Signal::shared_table(t.clone(), u.clone()).unwrap();
+        let b = a.clone();
+        let (Signal::Table { time_s, value }, Signal::Table { time_s: t2, .. }) = (&a, &b) else {
+            panic!("not tables");
+        };
+        assert!(Arc::ptr_eq(time_s, &t) && Arc::ptr_eq(value, &u) && Arc::ptr_eq(t2, &t));
+        let h = Cell::new(0);
+        assert_eq!(b.value_hinted(1.5, &h), 0.75);
+        // the same checks as `table`
+        let back: Arc<[f64]> = vec![0.0, 2.0, 1.0].into();
+        assert!(matches!(
+            Signal::shared_table(back, u.clone()),
+            Err(SignalError::Table { row: 2, .. })
+        ));
+        let short: Arc<[f64]> = vec![0.0, 1.0].into();
+        assert!(Signal::shared_table(short, u).is_err());
+        // a table still reads and writes as JSON arrays
+        let json = serde_json::to_string(&a).unwrap();
+        assert_eq!(
+            json,
+            r#"{"kind":"table","time_s":[0.0,1.0,2.0],"value":[0.0,1.0,0.5]}"#
+        );
+        assert_eq!(serde_json::from_str::<Signal>(&json).unwrap(), a);
+    }
 
     #[test]
     fn a_held_table_interval_is_the_interpolation_bit_for_bit() {

@@ -44,8 +44,10 @@ pub struct BenchInputs {
 impl BenchInputs {
     /// The record's velocity, acceleration and pressures as input signals.
     pub fn of(s: &BenchSignals) -> Result<Self, String> {
+        // one copy of the times, shared by every input's table
+        let t: std::sync::Arc<[f64]> = s.t.as_slice().into();
         let table = |y: &[f64]| {
-            Signal::table(s.t.clone(), y.to_vec()).map_err(|e| format!("{}: {e}", s.source))
+            Signal::shared_table(t.clone(), y.into()).map_err(|e| format!("{}: {e}", s.source))
         };
         let signals = net::INPUTS
             .iter()

@@ -15,7 +15,7 @@ pub(super) const CHANNELS: [Signal; 4] =
 pub(super) struct Prepared {
     /// Relative tolerance of the simulations (looser while tracing).
     pub(super) rtol: f64,
-    pub(super) t: Vec<f64>,
+    pub(super) t: Arc<[f64]>,
     /// The run's input: the measured command (open loop) or the position
     /// reference (a closed-loop record, whose rig's controller computes the
     /// command).
@@ -208,7 +208,7 @@ pub(super) fn prepare(
             restarts,
             count: Default::default(),
             recent: Default::default(),
-            t,
+            t: t.into(),
             input: input.into(),
             closed,
             command0,
@@ -328,7 +328,7 @@ pub(super) fn simulate_prefix(
 /// the first `n` samples, before the sensor lag.
 fn run_prefix(rig: &Model, p: &Prepared, n: usize) -> Result<Vec<Vec<f64>>, String> {
     let t = &p.t[..n];
-    let cmd = CmdSignal::table(p.t.clone(), p.input.to_vec()).map_err(|e| e.to_string())?;
+    let cmd = CmdSignal::shared_table(p.t.clone(), p.input.clone()).map_err(|e| e.to_string())?;
     // only the compared channels: position and pressures are states,
     // read without evaluating the circuit at each sample
     let opts = RunOptions {
@@ -565,7 +565,7 @@ mod tests {
             }],
             count: Default::default(),
             recent: Default::default(),
-            t,
+            t: t.into(),
         };
         assert!(simulate(&m, &p).is_ok(), "the mass has x and v");
         let mut roles = (*m.roles).clone();

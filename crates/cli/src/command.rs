@@ -230,12 +230,10 @@ fn table_of(file: &str, t: Vec<f64>, u: Vec<f64>, unit: CommandUnit) -> Result<T
     } else {
         (0, (0.0, f64::NAN))
     };
-    let signal = Signal::table(t, u).map_err(|e| CliError::Input(format!("{file}: {e}")))?;
     // the output times are the table's own (shared, not copied)
-    let Signal::Table { time_s: times, .. } = &signal else {
-        return Err(CliError::Input(format!("{file}: not a table")));
-    };
-    let times = times.clone();
+    let times: std::sync::Arc<[f64]> = t.into();
+    let signal = Signal::shared_table(times.clone(), u.into())
+        .map_err(|e| CliError::Input(format!("{file}: {e}")))?;
     Ok(Table {
         times,
         signal,

@@ -386,7 +386,8 @@ pub fn valve_record_with(
     let t: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
     let u: Vec<f64> = t.iter().map(|&t| command(t)).collect();
     let late: Vec<f64> = t.iter().map(|&t| command((t - delay).max(0.0))).collect();
-    let cmd = hydrocyl_system::signal::Signal::table(t.clone(), late).map_err(|e| e.to_string())?;
+    let cmd = hydrocyl_system::signal::Signal::shared_table(t.as_slice().into(), late.into())
+        .map_err(|e| e.to_string())?;
     let run = truth
         .simulate(
             cmd,
@@ -499,7 +500,8 @@ pub fn netlist_record(
     let t: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
     let u: Vec<f64> = t.iter().map(|&t| command(t)).collect();
     let cmd =
-        hydrocyl_system::signal::Signal::table(t.clone(), u.clone()).map_err(|e| e.to_string())?;
+        hydrocyl_system::signal::Signal::shared_table(t.as_slice().into(), u.as_slice().into())
+            .map_err(|e| e.to_string())?;
     let run = hydrocyl_system::rig::simulate(
         truth,
         cmd,

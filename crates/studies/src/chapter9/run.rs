@@ -96,7 +96,7 @@ pub fn input(v: &Value, case: &Case, t: &[f64]) -> Result<Signal, RigError> {
     let period = case.period();
     if is_closed_loop(v) {
         let x0 = case.start();
-        let value = t
+        let value: std::sync::Arc<[f64]> = t
             .iter()
             .map(|&ti| {
                 let ph = ti.rem_euclid(period) / period;
@@ -104,7 +104,7 @@ pub fn input(v: &Value, case: &Case, t: &[f64]) -> Result<Signal, RigError> {
                 x0 + case.speed() * period * up
             })
             .collect();
-        return Signal::table(t.to_vec(), value).map_err(|e| RigError::Invalid {
+        return Signal::shared_table(t.into(), value).map_err(|e| RigError::Invalid {
             path: "reference".into(),
             why: e.to_string(),
         });

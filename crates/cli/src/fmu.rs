@@ -14,7 +14,7 @@
 
 use crate::error::CliError;
 use crate::output::Outputs;
-use hydrocyl_fmu::package::{find_library, write_fmu};
+use hydrocyl_fmu::package::{find_library, fmu_archive};
 use hydrocyl_system::rig;
 use std::path::{Path, PathBuf};
 
@@ -59,7 +59,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let Some(f) = &rig_file {
         inputs.push(("--rig", f.as_path()));
     }
-    Outputs::new(&inputs).check("--out", &out)?;
+    let mut outputs = Outputs::new(&inputs);
+    let file = outputs.file("--out", &out)?;
     let mut value = rig::load(&rig_arg).map_err(|e| input(&e))?;
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(|e| input(&e))?;
@@ -74,7 +75,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "rig".into())
     };
-    write_fmu(&value, &name, &library, &out).map_err(|e| input(&e))?;
+    let archive = fmu_archive(&value, &name, &library).map_err(|e| input(&e))?;
+    outputs.write(file, &archive)?;
+    // an FMU is flushed to the disk before it is put in place, as before
+    outputs.commit(true)?;
     eprintln!(
         "hydrocyl: wrote {} (rig {name}, library {})",
         out.display(),

@@ -13,6 +13,12 @@
 //! Without `--fsync` the new content reaches the disk when the kernel writes
 //! it back, as for any file written in place; with `--fsync` it is flushed
 //! before the swap.
+//!
+//! An output path that is a symbolic link is written through it, as a shell's
+//! `>` does: the file it points to is replaced, the link stays. A path that is
+//! a stream (`/dev/stdout`, a pipe, a terminal, a device) is written to
+//! directly, as it is produced: there is no file to put in place, and what a
+//! failed run has written to a stream cannot be taken back.
 
 use crate::error::CliError;
 use std::fs::File;
@@ -55,9 +61,12 @@ fn unregister(tmp: &Path) {
 }
 
 /// `path` made absolute and resolved through symbolic links as far as it
-/// exists (a file that does not exist yet: its folder's canonical path and
-/// its name).
+/// exists (a file that does not exist yet, or a link to one: its folder's
+/// canonical path and its name).
 fn canonical(path: &Path) -> PathBuf {
+    // a link that points nowhere yet: the file a write through it creates
+    let linked = through_links(path);
+    let path = linked.as_deref().unwrap_or(path);
     if let Ok(c) = path.canonicalize() {
         return c;
     }
@@ -73,9 +82,47 @@ fn canonical(path: &Path) -> PathBuf {
 
 /// One output file being written.
 struct Pending {
+    /// The path as given (for messages).
     path: PathBuf,
-    tmp: PathBuf,
+    /// Where it is put in place, with its temporary file beside it; `None`
+    /// for a stream, written directly.
+    place: Option<Place>,
     writer: Option<BufWriter<File>>,
+}
+
+/// A regular output file: `target` (the given path through its symbolic
+/// links) and the temporary `tmp` in its folder.
+struct Place {
+    target: PathBuf,
+    tmp: PathBuf,
+}
+
+/// Most symbolic links followed to an output's file (Linux's own limit).
+const MAX_LINKS: usize = 40;
+
+/// `path` through its symbolic links, to the file (existing or not) that a
+/// write through it creates or replaces.
+fn through_links(path: &Path) -> std::io::Result<PathBuf> {
+    let mut p = path.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        match p.symlink_metadata() {
+            Ok(m) if m.file_type().is_symlink() => {
+                let to = std::fs::read_link(&p)?;
+                p = match p.parent() {
+                    Some(dir) if to.is_relative() => dir.join(to),
+                    _ => to,
+                };
+            }
+            _ => return Ok(p),
+        }
+    }
+    Err(std::io::Error::other("too many levels of symbolic links"))
+}
+
+/// Whether `path` (through its links) is a stream: it exists and is neither
+/// a regular file nor a folder (a pipe, a terminal, a device).
+fn is_stream(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
 /// The output files of one command (see the module doc).
@@ -124,21 +171,33 @@ impl Outputs {
     }
 
     /// Opens output `path` (option `option`): checks it, then creates its
-    /// temporary file `.<name>.tmp<pid>` next to it, so that a missing or
-    /// read-only folder is reported before any computation.
+    /// temporary file `.<name>.tmp<pid>` next to the file it names (through
+    /// its symbolic links), so that a missing or read-only folder is
+    /// reported before any computation; a stream is opened for writing.
     pub fn file(&mut self, option: &str, path: &Path) -> Result<OutputId, CliError> {
         self.check(option, path)?;
-        let name = path.file_name().unwrap_or_default().to_string_lossy();
-        let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
-        remove_temporaries_on_signal();
-        let f = File::create(&tmp).map_err(|source| CliError::Io {
+        let io = |source| CliError::Io {
             path: format!("{option} {}", path.display()),
             source,
-        })?;
-        register(&tmp);
+        };
+        let (f, place) = if is_stream(path) {
+            let f = std::fs::OpenOptions::new()
+                .write(true)
+                .open(path)
+                .map_err(io)?;
+            (f, None)
+        } else {
+            let target = through_links(path).map_err(io)?;
+            let name = target.file_name().unwrap_or_default().to_string_lossy();
+            let tmp = target.with_file_name(format!(".{name}.tmp{}", std::process::id()));
+            remove_temporaries_on_signal();
+            let f = File::create(&tmp).map_err(io)?;
+            register(&tmp);
+            (f, Some(Place { target, tmp }))
+        };
         self.files.push(Pending {
             path: path.to_path_buf(),
-            tmp,
+            place,
             // small: a block of rows larger than this goes straight to the file
             writer: Some(BufWriter::with_capacity(1 << 16, f)),
         });
@@ -235,16 +294,20 @@ impl Outputs {
             }
         }
         // (file, swapped: its old content is now under its temporary's name)
-        let mut done: Vec<(&Pending, bool)> = Vec::new();
-        for f in &self.files {
-            match put_in_place(&f.tmp, &f.path) {
-                Ok(swapped) => done.push((f, swapped)),
+        let mut done: Vec<(&Place, bool)> = Vec::new();
+        for (f, p) in self
+            .files
+            .iter()
+            .filter_map(|f| f.place.as_ref().map(|p| (f, p)))
+        {
+            match put_in_place(&p.tmp, &p.target) {
+                Ok(swapped) => done.push((p, swapped)),
                 Err(source) => {
                     for (g, swapped) in &done {
                         // a swap undone puts the new content back under the
                         // temporary's name, which the drop removes
-                        if !(*swapped && exchange(&g.tmp, &g.path).is_ok()) {
-                            let _ = std::fs::remove_file(&g.path);
+                        if !(*swapped && exchange(&g.tmp, &g.target).is_ok()) {
+                            let _ = std::fs::remove_file(&g.target);
                         }
                     }
                     return Err(CliError::Io {
@@ -254,11 +317,11 @@ impl Outputs {
                 }
             }
         }
-        for (f, swapped) in done {
+        for (p, swapped) in done {
             if swapped {
-                let _ = std::fs::remove_file(&f.tmp);
+                let _ = std::fs::remove_file(&p.tmp);
             }
-            unregister(&f.tmp);
+            unregister(&p.tmp);
         }
         self.files.clear();
         Ok(())
@@ -297,8 +360,10 @@ impl Drop for Outputs {
     fn drop(&mut self) {
         for f in self.files.drain(..) {
             drop(f.writer);
-            let _ = std::fs::remove_file(&f.tmp);
-            unregister(&f.tmp);
+            if let Some(p) = f.place {
+                let _ = std::fs::remove_file(&p.tmp);
+                unregister(&p.tmp);
+            }
         }
     }
 }

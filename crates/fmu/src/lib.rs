@@ -10,7 +10,7 @@
 //! [`Signal::External`](hydrocyl_system::signal::Signal::External);
 //! `fmi2DoStep` integrates it with the rig's solvers
 //! (`hydrocyl_integrators`), events located inside the step. `hydrocyl fmu`
-//! only packages ([`package::write_fmu`]).
+//! only packages ([`package::fmu_archive`]).
 //!
 //! * [`variables`]: the variables (input `command`, one output per output
 //!   channel, `solver.*` and every rig parameter by its `--set` path);

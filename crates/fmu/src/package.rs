@@ -24,14 +24,9 @@ pub enum FmuError {
     /// The slave library is missing or is not one.
     #[error("{0}")]
     Library(String),
-    /// Writing the archive failed.
-    #[error("{path}: {why}")]
-    Write {
-        /// The file.
-        path: String,
-        /// What failed.
-        why: String,
-    },
+    /// Building the archive failed.
+    #[error("the FMU archive: {0}")]
+    Archive(String),
 }
 
 /// Where the slave library is: `explicit` (`--library`), else the file named
@@ -40,8 +35,13 @@ pub enum FmuError {
 /// `hydrocyl`; test binaries run from `target/<profile>/deps/`).
 pub fn find_library(explicit: Option<&Path>) -> Result<PathBuf, FmuError> {
     let missing = |p: &Path, how: &str| {
+        let what = if p.is_dir() {
+            "is a folder, not the library file (libhydrocyl_fmu.so)"
+        } else {
+            "does not exist"
+        };
         FmuError::Library(format!(
-            "the FMU library {} ({how}) does not exist: build it with `cargo build -p hydrocyl-fmu` (same profile as hydrocyl) or name it with --library / ${LIBRARY_ENV}",
+            "the FMU library {} ({how}) {what}: build it with `cargo build -p hydrocyl-fmu` (same profile as hydrocyl) or name it with --library / ${LIBRARY_ENV}",
             p.display()
         ))
     };
@@ -71,16 +71,11 @@ pub fn find_library(explicit: Option<&Path>) -> Result<PathBuf, FmuError> {
         .ok_or_else(|| missing(&candidates[0], "next to the hydrocyl executable"))
 }
 
-/// Writes the FMU of `rig` (already with its `--set` overrides) to `out`.
-/// `model_name` names the rig (preset name or file stem). The archive is
-/// written to a temporary file beside `out` and renamed into place, so a
-/// failure leaves no file.
-pub fn write_fmu(
-    rig: &Value,
-    model_name: &str,
-    library: &Path,
-    out: &Path,
-) -> Result<(), FmuError> {
+/// The FMU archive (a zip: the model description, the rig, the slave
+/// library) of `rig`, already with its `--set` overrides. `model_name` names
+/// the rig (preset name or file stem). The caller writes it where it goes
+/// (`hydrocyl fmu` through its outputs: a temporary file put in place).
+pub fn fmu_archive(rig: &Value, model_name: &str, library: &Path) -> Result<Vec<u8>, FmuError> {
     let vars = Variables::of(rig)?;
     let lib = std::fs::read(library)
         .map_err(|e| FmuError::Library(format!("{}: {e}", library.display())))?;
@@ -106,38 +101,18 @@ pub fn write_fmu(
         ("resources/rig.json".into(), rig_text.as_bytes()),
         (format!("binaries/linux64/{id}.so"), &lib),
     ];
-    let err = |why: String| FmuError::Write {
-        path: out.display().to_string(),
-        why,
-    };
-    let name = out
-        .file_name()
-        .ok_or_else(|| err("not a file name".into()))?;
-    let tmp = out.with_file_name(format!(
-        ".{}.tmp{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| -> Result<(), String> {
-        let file = std::fs::File::create(&tmp).map_err(|e| e.to_string())?;
-        let mut zip = zip::ZipWriter::new(file);
+    let zipped = (|| -> zip::result::ZipResult<Vec<u8>> {
+        let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
         let opts = zip::write::SimpleFileOptions::default()
             .compression_method(zip::CompressionMethod::Deflated)
             .unix_permissions(0o644);
         for (path, bytes) in &files {
-            zip.start_file(path.as_str(), opts)
-                .map_err(|e| e.to_string())?;
-            zip.write_all(bytes).map_err(|e| e.to_string())?;
+            zip.start_file(path.as_str(), opts)?;
+            zip.write_all(bytes)?;
         }
-        let file = zip.finish().map_err(|e| e.to_string())?;
-        file.sync_all().map_err(|e| e.to_string())?;
-        std::fs::rename(&tmp, out).map_err(|e| e.to_string())
+        Ok(zip.finish()?.into_inner())
     })();
-    if let Err(why) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(err(why));
-    }
-    Ok(())
+    zipped.map_err(|e| FmuError::Archive(e.to_string()))
 }
 
 fn contains(hay: &[u8], needle: &[u8]) -> bool {

@@ -62,6 +62,11 @@ pub struct Ledger {
     pub error: f64,
     /// `(Σ storage − stored_change_from_states)` as a fraction of `E_in` \[-\].
     pub storage_error: f64,
+    /// The components whose model form does not conserve energy
+    /// ([`Component::energy_consistent`](hydrocyl_system::Component::energy_consistent)):
+    /// with any here, `error` and `storage_error` measure the form, not the
+    /// bookkeeping or the integration, and need not be small.
+    pub not_energy_consistent: Vec<String>,
 }
 
 impl Ledger {
@@ -216,6 +221,11 @@ pub fn ledger(
         stored_change_from_states_j: from_states,
         error: (e_in - e_load - sum_loss - sum_sto) / e_in,
         storage_error: (sum_sto - from_states) / e_in,
+        not_energy_consistent: circuit
+            .components()
+            .filter(|c| !c.energy_consistent())
+            .map(|c| c.name().to_string())
+            .collect(),
     })
 }
 

@@ -77,6 +77,40 @@ mod closed_forms {
     }
 }
 
+mod model_forms {
+    use super::*;
+    use hydrocyl_system::signal::Signal;
+
+    /// The ledger of `preset` over 0.3 s of a half-open spool, at rtol 1e-9.
+    fn preset_ledger(preset: &str) -> hydrocyl_energy::ledger::Ledger {
+        let v = hydrocyl_system::rig::preset(preset).unwrap();
+        let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-3).collect();
+        let u = Signal::Constant { value: 0.5 };
+        let opts = RunOptions {
+            rtol: 1e-9,
+            ledger: true,
+            ..RunOptions::dp45()
+        };
+        let run = hydrocyl_system::rig::simulate(&v, u.clone(), &t, &opts).unwrap();
+        let mut c = hydrocyl_system::rig::circuit(&v, u).unwrap();
+        c.set_ledger(true);
+        ledger(&c, &run, 0, t.len() - 1, &RodSide::default()).unwrap()
+    }
+
+    #[test]
+    fn a_ledger_over_the_generalised_form_names_it_and_the_fundamental_closes() {
+        // the fundamental form closes to rounding and names no component
+        let fundamental = preset_ledger("leaney-moog");
+        assert!(fundamental.error.abs() < 1e-12, "{}", fundamental.error);
+        assert!(fundamental.not_energy_consistent.is_empty());
+        // the one-pressure form does not conserve energy (docs/models.md,
+        // section 3): its residual is the form's, and the ledger says whose
+        let generalised = preset_ledger("leaney-moog-generalised");
+        assert_eq!(generalised.not_energy_consistent, vec!["cylinder".to_string()]);
+        assert!(generalised.error.abs() > 1e-6, "{}", generalised.error);
+    }
+}
+
 mod bad_input {
     use super::*;
 

@@ -206,6 +206,15 @@ pub trait Component {
     /// Power bookkeeping at this instant (see [`PowerTerms`]).
     fn power(&self, _t: f64, _x: &[f64], _w: &Wires, _dx: &[f64], _p: &mut PowerTerms) {}
 
+    /// Whether the component's model conserves energy, so that its
+    /// [`Component::power`] terms balance its port powers. `false` for a
+    /// model form that does not (the generalised one-pressure cylinder of
+    /// eqs 2.16–2.26): an energy ledger over it then does not close, and says
+    /// which component is why.
+    fn energy_consistent(&self) -> bool {
+        true
+    }
+
     /// Number of extra quadratures this component asks for (integrated
     /// alongside the states when [`Circuit::set_quadratures`](super::Circuit::set_quadratures) is on).
     fn n_quadratures(&self) -> usize {

@@ -188,6 +188,11 @@ impl Component for GeneralisedCylinder {
         dx[0] =
             w.get(self.dp) + 4.0 * self.cylinder.bulk_modulus.si() / w.get(self.vte).si() * extra;
     }
+    /// The form takes `p1 + γ² p2 = X Ps` as instantaneous and conserves
+    /// neither chamber's mass on its own (docs/models.md, section 3).
+    fn energy_consistent(&self) -> bool {
+        false
+    }
     fn power(&self, _t: f64, x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         let s = self.state(x, w);
         p.dissipated = s.dissipated;

@@ -15,7 +15,7 @@ pub struct Args {
 /// Runs `hydrocyl components`.
 pub fn run(args: Args) -> Result<(), CliError> {
     match args.type_name {
-        None => print!("{}", registry::catalog_markdown()),
+        None => crate::console::print(&registry::catalog_markdown()),
         Some(name) => {
             let t = registry::lookup(&name).ok_or_else(|| {
                 CliError::Input(format!(
@@ -27,8 +27,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                         .join(", ")
                 ))
             })?;
-            print!("{}", registry::type_markdown(t));
+            crate::console::print(&registry::type_markdown(t))
         }
     }
-    Ok(())
 }

@@ -194,11 +194,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map_err(|e| CliError::Input(e.to_string()))?;
     for (p, r) in args.data.iter().zip(&records) {
         if r.len() < SMALL_SAMPLE && !args.quiet {
-            eprintln!(
+            crate::console::note(format_args!(
                 "hydrocyl: warning: {}: {} samples, fewer than {SMALL_SAMPLE}: the ± intervals assume many independent samples and are not to be trusted",
                 p.display(),
                 r.len()
-            );
+            ));
         }
     }
     let opts = DiagnoseOptions {
@@ -287,14 +287,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     written?;
     if !args.quiet {
-        print!("{}", report.human());
+        crate::console::print(&report.human())?;
         if let Some(dir) = &args.plots {
-            println!("plots: {} SVG files in {}", plots.len(), dir.display());
+            crate::console::print(&format!(
+                "plots: {} SVG files in {}\n",
+                plots.len(),
+                dir.display()
+            ))?;
         }
-        eprintln!(
+        crate::console::note(format_args!(
             "hydrocyl: diagnose took {:.2} s in all (reading, fitting, writing)",
             crate::progress::wall()
-        );
+        ));
     }
     Ok(())
 }

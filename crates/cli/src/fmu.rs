@@ -43,10 +43,11 @@ pub struct Args {
 /// Runs `hydrocyl fmu`.
 pub fn run(args: Args) -> Result<(), CliError> {
     if args.list_presets {
-        for p in rig::PRESETS {
-            println!("{}", p.name);
-        }
-        return Ok(());
+        let names: String = rig::PRESETS
+            .iter()
+            .map(|p| format!("{}\n", p.name))
+            .collect();
+        return crate::console::print(&names);
     }
     let (Some(rig_arg), Some(out)) = (args.rig, args.out) else {
         return Err(CliError::Input("--rig and --out are required".into()));
@@ -79,10 +80,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
     outputs.write(file, &archive)?;
     // an FMU is flushed to the disk before it is put in place, as before
     outputs.commit(true)?;
-    eprintln!(
+    crate::console::note(format_args!(
         "hydrocyl: wrote {} (rig {name}, library {})",
         out.display(),
         library.display()
-    );
+    ));
     Ok(())
 }

@@ -7,6 +7,7 @@ mod bench_sim;
 mod command;
 mod command_stream;
 mod components;
+mod console;
 mod diagnose;
 mod error;
 mod fmu;
@@ -88,7 +89,7 @@ fn main() {
     progress::mark("end");
     progress::print_marks();
     if let Err(e) = r {
-        eprintln!("hydrocyl: error: {e}");
+        console::note(format_args!("hydrocyl: error: {e}"));
         std::process::exit(2);
     }
 }

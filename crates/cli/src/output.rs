@@ -42,7 +42,7 @@ pub fn remove_temporaries_on_signal() {
                     let _ = std::fs::remove_file(f);
                 }
             }
-            eprintln!("hydrocyl: interrupted; no output written");
+            crate::console::note(format_args!("hydrocyl: interrupted; no output written"));
             std::process::exit(130);
         });
     });

@@ -60,8 +60,9 @@ pub fn run(_: Args) -> Result<(), CliError> {
     let list = all();
     let w = list.iter().map(|p| p.0.len()).max().unwrap_or(0);
     let k = list.iter().map(|p| p.1.len()).max().unwrap_or(0);
-    for (name, kind, what) in list {
-        println!("{name:w$}  {kind:k$}  {what}");
-    }
-    Ok(())
+    let lines: String = list
+        .into_iter()
+        .map(|(name, kind, what)| format!("{name:w$}  {kind:k$}  {what}\n"))
+        .collect();
+    crate::console::print(&lines)
 }

@@ -47,7 +47,10 @@ pub fn print_marks() {
     if let Some(Some(m)) = MARKS.get() {
         if let Ok(m) = m.lock() {
             for (label, thread, t) in m.iter() {
-                eprintln!("phase {:8.3} ms  [{thread}] {label}", t.as_secs_f64() * 1e3);
+                crate::console::note(format_args!(
+                    "phase {:8.3} ms  [{thread}] {label}",
+                    t.as_secs_f64() * 1e3
+                ));
             }
         }
     }

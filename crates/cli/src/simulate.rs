@@ -177,8 +177,7 @@ fn run_bench(
             .map_err(|e| CliError::Input(e.to_string()))?;
         let text = serde_json::to_string_pretty(&shown)
             .map_err(|e| CliError::Input(format!("rig: {e}")))?;
-        println!("{text}");
-        return Ok(());
+        return crate::console::print(&format!("{text}\n"));
     }
     let (Some(input), Some(out)) = (&args.command, &args.out) else {
         return Err(CliError::Input("--command and --out are required".into()));
@@ -188,11 +187,11 @@ fn run_bench(
     let text = crate::bench_sim::simulate(bench, input)?;
     outputs.write(id, text.as_bytes())?;
     outputs.commit(args.fsync)?;
-    eprintln!(
+    crate::console::note(format_args!(
         "hydrocyl: simulated the friction bench on {} samples of {}",
         text.lines().count() - 1,
         input.display()
-    );
+    ));
     Ok(())
 }
 
@@ -315,12 +314,12 @@ fn chamber_channel(name: &str) -> Option<&str> {
 /// stroke, so the valve acts on ±1.
 fn warn_clamped(file: &Path, outside: usize, peak: (f64, f64)) {
     if outside > 0 {
-        eprintln!(
+        crate::console::note(format_args!(
             "hydrocyl: warning: {}: {outside} command samples outside ±1 (largest {} at t = {} s); the valve clamps them to ±1 (the spool's stroke)",
             file.display(),
             peak.0,
             peak.1
-        );
+        ));
     }
 }
 
@@ -388,8 +387,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         };
         let text = serde_json::to_string_pretty(&shown)
             .map_err(|e| CliError::Input(format!("rig: {e}")))?;
-        println!("{text}");
-        return Ok(());
+        return crate::console::print(&format!("{text}\n"));
     }
     let solver = Solver::parse(&args.solver).ok_or_else(|| {
         CliError::Input(format!(

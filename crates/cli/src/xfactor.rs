@@ -9,8 +9,6 @@
 //! 1.0 1.0
 //! ```
 
-use std::io::Write as _;
-
 use crate::error::CliError;
 
 /// Arguments of `hydrocyl xfactor`.
@@ -76,11 +74,5 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
         lines.push_str(&format!("{t:?} {x:?}\n"));
     }
-    let mut out = std::io::stdout().lock();
-    out.write_all(lines.as_bytes())
-        .and_then(|()| out.flush())
-        .map_err(|source| CliError::Io {
-            path: "<stdout>".into(),
-            source,
-        })
+    crate::console::print(&lines)
 }

@@ -742,3 +742,63 @@ fn a_long_command_file_read_in_halves_is_the_same_samples() {
         );
     }
 }
+
+/// An output path that is a symbolic link is written through it, as a
+/// shell's `>` does: the file it points to gets the run, the link stays a
+/// link (also one that points to a file not there yet); a stream
+/// (`/dev/stdout`) is written to directly.
+#[test]
+#[cfg(unix)]
+fn an_output_link_is_written_through_and_a_stream_is_written_to() {
+    let dir = tempfile::tempdir().unwrap();
+    let cmd = write_command(dir.path(), "cmd.csv", &square(50, 1e-3));
+    let target = dir.path().join("target.csv");
+    std::fs::write(&target, "old content\n").unwrap();
+    let link = dir.path().join("out.csv");
+    std::os::unix::fs::symlink("target.csv", &link).unwrap();
+    simulate_ok("leaney-moog", &cmd, &link, &[]);
+    assert!(link.symlink_metadata().unwrap().file_type().is_symlink());
+    let written = std::fs::read_to_string(&target).unwrap();
+    assert!(written.starts_with("time [s],command"), "{written}");
+    assert_eq!(written.lines().count(), 51);
+    // a link to a file that does not exist yet creates it
+    let dangling = dir.path().join("later.csv");
+    std::os::unix::fs::symlink("new.csv", &dangling).unwrap();
+    simulate_ok("leaney-moog", &cmd, &dangling, &[]);
+    assert!(dangling.symlink_metadata().unwrap().file_type().is_symlink());
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("new.csv")).unwrap(),
+        written
+    );
+    assert!(temporaries(dir.path()).is_empty());
+    // the run's rows on standard output
+    let st = simulate_ok("leaney-moog", &cmd, Path::new("/dev/stdout"), &["--quiet"]);
+    assert_eq!(String::from_utf8_lossy(&st.stdout), written);
+}
+
+/// A closed standard output (`hydrocyl presets | true`) is an error naming
+/// `<stdout>`, exit code 2, never a panic.
+#[test]
+fn a_closed_standard_output_is_an_error_not_a_panic() {
+    for args in [
+        &["components"][..],
+        &["simulate", "--rig", "leaney-moog", "--print-rig"][..],
+    ] {
+        let mut child = hydrocyl()
+            .args(args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // the reading end closes before the child writes
+        drop(child.stdout.take());
+        let st = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&st.stderr);
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(st.status.code() == Some(2) || st.status.success(), "{args:?}: {err}");
+        if st.status.code() == Some(2) {
+            assert!(err.contains("<stdout>"), "{args:?}: {err}");
+            assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        }
+    }
+}

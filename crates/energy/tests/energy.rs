@@ -106,7 +106,10 @@ mod model_forms {
         // the one-pressure form does not conserve energy (docs/models.md,
         // section 3): its residual is the form's, and the ledger says whose
         let generalised = preset_ledger("leaney-moog-generalised");
-        assert_eq!(generalised.not_energy_consistent, vec!["cylinder".to_string()]);
+        assert_eq!(
+            generalised.not_energy_consistent,
+            vec!["cylinder".to_string()]
+        );
         assert!(generalised.error.abs() > 1e-6, "{}", generalised.error);
     }
 }

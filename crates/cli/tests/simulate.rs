@@ -765,7 +765,11 @@ fn an_output_link_is_written_through_and_a_stream_is_written_to() {
     let dangling = dir.path().join("later.csv");
     std::os::unix::fs::symlink("new.csv", &dangling).unwrap();
     simulate_ok("leaney-moog", &cmd, &dangling, &[]);
-    assert!(dangling.symlink_metadata().unwrap().file_type().is_symlink());
+    assert!(dangling
+        .symlink_metadata()
+        .unwrap()
+        .file_type()
+        .is_symlink());
     assert_eq!(
         std::fs::read_to_string(dir.path().join("new.csv")).unwrap(),
         written
@@ -795,7 +799,10 @@ fn a_closed_standard_output_is_an_error_not_a_panic() {
         let st = child.wait_with_output().unwrap();
         let err = String::from_utf8_lossy(&st.stderr);
         assert!(!err.contains("panicked"), "{args:?}: {err}");
-        assert!(st.status.code() == Some(2) || st.status.success(), "{args:?}: {err}");
+        assert!(
+            st.status.code() == Some(2) || st.status.success(),
+            "{args:?}: {err}"
+        );
         if st.status.code() == Some(2) {
             assert!(err.contains("<stdout>"), "{args:?}: {err}");
             assert_eq!(err.lines().count(), 1, "{args:?}: {err}");

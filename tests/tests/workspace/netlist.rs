@@ -528,6 +528,49 @@ fn bad_netlists_are_refused_by_path() {
             &|v| v["outputs"]["p3"] = "cylinder.p3".into(),
             &["outputs.p3", "no output `p3`"],
         ),
+        (
+            // the piston cannot pass the cylinder's head (stroke 0.52 m)
+            "an end stop beyond the stroke",
+            &|v| v["components"]["load"]["stop_max"] = 0.5.into(),
+            &[
+                "components.load.stop_max",
+                "beyond the end of the stroke of components.cylinder",
+                "0.26 m",
+            ],
+        ),
+        (
+            // a second cylinder on the rod whose initial position contradicts
+            // the first's
+            "two cylinders on one rod starting apart",
+            &|v| {
+                let mut damper = v["components"]["cylinder"].clone();
+                damper["initial"] = serde_json::json!({"p1": 0.0, "p2": 0.0, "position": 0.1});
+                v["components"]["damper"] = damper;
+                v["components"]["cylinder"]["initial"]["position"] = 0.0.into();
+                let drain = serde_json::json!(
+                    {"type": "orifice", "area": 2.0e-6, "cd": 0.65, "density": 870.0}
+                );
+                v["components"]["drain_a"] = drain.clone();
+                v["components"]["drain_b"] = drain;
+                let connections = v["connections"].as_array_mut().unwrap();
+                for c in connections.iter_mut() {
+                    let joins = |port: &str| c.as_array().unwrap().iter().any(|e| e == port);
+                    if joins("cylinder.rod") {
+                        c.as_array_mut().unwrap().push("damper.rod".into());
+                    } else if joins("tank.port") {
+                        c.as_array_mut().unwrap().push("drain_a.b".into());
+                        c.as_array_mut().unwrap().push("drain_b.b".into());
+                    }
+                }
+                connections.push(serde_json::json!(["damper.A", "drain_a.a"]));
+                connections.push(serde_json::json!(["damper.B", "drain_b.a"]));
+            },
+            &[
+                "components.damper.initial.position",
+                "differs from components.cylinder.initial.position",
+                "give it on one of them",
+            ],
+        ),
     ];
     assert_refused(&base, cases);
 }

@@ -682,18 +682,37 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
         }
     }
 
-    // hints to the owners of nodes
-    let mut hints = Vec::new();
+    // hints to the owners of nodes; several components hinting one node (two
+    // cylinders on one rod) combine: the end stops to the travel both allow,
+    // anything else must agree
+    let mut hints: BTreeMap<(String, &str), (f64, String)> = BTreeMap::new();
     for inst in &instances {
         if let Some(h) = inst.ty.hints {
             for (port, key, value) in h(inst) {
-                if let Some(node) = inst.nodes.get(port) {
-                    hints.push((node.clone(), key, value, inst.name.clone()));
+                let Some(node) = inst.nodes.get(port) else {
+                    continue;
+                };
+                let from = inst.name.clone();
+                match hints.get_mut(&(node.clone(), key)) {
+                    None => {
+                        hints.insert((node.clone(), key), (value, from));
+                    }
+                    Some((v, _)) if key == "stop_min" => *v = v.max(value),
+                    Some((v, _)) if key == "stop_max" => *v = v.min(value),
+                    Some((v, _)) if *v == value => {}
+                    Some((v, first)) => {
+                        return err(
+                            format!("components.{from}.{key}"),
+                            format!(
+                                "{value} differs from components.{first}.{key} = {v}, and both are on node `{node}`: give it on one of them"
+                            ),
+                        )
+                    }
                 }
             }
         }
     }
-    for (node, key, value, from) in hints {
+    for ((node, key), (value, from)) in hints {
         for inst in instances.iter_mut() {
             let owned: Vec<String> = inst
                 .nodes

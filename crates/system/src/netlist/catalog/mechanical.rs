@@ -243,6 +243,23 @@ pub const TYPES: &[ComponentType] = &[
             StateSpec { name: "velocity", unit: "m/s", default: Absent, doc: "initial velocity (default 0 or the cylinder's)" },
         ],
         build: |i| {
+            // stops of its own lie inside the travel a cylinder on the rod
+            // allows: the piston cannot pass the cylinder's heads
+            for (key, beyond) in [("stop_min", -1.0), ("stop_max", 1.0)] {
+                if let (Some(own), Some(end)) = (i.opt(key), i.hint("rod", key)) {
+                    if beyond * (own - end) > 0.0 {
+                        let cylinder = i.hint_path("rod", key).unwrap_or_default();
+                        let cylinder = cylinder.trim_end_matches(&format!(".{key}"));
+                        let why = format!(
+                            "{own} m is beyond the end of the stroke of {cylinder} ({end} m from mid-stroke): the piston cannot pass the cylinder's head; give a stop inside the stroke or leave it out"
+                        );
+                        return Err(crate::netlist::registry::error_at(
+                            &format!("components.{}.{key}", i.name),
+                            &why,
+                        ));
+                    }
+                }
+            }
             let lo = i.opt("stop_min").or_else(|| i.hint("rod", "stop_min"));
             let hi = i.opt("stop_max").or_else(|| i.hint("rod", "stop_max"));
             let stops = match (lo, hi) {

@@ -27,6 +27,9 @@ pub enum CommandUnit {
     /// A position set-point \[m\] (closed-loop rigs, whose controller makes
     /// the command): `reference`, `reference [m]` or `reference [mm]`.
     Reference,
+    /// An imposed velocity \[m/s\] (a friction bench's drive): `command`,
+    /// `command [m/s]` or `command [mm/s]`.
+    Velocity,
 }
 
 impl CommandUnit {
@@ -36,6 +39,7 @@ impl CommandUnit {
             CommandUnit::Normalised => "-",
             CommandUnit::Volt => "V",
             CommandUnit::Reference => "m",
+            CommandUnit::Velocity => "m/s",
         }
     }
 
@@ -57,6 +61,8 @@ impl CommandUnit {
             (CommandUnit::Volt, Some("mV")) => Some(1e-3),
             (CommandUnit::Reference, Some("m")) => Some(1.0),
             (CommandUnit::Reference, Some("mm")) => Some(1e-3),
+            (CommandUnit::Velocity, Some("m/s")) => Some(1.0),
+            (CommandUnit::Velocity, Some("mm/s")) => Some(1e-3),
             _ => None,
         }
     }
@@ -66,6 +72,7 @@ impl CommandUnit {
             CommandUnit::Normalised => "-, 1 or % (a normalised spool demand)",
             CommandUnit::Volt => "V or mV (a drive voltage)",
             CommandUnit::Reference => "m or mm (a position set-point)",
+            CommandUnit::Velocity => "m/s or mm/s (the rod velocity the drive imposes)",
         }
     }
 }

@@ -62,6 +62,7 @@ pub const COLUMNS_HELP: &str = "\
 Output columns (one row per command sample; the header gives each unit, e.g. `position [m]`):
   time [s]            the command file's times
   command [-] or [V]  the command as read (normalised spool demand; pump drive voltage)
+  reference [m]       a closed-loop rig's position set-point (its `command` is the controller's output)
   position [m]        rod position from mid-stroke       velocity [m/s]  rod velocity (+ extends)
   p1, p2 [Pa]         cap-side and rod-side chamber pressures, gauge
   spool [m]           valve spool position               ps [Pa]   supply pressure at the valve
@@ -70,6 +71,7 @@ Output columns (one row per command sample; the header gives each unit, e.g. `po
   pump rigs:  pump_flow [m^3/s] pump flow; pp1, pp2 [Pa] pressures at the pump's ports (lines 1 and 2);
               relief_*_flow, check_*_flow, return_flow_* [m^3/s] flows through those valves;
               pilot_spool [m] the pilot-operated return valve's spool
+  benches:    the input is the imposed `command` velocity [m/s]; force [N] the load cell's
   netlists:   any other column is a component's probe, `<component>.<probe>` (see `hydrocyl components`)";
 
 /// Arguments of `hydrocyl simulate`.
@@ -145,18 +147,12 @@ const WINDOW: usize = 1 << 18;
 
 /// The CSV header of a run: `time [s]`, then each channel as `name [unit]`
 /// (the in-memory channel names stay bare; the readers take both forms).
-pub fn column_headers(run: &Run, command: CommandUnit) -> Vec<String> {
+/// The run's input is in the unit its readers take it in
+/// ([`hydrocyl_system::Circuit::set_probe_unit`]).
+pub fn column_headers(run: &Run) -> Vec<String> {
     std::iter::once("time [s]".to_string())
         .chain(run.channels.iter().map(|c| {
-            if c.name == "command" {
-                // a closed-loop rig's command is its controller's output,
-                // a normalised spool demand
-                let unit = match command {
-                    CommandUnit::Reference => CommandUnit::Normalised,
-                    u => u,
-                };
-                format!("command [{}]", unit.symbol())
-            } else if c.unit.is_empty() {
+            if c.unit.is_empty() {
                 c.name.clone()
             } else {
                 format!("{} [{}]", c.name, c.unit)
@@ -197,11 +193,13 @@ fn run_bench(
 
 /// The unit of a rig's input, from the netlist (the port that reads it,
 /// [`crate::rigfile::Checked::input_unit`]): the position set-point of a
-/// closed-loop rig, a pump drive's voltage, else a normalised spool demand.
+/// closed-loop rig, a pump drive's voltage, a bench drive's imposed velocity,
+/// else a normalised spool demand.
 fn command_unit(rig: &crate::rigfile::Checked) -> CommandUnit {
     match rig.input_unit() {
         Some("m") => CommandUnit::Reference,
         Some("V") => CommandUnit::Volt,
+        Some("m/s") => CommandUnit::Velocity,
         _ => CommandUnit::Normalised,
     }
 }
@@ -527,7 +525,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let (streamed, written) = match (table, &input) {
         (Some((reader, t0)), Input::Table(times)) if sim.circuit().history_free() => {
             w.rows(Rows::States {
-                unit,
                 solver,
                 rk4_step: args.rk4_step,
             });
@@ -571,7 +568,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 let mut sink = |block: &Run| -> Result<(), String> {
                     let r = check_solution(block, solver, args.rk4_step).and_then(|()| {
                         if !w.has_rows() {
-                            let mut header = column_headers(block, unit).join(",").into_bytes();
+                            let mut header = column_headers(block).join(",").into_bytes();
                             header.push(b'\n');
                             w.rows(Rows::Channels(header));
                         }

@@ -7,7 +7,6 @@
 //! row, and the bytes are those of one thread formatting every block in
 //! turn (a piece depends on its block alone).
 
-use crate::command::CommandUnit;
 use crate::error::CliError;
 use crate::output::{OutputId, Outputs};
 use hydrocyl_system::run::{ProbeReader, Run, Solver};
@@ -43,8 +42,6 @@ pub enum Rows {
     /// (made by [`Maker::states`]), checks the solution and makes the header
     /// from the first block.
     States {
-        /// The rig's input unit (for the header).
-        unit: CommandUnit,
         /// The method, for the remedy of an unstable solution.
         solver: Solver,
         /// rk4's step, for the same.
@@ -90,22 +87,13 @@ impl Maker {
                 hydrocyl_identify::plaincsv::append_rows(&columns, out);
                 Ok(f64::INFINITY)
             }
-            (
-                Rows::States {
-                    unit,
-                    solver,
-                    rk4_step,
-                },
-                Some(r),
-            ) => {
+            (Rows::States { solver, rk4_step }, Some(r)) => {
                 let run = &mut self.run;
                 r.read_channels(&block.time, &block.values, run);
                 crate::simulate::check_solution(run, *solver, *rk4_step)?;
                 if seq == 0 {
                     out.extend_from_slice(
-                        crate::simulate::column_headers(run, *unit)
-                            .join(",")
-                            .as_bytes(),
+                        crate::simulate::column_headers(run).join(",").as_bytes(),
                     );
                     out.push(b'\n');
                 }

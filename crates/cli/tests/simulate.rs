@@ -809,3 +809,50 @@ fn a_closed_standard_output_is_an_error_not_a_panic() {
         }
     }
 }
+
+/// The input column is read and written in the unit its rig takes it in: a
+/// bench drive's imposed velocity in m/s or mm/s (a spool demand's % is
+/// refused), a closed-loop rig's set-point in m, so that its output reads
+/// back as a command file.
+#[test]
+fn the_input_column_is_in_the_unit_of_its_rig() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let out = dir.path().join("out.csv");
+    let m_s = write("m_s.csv", "time,command [m/s]\n0,0\n0.1,0.05\n");
+    let mm_s = write("mm_s.csv", "time,command [mm/s]\n0,0\n0.1,50\n");
+    simulate_ok("emps", &m_s, &out, &["--quiet"]);
+    let in_m_s = std::fs::read_to_string(&out).unwrap();
+    simulate_ok("emps", &mm_s, &out, &["--quiet"]);
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), in_m_s);
+    let percent = write("percent.csv", "time,command [%]\n0,0\n0.1,50\n");
+    let st = hydrocyl()
+        .args(["simulate", "--rig", "emps", "--command"])
+        .arg(&percent)
+        .arg("--out")
+        .arg(dir.path().join("none.csv"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert_eq!(st.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("row 1, column `command [%]`") && err.contains("m/s"),
+        "{err}"
+    );
+    assert!(!dir.path().join("none.csv").exists());
+    // the closed-loop set-point: written in m, read back as the same run
+    let mm = write("mm.csv", "time,reference [mm]\n0,0\n0.1,20\n");
+    let first = dir.path().join("first.csv");
+    simulate_ok("leaney-moog-closed-loop", &mm, &first, &["--quiet"]);
+    let text = std::fs::read_to_string(&first).unwrap();
+    assert!(
+        text.lines().next().unwrap().contains("reference [m]"),
+        "{text}"
+    );
+    simulate_ok("leaney-moog-closed-loop", &first, &out, &["--quiet"]);
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), text);
+}

@@ -92,6 +92,9 @@ pub struct Circuit {
     /// wire index.
     publisher: Vec<Option<usize>>,
     probe_names: Option<Vec<Option<String>>>,
+    /// Units given to probes by [`Circuit::set_probe_unit`]:
+    /// `(component, probe, unit)`.
+    probe_units: Vec<(String, String, &'static str)>,
     /// Every component has tangents and the analytic Jacobian is wanted.
     analytic: bool,
     tangents: RefCell<Tangents>,
@@ -199,6 +202,7 @@ impl Circuit {
             wire_names: net.names,
             publisher,
             probe_names: None,
+            probe_units: Vec::new(),
             analytic,
             tangents: RefCell::new(Tangents::default()),
             filled: RefCell::new(FillKey::default()),
@@ -315,9 +319,21 @@ impl Circuit {
     }
 
     /// The probes of every component, in component order, under the names
-    /// given by [`Circuit::name_probes`] (if it was called).
+    /// given by [`Circuit::name_probes`] (if it was called), in the units
+    /// given by [`Circuit::set_probe_unit`].
     pub fn probes(&self) -> Vec<Probe> {
-        let all = self.comps.iter().flat_map(|c| c.probes());
+        let all = self.comps.iter().flat_map(|c| {
+            c.probes().into_iter().map(move |mut p| {
+                if let Some((_, _, u)) = self
+                    .probe_units
+                    .iter()
+                    .find(|(comp, probe, _)| comp == c.name() && *probe == p.name)
+                {
+                    p.unit = u;
+                }
+                p
+            })
+        });
         match &self.probe_names {
             None => all.collect(),
             Some(names) => all
@@ -346,6 +362,17 @@ impl Circuit {
             })
             .collect();
         self.probe_names = Some(names);
+    }
+
+    /// Gives probe `probe` of component `component` the unit `unit`: a
+    /// signal's probe is read in the unit of what the signal means where it
+    /// is used (a command input feeding a position controller's set-point
+    /// is in m), which its wire (a bare signal) cannot say.
+    pub fn set_probe_unit(&mut self, component: &str, probe: &str, unit: &'static str) {
+        self.probe_units
+            .retain(|(c, p, _)| !(c == component && p == probe));
+        self.probe_units
+            .push((component.to_string(), probe.to_string(), unit));
     }
 
     /// Diagnostics of every component, names prefixed by the component's;

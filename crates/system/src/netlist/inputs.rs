@@ -43,14 +43,18 @@ impl Schematic {
 
     /// The unit in which the components reading the input take it, from the
     /// reading port's declaration (`… [V]` for a pump drive, `… [m]` for a
-    /// position controller's set-point, `… [-]` for a spool demand); `None`
-    /// when the netlist has not exactly one input, nothing reads it on a
-    /// signal node, or the reading port names no unit.
+    /// position controller's set-point, `… [-]` for a spool demand), or the
+    /// imposed velocity's m/s of a bench drive; `None` when the netlist has
+    /// not exactly one input, nothing reads it on a signal node, or the
+    /// reading port names no unit.
     pub fn input_unit(&self) -> Option<&'static str> {
         let mut inputs = self.inputs();
         let (input, None) = (inputs.next()?, inputs.next()) else {
             return None;
         };
+        if input.ty.name == "imposed_motion" {
+            return Some("m/s");
+        }
         let (_, ports) = self.nodes.get(input.nodes.get("out")?)?;
         ports
             .iter()
@@ -86,7 +90,7 @@ mod tests {
         // the friction bench's drive takes the velocity; it shows no command
         let s = schematic("emps");
         assert_eq!(s.inputs().count(), 1);
-        assert_eq!((s.input_channel(), s.input_unit()), (None, None));
+        assert_eq!((s.input_channel(), s.input_unit()), (None, Some("m/s")));
     }
 
     /// Two inputs, each driving its own first-order spool: each spool

@@ -108,6 +108,38 @@ fn assert_one_line_error(r: (Option<i32>, String, bool), must: &[&str]) {
     }
 }
 
+/// A smoother half-width wider than the record is refused, not clamped:
+/// on a friction bench and on the valve rig.
+#[test]
+fn a_window_wider_than_the_record_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("short.csv");
+    std::fs::write(&data, good_csv()).unwrap();
+    let valve = fixtures().join("valve-internal_leakage.csv");
+    for (rig, data, most) in [
+        (fixtures().join("bench-none.rig.json"), data, "at most 199"),
+        (PathBuf::from("leaney-moog"), valve, "at most 999"),
+    ] {
+        let report = dir.path().join("report.json");
+        let out = bin()
+            .args(["diagnose", "--rig"])
+            .arg(&rig)
+            .arg("--data")
+            .arg(&data)
+            .arg("--report")
+            .arg(&report)
+            .args(["--window", "100000"])
+            .output()
+            .unwrap();
+        let r = (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+            report.exists(),
+        );
+        assert_one_line_error(r, &["half-width (window) of 100000", most]);
+    }
+}
+
 #[test]
 fn missing_force_column_is_named() {
     let csv = good_csv()

@@ -179,6 +179,16 @@ pub enum DataError {
         /// The signal.
         signal: String,
     },
+    /// The smoother half-width asked for is wider than the record allows.
+    #[error("{file}: a smoother half-width (window) of {half_window} samples does not fit its {samples} samples: at most {max}", max = samples.saturating_sub(1) / 2)]
+    WindowTooWide {
+        /// The record.
+        file: String,
+        /// The half-width asked for.
+        half_window: usize,
+        /// The record's samples.
+        samples: usize,
+    },
     /// A cell is not a number.
     #[error("{file}: row {row}, column '{column}': '{text}' is not a number")]
     NotANumber {

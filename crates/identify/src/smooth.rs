@@ -240,6 +240,23 @@ fn apply(w: &Weights, y: &[f64]) -> (f64, f64, f64) {
     a
 }
 
+/// Checks a half-width asked for against record `rec`: a window of
+/// `2 h + 1` samples inside it, never clamped silently.
+pub fn check_half_window(
+    rec: &crate::data::Record,
+    h: usize,
+) -> Result<(), crate::data::DataError> {
+    let samples = rec.time.len();
+    if h == 0 || 2 * h + 1 > samples {
+        return Err(crate::data::DataError::WindowTooWide {
+            file: rec.source.clone(),
+            half_window: h,
+            samples,
+        });
+    }
+    Ok(())
+}
+
 /// Smooths with a given half-width (`criterion = "fixed"`).
 pub fn smooth_with(t: &[f64], y: &[f64], half_window: usize, order: usize) -> Smoothed {
     smooth_fixed(t, y, half_window, order).0

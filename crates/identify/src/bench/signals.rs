@@ -64,6 +64,9 @@ pub fn bench_signals(
             info,
         ));
     }
+    if let Some(h) = half_window {
+        crate::smooth::check_half_window(rec, h)?;
+    }
     let (x, v, a, info) = if let Some(x) = rec.get(Signal::Position) {
         let s = match half_window {
             Some(h) => crate::smooth::smooth_with(&t, x, h, 3),

@@ -942,3 +942,29 @@ fn variant_files_run_through_the_rig_facade() {
     }
     assert_eq!(found, 4);
 }
+
+/// A parameter spelled flat in the file (`"orifice.cd": 0.625` instead of
+/// `"orifice": {"cd": 0.625}`) stays given once: `--print-rig`'s netlist
+/// reads back, and `--set` changes it where it is.
+#[test]
+fn a_flat_spelled_parameter_prints_and_sets_where_it_is() {
+    let mut v = load("fixtures/rigs/leaney-moog.json");
+    let valve = v["components"]["valve"].as_object_mut().unwrap();
+    let cd = valve["orifice"]
+        .as_object_mut()
+        .unwrap()
+        .remove("cd")
+        .unwrap();
+    valve.insert("orifice.cd".into(), cd);
+    rig::check(&v).unwrap();
+    let shown = hydrocyl_system::netlist::expanded(&v).unwrap();
+    rig::check(&shown).unwrap();
+    assert_eq!(shown["components"]["valve"]["orifice.cd"], 0.625);
+    assert!(shown["components"]["valve"]["orifice"].get("cd").is_none());
+    rig::apply_set(&mut v, "valve.orifice.cd=0.6").unwrap();
+    rig::check(&v).unwrap();
+    assert_eq!(v["components"]["valve"]["orifice.cd"], 0.6);
+    let p = rig::parameters(&v);
+    let cd = p.iter().find(|p| p.path == "valve.orifice.cd").unwrap();
+    assert_eq!(cd.value, Some(0.6));
+}

@@ -358,8 +358,24 @@ impl Instance {
     }
 }
 
-/// Inserts `value` at dotted `path` in a JSON object, creating objects.
+/// Inserts `value` at dotted `path` in a JSON object, creating objects. A
+/// key spelled flat in the object (`"orifice.cd"`, or `"orifice.x"` holding
+/// `{"cd": …}`) is followed as it is spelled, so that the parameter stays
+/// given once.
 pub(crate) fn insert_path(root: &mut Map<String, Value>, path: &str, value: Value) {
+    if root.contains_key(path) {
+        root.insert(path.to_string(), value);
+        return;
+    }
+    let flat_head = path
+        .match_indices('.')
+        .map(|(i, _)| i)
+        .find(|&i| root.get(&path[..i]).is_some_and(Value::is_object) && path[..i].contains('.'));
+    if let Some(i) = flat_head {
+        if let Some(Value::Object(m)) = root.get_mut(&path[..i]) {
+            return insert_path(m, &path[i + 1..], value);
+        }
+    }
     match path.split_once('.') {
         None => {
             root.insert(path.to_string(), value);

@@ -493,7 +493,7 @@ fn parse_samples(
             })?;
             if !v.is_finite() {
                 return Err(CliError::Input(format!(
-                    "{file}: row {row}, column `{col}`: {v} is not finite"
+                    "{file}: row {row}, column `{col}`: `{s}` is not a finite number"
                 )));
             }
             Ok(v)

@@ -38,13 +38,13 @@ pub struct Args {
     #[arg(long)]
     pub plots: Option<PathBuf>,
     /// Least share of the residual an effect must explain to be added.
-    #[arg(long, default_value_t = 0.03)]
+    #[arg(long, default_value_t = 0.03, allow_negative_numbers = true)]
     pub min_share: f64,
     /// Share at the end of each record held out from the tracing fit.
-    #[arg(long, default_value_t = 0.3)]
+    #[arg(long, default_value_t = 0.3, allow_negative_numbers = true)]
     pub holdout: f64,
     /// Smoother half-width in samples (default: chosen by GCV).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub window: Option<usize>,
     /// Restrict the effects the loop may add (comma separated catalog ids).
     #[arg(long, value_delimiter = ',')]

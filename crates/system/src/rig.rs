@@ -402,6 +402,13 @@ pub fn apply_set(rig: &mut Value, assignment: &str) -> Result<(), RigError> {
             why: "an override is `path=value`".into(),
         })?;
     let path = path.trim();
+    // `1e400`, `inf`, `NaN`: a number, but not one a rig can hold
+    if text.trim().parse::<f64>().is_ok_and(|x| !x.is_finite()) {
+        return Err(RigError::Invalid {
+            path: path.to_string(),
+            why: format!("`{}` is not a finite number", text.trim()),
+        });
+    }
     let new: Value = serde_json::from_str(text.trim())
         .unwrap_or_else(|_| Value::String(text.trim().to_string()));
     if rig.get("kind").and_then(Value::as_str) == Some(crate::netlist::KIND) {

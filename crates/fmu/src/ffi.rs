@@ -307,7 +307,8 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> Status {
     }
 }
 
-/// `fmi2ExitInitializationMode`: assembles the circuit.
+/// `fmi2ExitInitializationMode`: checks the parameters set as a whole and
+/// assembles the circuit.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> Status {
     unsafe {
@@ -385,8 +386,10 @@ pub unsafe extern "C" fn fmi2GetReal(
     unsafe { get_each(c, "fmi2GetReal", vr, nvr, value, Slave::get_real) }
 }
 
-/// `fmi2SetReal`: the input, or a parameter (checked with the rig's rules;
-/// a rejected value is `fmi2Error` with a message naming the parameter).
+/// `fmi2SetReal`: the input, or a parameter (its value checked on its own;
+/// a rejected value is `fmi2Error` with a message naming the parameter and
+/// the rule; the rules relating parameters are checked at
+/// `fmi2ExitInitializationMode`).
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetReal(
     c: *mut c_void,

@@ -15,6 +15,7 @@ use crate::variables::{
     circuit_with_input, output_channels, Role, SolverParam, Variables, METHODS,
 };
 use hydrocyl_system::external::ExternalInput;
+use hydrocyl_system::netlist::{self, registry};
 use hydrocyl_system::rig::{self, RigError};
 use hydrocyl_system::run::RunOptions;
 use hydrocyl_system::simulation::Simulation;
@@ -164,7 +165,8 @@ impl Slave {
         self.phase
     }
 
-    /// The rig with the parameters set so far.
+    /// The rig with the parameters set so far (each value checked on its
+    /// own; the set as a whole is checked when the circuit is assembled).
     pub fn rig(&self) -> &Value {
         &self.rig
     }
@@ -250,8 +252,11 @@ impl Slave {
         Ok(())
     }
 
-    /// `fmi2ExitInitializationMode`: assembles the circuit with the
-    /// parameters set, at the rig's initial state.
+    /// `fmi2ExitInitializationMode`: checks the parameters set together
+    /// (the rig's rules that relate several of them) and assembles the
+    /// circuit, at the rig's initial state. A rig the parameters make invalid
+    /// is an error naming the parameters set; the instance stays in
+    /// initialisation mode, where they can be corrected.
     pub fn exit_initialization(&mut self) -> Result<(), SlaveError> {
         self.expect(&[Phase::Initializing], "fmi2ExitInitializationMode")?;
         self.ensure_sim()?;
@@ -280,12 +285,42 @@ impl Slave {
             .ok_or_else(|| format!("unknown value reference {vr}"))
     }
 
+    /// The parameters whose values differ from their start values, as
+    /// `name = value`, comma-separated (`none` if there are none).
+    fn parameters_set(&self) -> String {
+        let set: Vec<String> = self
+            .vars
+            .list
+            .iter()
+            .zip(&self.values)
+            .filter(|(v, x)| {
+                matches!(v.role, Role::Parameter(_) | Role::Solver(_))
+                    && x.to_bits() != v.start.to_bits()
+            })
+            .map(|(v, x)| format!("{} = {x}", v.name))
+            .collect();
+        if set.is_empty() {
+            "none".into()
+        } else {
+            set.join(", ")
+        }
+    }
+
+    /// Assembles the circuit unless it is: the rig with the parameters set
+    /// is checked as a whole first ([`rig::check`]: the rules relating
+    /// several parameters, which `fmi2SetReal` leaves to this point).
     fn ensure_sim(&mut self) -> Result<(), SlaveError> {
         if self.sim.is_some() {
             return Ok(());
         }
-        let (circuit, input) =
-            circuit_with_input(&self.rig).map_err(|e| format!("assembling the rig: {e}"))?;
+        let (circuit, input) = rig::check(&self.rig)
+            .and_then(|_| circuit_with_input(&self.rig))
+            .map_err(|e| {
+                format!(
+                    "the parameters set ({}) do not make a valid rig: {e}",
+                    self.parameters_set()
+                )
+            })?;
         let probes = output_channels(&circuit, &crate::variables::input_name(&self.rig));
         let mut wires = Vec::with_capacity(self.vars.outputs.len());
         for (name, _) in &self.vars.outputs {
@@ -352,8 +387,12 @@ impl Slave {
     }
 
     /// `fmi2SetReal` of one variable: the input at any time; a parameter
-    /// before the end of initialisation, checked by re-checking the rig (the
-    /// message names the parameter and the rule it breaks).
+    /// before the end of initialisation. A parameter's value is checked on
+    /// its own here (finite, inside the range its component declares; the
+    /// message names the parameter and the rule it breaks); the rules that
+    /// relate several parameters are checked once on the whole set, when the
+    /// circuit is next assembled (`fmi2ExitInitializationMode`, or an output
+    /// read in initialisation mode), so parameters can be set in any order.
     pub fn set_real(&mut self, vr: u32, value: f64) -> Result<(), SlaveError> {
         let v = self.var(vr)?;
         if v.integer {
@@ -388,18 +427,19 @@ impl Slave {
                     &[Phase::Instantiated, Phase::Initializing],
                     &format!("setting fixed parameter `{name}`"),
                 )?;
-                let ok = match sp {
-                    SolverParam::Method => {
-                        value >= 0.0 && value < METHODS.len() as f64 && value.fract() == 0.0
-                    }
-                    SolverParam::Rtol => value > 0.0 && value < 1.0,
-                    SolverParam::HMax | SolverParam::Rk4Step => value.is_finite() && value > 0.0,
+                let (ok, rule) = match sp {
+                    SolverParam::Method => (
+                        value >= 0.0 && value < METHODS.len() as f64 && value.fract() == 0.0,
+                        "must be 0 (dp45), 1 (rosenbrock) or 2 (rk4)",
+                    ),
+                    SolverParam::Rtol => (value > 0.0 && value < 1.0, "must be in (0, 1)"),
+                    SolverParam::HMax | SolverParam::Rk4Step => (
+                        value.is_finite() && value > 0.0,
+                        "must be finite and > 0 [s]",
+                    ),
                 };
                 if !ok {
-                    return Err(format!(
-                        "parameter `{name}` = {value} rejected: {}",
-                        v.description
-                    ));
+                    return Err(format!("parameter `{name}` = {value} rejected: {rule}"));
                 }
             }
             Role::Parameter(path) => {
@@ -416,13 +456,14 @@ impl Slave {
                         "parameter `{name}` = {value} rejected: must be finite"
                     ));
                 };
-                let mut r = self.rig.clone();
-                let checked = rig::apply_set(&mut r, &format!("{path}={text}"))
-                    .and_then(|_| rig::check(&r))
-                    .and_then(|_| circuit_with_input(&r).map(|_| ()));
-                if let Err(e) = checked {
-                    return Err(format!("parameter `{name}` = {value} rejected: {e}"));
+                let rejected =
+                    |why: String| format!("parameter `{name}` = {value} rejected: {why}");
+                if value.is_finite() {
+                    own_rule(&self.rig, path, value).map_err(rejected)?;
                 }
+                let mut r = self.rig.clone();
+                rig::apply_set(&mut r, &format!("{path}={text}"))
+                    .map_err(|e| rejected(e.to_string()))?;
                 self.rig = r;
             }
         }
@@ -459,11 +500,22 @@ impl Slave {
         Ok(())
     }
 
-    /// `fmi2DoStep`: integrates from `t` (the time reached) to `t + h`.
+    /// `fmi2DoStep`: integrates from `t` (the time reached) to `t + h`. A
+    /// time or step that is not a finite number, a non-positive step or a
+    /// `t` other than the time reached is refused before any integration
+    /// (the instance stays usable).
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<(), SlaveError> {
         self.expect(&[Phase::Stepping], "fmi2DoStep")?;
+        if !t.is_finite() {
+            return Err(format!("communication point t = {t} s is not finite"));
+        }
         if !(h > 0.0 && h.is_finite()) {
-            return Err(format!("communication step {h} s is not positive"));
+            return Err(format!(
+                "communication step h = {h} s is not finite and positive"
+            ));
+        }
+        if !(t + h).is_finite() {
+            return Err(format!("t + h = {t} s + {h} s is not finite"));
         }
         let method = METHODS[self.values[self.index(SolverParam::Method)] as usize];
         let rtol = self.values[self.index(SolverParam::Rtol)];
@@ -528,6 +580,37 @@ impl Slave {
     }
 }
 
+/// The rules a rig parameter's value must meet on its own, whatever the
+/// other parameters are: for a netlist, the range its component type
+/// declares ([`registry::ParamSpec::range`]) or an initial state's own rule
+/// ([`registry::StateSpec::check`]). The rules relating several parameters
+/// (a chamber longer than half the stroke, ...) are [`rig::check`]'s.
+fn own_rule(rig: &Value, path: &str, value: f64) -> Result<(), String> {
+    if rig.get("kind").and_then(Value::as_str) != Some(netlist::KIND) {
+        return Ok(());
+    }
+    let Some((component, name)) = path.split_once('.') else {
+        return Ok(());
+    };
+    let Some(ty) = rig
+        .pointer(&format!("/components/{component}/type"))
+        .and_then(Value::as_str)
+        .and_then(registry::lookup)
+    else {
+        return Ok(());
+    };
+    match name.strip_prefix("initial.") {
+        Some(state) => ty.state(state).map_or(Ok(()), |s| s.check(value)),
+        None => match ty.param(name) {
+            Some(p) if !p.range.contains(value) => Err(match p.unit {
+                "-" | "" => format!("must be {}", p.range.describe()),
+                unit => format!("must be {} [{unit}]", p.range.describe()),
+            }),
+            _ => Ok(()),
+        },
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -587,6 +670,91 @@ mod tests {
         assert_eq!(other.time(), 0.1);
         assert_eq!(go(&mut other, 100, 150), first);
         assert!(Snapshot::deserialize(b"{}").is_err());
+    }
+
+    /// Lengthening the stroke past twice the chamber lengths, then the
+    /// chambers: the stroke alone breaks the rig's rule relating it to the
+    /// chambers, the whole set does not. The set is checked as a whole at
+    /// initialisation, which names the parameters set when it is invalid.
+    #[test]
+    fn related_parameters_can_be_set_in_any_order() {
+        let mut s = Slave::new(rig::preset("leaney-moog").unwrap()).unwrap();
+        let start = |s: &Slave, name: &str| s.variables().list[vr(s, name) as usize].start;
+        let stroke = 2.0
+            * start(&s, "cylinder.chamber_length_1").max(start(&s, "cylinder.chamber_length_2"))
+            + start(&s, "cylinder.stroke");
+        s.set_real(vr(&s, "cylinder.stroke"), stroke).unwrap();
+        s.enter_initialization().unwrap();
+        // the stroke alone breaks the chambers' rule: refused at exit, named
+        let e = s.exit_initialization().unwrap_err();
+        assert!(
+            e.contains(&format!("cylinder.stroke = {stroke}"))
+                && e.contains("chamber_length_1 must exceed half the stroke"),
+            "{e}"
+        );
+        assert_eq!(s.phase(), Phase::Initializing);
+        let e = s.get_real(vr(&s, "position")).unwrap_err();
+        assert!(e.contains("cylinder.stroke"), "{e}");
+        // the chambers follow: the whole set is valid
+        for c in ["cylinder.chamber_length_1", "cylinder.chamber_length_2"] {
+            s.set_real(vr(&s, c), 0.6 * stroke).unwrap();
+        }
+        s.exit_initialization().unwrap();
+        s.set_real(vr(&s, "command"), 0.2).unwrap();
+        s.do_step(0.0, 1e-2).unwrap();
+        assert!(s.get_real(vr(&s, "position")).unwrap() > 0.0);
+    }
+
+    /// A value wrong on its own is still refused at once, naming the rule.
+    #[test]
+    fn a_value_out_of_its_own_range_is_refused_when_set() {
+        let mut s = Slave::new(rig::preset("leaney-moog").unwrap()).unwrap();
+        let e = s.set_real(vr(&s, "cylinder.stroke"), -0.1).unwrap_err();
+        assert!(
+            e.contains("cylinder.stroke") && e.contains("must be > 0 [m]"),
+            "{e}"
+        );
+        let e = s.set_real(vr(&s, "cylinder.stroke"), f64::NAN).unwrap_err();
+        assert!(e.contains("must be finite"), "{e}");
+        let e = s.set_real(vr(&s, "cylinder.initial.p1"), -2e5).unwrap_err();
+        assert!(e.contains("below absolute vacuum"), "{e}");
+        assert_eq!(s.rig(), &rig::preset("leaney-moog").unwrap());
+        // solver parameters: the message is the rule, not the description
+        for (name, bad, rule) in [
+            ("solver.rtol", 0.0, "must be in (0, 1)"),
+            ("solver.h_max", -1.0, "must be finite and > 0 [s]"),
+            (
+                "solver.rk4_step",
+                f64::INFINITY,
+                "must be finite and > 0 [s]",
+            ),
+        ] {
+            let e = s.set_real(vr(&s, name), bad).unwrap_err();
+            assert!(e.contains(rule) && !e.contains("tolerance of"), "{e}");
+        }
+        let e = s.set_integer(vr(&s, "solver.method"), 7).unwrap_err();
+        assert!(
+            e.contains("must be 0 (dp45), 1 (rosenbrock) or 2 (rk4)"),
+            "{e}"
+        );
+        s.enter_initialization().unwrap();
+        s.exit_initialization().unwrap();
+    }
+
+    /// A communication point that is not a number is refused up front; the
+    /// instance goes on stepping.
+    #[test]
+    fn a_nan_communication_point_is_refused_and_the_instance_goes_on() {
+        let mut s = Slave::new(rig::preset("leaney-moog").unwrap()).unwrap();
+        s.enter_initialization().unwrap();
+        s.exit_initialization().unwrap();
+        for (t, h) in [(f64::NAN, 1e-3), (f64::INFINITY, 1e-3), (0.0, f64::NAN)] {
+            let e = s.do_step(t, h).unwrap_err();
+            assert!(e.contains("not finite"), "{e}");
+            assert_eq!(s.phase(), Phase::Stepping);
+        }
+        s.do_step(0.0, 1e-3).unwrap();
+        assert_eq!(s.time(), 1e-3);
     }
 
     #[test]

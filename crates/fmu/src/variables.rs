@@ -29,6 +29,18 @@ pub fn input_name(rig: &Value) -> String {
         .unwrap_or_else(|| INPUT.into())
 }
 
+/// The unit of `rig`'s input variable: the one in which the rig takes its
+/// input ([`Schematic::input_unit`](hydrocyl_system::netlist::Schematic::input_unit):
+/// `m` for a closed-loop rig's set-point, `V` for a pump drive's voltage,
+/// `m/s` for a friction bench's imposed velocity); `None` for a
+/// dimensionless spool demand or where the rig declares none.
+pub fn input_unit(rig: &Value) -> Option<&'static str> {
+    hydrocyl_system::netlist::schematic(rig)
+        .ok()
+        .and_then(|s| s.input_unit())
+        .and_then(unit_name)
+}
+
 /// The solver methods by their `solver.method` number.
 pub const METHODS: [Solver; 3] = [Solver::Dp45, Solver::Rosenbrock, Solver::Rk4];
 
@@ -140,9 +152,9 @@ impl Variables {
             role: Role::Input,
             integer: false,
             start: 0.0,
-            unit: None,
+            unit: input_unit(rig),
             description: if input_name == INPUT {
-                "the rig's command (normalised spool demand of a valve rig, drive voltage of a pump rig); linear inside a step with fmi2SetRealInputDerivatives".into()
+                "the rig's command (normalised spool demand of a valve rig, drive voltage of a pump rig, imposed rod velocity of a friction bench); linear inside a step with fmi2SetRealInputDerivatives".into()
             } else {
                 format!("the rig's input `{input_name}` (a closed-loop rig's position set-point [m]); linear inside a step with fmi2SetRealInputDerivatives")
             },
@@ -266,6 +278,21 @@ mod tests {
                 .filter(|x| matches!(x.role, Role::Parameter(_)))
                 .count();
             assert_eq!(n_par, rig::parameters(&rig).len(), "{}", preset.name);
+        }
+        // the input carries the unit the rig takes it in; a spool demand has none
+        for (preset, name, unit) in [
+            ("leaney-moog", "command", None),
+            ("leaney-moog-closed-loop", "reference", Some("m")),
+            ("wang-hybrid", "command", Some("V")),
+            ("emps", "command", Some("m/s")),
+            ("tudelft-seal-25", "command", Some("m/s")),
+        ] {
+            let v = Variables::of(&rig::preset(preset).unwrap()).unwrap();
+            assert_eq!(
+                (v.list[0].name.as_str(), v.list[0].unit),
+                (name, unit),
+                "{preset}"
+            );
         }
         // the spool lags the command: nothing feeds through
         let v = Variables::of(&rig::preset("leaney-moog").unwrap()).unwrap();

@@ -41,19 +41,25 @@ impl Schematic {
             .map(|(col, _)| col.clone())
     }
 
-    /// The unit in which the components reading the input take it, from the
-    /// reading port's declaration (`… [V]` for a pump drive, `… [m]` for a
-    /// position controller's set-point, `… [-]` for a spool demand), or the
-    /// imposed velocity's m/s of a bench drive; `None` when the netlist has
-    /// not exactly one input, nothing reads it on a signal node, or the
-    /// reading port names no unit.
+    /// The unit in which the input is taken: for a signal source, from the
+    /// declaration of the port reading it (`… [V]` for a pump drive, `… [m]`
+    /// for a position controller's set-point, `… [-]` for a spool demand);
+    /// for an imposed-motion drive, the rod's velocity it imposes (its
+    /// `velocity` probe's unit, `m/s`). `None` when the netlist has not
+    /// exactly one input, nothing reads it on a signal node, or the reading
+    /// port names no unit.
     pub fn input_unit(&self) -> Option<&'static str> {
         let mut inputs = self.inputs();
         let (input, None) = (inputs.next()?, inputs.next()) else {
             return None;
         };
         if input.ty.name == "imposed_motion" {
-            return Some("m/s");
+            return input
+                .ty
+                .probes
+                .iter()
+                .find(|(p, _)| *p == "velocity")
+                .map(|(_, u)| *u);
         }
         let (_, ports) = self.nodes.get(input.nodes.get("out")?)?;
         ports
@@ -87,10 +93,12 @@ mod tests {
         let s = schematic("leaney-moog");
         assert_eq!(s.input_channel().as_deref(), Some("command"));
         assert_eq!(s.input_unit(), Some("-"));
-        // the friction bench's drive takes the velocity; it shows no command
-        let s = schematic("emps");
-        assert_eq!(s.inputs().count(), 1);
-        assert_eq!((s.input_channel(), s.input_unit()), (None, Some("m/s")));
+        // the friction benches' drive takes the rod's velocity; it shows no command
+        for bench in ["emps", "tudelft-seal-25"] {
+            let s = schematic(bench);
+            assert_eq!(s.inputs().count(), 1);
+            assert_eq!((s.input_channel(), s.input_unit()), (None, Some("m/s")));
+        }
     }
 
     /// Two inputs, each driving its own first-order spool: each spool

@@ -238,17 +238,8 @@ fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistError> {
         let value = match given_initial.get(s.name) {
             Some(Value::Number(n)) => {
                 let x = n.as_f64().unwrap_or(f64::NAN);
-                if !x.is_finite() {
-                    return err(at, "must be finite");
-                }
-                // a gauge pressure of a chamber or a volume (not a
-                // difference, such as the load pressure) below vacuum
-                let vacuum = crate::rig::ABSOLUTE_VACUUM_GAUGE_PA;
-                if s.unit == "Pa" && matches!(s.name, "p1" | "p2" | "pressure") && x < vacuum {
-                    return err(
-                        at,
-                        format!("{x} Pa is below absolute vacuum ({vacuum} Pa gauge)"),
-                    );
+                if let Err(why) = s.check(x) {
+                    return err(at, why);
                 }
                 Some(x)
             }

@@ -207,6 +207,25 @@ pub struct StateSpec {
     pub doc: &'static str,
 }
 
+impl StateSpec {
+    /// Checks an initial value given for this state on its own: finite, and
+    /// a chamber's or a volume's gauge pressure (`p1`, `p2`, `pressure` in
+    /// Pa; not a difference such as a load pressure) not below absolute
+    /// vacuum. The error says the rule.
+    pub fn check(&self, value: f64) -> Result<(), String> {
+        if !value.is_finite() {
+            return Err("must be finite".into());
+        }
+        let vacuum = crate::rig::ABSOLUTE_VACUUM_GAUGE_PA;
+        if self.unit == "Pa" && matches!(self.name, "p1" | "p2" | "pressure") && value < vacuum {
+            return Err(format!(
+                "{value} Pa is below absolute vacuum ({vacuum} Pa gauge)"
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Makes the component from a checked instance.
 pub type Builder = fn(&Instance) -> Result<Box<dyn Component>, String>;
 

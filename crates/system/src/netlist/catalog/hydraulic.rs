@@ -158,7 +158,7 @@ pub const TYPES: &[ComponentType] = &[
     },
     ComponentType {
         name: "algebraic_node",
-        summary: "a node between resistive components with no volume: the assembler solves its pressure so the flows into it sum to zero (Newton on the components' slopes)",
+        summary: "a node between resistive components with no volume: the assembler solves its pressure so the flows into it sum to zero (Newton on the components' slopes); a component may join only one such node (a longer chain needs a volume between nodes)",
         ports: &[port(
             "node",
             HYD,

@@ -229,42 +229,16 @@ fn check_initial_pressures(rig: &crate::rigfile::Checked) -> Result<(), CliError
     Ok(())
 }
 
-/// Pressures far below absolute vacuum (ten times its depth) or a
-/// non-finite value: the solution is not physical, the integration blew up.
-const ABSURD_PRESSURE_PA: f64 = 10.0 * rig::ABSOLUTE_VACUUM_GAUGE_PA;
-
-/// A chamber pressure between this and [`ABSURD_PRESSURE_PA`] from an
-/// error-controlled solver is read as the constant-B liquid cavitating
-/// (finite, the same with any tolerance); below it, as a blow-up \[Pa\].
-const LIQUID_TENSION_LIMIT_PA: f64 = -1.0e8;
-
 /// Checks the solution for the signs of an unstable integration (a
-/// non-finite value, a chamber pressure far below vacuum) and names the fix.
+/// non-finite value, a chamber pressure far below vacuum:
+/// [`Run::unphysical`]) and names the fix.
 pub(crate) fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result<(), CliError> {
-    let bad = run.channels.iter().find_map(|c| {
-        let chamber = c.unit == "Pa" && chamber_channel(&c.name).is_some();
-        let floor = if chamber {
-            ABSURD_PRESSURE_PA
-        } else {
-            f64::NEG_INFINITY
-        };
-        // NaN and ±∞ fail the first test; no early exit inside a chunk, so
-        // that the test is made on several values at once
-        let ok = |v: f64| v.is_finite() & (v >= floor);
-        if c.values
-            .chunks(16)
-            .all(|ch| ch.iter().fold(true, |a, &v| a & ok(v)))
-        {
-            return None;
-        }
-        let k = c.values.iter().position(|&v| !ok(v))?;
-        let v = c.values[k];
-        let at = format!("{} = {v:e} {} at t = {} s", c.name, c.unit, run.time[k]);
-        // an error-controlled solver that met its tolerance on a finite,
-        // moderate tension: the liquid model left its range, not the solver
-        let adaptive = matches!(solver, Solver::Auto | Solver::Dp45 | Solver::Rosenbrock);
-        let tension = adaptive && v.is_finite() && v > LIQUID_TENSION_LIMIT_PA;
-        Some((at, tension.then(|| chamber_channel(&c.name)).flatten()))
+    // an error-controlled solver that met its tolerance on a finite,
+    // moderate tension: the liquid model left its range, not the solver
+    let adaptive = matches!(solver, Solver::Auto | Solver::Dp45 | Solver::Rosenbrock);
+    let bad = run.unphysical().map(|u| {
+        let cylinder = u.chamber_of.clone().filter(|_| adaptive && u.is_tension());
+        (u.what, cylinder)
     });
     let Some((what, below_vacuum)) = bad else {
         return Ok(());
@@ -293,18 +267,6 @@ pub(crate) fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result
         "the {} solution is unstable ({what}); {fix}",
         solver.name()
     )))
-}
-
-/// The cylinder whose chamber pressure a channel is: `p1`, `p2` (the
-/// presets' `cylinder`) or `<cylinder>.p1`, `<cylinder>.p2`.
-fn chamber_channel(name: &str) -> Option<&str> {
-    match name {
-        "p1" | "p2" => Some("cylinder"),
-        _ => name
-            .strip_suffix(".p1")
-            .or_else(|| name.strip_suffix(".p2"))
-            .filter(|c| !c.is_empty()),
-    }
 }
 
 /// Warns when a normalised valve command leaves ±1 (`outside` samples, the

@@ -23,7 +23,9 @@ use hydrocyl_integrators::{
 use std::time::{Duration, Instant};
 use thiserror::Error;
 
+mod physical;
 mod probes;
+pub use physical::{chamber_channel, Unphysical, ABSURD_PRESSURE_PA, LIQUID_TENSION_LIMIT_PA};
 pub use probes::{ProbeReader, ProbeSet};
 
 /// Why a run failed.

@@ -1,0 +1,124 @@
+//! Whether a run's solution is physical: the signs of an integration that
+//! blew up (a non-finite value, a chamber pressure far below absolute
+//! vacuum), found the same way for every client (the CLI names its remedy,
+//! Python raises `SimulationError`).
+
+use super::Run;
+use crate::rig::ABSOLUTE_VACUUM_GAUGE_PA;
+
+/// Pressures far below absolute vacuum (ten times its depth) or a
+/// non-finite value: the solution is not physical \[Pa\].
+pub const ABSURD_PRESSURE_PA: f64 = 10.0 * ABSOLUTE_VACUUM_GAUGE_PA;
+
+/// A chamber pressure between this and [`ABSURD_PRESSURE_PA`] from an
+/// error-controlled solver is read as the constant-B liquid cavitating
+/// (finite, the same with any tolerance); below it, as a blow-up \[Pa\].
+pub const LIQUID_TENSION_LIMIT_PA: f64 = -1.0e8;
+
+/// The first sample of a run that is not physical.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Unphysical {
+    /// `<channel> = <value> <unit> at t = <time> s`.
+    pub what: String,
+    /// The cylinder whose chamber pressure it is, when it is a chamber
+    /// pressure (finite, far below vacuum).
+    pub chamber_of: Option<String>,
+    /// The value itself.
+    pub value: f64,
+}
+
+impl Unphysical {
+    /// Whether it reads as the liquid's tension rather than a blow-up: a
+    /// finite chamber pressure above [`LIQUID_TENSION_LIMIT_PA`] (from an
+    /// error-controlled solver that met its tolerance, the constant-B oil
+    /// has left its range: the chamber cavitates).
+    pub fn is_tension(&self) -> bool {
+        self.chamber_of.is_some() && self.value.is_finite() && self.value > LIQUID_TENSION_LIMIT_PA
+    }
+}
+
+/// The cylinder whose chamber pressure a channel is: `p1`, `p2` (the
+/// presets' `cylinder`) or `<cylinder>.p1`, `<cylinder>.p2`.
+pub fn chamber_channel(name: &str) -> Option<&str> {
+    match name {
+        "p1" | "p2" => Some("cylinder"),
+        _ => name
+            .strip_suffix(".p1")
+            .or_else(|| name.strip_suffix(".p2"))
+            .filter(|c| !c.is_empty()),
+    }
+}
+
+impl Run {
+    /// The first sample that is not physical (a non-finite value in any
+    /// channel, a chamber pressure below [`ABSURD_PRESSURE_PA`]), if any.
+    pub fn unphysical(&self) -> Option<Unphysical> {
+        self.channels.iter().find_map(|c| {
+            let chamber = c.unit == "Pa" && chamber_channel(&c.name).is_some();
+            let floor = if chamber {
+                ABSURD_PRESSURE_PA
+            } else {
+                f64::NEG_INFINITY
+            };
+            // NaN and ±∞ fail the first test; no early exit inside a chunk,
+            // so that the test is made on several values at once
+            let ok = |v: f64| v.is_finite() & (v >= floor);
+            if c.values
+                .chunks(16)
+                .all(|ch| ch.iter().fold(true, |a, &v| a & ok(v)))
+            {
+                return None;
+            }
+            let k = c.values.iter().position(|&v| !ok(v))?;
+            let v = c.values[k];
+            Some(Unphysical {
+                what: format!("{} = {v:e} {} at t = {} s", c.name, c.unit, self.time[k]),
+                chamber_of: chamber_channel(&c.name)
+                    .filter(|_| chamber && v.is_finite())
+                    .map(str::to_string),
+                value: v,
+            })
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::Channel;
+
+    fn run(name: &str, unit: &'static str, values: Vec<f64>) -> Run {
+        Run {
+            time: (0..values.len()).map(|k| k as f64 * 0.1).collect(),
+            channels: vec![Channel {
+                name: name.into(),
+                unit,
+                values,
+            }],
+            ..Run::default()
+        }
+    }
+
+    #[test]
+    fn a_blow_up_a_tension_and_a_good_run_are_told_apart() {
+        // within ten times the depth of vacuum: physical enough
+        assert_eq!(run("p1", "Pa", vec![1e5, -5e5, 2e6]).unphysical(), None);
+        // far below vacuum, finite and moderate: the liquid's tension
+        let u = run("damper.p2", "Pa", vec![1e5, -4e6])
+            .unphysical()
+            .unwrap();
+        assert_eq!(u.chamber_of.as_deref(), Some("damper"));
+        assert!(u.is_tension());
+        assert_eq!(u.what, "damper.p2 = -4e6 Pa at t = 0.1 s");
+        // far beyond the tension limit: a blow-up
+        let u = run("p1", "Pa", vec![-1e9]).unphysical().unwrap();
+        assert!(!u.is_tension());
+        // a non-finite value in any channel; a pressure that is not a
+        // chamber's may be as low as it likes
+        let u = run("position", "m", vec![0.0, f64::NAN])
+            .unphysical()
+            .unwrap();
+        assert_eq!((u.chamber_of, u.what.contains("NaN")), (None, true));
+        assert_eq!(run("ps", "Pa", vec![-1e7]).unphysical(), None);
+    }
+}

@@ -8,7 +8,7 @@ solver failure raises SimulationError.
 """
 
 import os
-from typing import Any, Literal, Mapping, Optional, Sequence, Union
+from typing import Any, Iterator, Literal, Mapping, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -18,7 +18,11 @@ PRESETS: list[str]
 """Names of the built-in rigs (``Rig.load(name)``)."""
 
 ArrayLike = npt.ArrayLike
-Solver = Literal["dp45", "rosenbrock", "rk4"]
+Solver = Literal["auto", "dp45", "rosenbrock", "rk4", "exponential"]
+"""``auto`` (the default, as the CLI's ``--solver``): Dormand–Prince 5(4)
+while the run is not stiff, Rosenbrock while it is; ``dp45``,
+``rosenbrock``; the fixed-step ``rk4`` and ``exponential`` (steps of
+``rk4_step``)."""
 ParamValue = Union[float, int, str, bool, None]
 
 class SimulationError(Exception):
@@ -35,30 +39,38 @@ class Rig:
     in Pa gauge), checked after every edit. Picklable (as its JSON)."""
 
     @staticmethod
-    def load(name_or_path: str) -> Rig:
-        """A preset by name or a rig JSON file by path (``--rig``)."""
+    def load(name_or_path: Union[str, os.PathLike[str]]) -> Rig:
+        """A preset by name or a rig JSON file by path (``--rig``): a
+        duplicate key is refused, an older kind (``valve-cylinder``,
+        ``hybrid-pump``) is read as its netlist."""
     @staticmethod
     def from_json(text: str) -> Rig:
-        """A rig from rig-file JSON text (as ``to_json`` writes it)."""
+        """A rig from rig-file JSON text, read as ``load`` reads a file
+        (messages name it ``JSON text``)."""
     @staticmethod
     def presets() -> list[str]:
         """Names of the built-in presets."""
     @property
     def kind(self) -> str:
-        """The rig kind: ``valve-cylinder``, ``wang-hybrid``, ..."""
+        """The rig kind: ``netlist`` (older kinds are read as netlists)."""
     def set(self, path: str, value: ParamValue) -> None:
         """Sets one parameter as ``--set path=value`` does, then checks the
-        rig; on error (ValueError) the rig is unchanged. SI units."""
+        rig; on error (ValueError) the rig is unchanged. SI units; None
+        sets ``null`` (e.g. an initial pressure computed from the steady
+        state)."""
     def update(self, values: Mapping[str, ParamValue]) -> None:
-        """Sets several parameters, then checks the rig once."""
+        """Sets several parameters, then checks the rig once;
+        ``rig.update(rig.parameters())`` changes nothing."""
     def get(self, path: str) -> Any:
         """The value at a parameter path (number, string, None, or a
         dict/list for an inner path)."""
     def parameters(self) -> dict[str, Optional[float]]:
-        """Every numeric parameter, ``{path: value}`` (SI; None for null)."""
+        """Every numeric parameter, ``{path: value}`` (SI, defaults filled
+        in; None for ``null``, e.g. an initial pressure the rig computes)."""
     def describe(self) -> dict[str, dict[str, Any]]:
-        """Every parameter: ``{path: {"value", "unit", "doc"}}`` (netlists
-        declare the SI unit and meaning; other kinds give None)."""
+        """Every parameter: ``{path: {"value", "unit", "doc"}}``, the values
+        of ``parameters()``, the SI unit and meaning from the component
+        registry (``hydrocyl components``); None where a rig declares none."""
     def to_json(self) -> str:
         """The rig as rig-file JSON text (``--print-rig``)."""
     def copy(self) -> Rig: ...
@@ -67,22 +79,25 @@ class Rig:
         t: ArrayLike,
         u: ArrayLike,
         *,
-        solver: Solver = "dp45",
+        solver: Solver = "auto",
         rtol: float = 1e-6,
         rk4_step: float = 2e-5,
         h_max: Optional[float] = None,
         ledger: bool = False,
     ) -> Run:
         """Simulates on the command ``u`` at times ``t`` [s] (linear between
-        samples) and samples the run at ``t``. ``u``: normalised spool
+        samples) and samples the run at ``t``; ``t`` and ``u`` are 1-D
+        (ValueError naming the argument otherwise). ``u``: normalised spool
         demand (valve rigs) or drive voltage [V] (pump rigs). ``rk4_step``
         and ``h_max`` (default 0.01) in s. ``ledger=True`` adds
-        ``run.ledger``. Releases the GIL."""
+        ``run.ledger``. Releases the GIL; runs the rig as it is when called
+        (a ``set`` from another thread meanwhile does not change the run)."""
 
 class Run:
     """One run: ``time`` [s] and channels in SI (``units``): ``command``,
     ``position`` [m], ``velocity`` [m/s], ``p1``, ``p2`` [Pa gauge], then
-    the rig's other outputs. ``run["position"]`` is a channel."""
+    the rig's other outputs. ``run["position"]`` is a channel; iterating a
+    run gives the channel names, as a dict its keys."""
 
     @property
     def time(self) -> npt.NDArray[np.float64]: ...
@@ -107,6 +122,8 @@ class Run:
         energy in, ``efficiency``."""
     def __getitem__(self, name: str) -> npt.NDArray[np.float64]: ...
     def __contains__(self, name: str) -> bool: ...
+    def __iter__(self) -> Iterator[str]:
+        """The channel names (as ``keys()``)."""
     def keys(self) -> list[str]: ...
     def to_pandas(self) -> Any:
         """A pandas DataFrame (``time`` and the channels); ImportError
@@ -114,7 +131,8 @@ class Run:
 
 class BatchRun:
     """Runs of ``simulate_batch``: per channel an ``(N, len(time))`` array,
-    row i from parameter set i (SI units as in ``Run.units``)."""
+    row i from parameter set i (SI units as in ``Run.units``). Iterating
+    gives the channel names; ``len`` is the number of runs."""
 
     @property
     def time(self) -> npt.NDArray[np.float64]: ...
@@ -138,6 +156,8 @@ class BatchRun:
     def __len__(self) -> int: ...
     def __getitem__(self, name: str) -> npt.NDArray[np.float64]: ...
     def __contains__(self, name: str) -> bool: ...
+    def __iter__(self) -> Iterator[str]:
+        """The channel names (as ``keys()``)."""
     def keys(self) -> list[str]: ...
 
 def simulate_batch(
@@ -146,7 +166,7 @@ def simulate_batch(
     u: ArrayLike,
     params: Mapping[str, ArrayLike],
     *,
-    solver: Solver = "dp45",
+    solver: Solver = "auto",
     rtol: float = 1e-6,
     rk4_step: float = 2e-5,
     h_max: Optional[float] = None,
@@ -156,8 +176,9 @@ def simulate_batch(
 ) -> BatchRun:
     """Runs ``rig`` once per parameter set (``params``: path -> N values,
     SI) in parallel with the GIL released; results in set order,
-    independent of ``threads``. ``channels`` (default: all) names the
-    channels kept, and only they are read in each run."""
+    independent of ``threads`` (at least 1; default: all cores).
+    ``channels`` (default: all) names the channels kept, and only they are
+    read in each run."""
 
 def xfactor(gamma: float, travel: ArrayLike) -> npt.NDArray[np.float64]:
     """Leaney's X factor (dimensionless) for area ratio ``gamma`` = A1/A2
@@ -174,4 +195,4 @@ def diagnose(
 ) -> dict[str, Any]:
     """``hydrocyl diagnose`` on a valve rig and one measured record (CSV
     path or dict of arrays by column name, SI or with unit suffixes); the
-    report as a dict."""
+    report as a dict. ``window`` is at least 1."""

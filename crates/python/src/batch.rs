@@ -3,17 +3,17 @@
 //! `(N, len(t))` arrays in parameter-set order, so they do not depend on
 //! the number of threads (each run is sequential and deterministic).
 
-use crate::convert::{array, no_channel, vector, Named};
+use crate::convert::{array, count_arg, no_channel, vector, vector_arg, Named};
 use crate::errors::{detached, Failure, Outcome};
 use crate::rig::Rig;
 use crate::sim;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::Run;
 use numpy::ndarray::Array2;
-use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike1};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyIterator, PyList};
 use rayon::prelude::*;
 use serde_json::Value;
 
@@ -114,25 +114,28 @@ fn one(
 /// the solver settings are those of `Rig.simulate`. `channels` (default:
 /// all) limits the channels returned.
 ///
+/// The runs are of `rig` as it is when called (a `set` from another thread
+/// meanwhile does not change them). `threads` is at least 1.
+///
 /// `on_error="raise"` (default) raises the error of the first failing set
 /// (ValueError for an invalid set, SimulationError for a solver failure,
 /// both naming the set); `on_error="nan"` fills its rows with NaN and
 /// reports it in `batch.ok` / `batch.errors`.
 #[pyfunction]
-#[pyo3(signature = (rig, t, u, params, *, solver = "dp45", rtol = 1e-6, rk4_step = 2e-5, h_max = None, channels = None, threads = None, on_error = "raise"))]
+#[pyo3(signature = (rig, t, u, params, *, solver = "auto", rtol = 1e-6, rk4_step = 2e-5, h_max = None, channels = None, threads = None, on_error = "raise"))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_batch(
     py: Python<'_>,
     rig: &Rig,
-    t: PyArrayLike1<'_, f64, AllowTypeChange>,
-    u: PyArrayLike1<'_, f64, AllowTypeChange>,
+    t: &Bound<'_, PyAny>,
+    u: &Bound<'_, PyAny>,
     params: &Bound<'_, PyDict>,
     solver: &str,
     rtol: f64,
     rk4_step: f64,
     h_max: Option<f64>,
     channels: Option<Vec<String>>,
-    threads: Option<usize>,
+    threads: Option<i64>,
     on_error: &str,
 ) -> PyResult<PyBatch> {
     let raise = match on_error {
@@ -144,10 +147,8 @@ pub fn simulate_batch(
             )))
         }
     };
-    if threads == Some(0) {
-        return Err(PyValueError::new_err("threads: must be at least 1"));
-    }
-    let (t, u) = (vector(t), vector(u));
+    let threads = count_arg("threads", "thread count", threads)?;
+    let (t, u) = (vector_arg("t", t)?, vector_arg("u", u)?);
     let mut sets = Sets {
         paths: Vec::new(),
         columns: Vec::new(),
@@ -176,7 +177,8 @@ pub fn simulate_batch(
             "params: no parameter sets (give {path: array of N values}, N >= 1)",
         ));
     }
-    let base = &rig.value;
+    let snapshot = rig.snapshot();
+    let base = &*snapshot;
     let keep = channels.as_deref();
     // the channels asked for are checked once, before any run, and only
     // they are read in each (a stored one, e.g. a position or a chamber
@@ -389,6 +391,12 @@ impl PyBatch {
     /// The channel names.
     fn keys(&self) -> Vec<String> {
         self.channels.names.clone()
+    }
+
+    /// Iterates over the channel names, as a dict over its keys (`len` is
+    /// the number of runs).
+    fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyIterator>> {
+        PyList::new(py, &self.channels.names)?.try_iter()
     }
 
     fn __repr__(&self) -> String {

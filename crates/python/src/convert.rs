@@ -1,8 +1,8 @@
 //! Values between Python and the rig JSON / numpy: JSON values as Python
 //! objects, Python values as the text `--set path=value` takes, arrays.
 
-use numpy::{AllowTypeChange, PyArray1, PyArrayLike1};
-use pyo3::exceptions::{PyKeyError, PyTypeError};
+use numpy::{AllowTypeChange, PyArray1, PyArrayLike1, PyArrayLikeDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyKeyError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
 use serde_json::Value;
@@ -66,6 +66,47 @@ pub fn set_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
 /// dtype), copied.
 pub fn vector(x: PyArrayLike1<'_, f64, AllowTypeChange>) -> Vec<f64> {
     x.as_array().to_vec()
+}
+
+/// The 1-D float array given as argument `name` (any array-like of real
+/// numbers), copied; anything else is a one-line ValueError naming the
+/// argument, the shape expected and what was given (`t: expected a 1-D
+/// array of numbers, got a 2-D array of shape (2, 401)`).
+pub fn vector_arg(name: &str, x: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let got = if x.is_none() {
+        "None".to_string()
+    } else if let Ok(a) = x.extract::<PyArrayLike1<'_, f64, AllowTypeChange>>() {
+        return Ok(vector(a));
+    } else if let Ok(a) = x.extract::<PyArrayLikeDyn<'_, f64, AllowTypeChange>>() {
+        match a.shape() {
+            [] => "a scalar (a 0-D array)".to_string(),
+            dims => format!(
+                "a {}-D array of shape ({})",
+                dims.len(),
+                dims.iter()
+                    .map(usize::to_string)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        }
+    } else {
+        format!("a {} that is not numbers", x.get_type().name()?)
+    };
+    Err(PyValueError::new_err(format!(
+        "{name}: expected a 1-D array of numbers, got {got}"
+    )))
+}
+
+/// A count given as argument `name` (at least 1), or `None`; below 1 is a
+/// ValueError naming the argument and the rule: `{name}: -1 is not a
+/// {what} (must be at least 1)`.
+pub fn count_arg(name: &str, what: &str, n: Option<i64>) -> PyResult<Option<usize>> {
+    n.map(|n| {
+        usize::try_from(n).ok().filter(|&k| k >= 1).ok_or_else(|| {
+            PyValueError::new_err(format!("{name}: {n} is not a {what} (must be at least 1)"))
+        })
+    })
+    .transpose()
 }
 
 /// A 1-D numpy array owning `v`.

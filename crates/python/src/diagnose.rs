@@ -84,7 +84,7 @@ pub fn diagnose<'py>(
     record: &Bound<'py, PyAny>,
     min_share: f64,
     holdout: f64,
-    window: Option<usize>,
+    window: Option<i64>,
     effects: Option<Vec<String>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let bad = |m: String| Err(PyValueError::new_err(m));
@@ -94,9 +94,10 @@ pub fn diagnose<'py>(
     if !(0.05..=0.5).contains(&holdout) {
         return bad(format!("holdout {holdout}: must be in [0.05, 0.5]"));
     }
-    if window == Some(0) {
-        return bad("window 0: must be at least 1".into());
-    }
+    let window = match window {
+        Some(w) if w < 1 => return bad(format!("window {w}: must be at least 1")),
+        w => w.and_then(|w| usize::try_from(w).ok()),
+    };
     let candidates = effects
         .map(|ids| {
             ids.iter()
@@ -108,7 +109,8 @@ pub fn diagnose<'py>(
                 .collect::<PyResult<Vec<_>>>()
         })
         .transpose()?;
-    let valve = valve_rig_from(&rig.value).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let valve =
+        valve_rig_from(&rig.snapshot()).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let rec = read_record(record)?;
     let opts = DiagnoseOptions {
         min_share,

@@ -2,29 +2,103 @@
 //! it, edited by the same parameter paths as `--set`, checked after every
 //! edit, and simulated on a sampled command.
 
-use crate::convert::{json_to_py, set_text, vector};
+use crate::convert::{json_to_py, set_text, vector_arg};
 use crate::errors::detached;
 use crate::run::PyRun;
 use crate::sim;
-use hydrocyl_system::rig;
-use numpy::{AllowTypeChange, PyArrayLike1};
-use pyo3::exceptions::PyValueError;
+use hydrocyl_system::{netlist, rig};
+use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use serde_json::Value;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
 
 /// A rig: its JSON value (kind and parameters, SI units as the rig files
 /// name them), always checked.
-#[pyclass(module = "hydrocyl", name = "Rig")]
-#[derive(Clone)]
+///
+/// The value is held as a shared snapshot behind a lock rather than in a
+/// mutable Python object: `simulate`, `simulate_batch` and `diagnose` take
+/// the snapshot and release the GIL without borrowing the rig, so a `set`
+/// from another thread meanwhile succeeds (it replaces the snapshot) and
+/// does not change the run under way.
+#[pyclass(module = "hydrocyl", name = "Rig", frozen)]
 pub struct Rig {
-    /// The rig's JSON value (checked).
-    pub value: Value,
+    /// The rig's JSON value (checked), replaced whole by every edit.
+    value: Mutex<Arc<Value>>,
 }
+
+/// How `Rig.from_json` names its text in messages, where `Rig.load` names
+/// the file.
+const JSON_TEXT: &str = "JSON text";
 
 /// A bad rig or path as the CLI words it.
 fn input(e: rig::RigError) -> PyErr {
     PyValueError::new_err(e.to_string())
+}
+
+/// A rig source (preset name or file path) read as `--rig` reads it:
+/// [`rig::load`] (duplicate keys refused, an older kind migrated to its
+/// netlist, a retired kind named), then checked, a bad path's line in the
+/// file added to the message.
+fn read_rig(source: &str) -> Result<Value, rig::RigError> {
+    let value = rig::load(source)?;
+    rig::check(&value).map_err(|e| rig::at_line(e, source))?;
+    Ok(value)
+}
+
+/// A file in the temporary folder holding a rig's JSON text, removed when
+/// dropped: `Rig.from_json` reads it through [`read_rig`], the one reader
+/// of rig files.
+struct TextFile(PathBuf);
+
+impl TextFile {
+    /// Writes `text` to a new file (its name unique in this process).
+    fn new(text: &str) -> std::io::Result<Self> {
+        static NEXT: AtomicU64 = AtomicU64::new(0);
+        let path = std::env::temp_dir().join(format!(
+            "hydrocyl-rig-{}-{}.json",
+            std::process::id(),
+            NEXT.fetch_add(1, Ordering::Relaxed)
+        ));
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&path)
+            .and_then(|mut f| std::io::Write::write_all(&mut f, text.as_bytes()))?;
+        Ok(Self(path))
+    }
+}
+
+impl Drop for TextFile {
+    fn drop(&mut self) {
+        // best effort: a file left behind in the temporary folder is harmless
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+/// Every parameter of a rig value with its value as the rig gives it: for
+/// a netlist, [`netlist::parameters_of`] the netlist as read (defaults
+/// filled in, unit and meaning from the component registry), so that a
+/// `null` the rig computes (an initial chamber pressure from the steady
+/// state) is `None`, not the computed value; other kinds as
+/// [`rig::parameters`] lists them.
+fn parameters_of(v: &Value) -> Vec<rig::Parameter> {
+    if v.get("kind").and_then(Value::as_str) == Some(netlist::KIND) {
+        if let Ok(s) = netlist::read(v) {
+            return netlist::parameters_of(&s)
+                .into_iter()
+                .map(|p| rig::Parameter {
+                    path: p.path,
+                    value: p.value,
+                    unit: Some(p.unit),
+                    doc: Some(p.doc),
+                })
+                .collect();
+        }
+    }
+    rig::parameters(v)
 }
 
 impl Rig {
@@ -33,24 +107,49 @@ impl Rig {
         rig::PRESETS.iter().map(|p| p.name).collect()
     }
 
-    /// A checked rig from a JSON value.
-    pub fn checked(value: Value) -> PyResult<Self> {
-        rig::check(&value).map_err(input)?;
-        Ok(Self { value })
+    /// A rig holding `value` (checked by the caller).
+    fn new(value: Value) -> Self {
+        Self {
+            value: Mutex::new(Arc::new(value)),
+        }
     }
 
-    /// The value at a parameter path: a parameter `rig::parameters` lists
+    /// A checked rig from a JSON value.
+    fn checked(value: Value) -> PyResult<Self> {
+        rig::check(&value).map_err(input)?;
+        Ok(Self::new(value))
+    }
+
+    /// The rig's value now: a snapshot that later edits of the rig leave
+    /// alone (they replace it).
+    pub fn snapshot(&self) -> Arc<Value> {
+        Arc::clone(&self.value.lock().unwrap_or_else(PoisonError::into_inner))
+    }
+
+    /// Applies `--set` assignments to a copy of the rig's value, checks it
+    /// and, when all is well, makes it the rig's value; on error the rig is
+    /// unchanged. No Python code runs in between, so no other thread's edit
+    /// is lost.
+    fn edit(&self, assignments: &[String]) -> PyResult<()> {
+        let mut v = Value::clone(&self.snapshot());
+        for a in assignments {
+            rig::apply_set(&mut v, a).map_err(input)?;
+        }
+        rig::check(&v).map_err(input)?;
+        *self.value.lock().unwrap_or_else(PoisonError::into_inner) = Arc::new(v);
+        Ok(())
+    }
+
+    /// The value at a parameter path: a parameter [`parameters_of`] lists
     /// (every `--set` path of a netlist), else a JSON path of an older rig
     /// kind (object keys, array indices); or the error `--set` gives for it.
     fn at(&self, path: &str) -> Result<Value, rig::RigError> {
-        if let Some(p) = rig::parameters(&self.value)
-            .into_iter()
-            .find(|p| p.path == path)
-        {
+        let value = self.snapshot();
+        if let Some(p) = parameters_of(&value).into_iter().find(|p| p.path == path) {
             return Ok(p.value.map_or(Value::Null, Value::from));
         }
-        let mut cur = &self.value;
-        let netlist = self.kind() == hydrocyl_system::netlist::KIND;
+        let mut cur = &*value;
+        let netlist = self.kind() == netlist::KIND;
         for seg in path.split('.') {
             let next = match cur {
                 Value::Object(m) if !netlist => m.get(seg),
@@ -61,7 +160,7 @@ impl Rig {
                 Some(v) => cur = v,
                 None => {
                     // Same wording as `--set` on a missing path.
-                    let mut probe = self.value.clone();
+                    let mut probe = Value::clone(&value);
                     return Err(rig::apply_set(&mut probe, &format!("{path}=0"))
                         .err()
                         .unwrap_or_else(|| rig::RigError::UnknownPath {
@@ -77,23 +176,51 @@ impl Rig {
 
 #[pymethods]
 impl Rig {
-    /// Loads a preset by name (`Rig.presets()`) or a rig JSON file by path,
-    /// as `hydrocyl simulate --rig NAME_OR_PATH` does, and checks it.
-    /// Raises ValueError with the CLI's message for an unknown preset, an
-    /// unreadable or malformed file or a parameter out of range.
+    /// Loads a preset by name (`Rig.presets()`) or a rig JSON file by path
+    /// (a `str` or any `os.PathLike`), as `hydrocyl simulate --rig
+    /// NAME_OR_PATH` does, and checks it: a duplicate key is refused, an
+    /// older rig kind (`valve-cylinder`, `hybrid-pump`) is read as its
+    /// netlist. Raises ValueError with the CLI's message for an unknown
+    /// preset, an unreadable or malformed file or a parameter out of range.
     #[staticmethod]
-    fn load(name_or_path: &str) -> PyResult<Self> {
-        let value = rig::load(name_or_path).map_err(input)?;
-        rig::check(&value).map_err(|e| input(rig::at_line(e, name_or_path)))?;
-        Ok(Self { value })
+    fn load(name_or_path: PathBuf) -> PyResult<Self> {
+        let source = name_or_path.to_str().ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "rig `{}`: the path is not valid UTF-8",
+                name_or_path.display()
+            ))
+        })?;
+        Ok(Self::new(read_rig(source).map_err(input)?))
     }
 
-    /// A rig from the text of a rig JSON file (as `to_json` writes it).
+    /// A rig from the text of a rig JSON file, read exactly as `load` reads
+    /// the file (the text goes through the same reader: duplicate keys
+    /// refused with their line, an older kind read as its netlist, a
+    /// retired kind named); messages name the text `JSON text` where
+    /// `load` names the file. OSError if the text cannot be put in a
+    /// temporary file for the reader.
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<Self> {
+        let file = TextFile::new(text).map_err(|e| {
+            PyOSError::new_err(format!(
+                "Rig.from_json: cannot write the text to a temporary file in {}: {e}",
+                std::env::temp_dir().display()
+            ))
+        })?;
+        let source = file.0.to_string_lossy().into_owned();
+        read_rig(&source)
+            .map(Self::new)
+            .map_err(|e| PyValueError::new_err(e.to_string().replace(&source, JSON_TEXT)))
+    }
+
+    /// A rig from its own `to_json` text (how a pickled rig is restored):
+    /// that text is a checked netlist already, so it is only parsed and
+    /// checked again.
+    #[staticmethod]
+    fn _from_rig_json(text: &str) -> PyResult<Self> {
         let v: Value = serde_json::from_str(text).map_err(|e| {
             input(rig::RigError::Invalid {
-                path: "rig".into(),
+                path: JSON_TEXT.into(),
                 why: format!("not valid JSON: {e}"),
             })
         })?;
@@ -106,10 +233,10 @@ impl Rig {
         Self::preset_names()
     }
 
-    /// The rig kind (`valve-cylinder`, `wang-hybrid`, ...).
+    /// The rig kind (`netlist` for every rig read by `load`/`from_json`).
     #[getter]
     fn kind(&self) -> String {
-        self.value
+        self.snapshot()
             .get("kind")
             .and_then(Value::as_str)
             .unwrap_or_default()
@@ -117,27 +244,26 @@ impl Rig {
     }
 
     /// Sets one parameter by its path, exactly as `--set path=value` does
-    /// (a number replaces a number or a `null`; a string a string), then
-    /// checks the rig. On error (ValueError, the CLI's message) the rig is
-    /// unchanged. Values are SI, as the rig file names them.
-    fn set(&mut self, path: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        let mut v = self.value.clone();
-        rig::apply_set(&mut v, &format!("{path}={}", set_text(value)?)).map_err(input)?;
-        *self = Self::checked(v)?;
-        Ok(())
+    /// (a number replaces a number or a `null`; None sets `null`, which for
+    /// an initial chamber pressure means "computed from the steady state";
+    /// a string replaces a string), then checks the rig. On error
+    /// (ValueError, the CLI's message) the rig is unchanged. Values are SI,
+    /// as the rig file names them.
+    fn set(&self, path: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.edit(&[format!("{path}={}", set_text(value)?)])
     }
 
-    /// Sets several parameters (`{path: value}`), in order, then checks the
-    /// rig once (for changes that are only consistent together). On error
-    /// the rig is unchanged.
-    fn update(&mut self, values: &Bound<'_, PyDict>) -> PyResult<()> {
-        let mut v = self.value.clone();
+    /// Sets several parameters (`{path: value}`, None for `null`), in
+    /// order, then checks the rig once (for changes that are only
+    /// consistent together). On error the rig is unchanged.
+    /// `rig.update(rig.parameters())` changes nothing.
+    fn update(&self, values: &Bound<'_, PyDict>) -> PyResult<()> {
+        let mut assignments = Vec::with_capacity(values.len());
         for (k, x) in values.iter() {
             let path: String = k.extract()?;
-            rig::apply_set(&mut v, &format!("{path}={}", set_text(&x)?)).map_err(input)?;
+            assignments.push(format!("{path}={}", set_text(&x)?));
         }
-        *self = Self::checked(v)?;
-        Ok(())
+        self.edit(&assignments)
     }
 
     /// The value at a parameter path (a number, a string, None for a `null`
@@ -147,19 +273,39 @@ impl Rig {
         json_to_py(py, &self.at(path).map_err(input)?)
     }
 
-    /// Every numeric (or `null`) parameter: `{path: value}` in sorted path
-    /// order, the paths `set` and `--set` take (values SI; None for `null`).
+    /// Every numeric (or `null`) parameter: `{path: value}` in component
+    /// order, the paths `set` and `--set` take (values SI, defaults filled
+    /// in; None for `null`, e.g. an initial chamber pressure the rig
+    /// computes from the steady state, so that `update(parameters())` keeps
+    /// it computed).
     fn parameters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for p in rig::parameters(&self.value) {
+        for p in parameters_of(&self.snapshot()) {
             d.set_item(p.path, p.value)?;
+        }
+        Ok(d)
+    }
+
+    /// Every parameter with its SI unit and meaning:
+    /// `{path: {"value": ..., "unit": ..., "doc": ...}}`, the paths and
+    /// values of `parameters()`. A netlist's units and meanings are those
+    /// of the component registry (`hydrocyl components`); a rig kind that
+    /// declares none gives None for them.
+    fn describe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for p in parameters_of(&self.snapshot()) {
+            let e = PyDict::new(py);
+            e.set_item("value", p.value)?;
+            e.set_item("unit", p.unit)?;
+            e.set_item("doc", p.doc)?;
+            d.set_item(p.path, e)?;
         }
         Ok(d)
     }
 
     /// The rig as the JSON text of a rig file (what `--print-rig` prints).
     fn to_json(&self) -> PyResult<String> {
-        serde_json::to_string_pretty(&self.value).map_err(|e| {
+        serde_json::to_string_pretty(&*self.snapshot()).map_err(|e| {
             input(rig::RigError::Invalid {
                 path: "rig".into(),
                 why: e.to_string(),
@@ -169,15 +315,17 @@ impl Rig {
 
     /// A copy (edits of the copy leave this rig alone).
     fn copy(&self) -> Self {
-        self.clone()
+        Self {
+            value: Mutex::new(self.snapshot()),
+        }
     }
 
     fn __copy__(&self) -> Self {
-        self.clone()
+        self.copy()
     }
 
     fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Self {
-        self.clone()
+        self.copy()
     }
 
     /// Pickles as its JSON text (for multiprocessing and Dask workers).
@@ -185,54 +333,60 @@ impl Rig {
         &self,
         py: Python<'py>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
-        let ctor = py.get_type::<Rig>().getattr("from_json")?;
-        Ok((ctor, PyTuple::new(py, [self.value.to_string()])?))
+        let ctor = py.get_type::<Rig>().getattr("_from_rig_json")?;
+        Ok((ctor, PyTuple::new(py, [self.snapshot().to_string()])?))
     }
 
     fn __eq__(&self, other: &Self) -> bool {
-        self.value == other.value
+        self.snapshot() == other.snapshot()
     }
 
     fn __repr__(&self) -> String {
         format!(
             "Rig(kind={:?}, {} parameters)",
             self.kind(),
-            rig::parameters(&self.value).len()
+            parameters_of(&self.snapshot()).len()
         )
     }
 
     /// Simulates the rig on the command `u` given at times `t` [s] (linear
     /// between samples, as `hydrocyl simulate --command` reads its CSV) and
     /// samples the run at `t`. `u` is the normalised spool demand of a valve
-    /// rig or the drive voltage [V] of a pump rig.
+    /// rig or the drive voltage [V] of a pump rig; `t` and `u` are 1-D
+    /// arrays of the same length.
     ///
-    /// `solver`: "dp45" (default), "rosenbrock" or "rk4"; `rtol`: relative
-    /// tolerance of the adaptive methods; `rk4_step` [s]; `h_max`: largest
-    /// step [s] (default 0.01); `ledger=True` adds the energy ledger
-    /// (`run.ledger`). The GIL is released while it runs.
+    /// `solver`: "auto" (default, as the CLI's: Dormand–Prince while the
+    /// run is not stiff, Rosenbrock while it is), "dp45", "rosenbrock",
+    /// "rk4" or "exponential"; `rtol`: relative tolerance of the adaptive
+    /// methods; `rk4_step` [s]: the step of the fixed-step methods; `h_max`:
+    /// largest step [s] (default 0.01); `ledger=True` adds the energy ledger
+    /// (`run.ledger`). The run is of the rig as it is when called (a `set`
+    /// from another thread meanwhile does not change it); the GIL is
+    /// released while it runs.
     ///
     /// ValueError for bad input (the CLI's message); SimulationError when
     /// the solver fails (time and state in the message).
-    #[pyo3(signature = (t, u, *, solver = "dp45", rtol = 1e-6, rk4_step = 2e-5, h_max = None, ledger = false))]
+    #[pyo3(signature = (t, u, *, solver = "auto", rtol = 1e-6, rk4_step = 2e-5, h_max = None, ledger = false))]
     #[allow(clippy::too_many_arguments)]
     fn simulate(
         &self,
         py: Python<'_>,
-        t: PyArrayLike1<'_, f64, AllowTypeChange>,
-        u: PyArrayLike1<'_, f64, AllowTypeChange>,
+        t: &Bound<'_, PyAny>,
+        u: &Bound<'_, PyAny>,
         solver: &str,
         rtol: f64,
         rk4_step: f64,
         h_max: Option<f64>,
         ledger: bool,
     ) -> PyResult<PyRun> {
-        let (t, u) = (vector(t), vector(u));
-        let value = &self.value;
-        let out = detached(py, || {
+        let (t, u) = (vector_arg("t", t)?, vector_arg("u", u)?);
+        let value = self.snapshot();
+        let (out, command_unit) = detached(py, || {
             let opts = sim::options(solver, rtol, rk4_step, h_max, ledger)?;
             let cmd = sim::command(&t, &u)?;
-            sim::simulate(value, &cmd, &t, &opts)
+            let out = sim::simulate(&value, &cmd, &t, &opts)?;
+            Ok((out, sim::command_unit(&value)))
         })?;
-        PyRun::new(py, out)
+        PyRun::new(py, out, command_unit)
     }
 }

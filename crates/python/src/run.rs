@@ -8,7 +8,7 @@ use hydrocyl_energy::ledger::{Ledger, Term};
 use numpy::PyArray1;
 use pyo3::exceptions::{PyImportError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyIterator, PyList};
 
 /// A run: `time` [s] and one array per channel, SI units (`units` names
 /// them): `command`, `position` [m], `velocity` [m/s], `p1`, `p2` [Pa gauge],
@@ -51,14 +51,23 @@ fn ledger_dict<'py>(py: Python<'py>, l: &Ledger) -> PyResult<Bound<'py, PyDict>>
 }
 
 impl PyRun {
-    /// Wraps a finished run (needs the GIL: makes the numpy arrays).
-    pub fn new(py: Python<'_>, s: Simulated) -> PyResult<Self> {
+    /// Wraps a finished run (needs the GIL: makes the numpy arrays);
+    /// `command_unit`, where given, is the `command` channel's unit (the
+    /// CLI's, [`crate::sim::command_unit`]).
+    pub fn new(py: Python<'_>, s: Simulated, command_unit: Option<&'static str>) -> PyResult<Self> {
         let r = s.run;
         let st = &r.stats;
         Ok(Self {
             n: r.time.len(),
             time: array(py, r.time).unbind(),
-            units: r.channels.iter().map(|c| c.unit).collect(),
+            units: r
+                .channels
+                .iter()
+                .map(|c| match command_unit {
+                    Some(u) if c.name == "command" => u,
+                    _ => c.unit,
+                })
+                .collect(),
             channels: Named {
                 names: r.channels.iter().map(|c| c.name.clone()).collect(),
                 values: r
@@ -168,6 +177,11 @@ impl PyRun {
     /// The channel names (`time` is `run.time`).
     fn keys(&self) -> Vec<String> {
         self.channels.names.clone()
+    }
+
+    /// Iterates over the channel names, as a dict over its keys.
+    fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyIterator>> {
+        PyList::new(py, &self.channels.names)?.try_iter()
     }
 
     /// A pandas DataFrame with `time` and every channel as columns (the

@@ -62,6 +62,23 @@ pub fn command(t: &[f64], u: &[f64]) -> Outcome<Signal> {
         .map_err(|e| Failure::Input(format!("command (t, u): {e}")))
 }
 
+/// The unit of a run's `command` channel as the CLI's output header gives
+/// it: where `command` is the rig's input as read (an open-loop netlist),
+/// the unit in which the rig reads that input ([`Schematic::input_unit`]
+/// of `hydrocyl_system::netlist`: `V` for a pump drive, `-` for a spool
+/// demand); `None` (the channel's own unit) otherwise, e.g. a closed-loop
+/// rig's controller output.
+///
+/// [`Schematic::input_unit`]: hydrocyl_system::netlist::Schematic::input_unit
+pub fn command_unit(value: &Value) -> Option<&'static str> {
+    let s = hydrocyl_system::netlist::read(value).ok()?;
+    if s.input_channel().as_deref() == Some("command") {
+        s.input_unit()
+    } else {
+        None
+    }
+}
+
 /// A run and, when the options ask for it, its energy ledger over the whole
 /// run (or why there is none).
 pub struct Simulated {

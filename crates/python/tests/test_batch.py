@@ -86,7 +86,7 @@ def test_a_solver_failure_in_a_batch_is_a_simulation_error(step, sets):
     params[p1] = np.full(12, 2e6)
     params[p1][5] = 1e30
     with pytest.raises(hydrocyl.SimulationError, match=r"^run 5 \(.*\): simulation: solver dp45: .*state at t") as e:
-        hydrocyl.simulate_batch(rig, t, u, params)
+        hydrocyl.simulate_batch(rig, t, u, params, solver="dp45")
     assert e.value.time == 0.0 and 1e30 in e.value.state.values()
     kept = hydrocyl.simulate_batch(rig, t, u, params, on_error="nan")
     assert list(kept.ok) == [i != 5 for i in range(12)]
@@ -106,6 +106,15 @@ def test_bad_batch_inputs(step, sets):
         hydrocyl.simulate_batch(rig, t, u, params, solver="euler")
     with pytest.raises(ValueError, match="threads"):
         hydrocyl.simulate_batch(rig, t, u, params, threads=0)
+
+
+@pytest.mark.parametrize("threads", [0, -1])
+def test_a_thread_count_below_one_is_a_value_error_naming_it(step, sets, threads):
+    t, u = step
+    rig, params = sets
+    with pytest.raises(ValueError) as e:
+        hydrocyl.simulate_batch(rig, t, u, params, threads=threads)
+    assert str(e.value) == f"threads: {threads} is not a thread count (must be at least 1)"
 
 
 def test_two_python_threads_run_batches_at_the_same_time(sets):

@@ -53,3 +53,10 @@ def test_diagnose_errors(repo):
         hydrocyl.diagnose(rig, {"time": t, "command": 0 * t})
     with pytest.raises(ValueError, match="no-such.csv"):
         hydrocyl.diagnose(rig, str(repo / "no-such.csv"))
+
+
+@pytest.mark.parametrize("window", [0, -1])
+def test_a_window_below_one_is_a_value_error_naming_it(repo, window):
+    with pytest.raises(ValueError) as e:
+        hydrocyl.diagnose(hydrocyl.Rig.load("leaney-moog"), str(repo / RECORD), window=window)
+    assert str(e.value) == f"window {window}: must be at least 1"

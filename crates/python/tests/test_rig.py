@@ -2,9 +2,14 @@
 and errors worded as the CLI words them."""
 
 import copy
+import json
 import math
+import pathlib
 import pickle
+import threading
+import time
 
+import numpy as np
 import pytest
 
 import hydrocyl
@@ -117,3 +122,116 @@ def test_set_rejects_values_that_are_not_parameters():
     rig = hydrocyl.Rig.load("leaney-moog")
     with pytest.raises(TypeError):
         rig.set(path_of(rig, "mass"), [1, 2])
+
+
+def test_describe_gives_each_parameters_value_unit_and_meaning_from_the_registry(cli):
+    """`describe()` (documented, once missing): `{path: {value, unit, doc}}`
+    for every parameter, the unit and meaning those of the component
+    registry, as `hydrocyl components --type <type>` prints them."""
+    rig = hydrocyl.Rig.load("leaney-moog")
+    described = rig.describe()
+    assert list(described) == list(rig.parameters())
+    assert described["load.mass"] == {"value": 100.0, "unit": "kg", "doc": "moving mass m"}
+    types = {name: c["type"] for name, c in json.loads(rig.to_json())["components"].items()}
+    tables = {}
+    for path, entry in described.items():
+        assert set(entry) == {"value", "unit", "doc"}, path
+        assert entry["value"] == rig.parameters()[path], path
+        component, name = path.split(".", 1)
+        ty = types[component]
+        if ty not in tables:
+            tables[ty] = run_cli(cli, "components", "--type", ty)[1].splitlines()
+        row = f"| `{name}` | {entry['unit']} |"
+        assert any(line.startswith(row) and line.endswith(f"| {entry['doc']} |") for line in tables[ty]), path
+    assert described["cylinder.initial.p1"]["value"] is None
+    assert described["cylinder.initial.p1"]["unit"] == "Pa"
+
+
+def test_null_parameters_are_none_and_stay_null_through_update():
+    """`cylinder.initial.p1` is `null` in the preset (computed from the
+    steady state): parameters() and get() give None, and
+    `update(parameters())` keeps it null, so it still follows the supply."""
+    rig = hydrocyl.Rig.load("leaney-moog")
+    p1 = "cylinder.initial.p1"
+    assert rig.parameters()[p1] is None and rig.get(p1) is None
+    again = rig.copy()
+    again.update(again.parameters())
+    assert again.get(p1) is None and again.parameters() == rig.parameters()
+    t = np.linspace(0.0, 0.01, 11)
+    u = np.zeros_like(t)
+    start = again.simulate(t, u)["p1"][0]
+    again.set("supply.pressure", 2 * rig.get("supply.pressure"))
+    assert again.simulate(t, u)["p1"][0] > 1.5 * start
+    # a number freezes it, None makes it computed again
+    again.set(p1, 3e6)
+    assert again.get(p1) == 3e6
+    again.set(p1, None)
+    assert again.get(p1) is None
+
+
+def test_set_while_another_thread_simulates_succeeds_and_leaves_the_run_alone():
+    """`simulate` and `simulate_batch` release the GIL; a `set` from another
+    thread meanwhile succeeds (once `RuntimeError: Already borrowed`) and
+    does not change the run, which simulates the rig as it was."""
+    rig = hydrocyl.Rig.load("leaney-moog")
+    mass = path_of(rig, "mass")
+    t = np.linspace(0.0, 0.1, 201)
+    u = np.where(t < 0.01, 0.0, 0.4)
+    settings = dict(solver="rk4", rk4_step=2e-7)  # 5e5 steps: long enough to overlap
+    expected = rig.copy().simulate(t, u, **settings)
+    for call in (
+        lambda: rig.simulate(t, u, **settings),
+        lambda: hydrocyl.simulate_batch(rig, t, u, {"supply.pressure": [7e6]}, **settings),
+    ):
+        rig.set(mass, 100.0)
+        out, started = {}, threading.Event()
+
+        def work():
+            started.set()
+            out["run"] = call()
+
+        worker = threading.Thread(target=work)
+        worker.start()
+        started.wait()
+        time.sleep(0.05)
+        during = 0
+        while worker.is_alive():
+            rig.set(mass, 50.0 + during)
+            during += worker.is_alive()
+            time.sleep(0.01)
+        worker.join()
+        assert during > 0
+        assert rig.get(mass) > 50.0
+        got = out["run"]
+        position = got["position"] if got["position"].ndim == 1 else got["position"][0]
+        np.testing.assert_array_equal(position, expected["position"])
+
+
+def test_from_json_reads_the_text_as_load_reads_a_file(repo, tmp_path):
+    """from_json and load share one reader: an older `valve-cylinder` file
+    becomes its netlist, a duplicate key is refused with its line, a
+    retired `hybrid-variant` names the netlists that replace it."""
+    legacy = repo / "fixtures" / "legacy" / "festo-hanging-load.rig.json"
+    from_text = hydrocyl.Rig.from_json(legacy.read_text())
+    assert from_text.kind == "netlist"
+    assert from_text == hydrocyl.Rig.load(str(legacy))
+    lines = (repo / "fixtures" / "rigs" / "leaney-moog.json").read_text().splitlines()
+    assert lines[2].lstrip().startswith('"name"')
+    duplicated = "\n".join([*lines[:3], lines[2], *lines[3:]])
+    retired = '{"kind": "hybrid-variant"}'
+    for text, message in [(duplicated, "duplicate key at line 4"), (retired, "hybrid-variant` kind is retired")]:
+        f = tmp_path / "rig.json"
+        f.write_text(text)
+        with pytest.raises(ValueError, match=message) as from_file:
+            hydrocyl.Rig.load(str(f))
+        with pytest.raises(ValueError, match=message) as from_text:
+            hydrocyl.Rig.from_json(text)
+        assert str(from_text.value).replace("JSON text", str(f)) == str(from_file.value)
+        assert "\n" not in str(from_text.value)
+
+
+def test_load_takes_a_path_like(repo):
+    path = repo / "fixtures" / "rigs" / "leaney-moog.json"
+    assert hydrocyl.Rig.load(pathlib.Path(path)) == hydrocyl.Rig.load(str(path))
+    with pytest.raises(ValueError, match="not a preset"):
+        hydrocyl.Rig.load(pathlib.Path("no-such-rig.json"))

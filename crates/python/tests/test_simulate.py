@@ -1,6 +1,7 @@
 """Rig.simulate: equal to `hydrocyl simulate` on the same rig and command,
 the energy ledger, pandas as an optional extra, and errors."""
 
+import re
 import sys
 import types
 
@@ -123,7 +124,7 @@ def test_solver_failure_is_a_simulation_error_with_time_and_state(cli, tmp_path,
     p1 = path_of(rig, "p1")
     rig.set(p1, 1e30)
     with pytest.raises(hydrocyl.SimulationError) as e:
-        rig.simulate(t, u)
+        rig.simulate(t, u, solver="dp45")
     err = e.value
     assert err.time == t[0]
     assert err.state and all(np.isfinite(v) for v in err.state.values())
@@ -169,3 +170,78 @@ def test_a_solver_failure_in_mid_run_carries_the_state_before_it(cli, tmp_path):
 def test_a_panic_becomes_a_runtime_error():
     with pytest.raises(RuntimeError, match="internal error .*deliberate test panic"):
         hydrocyl._panic_for_test()
+
+
+@pytest.mark.parametrize(
+    "preset, level, column",
+    [("leaney-moog", 0.4, "command"), ("wang-hybrid", 2.0, "command"), ("leaney-moog-closed-loop", 0.01, "reference")],
+)
+def test_units_are_those_of_the_cli_header(cli, tmp_path, preset, level, column):
+    """run.units agrees with the CLI's output header (`command [V]` on the
+    pump rig, once `-` in Python). The closed-loop rig's `reference` is
+    left out: its unit is being settled in the rig crates."""
+    t = np.linspace(0.0, 0.05, 51)
+    u = np.where(t < 0.01, 0.0, level)
+    cmd, out = tmp_path / "cmd.csv", tmp_path / "out.csv"
+    write_command(cmd, t, u, column)
+    run_cli(cli, "simulate", "--rig", preset, "--command", cmd, "--out", out)
+    header = out.read_text().splitlines()[0].split(",")
+    units = {m.group(1): m.group(2) or "" for m in (re.fullmatch(r"(.*?)(?: \[(.*)\])?", h) for h in header)}
+    run = hydrocyl.Rig.load(preset).simulate(t, u)
+    assert units.pop("time") == "s"
+    got = {k: v for k, v in run.units.items() if k != "reference"}
+    assert got == {k: v for k, v in units.items() if k != "reference"}
+    assert run.units["command"] == ("V" if preset == "wang-hybrid" else "-")
+
+
+@pytest.mark.parametrize("arg", ["t", "u"])
+@pytest.mark.parametrize("bad", ["2-D", "0-D", "None"])
+def test_a_command_that_is_not_1d_is_a_one_line_value_error_naming_it(step, arg, bad):
+    t, u = step
+    value = {"2-D": np.stack([t, t]), "0-D": np.float64(1.0), "None": None}[bad]
+    args = {"t": t, "u": u, arg: value}
+    rig = hydrocyl.Rig.load("leaney-moog")
+    for call in (
+        lambda: rig.simulate(args["t"], args["u"]),
+        lambda: hydrocyl.simulate_batch(rig, args["t"], args["u"], {"load.mass": [100.0]}),
+    ):
+        with pytest.raises(ValueError) as e:
+            call()
+        message = str(e.value)
+        assert message.startswith(f"{arg}: ") and "1-D array" in message, message
+        assert "\n" not in message
+
+
+def test_iterating_a_run_or_a_batch_gives_the_channel_names(step):
+    t, u = step
+    rig = hydrocyl.Rig.load("leaney-moog")
+    run = rig.simulate(t, u)
+    assert list(run) == run.names == run.keys()
+    assert [k for k in run] == run.names and dict(run.channels).keys() == set(run)
+    batch = hydrocyl.simulate_batch(rig, t, u, {"load.mass": [90.0, 110.0]})
+    assert list(batch) == batch.names and len(batch) == 2
+
+
+def test_the_default_solver_is_the_clis_auto(cli, tmp_path, repo):
+    """Python's default solver is `auto`, as the CLI's `--solver`; the stub
+    lists every solver the package accepts."""
+    assert 'solver="auto"' in hydrocyl.Rig.simulate.__text_signature__
+    assert 'solver="auto"' in hydrocyl.simulate_batch.__text_signature__
+    rig = hydrocyl.Rig.load("tudelft-seal-25")
+    t = np.linspace(0.0, 0.2, 201)
+    u = 0.01 * t / 0.2
+    cmd, out = tmp_path / "cmd.csv", tmp_path / "out.csv"
+    write_command(cmd, t, u)
+    run_cli(cli, "simulate", "--rig", "tudelft-seal-25", "--command", cmd, "--out", out)
+    assert_equal_to_cli(rig.simulate(t, u), read_csv(out))
+    default, auto = rig.simulate(t, u).stats, rig.simulate(t, u, solver="auto").stats
+    assert {k: v for k, v in default.items() if k != "wall_s"} == {k: v for k, v in auto.items() if k != "wall_s"}
+    stub = (repo / "crates" / "python" / "hydrocyl.pyi").read_text()
+    listed = re.findall(r'"(\w+)"', re.search(r"Solver = Literal\[(.*?)\]", stub).group(1))
+    with pytest.raises(ValueError) as e:
+        rig.simulate(t, u, solver="euler")
+    accepted = re.findall(r"\w+", str(e.value).split("(use ")[1])
+    assert sorted(listed) == sorted(w for w in accepted if w != "or")
+    for name in listed:
+        rig.simulate(t, u, solver=name)
+    assert stub.count('solver: Solver = "auto"') == 2

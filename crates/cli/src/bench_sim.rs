@@ -29,10 +29,8 @@ pub fn load(
     if rig::preset(spec).is_some() {
         return Ok(None);
     }
-    let is_bench = std::fs::read_to_string(spec)
-        .ok()
-        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-        .is_some_and(|v| bench::is_bench_rig(&v));
+    // read as every rig file is (a byte-order mark, an older kind)
+    let is_bench = rig::load(spec).is_ok_and(|v| bench::is_bench_rig(&v));
     if !is_bench {
         return Ok(None);
     }

@@ -7,12 +7,11 @@ use crate::errors::detached;
 use crate::run::PyRun;
 use crate::sim;
 use hydrocyl_system::{netlist, rig};
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use serde_json::Value;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 
 /// A rig: its JSON value (kind and parameters, SI units as the rig files
@@ -46,36 +45,6 @@ fn read_rig(source: &str) -> Result<Value, rig::RigError> {
     let value = rig::load(source)?;
     rig::check(&value).map_err(|e| rig::at_line(e, source))?;
     Ok(value)
-}
-
-/// A file in the temporary folder holding a rig's JSON text, removed when
-/// dropped: `Rig.from_json` reads it through [`read_rig`], the one reader
-/// of rig files.
-struct TextFile(PathBuf);
-
-impl TextFile {
-    /// Writes `text` to a new file (its name unique in this process).
-    fn new(text: &str) -> std::io::Result<Self> {
-        static NEXT: AtomicU64 = AtomicU64::new(0);
-        let path = std::env::temp_dir().join(format!(
-            "hydrocyl-rig-{}-{}.json",
-            std::process::id(),
-            NEXT.fetch_add(1, Ordering::Relaxed)
-        ));
-        std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&path)
-            .and_then(|mut f| std::io::Write::write_all(&mut f, text.as_bytes()))?;
-        Ok(Self(path))
-    }
-}
-
-impl Drop for TextFile {
-    fn drop(&mut self) {
-        // best effort: a file left behind in the temporary folder is harmless
-        let _ = std::fs::remove_file(&self.0);
-    }
 }
 
 /// Every parameter of a rig value with its value as the rig gives it: for
@@ -194,23 +163,14 @@ impl Rig {
     }
 
     /// A rig from the text of a rig JSON file, read exactly as `load` reads
-    /// the file (the text goes through the same reader: duplicate keys
-    /// refused with their line, an older kind read as its netlist, a
-    /// retired kind named); messages name the text `JSON text` where
-    /// `load` names the file. OSError if the text cannot be put in a
-    /// temporary file for the reader.
+    /// the file (`rig::parse`: duplicate keys refused with their line, an
+    /// older kind read as its netlist, a retired kind named, then checked);
+    /// messages name the text `JSON text` where `load` names the file.
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<Self> {
-        let file = TextFile::new(text).map_err(|e| {
-            PyOSError::new_err(format!(
-                "Rig.from_json: cannot write the text to a temporary file in {}: {e}",
-                std::env::temp_dir().display()
-            ))
-        })?;
-        let source = file.0.to_string_lossy().into_owned();
-        read_rig(&source)
-            .map(Self::new)
-            .map_err(|e| PyValueError::new_err(e.to_string().replace(&source, JSON_TEXT)))
+        let value = rig::parse(text, JSON_TEXT).map_err(input)?;
+        rig::check(&value).map_err(|e| input(rig::at_line_in(e, text, JSON_TEXT)))?;
+        Ok(Self::new(value))
     }
 
     /// A rig from its own `to_json` text (how a pickled rig is restored):
@@ -381,12 +341,11 @@ impl Rig {
     ) -> PyResult<PyRun> {
         let (t, u) = (vector_arg("t", t)?, vector_arg("u", u)?);
         let value = self.snapshot();
-        let (out, command_unit) = detached(py, || {
+        let out = detached(py, || {
             let opts = sim::options(solver, rtol, rk4_step, h_max, ledger)?;
             let cmd = sim::command(&t, &u)?;
-            let out = sim::simulate(&value, &cmd, &t, &opts)?;
-            Ok((out, sim::command_unit(&value)))
+            sim::simulate(&value, &cmd, &t, &opts)
         })?;
-        PyRun::new(py, out, command_unit)
+        PyRun::new(py, out)
     }
 }

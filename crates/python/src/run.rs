@@ -47,27 +47,21 @@ fn ledger_dict<'py>(py: Python<'py>, l: &Ledger) -> PyResult<Bound<'py, PyDict>>
     d.set_item("error", l.error)?;
     d.set_item("storage_error", l.storage_error)?;
     d.set_item("efficiency", l.efficiency())?;
+    d.set_item("not_energy_consistent", l.not_energy_consistent.clone())?;
     Ok(d)
 }
 
 impl PyRun {
-    /// Wraps a finished run (needs the GIL: makes the numpy arrays);
-    /// `command_unit`, where given, is the `command` channel's unit (the
-    /// CLI's, [`crate::sim::command_unit`]).
-    pub fn new(py: Python<'_>, s: Simulated, command_unit: Option<&'static str>) -> PyResult<Self> {
+    /// Wraps a finished run (needs the GIL: makes the numpy arrays); its
+    /// channels' units are the CLI header's (the input's is the unit its
+    /// readers take it in, `Circuit::set_probe_unit`).
+    pub fn new(py: Python<'_>, s: Simulated) -> PyResult<Self> {
         let r = s.run;
         let st = &r.stats;
         Ok(Self {
             n: r.time.len(),
             time: array(py, r.time).unbind(),
-            units: r
-                .channels
-                .iter()
-                .map(|c| match command_unit {
-                    Some(u) if c.name == "command" => u,
-                    _ => c.unit,
-                })
-                .collect(),
+            units: r.channels.iter().map(|c| c.unit).collect(),
             channels: Named {
                 names: r.channels.iter().map(|c| c.name.clone()).collect(),
                 values: r

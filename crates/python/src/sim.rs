@@ -62,23 +62,6 @@ pub fn command(t: &[f64], u: &[f64]) -> Outcome<Signal> {
         .map_err(|e| Failure::Input(format!("command (t, u): {e}")))
 }
 
-/// The unit of a run's `command` channel as the CLI's output header gives
-/// it: where `command` is the rig's input as read (an open-loop netlist),
-/// the unit in which the rig reads that input ([`Schematic::input_unit`]
-/// of `hydrocyl_system::netlist`: `V` for a pump drive, `-` for a spool
-/// demand); `None` (the channel's own unit) otherwise, e.g. a closed-loop
-/// rig's controller output.
-///
-/// [`Schematic::input_unit`]: hydrocyl_system::netlist::Schematic::input_unit
-pub fn command_unit(value: &Value) -> Option<&'static str> {
-    let s = hydrocyl_system::netlist::read(value).ok()?;
-    if s.input_channel().as_deref() == Some("command") {
-        s.input_unit()
-    } else {
-        None
-    }
-}
-
 /// A run and, when the options ask for it, its energy ledger over the whole
 /// run (or why there is none).
 pub struct Simulated {
@@ -99,8 +82,59 @@ pub fn simulate(
         RigError::Sim(_) => locate_failure(value, command, t, opts, e.to_string()),
         other => Failure::Input(other.to_string()),
     })?;
+    if let Some(u) = run.unphysical() {
+        return Err(unphysical(value, command, opts, &run, u));
+    }
     let ledger = opts.ledger.then(|| whole_run_ledger(value, command, &run));
     Ok(Simulated { run, ledger })
+}
+
+/// A run that finished but is not physical ([`Run::unphysical`]) as a
+/// [`Failure::Solver`]: the CLI's diagnosis and remedy in Python's words,
+/// the time and the state of the first such sample.
+fn unphysical(
+    value: &Value,
+    command: &Signal,
+    opts: &RunOptions,
+    run: &Run,
+    u: hydrocyl_system::run::Unphysical,
+) -> Failure {
+    let solver = opts.solver;
+    let adaptive = solver != Solver::Rk4;
+    let message = match u.chamber_of.as_deref().filter(|_| adaptive && u.is_tension()) {
+        Some(cylinder) => format!(
+            "a chamber pressure fell far below absolute vacuum ({}): the oil, a liquid of constant bulk modulus, has left its range (the chamber cavitates); give it entrained air (rig.set('{cylinder}.air_fraction', 0.005)), or if the {} run is unstable instead, try a smaller rtol",
+            u.what,
+            solver.name()
+        ),
+        None if solver == Solver::Rk4 => format!(
+            "the rk4 solution is unstable ({}): rk4_step {} is too large for this rig: use a smaller step or solver='auto'",
+            u.what, opts.rk4_step
+        ),
+        None => format!(
+            "the {} solution is unstable ({}); try solver='rosenbrock' or a smaller rtol",
+            solver.name(),
+            u.what
+        ),
+    };
+    let names = Simulation::new(value, command.clone())
+        .map(|s| s.circuit().state_names())
+        .unwrap_or_default();
+    let state: Vec<(String, f64)> = names
+        .into_iter()
+        .zip(run.state(u.sample).iter().copied())
+        .collect();
+    let time = run.time[u.sample];
+    let listed = state
+        .iter()
+        .map(|(k, v)| format!("{k} = {v:e}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    Failure::Solver {
+        message: format!("{message}; state at t = {time} s: {listed}"),
+        time,
+        state,
+    }
 }
 
 /// The ledger of `run` over all its samples, on a fresh circuit of the same

@@ -178,8 +178,7 @@ def test_a_panic_becomes_a_runtime_error():
 )
 def test_units_are_those_of_the_cli_header(cli, tmp_path, preset, level, column):
     """run.units agrees with the CLI's output header (`command [V]` on the
-    pump rig, once `-` in Python). The closed-loop rig's `reference` is
-    left out: its unit is being settled in the rig crates."""
+    pump rig, once `-` in Python; the closed-loop set-point in m)."""
     t = np.linspace(0.0, 0.05, 51)
     u = np.where(t < 0.01, 0.0, level)
     cmd, out = tmp_path / "cmd.csv", tmp_path / "out.csv"
@@ -189,9 +188,10 @@ def test_units_are_those_of_the_cli_header(cli, tmp_path, preset, level, column)
     units = {m.group(1): m.group(2) or "" for m in (re.fullmatch(r"(.*?)(?: \[(.*)\])?", h) for h in header)}
     run = hydrocyl.Rig.load(preset).simulate(t, u)
     assert units.pop("time") == "s"
-    got = {k: v for k, v in run.units.items() if k != "reference"}
-    assert got == {k: v for k, v in units.items() if k != "reference"}
+    assert run.units == units
     assert run.units["command"] == ("V" if preset == "wang-hybrid" else "-")
+    if column == "reference":
+        assert run.units["reference"] == "m"
 
 
 @pytest.mark.parametrize("arg", ["t", "u"])
@@ -245,3 +245,28 @@ def test_the_default_solver_is_the_clis_auto(cli, tmp_path, repo):
     for name in listed:
         rig.simulate(t, u, solver=name)
     assert stub.count('solver: Solver = "auto"') == 2
+
+
+def test_a_run_that_is_not_physical_is_a_simulation_error():
+    """A fixed rk4 step far too long for the rig finishes with finite but
+    absurd values: a chamber pressure far below vacuum. It is a
+    SimulationError naming the sample and the remedy, as the CLI's line."""
+    t = np.linspace(0.0, 0.5, 501)
+    u = 0.2 * np.sin(4.0 * np.pi * t)
+    rig = hydrocyl.Rig.load("leaney-moog")
+    with pytest.raises(hydrocyl.SimulationError) as e:
+        rig.simulate(t, u, solver="rk4", rk4_step=0.1)
+    err = e.value
+    assert "the rk4 solution is unstable" in str(err) and "rk4_step 0.1" in str(err)
+    assert err.time in t and err.state
+    # the same rig with a sound step runs
+    assert np.isfinite(rig.simulate(t, u, solver="rk4").time).all()
+
+
+def test_a_ledger_over_a_form_that_does_not_conserve_energy_says_whose():
+    t = np.linspace(0.0, 0.3, 301)
+    u = np.full_like(t, 0.5)
+    led = hydrocyl.Rig.load("leaney-moog").simulate(t, u, ledger=True, rtol=1e-9).ledger
+    assert led["not_energy_consistent"] == [] and abs(led["error"]) < 1e-12
+    led = hydrocyl.Rig.load("leaney-moog-generalised").simulate(t, u, ledger=True, rtol=1e-9).ledger
+    assert led["not_energy_consistent"] == ["cylinder"]

@@ -195,19 +195,28 @@ pub fn load(name_or_path: &str) -> Result<Value, RigError> {
                 .join(", ")
         ),
     })?;
-    let v: Value = serde_json::from_str(&text).map_err(|e| RigError::Invalid {
-        path: name_or_path.into(),
+    parse(&text, name_or_path)
+}
+
+/// Reads the text of a rig file (`source` names it in messages: the file,
+/// or `JSON text`): a leading byte-order mark skipped, duplicate keys
+/// refused with their line, a retired kind named, an older kind read as its
+/// netlist. [`load`] reads a file through it.
+pub fn parse(text: &str, source: &str) -> Result<Value, RigError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let v: Value = serde_json::from_str(text).map_err(|e| RigError::Invalid {
+        path: source.into(),
         why: format!("not valid JSON: {e}"),
     })?;
-    if let Some((key, line)) = crate::netlist::locate::scan(&text).duplicate {
+    if let Some((key, line)) = crate::netlist::locate::scan(text).duplicate {
         return Err(RigError::Invalid {
-            path: format!("{name_or_path}: {key}"),
+            path: format!("{source}: {key}"),
             why: format!("duplicate key at line {line} (a key may appear once in an object)"),
         });
     }
     if v.get("kind").and_then(Value::as_str) == Some(RETIRED_VARIANT_KIND) {
         return Err(RigError::Invalid {
-            path: format!("{name_or_path}: kind"),
+            path: format!("{source}: kind"),
             why: "the `hybrid-variant` kind is retired: its circuits are netlists now \
                   (fixtures/rigs/wang-hybrid-{solenoid,needle,improved}.json), and the needle \
                   opening per speed is the parameter `needle_valve.area` (`--set needle_valve.area=<m^2>`)"
@@ -218,7 +227,7 @@ pub fn load(name_or_path: &str) -> Result<Value, RigError> {
     match crate::netlist::migrate::migrate(&v) {
         Ok(Some(n)) => Ok(n),
         Ok(None) => Ok(v),
-        Err(e) => Err(at_line(e, name_or_path)),
+        Err(e) => Err(at_line_in(e, text, source)),
     }
 }
 
@@ -232,6 +241,12 @@ pub fn at_line(e: RigError, source: &str) -> RigError {
     let Ok(text) = std::fs::read_to_string(source) else {
         return e;
     };
+    at_line_in(e, &text, source)
+}
+
+/// [`at_line`] on the rig's text `text`, named `source` in the message.
+pub fn at_line_in(e: RigError, text: &str, source: &str) -> RigError {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     // an error about the file itself (it does not read, a duplicate key)
     // names it already
     if let RigError::Invalid { path, .. } = &e {
@@ -239,7 +254,7 @@ pub fn at_line(e: RigError, source: &str) -> RigError {
             return e;
         }
     }
-    let located = crate::netlist::locate::scan(&text);
+    let located = crate::netlist::locate::scan(text);
     // the file is named always, with the line where the path has one
     let place = |path: &str| match located.line_of(path).filter(|_| !path.is_empty()) {
         Some(l) => format!("(line {l} of {source})"),
@@ -474,6 +489,32 @@ fn describe(v: &Value) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rig_text_reads_as_a_file_does_and_a_byte_order_mark_is_skipped() {
+        let text = serde_json::to_string_pretty(&preset("leaney-moog").unwrap()).unwrap();
+        let plain = parse(&text, "JSON text").unwrap();
+        assert_eq!(
+            parse(&format!("\u{feff}{text}"), "JSON text").unwrap(),
+            plain
+        );
+        // a duplicate key is refused with its line, as in a file
+        let twice = text.replacen("\"mass\": 100.0", "\"mass\": 100.0, \"mass\": 5.0", 1);
+        let e = parse(&twice, "JSON text").unwrap_err().to_string();
+        assert!(
+            e.contains("JSON text: ") && e.contains("duplicate key at line"),
+            "{e}"
+        );
+        // a path's line is found in the text
+        let mut bad = plain.clone();
+        bad["components"]["load"]["mass"] = (-1.0).into();
+        let shown = serde_json::to_string_pretty(&bad).unwrap();
+        let e = at_line_in(check(&bad).unwrap_err(), &shown, "JSON text").to_string();
+        assert!(
+            e.contains("components.load.mass") && e.contains("of JSON text)"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn parameters_are_set_paths_with_units() {

@@ -25,6 +25,8 @@ pub struct Unphysical {
     pub chamber_of: Option<String>,
     /// The value itself.
     pub value: f64,
+    /// Its sample: [`Run::time`]`[sample]`, [`Run::state`]`(sample)`.
+    pub sample: usize,
 }
 
 impl Unphysical {
@@ -77,6 +79,7 @@ impl Run {
                     .filter(|_| chamber && v.is_finite())
                     .map(str::to_string),
                 value: v,
+                sample: k,
             })
         })
     }

@@ -60,7 +60,7 @@ class Rig:
         state)."""
     def update(self, values: Mapping[str, ParamValue]) -> None:
         """Sets several parameters, then checks the rig once;
-        ``rig.update(rig.parameters())`` changes nothing."""
+        ``rig.update(rig.parameters())`` changes no value (defaults are written out)."""
     def get(self, path: str) -> Any:
         """The value at a parameter path (number, string, None, or a
         dict/list for an inner path)."""

@@ -45,7 +45,7 @@ pub struct Args {
     pub holdout: f64,
     /// Smoother half-width in samples (default: chosen by GCV).
     #[arg(long, allow_negative_numbers = true)]
-    pub window: Option<usize>,
+    pub window: Option<i64>,
     /// Restrict the effects the loop may add (comma separated catalog ids).
     #[arg(long, value_delimiter = ',')]
     pub effects: Option<Vec<String>>,
@@ -152,9 +152,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.holdout
         )));
     }
-    if args.window == Some(0) {
-        return Err(CliError::Input("--window 0: must be at least 1".into()));
-    }
+    let window = match args.window {
+        Some(w) if w < 1 => {
+            return Err(CliError::Input(format!("--window {w}: must be at least 1")))
+        }
+        w => w.map(|w| w as usize),
+    };
     let candidates = match &args.effects {
         None => None,
         Some(ids) => Some(
@@ -204,7 +207,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let opts = DiagnoseOptions {
         min_share: args.min_share,
         holdout: args.holdout,
-        half_window: args.window,
+        half_window: window,
         candidates,
         ..DiagnoseOptions::default()
     };

@@ -14,8 +14,10 @@
 //! it back, as for any file written in place; with `--fsync` it is flushed
 //! before the swap.
 //!
-//! An output path that is a symbolic link is written through it, as a shell's
-//! `>` does: the file it points to is replaced, the link stays. A path that is
+//! An output path that is a symbolic link is written through it: the file it
+//! points to is replaced, the link stays (the new file takes the old one's
+//! permissions; being a new file, it does not keep the old one's hard links,
+//! where a shell's `>`, writing in place, would). A path that is
 //! a stream (`/dev/stdout`, a pipe, a terminal, a device) is written to
 //! directly, as it is produced: there is no file to put in place, and what a
 //! failed run has written to a stream cannot be taken back.
@@ -193,6 +195,10 @@ impl Outputs {
             remove_temporaries_on_signal();
             let f = File::create(&tmp).map_err(io)?;
             register(&tmp);
+            // the file it replaces keeps its permissions
+            if let Ok(m) = std::fs::metadata(&target) {
+                let _ = f.set_permissions(m.permissions());
+            }
             (f, Some(Place { target, tmp }))
         };
         self.files.push(Pending {
@@ -289,7 +295,8 @@ impl Outputs {
                 source,
             };
             let file = w.into_inner().map_err(|e| io(e.into_error()))?;
-            if fsync {
+            // a stream (a pipe, a terminal) has no disk to flush to
+            if fsync && f.place.is_some() {
                 file.sync_all().map_err(io)?;
             }
         }

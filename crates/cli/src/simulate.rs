@@ -52,7 +52,7 @@ use crate::progress::Progress;
 use crate::writer::{Block, Maker, Rows, Writer};
 use hydrocyl_identify::bench::FrictionBench;
 use hydrocyl_system::rig;
-use hydrocyl_system::run::{ProbeReader, Run, RunOptions, Solver};
+use hydrocyl_system::run::{Cause, ProbeReader, Run, RunOptions, Solver};
 use hydrocyl_system::signal::{Signal, StreamedTable};
 use hydrocyl_system::simulation::Simulation;
 use std::path::{Path, PathBuf};
@@ -233,20 +233,14 @@ fn check_initial_pressures(rig: &crate::rigfile::Checked) -> Result<(), CliError
 /// non-finite value, a chamber pressure far below vacuum:
 /// [`Run::unphysical`]) and names the fix.
 pub(crate) fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result<(), CliError> {
-    // an error-controlled solver that met its tolerance on a finite,
-    // moderate tension: the liquid model left its range, not the solver
-    let adaptive = matches!(solver, Solver::Auto | Solver::Dp45 | Solver::Rosenbrock);
-    let bad = run.unphysical().map(|u| {
-        let cylinder = u.chamber_of.clone().filter(|_| adaptive && u.is_tension());
-        (u.what, cylinder)
-    });
-    let Some((what, below_vacuum)) = bad else {
+    let Some(u) = run.unphysical() else {
         return Ok(());
     };
-    if let Some(cylinder) = below_vacuum {
+    let what = &u.what;
+    let message = match u.cause(solver) {
         // a finite chamber pressure far below vacuum: the same with any
         // solver and tolerance when the liquid has no cavitation model
-        return Err(CliError::Input(format!(
+        Cause::Cavitation { cylinder } => format!(
             "a chamber pressure fell far below absolute vacuum ({what}): the oil, a liquid of constant bulk modulus, has left its range (the chamber cavitates); give it entrained air (--set {cylinder}.air_fraction=0.005, docs/hybrid.md), or if the {} run is unstable instead, try a smaller --rtol{}",
             solver.name(),
             if matches!(solver, Solver::Rosenbrock) {
@@ -254,19 +248,17 @@ pub(crate) fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result
             } else {
                 " or --solver rosenbrock"
             }
-        )));
-    }
-    let fix = if solver == Solver::Rk4 {
-        format!(
-            "--rk4-step {rk4_step} is too large for this rig: use a smaller step or --solver auto"
-        )
-    } else {
-        "try --solver rosenbrock or a smaller --rtol".to_string()
+        ),
+        Cause::StepTooLong => format!(
+            "the {} solution is unstable ({what}); --rk4-step {rk4_step} is too large for this rig: use a smaller step or --solver auto",
+            solver.name()
+        ),
+        Cause::Unstable => format!(
+            "the {} solution is unstable ({what}); try --solver rosenbrock or a smaller --rtol",
+            solver.name()
+        ),
     };
-    Err(CliError::Input(format!(
-        "the {} solution is unstable ({what}); {fix}",
-        solver.name()
-    )))
+    Err(CliError::Input(message))
 }
 
 /// Warns when a normalised valve command leaves ±1 (`outside` samples, the

@@ -140,6 +140,31 @@ fn a_window_wider_than_the_record_is_refused() {
     }
 }
 
+/// Negative option values reach their range checks (one line, exit 2).
+#[test]
+fn negative_options_are_refused_by_their_range() {
+    let valve = fixtures().join("valve-none.csv");
+    for (args, words) in [
+        (["--min-share", "-1"], "--min-share -1: must be in [0, 1)"),
+        (
+            ["--holdout", "-0.1"],
+            "--holdout -0.1: must be in [0.05, 0.5]",
+        ),
+        (["--window", "-3"], "--window -3: must be at least 1"),
+    ] {
+        let out = bin()
+            .args(["diagnose", "--rig", "leaney-moog", "--data"])
+            .arg(&valve)
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains(words), "{words}: {err}");
+    }
+}
+
 #[test]
 fn missing_force_column_is_named() {
     let csv = good_csv()

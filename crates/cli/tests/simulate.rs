@@ -775,9 +775,11 @@ fn an_output_link_is_written_through_and_a_stream_is_written_to() {
         written
     );
     assert!(temporaries(dir.path()).is_empty());
-    // the run's rows on standard output
-    let st = simulate_ok("leaney-moog", &cmd, Path::new("/dev/stdout"), &["--quiet"]);
-    assert_eq!(String::from_utf8_lossy(&st.stdout), written);
+    // the run's rows on standard output (a stream has no disk to flush to)
+    for extra in [&["--quiet"][..], &["--quiet", "--fsync"][..]] {
+        let st = simulate_ok("leaney-moog", &cmd, Path::new("/dev/stdout"), extra);
+        assert_eq!(String::from_utf8_lossy(&st.stdout), written);
+    }
 }
 
 /// A closed standard output (`hydrocyl presets | true`) is an error naming
@@ -786,27 +788,25 @@ fn an_output_link_is_written_through_and_a_stream_is_written_to() {
 fn a_closed_standard_output_is_an_error_not_a_panic() {
     for args in [
         &["components"][..],
+        &["presets"][..],
         &["simulate", "--rig", "leaney-moog", "--print-rig"][..],
     ] {
-        let mut child = hydrocyl()
+        // the reading end is closed before the child starts
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let st = hydrocyl()
             .args(args)
-            .stdout(std::process::Stdio::piped())
+            .stdout(writer)
             .stderr(std::process::Stdio::piped())
-            .spawn()
+            .output()
             .unwrap();
-        // the reading end closes before the child writes
-        drop(child.stdout.take());
-        let st = child.wait_with_output().unwrap();
         let err = String::from_utf8_lossy(&st.stderr);
-        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert_eq!(st.status.code(), Some(2), "{args:?}: {err}");
         assert!(
-            st.status.code() == Some(2) || st.status.success(),
+            err.contains("<stdout>") && !err.contains("panicked"),
             "{args:?}: {err}"
         );
-        if st.status.code() == Some(2) {
-            assert!(err.contains("<stdout>"), "{args:?}: {err}");
-            assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
-        }
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
     }
 }
 
@@ -855,4 +855,44 @@ fn the_input_column_is_in_the_unit_of_its_rig() {
     );
     simulate_ok("leaney-moog-closed-loop", &first, &out, &["--quiet"]);
     assert_eq!(std::fs::read_to_string(&out).unwrap(), text);
+}
+
+/// A number a rig or a command cannot hold (`1e400` overflows, `inf`,
+/// `NaN`) is named as such, in a command cell and in a `--set`.
+#[test]
+fn a_number_that_is_not_finite_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = write_command(dir.path(), "good.csv", &square(20, 1e-3));
+    let big = dir.path().join("big.csv");
+    std::fs::write(&big, "time,command\n0,1e400\n0.01,1\n").unwrap();
+    let out = dir.path().join("out.csv");
+    let run = |cmd: &Path, extra: &[&str]| {
+        let st = hydrocyl()
+            .args(["simulate", "--rig", "leaney-moog", "--command"])
+            .arg(cmd)
+            .arg("--out")
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap();
+        (
+            st.status.code(),
+            String::from_utf8_lossy(&st.stderr).to_string(),
+        )
+    };
+    let (code, err) = run(&big, &[]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("row 2, column `command`: `1e400` is not a finite number"),
+        "{err}"
+    );
+    for v in ["1e400", "inf", "NaN"] {
+        let (code, err) = run(&good, &["--set", &format!("load.mass={v}")]);
+        assert_eq!(code, Some(2), "{err}");
+        assert!(
+            err.contains(&format!("`{v}` is not a finite number")),
+            "{err}"
+        );
+    }
+    assert!(!out.exists());
 }

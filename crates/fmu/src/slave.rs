@@ -430,12 +430,20 @@ impl Slave {
                 let (ok, rule) = match sp {
                     SolverParam::Method => (
                         value >= 0.0 && value < METHODS.len() as f64 && value.fract() == 0.0,
-                        "must be 0 (dp45), 1 (rosenbrock) or 2 (rk4)",
+                        format!(
+                            "must be {}",
+                            METHODS
+                                .iter()
+                                .enumerate()
+                                .map(|(i, m)| format!("{i} ({})", m.name()))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        ),
                     ),
-                    SolverParam::Rtol => (value > 0.0 && value < 1.0, "must be in (0, 1)"),
+                    SolverParam::Rtol => (value > 0.0 && value < 1.0, "must be in (0, 1)".into()),
                     SolverParam::HMax | SolverParam::Rk4Step => (
                         value.is_finite() && value > 0.0,
-                        "must be finite and > 0 [s]",
+                        "must be finite and > 0 [s]".into(),
                     ),
                 };
                 if !ok {
@@ -601,13 +609,7 @@ fn own_rule(rig: &Value, path: &str, value: f64) -> Result<(), String> {
     };
     match name.strip_prefix("initial.") {
         Some(state) => ty.state(state).map_or(Ok(()), |s| s.check(value)),
-        None => match ty.param(name) {
-            Some(p) if !p.range.contains(value) => Err(match p.unit {
-                "-" | "" => format!("must be {}", p.range.describe()),
-                unit => format!("must be {} [{unit}]", p.range.describe()),
-            }),
-            _ => Ok(()),
-        },
+        None => ty.param(name).map_or(Ok(()), |p| p.check(value)),
     }
 }
 
@@ -711,7 +713,7 @@ mod tests {
         let mut s = Slave::new(rig::preset("leaney-moog").unwrap()).unwrap();
         let e = s.set_real(vr(&s, "cylinder.stroke"), -0.1).unwrap_err();
         assert!(
-            e.contains("cylinder.stroke") && e.contains("must be > 0 [m]"),
+            e.contains("cylinder.stroke") && e.contains("-0.1 [m] is out of range: must be > 0"),
             "{e}"
         );
         let e = s.set_real(vr(&s, "cylinder.stroke"), f64::NAN).unwrap_err();
@@ -734,7 +736,7 @@ mod tests {
         }
         let e = s.set_integer(vr(&s, "solver.method"), 7).unwrap_err();
         assert!(
-            e.contains("must be 0 (dp45), 1 (rosenbrock) or 2 (rk4)"),
+            e.contains("must be 0 (dp45), 1 (rosenbrock), 2 (rk4)"),
             "{e}"
         );
         s.enter_initialization().unwrap();

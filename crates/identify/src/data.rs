@@ -189,6 +189,12 @@ pub enum DataError {
         /// The record's samples.
         samples: usize,
     },
+    /// A smoother half-width given for records that are not smoothed.
+    #[error("{file}: a steady-state bench's samples are not smoothed (measured velocity, zero acceleration): leave out the smoother half-width (window)")]
+    WindowNotUsed {
+        /// The record.
+        file: String,
+    },
     /// A cell is not a number.
     #[error("{file}: row {row}, column '{column}': '{text}' is not a number")]
     NotANumber {

@@ -240,26 +240,24 @@ fn apply(w: &Weights, y: &[f64]) -> (f64, f64, f64) {
     a
 }
 
-/// Checks a half-width asked for against record `rec`: a window of
-/// `2 h + 1` samples inside it, never clamped silently.
-pub fn check_half_window(
+/// Smooths the samples `y` of record `rec` with a given half-width
+/// (`criterion = "fixed"`): a window of `2 h + 1` samples must fit inside
+/// the record, never clamped silently.
+pub fn smooth_with(
     rec: &crate::data::Record,
-    h: usize,
-) -> Result<(), crate::data::DataError> {
+    y: &[f64],
+    half_window: usize,
+    order: usize,
+) -> Result<Smoothed, crate::data::DataError> {
     let samples = rec.time.len();
-    if h == 0 || 2 * h + 1 > samples {
+    if half_window == 0 || 2 * half_window + 1 > samples {
         return Err(crate::data::DataError::WindowTooWide {
             file: rec.source.clone(),
-            half_window: h,
+            half_window,
             samples,
         });
     }
-    Ok(())
-}
-
-/// Smooths with a given half-width (`criterion = "fixed"`).
-pub fn smooth_with(t: &[f64], y: &[f64], half_window: usize, order: usize) -> Smoothed {
-    smooth_fixed(t, y, half_window, order).0
+    Ok(smooth_fixed(&rec.time, y, half_window, order).0)
 }
 
 /// Smooths with the half-width that minimises GCV among a geometric ladder
@@ -342,7 +340,7 @@ mod tests {
             .iter()
             .map(|&x| 1.0 + 2.0 * x - 3.0 * x * x + 5.0 * x.powi(3))
             .collect();
-        let s = smooth_with(&t, &y, 6, 3);
+        let s = smooth_fixed(&t, &y, 6, 3).0;
         for (i, &x) in t.iter().enumerate() {
             assert!((s.value[i] - y[i]).abs() < 1e-9);
             assert!((s.d1[i] - (2.0 - 6.0 * x + 15.0 * x * x)).abs() < 1e-6);
@@ -366,7 +364,7 @@ mod tests {
             let f = |x: f64| c[0] + c[1] * x + c[2] * x * x + c[3] * x.powi(3);
             let df = |x: f64| c[1] + 2.0 * c[2] * x + 3.0 * c[3] * x * x;
             let y: Vec<f64> = t.iter().map(|&x| f(x)).collect();
-            let s = smooth_with(&t, &y, h, 3);
+            let s = smooth_fixed(&t, &y, h, 3).0;
             for (i, &x) in t.iter().enumerate() {
                 proptest::prop_assert!((s.value[i] - y[i]).abs() < 1e-8);
                 proptest::prop_assert!((s.d1[i] - df(x)).abs() < 1e-4 * (1.0 + df(x).abs()));

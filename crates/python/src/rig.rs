@@ -216,7 +216,7 @@ impl Rig {
     /// Sets several parameters (`{path: value}`, None for `null`), in
     /// order, then checks the rig once (for changes that are only
     /// consistent together). On error the rig is unchanged.
-    /// `rig.update(rig.parameters())` changes nothing.
+    /// `rig.update(rig.parameters())` changes no value (a default it writes out stays the default).
     fn update(&self, values: &Bound<'_, PyDict>) -> PyResult<()> {
         let mut assignments = Vec::with_capacity(values.len());
         for (k, x) in values.iter() {

@@ -7,7 +7,7 @@ use crate::errors::{Failure, Outcome};
 use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
 use hydrocyl_integrators::SolveError;
 use hydrocyl_system::rig::{self, RigError};
-use hydrocyl_system::run::{Run, RunOptions, SimError, Solver};
+use hydrocyl_system::run::{Cause, Run, RunOptions, SimError, Solver};
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::simulation::Simulation;
 use serde_json::Value;
@@ -100,18 +100,19 @@ fn unphysical(
     u: hydrocyl_system::run::Unphysical,
 ) -> Failure {
     let solver = opts.solver;
-    let adaptive = solver != Solver::Rk4;
-    let message = match u.chamber_of.as_deref().filter(|_| adaptive && u.is_tension()) {
-        Some(cylinder) => format!(
+    let message = match u.cause(solver) {
+        Cause::Cavitation { cylinder } => format!(
             "a chamber pressure fell far below absolute vacuum ({}): the oil, a liquid of constant bulk modulus, has left its range (the chamber cavitates); give it entrained air (rig.set('{cylinder}.air_fraction', 0.005)), or if the {} run is unstable instead, try a smaller rtol",
             u.what,
             solver.name()
         ),
-        None if solver == Solver::Rk4 => format!(
-            "the rk4 solution is unstable ({}): rk4_step {} is too large for this rig: use a smaller step or solver='auto'",
-            u.what, opts.rk4_step
+        Cause::StepTooLong => format!(
+            "the {} solution is unstable ({}): rk4_step {} is too large for this rig: use a smaller step or solver='auto'",
+            solver.name(),
+            u.what,
+            opts.rk4_step
         ),
-        None => format!(
+        Cause::Unstable => format!(
             "the {} solution is unstable ({}); try solver='rosenbrock' or a smaller rtol",
             solver.name(),
             u.what

@@ -25,7 +25,9 @@ use thiserror::Error;
 
 mod physical;
 mod probes;
-pub use physical::{chamber_channel, Unphysical, ABSURD_PRESSURE_PA, LIQUID_TENSION_LIMIT_PA};
+pub use physical::{
+    chamber_channel, Cause, Unphysical, ABSURD_PRESSURE_PA, LIQUID_TENSION_LIMIT_PA,
+};
 pub use probes::{ProbeReader, ProbeSet};
 
 /// Why a run failed.

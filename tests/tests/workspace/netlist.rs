@@ -543,27 +543,8 @@ fn bad_netlists_are_refused_by_path() {
             // the first's
             "two cylinders on one rod starting apart",
             &|v| {
-                let mut damper = v["components"]["cylinder"].clone();
-                damper["initial"] = serde_json::json!({"p1": 0.0, "p2": 0.0, "position": 0.1});
-                v["components"]["damper"] = damper;
+                add_damper(v, 0.52, Some(0.1));
                 v["components"]["cylinder"]["initial"]["position"] = 0.0.into();
-                let drain = serde_json::json!(
-                    {"type": "orifice", "area": 2.0e-6, "cd": 0.65, "density": 870.0}
-                );
-                v["components"]["drain_a"] = drain.clone();
-                v["components"]["drain_b"] = drain;
-                let connections = v["connections"].as_array_mut().unwrap();
-                for c in connections.iter_mut() {
-                    let joins = |port: &str| c.as_array().unwrap().iter().any(|e| e == port);
-                    if joins("cylinder.rod") {
-                        c.as_array_mut().unwrap().push("damper.rod".into());
-                    } else if joins("tank.port") {
-                        c.as_array_mut().unwrap().push("drain_a.b".into());
-                        c.as_array_mut().unwrap().push("drain_b.b".into());
-                    }
-                }
-                connections.push(serde_json::json!(["damper.A", "drain_a.a"]));
-                connections.push(serde_json::json!(["damper.B", "drain_b.a"]));
             },
             &[
                 "components.damper.initial.position",
@@ -571,8 +552,50 @@ fn bad_netlists_are_refused_by_path() {
                 "give it on one of them",
             ],
         ),
+        (
+            // the shorter stroke limits the rod, and is the one named
+            "an end stop beyond the shorter of two strokes",
+            &|v| {
+                add_damper(v, 0.3, None);
+                v["components"]["load"]["stop_max"] = 0.2.into();
+            },
+            &[
+                "components.load.stop_max",
+                "beyond the end of the stroke of components.damper (0.15 m",
+            ],
+        ),
     ];
     assert_refused(&base, cases);
+}
+
+/// A second cylinder `damper` of `stroke` on the rod of `v` (a copy of its
+/// `cylinder`), its chambers drained to tank through orifices, starting at
+/// `position` if given.
+fn add_damper(v: &mut Value, stroke: f64, position: Option<f64>) {
+    let mut damper = v["components"]["cylinder"].clone();
+    damper["stroke"] = stroke.into();
+    damper["initial"] = serde_json::json!({"p1": 0.0, "p2": 0.0});
+    if let Some(x) = position {
+        damper["initial"]["position"] = x.into();
+    }
+    v["components"]["damper"] = damper;
+    let drain = serde_json::json!(
+        {"type": "orifice", "area": 2.0e-6, "cd": 0.65, "density": 870.0}
+    );
+    v["components"]["drain_a"] = drain.clone();
+    v["components"]["drain_b"] = drain;
+    let connections = v["connections"].as_array_mut().unwrap();
+    for c in connections.iter_mut() {
+        let joins = |port: &str| c.as_array().unwrap().iter().any(|e| e == port);
+        if joins("cylinder.rod") {
+            c.as_array_mut().unwrap().push("damper.rod".into());
+        } else if joins("tank.port") {
+            c.as_array_mut().unwrap().push("drain_a.b".into());
+            c.as_array_mut().unwrap().push("drain_b.b".into());
+        }
+    }
+    connections.push(serde_json::json!(["damper.A", "drain_a.a"]));
+    connections.push(serde_json::json!(["damper.B", "drain_b.a"]));
 }
 
 /// Each case's edit of `base` is refused with a one-line error holding its words.

@@ -41,6 +41,11 @@ pub fn bench_signals(
         .get(Signal::P2)
         .map_or_else(|| zeros.clone(), |p| p.to_vec());
     if steady_state {
+        if half_window.is_some() {
+            return Err(crate::data::DataError::WindowNotUsed {
+                file: rec.source.clone(),
+            });
+        }
         let v = rec.require(Signal::Velocity)?.to_vec();
         let info = crate::smooth::SmootherInfo {
             method: "none (steady-state samples: measured velocity, zero acceleration)".into(),
@@ -64,19 +69,16 @@ pub fn bench_signals(
             info,
         ));
     }
-    if let Some(h) = half_window {
-        crate::smooth::check_half_window(rec, h)?;
-    }
     let (x, v, a, info) = if let Some(x) = rec.get(Signal::Position) {
         let s = match half_window {
-            Some(h) => crate::smooth::smooth_with(&t, x, h, 3),
+            Some(h) => crate::smooth::smooth_with(rec, x, h, 3)?,
             None => crate::smooth::smooth_gcv(&t, x, 3, 400),
         };
         (s.value, s.d1, s.d2, s.info)
     } else {
         let vel = rec.require(Signal::Velocity)?;
         let s = match half_window {
-            Some(h) => crate::smooth::smooth_with(&t, vel, h, 3),
+            Some(h) => crate::smooth::smooth_with(rec, vel, h, 3)?,
             None => crate::smooth::smooth_gcv(&t, vel, 3, 400),
         };
         let mut x = vec![0.0; t.len()];

@@ -142,10 +142,7 @@ pub(super) fn prepare(
     let command0 = rec.get(Signal::Command).map(|u| u[0]);
     let x = rec.require(Signal::Position)?;
     let s = match half {
-        Some(h) => {
-            crate::smooth::check_half_window(rec, h)?;
-            smooth_with(&t, x, h, 3)
-        }
+        Some(h) => smooth_with(rec, x, h, 3)?,
         None => smooth_gcv(&t, x, 3, 400),
     };
     let position_ok = !excluded.contains(&Signal::Position);

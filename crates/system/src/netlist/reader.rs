@@ -181,15 +181,8 @@ fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistError> {
         let at = format!("{path}.{}", p.name);
         match (given.get(p.name), p.default) {
             (Some(&x), _) => {
-                if !p.range.contains(x) {
-                    return err(
-                        at,
-                        format!(
-                            "{x} [{}] is out of range: must be {}",
-                            p.unit,
-                            p.range.describe()
-                        ),
-                    );
+                if let Err(why) = p.check(x) {
+                    return err(at, why);
                 }
                 params.insert(p.name.to_string(), x);
             }
@@ -688,8 +681,17 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                     None => {
                         hints.insert((node.clone(), key), (value, from));
                     }
-                    Some((v, _)) if key == "stop_min" => *v = v.max(value),
-                    Some((v, _)) if key == "stop_max" => *v = v.min(value),
+                    // the tighter stop, and the component it comes from
+                    Some((v, by)) if key == "stop_min" => {
+                        if value > *v {
+                            (*v, *by) = (value, from);
+                        }
+                    }
+                    Some((v, by)) if key == "stop_max" => {
+                        if value < *v {
+                            (*v, *by) = (value, from);
+                        }
+                    }
                     Some((v, _)) if *v == value => {}
                     Some((v, first)) => {
                         return err(

@@ -177,6 +177,22 @@ pub struct ParamSpec {
     pub doc: &'static str,
 }
 
+impl ParamSpec {
+    /// Checks a value given for this parameter on its own: inside its
+    /// range. The error says the value and the rule.
+    pub fn check(&self, value: f64) -> Result<(), String> {
+        if self.range.contains(value) {
+            Ok(())
+        } else {
+            Err(format!(
+                "{value} [{}] is out of range: must be {}",
+                self.unit,
+                self.range.describe()
+            ))
+        }
+    }
+}
+
 /// Shorthand for a [`ParamSpec`] table entry.
 pub const fn param(
     name: &'static str,
@@ -428,15 +444,7 @@ pub fn check_param(ty: &str, param: &str, value: f64) -> Result<(), String> {
     let spec = lookup(ty)
         .and_then(|t| t.params.iter().find(|p| p.name == param))
         .ok_or_else(|| format!("`{ty}` has no parameter `{param}`"))?;
-    if spec.range.contains(value) {
-        Ok(())
-    } else {
-        Err(format!(
-            "{value} is outside {} [{}]",
-            spec.range.describe(),
-            spec.unit
-        ))
-    }
+    spec.check(value)
 }
 
 /// The catalog as Markdown (the docs table and `hydrocyl components`):

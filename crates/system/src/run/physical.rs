@@ -3,7 +3,7 @@
 //! vacuum), found the same way for every client (the CLI names its remedy,
 //! Python raises `SimulationError`).
 
-use super::Run;
+use super::{Run, Solver};
 use crate::rig::ABSOLUTE_VACUUM_GAUGE_PA;
 
 /// Pressures far below absolute vacuum (ten times its depth) or a
@@ -29,13 +29,42 @@ pub struct Unphysical {
     pub sample: usize,
 }
 
+/// What a solution that is not physical says about its cause, for a
+/// client to word with its own names for the settings.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Cause {
+    /// An error-controlled solver met its tolerance on a finite, moderate
+    /// tension: the oil, a liquid of constant bulk modulus, has left its
+    /// range in a chamber of `cylinder` (give it entrained air), unless
+    /// the run is unstable after all (a smaller tolerance tells).
+    Cavitation {
+        /// The cylinder whose chamber it is.
+        cylinder: String,
+    },
+    /// A fixed-step method ([`Solver::fixed_step`]): its step is too long
+    /// for the rig.
+    StepTooLong,
+    /// An error-controlled solver blew up: another method or a smaller
+    /// tolerance.
+    Unstable,
+}
+
 impl Unphysical {
     /// Whether it reads as the liquid's tension rather than a blow-up: a
-    /// finite chamber pressure above [`LIQUID_TENSION_LIMIT_PA`] (from an
-    /// error-controlled solver that met its tolerance, the constant-B oil
-    /// has left its range: the chamber cavitates).
+    /// finite chamber pressure above [`LIQUID_TENSION_LIMIT_PA`].
     pub fn is_tension(&self) -> bool {
         self.chamber_of.is_some() && self.value.is_finite() && self.value > LIQUID_TENSION_LIMIT_PA
+    }
+
+    /// Its cause, from a run by `solver`.
+    pub fn cause(&self, solver: Solver) -> Cause {
+        match &self.chamber_of {
+            Some(c) if !solver.fixed_step() && self.is_tension() => Cause::Cavitation {
+                cylinder: c.clone(),
+            },
+            _ if solver.fixed_step() => Cause::StepTooLong,
+            _ => Cause::Unstable,
+        }
     }
 }
 
@@ -114,8 +143,17 @@ mod tests {
         assert!(u.is_tension());
         assert_eq!(u.what, "damper.p2 = -4e6 Pa at t = 0.1 s");
         // far beyond the tension limit: a blow-up
+        assert_eq!(
+            u.cause(Solver::Auto),
+            Cause::Cavitation {
+                cylinder: "damper".into()
+            }
+        );
+        // the same from a fixed step: the step is too long
+        assert_eq!(u.cause(Solver::Exponential), Cause::StepTooLong);
         let u = run("p1", "Pa", vec![-1e9]).unphysical().unwrap();
         assert!(!u.is_tension());
+        assert_eq!(u.cause(Solver::Dp45), Cause::Unstable);
         // a non-finite value in any channel; a pressure that is not a
         // chamber's may be as low as it likes
         let u = run("position", "m", vec![0.0, f64::NAN])

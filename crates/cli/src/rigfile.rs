@@ -56,12 +56,7 @@ impl Checked {
     pub fn parameters(&self) -> Vec<rig::Parameter> {
         netlist::parameters_of(&self.schematic)
             .into_iter()
-            .map(|p| rig::Parameter {
-                path: p.path,
-                value: p.value,
-                unit: Some(p.unit),
-                doc: Some(p.doc),
-            })
+            .map(rig::Parameter::from)
             .collect()
     }
 

@@ -58,12 +58,7 @@ fn parameters_of(v: &Value) -> Vec<rig::Parameter> {
         if let Ok(s) = netlist::read(v) {
             return netlist::parameters_of(&s)
                 .into_iter()
-                .map(|p| rig::Parameter {
-                    path: p.path,
-                    value: p.value,
-                    unit: Some(p.unit),
-                    doc: Some(p.doc),
-                })
+                .map(rig::Parameter::from)
                 .collect();
         }
     }

@@ -350,6 +350,18 @@ pub struct Parameter {
     pub doc: Option<&'static str>,
 }
 
+impl From<crate::netlist::ParamInfo> for Parameter {
+    /// A netlist's parameter, with its unit and meaning.
+    fn from(p: crate::netlist::ParamInfo) -> Self {
+        Self {
+            path: p.path,
+            value: p.value,
+            unit: Some(p.unit),
+            doc: Some(p.doc),
+        }
+    }
+}
+
 /// Every parameter of a rig as `--set` paths. For a netlist: every
 /// parameter and initial state of every component, defaults filled in, with
 /// unit and meaning (a netlist that does not read gives none). For the older
@@ -357,16 +369,7 @@ pub struct Parameter {
 pub fn parameters(v: &Value) -> Vec<Parameter> {
     if v.get("kind").and_then(Value::as_str) == Some(crate::netlist::KIND) {
         return crate::netlist::parameters(v)
-            .map(|ps| {
-                ps.into_iter()
-                    .map(|p| Parameter {
-                        path: p.path,
-                        value: p.value,
-                        unit: Some(p.unit),
-                        doc: Some(p.doc),
-                    })
-                    .collect()
-            })
+            .map(|ps| ps.into_iter().map(Parameter::from).collect())
             .unwrap_or_default();
     }
     fn walk(v: &Value, prefix: &str, out: &mut Vec<Parameter>) {

@@ -637,6 +637,49 @@ fn the_written_rows_are_the_in_process_run_byte_for_byte() {
     }
 }
 
+/// The hybrid rig (an algebraic node, whose solves start from the last
+/// solution: its wires depend on what ran before) reads its outputs on the
+/// solving circuit between blocks of steps; the reads leave the circuit as
+/// they found it, so the written rows are the in-process run's (which reads
+/// them after the solve), byte for byte, with either solver.
+#[test]
+fn the_hybrid_rig_written_is_its_in_process_run() {
+    use hydrocyl_identify::plaincsv::{run_columns, write_columns};
+    use hydrocyl_system::{rig, run::RunOptions, run::Solver, signal::Signal};
+    let dir = tempfile::tempdir().unwrap();
+    let rows: Vec<(f64, f64)> = (0..=500)
+        .map(|k| {
+            let t = k as f64 * 1e-3;
+            (t, 2.0 * (std::f64::consts::TAU * 2.0 * t).sin())
+        })
+        .collect();
+    let cmd = write_command(dir.path(), "cmd.csv", &rows);
+    let (t, u): (Vec<f64>, Vec<f64>) = rows.iter().copied().unzip();
+    for solver in [Solver::Rosenbrock, Solver::Auto] {
+        let run = rig::simulate(
+            &rig::load("wang-hybrid").unwrap(),
+            Signal::table(t.clone(), u.clone()).unwrap(),
+            &t,
+            &RunOptions {
+                solver,
+                ..RunOptions::default()
+            },
+        )
+        .unwrap();
+        let (names, columns) = run_columns(&run);
+        let whole = String::from_utf8(write_columns(&names, &columns)).unwrap();
+        let out = dir.path().join("out.csv");
+        simulate_ok("wang-hybrid", &cmd, &out, &["--solver", solver.name()]);
+        let written = std::fs::read_to_string(&out).unwrap();
+        let body = |s: &str| s.split_once('\n').map(|(_, b)| b.to_string()).unwrap();
+        assert!(
+            body(&written) == body(&whole),
+            "{}: the rows differ",
+            solver.name()
+        );
+    }
+}
+
 /// The temporaries left in `dir` (none after any run, good or failed).
 fn temporaries(dir: &Path) -> Vec<String> {
     std::fs::read_dir(dir)

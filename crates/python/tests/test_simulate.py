@@ -23,7 +23,11 @@ def assert_equal_to_cli(run, csv):
 
 @pytest.mark.parametrize(
     "preset, level, solver",
-    [("leaney-moog", 0.4, "dp45"), ("leaney-moog", -0.3, "rosenbrock"), ("wang-hybrid", 2.0, "dp45")],
+    [("leaney-moog", 0.4, "dp45"), ("leaney-moog", -0.3, "rosenbrock"), ("wang-hybrid", 2.0, "dp45"),
+     # the hybrid's algebraic node starts each solve from its last: the CLI
+     # reads outputs during the solve, Python after it, and the same run
+     # comes out only if reading leaves the circuit as it found it
+     ("wang-hybrid", 2.0, "rosenbrock"), ("wang-hybrid", 2.0, "auto")],
 )
 def test_simulate_equals_the_cli(cli, tmp_path, preset, level, solver):
     t = np.linspace(0.0, 0.2, 401)

@@ -102,8 +102,27 @@ pub struct Circuit {
     filled: RefCell<FillKey>,
 }
 
+/// What a circuit's evaluations leave behind ([`Circuit::memory`]).
+#[derive(Clone, Debug)]
+pub struct CircuitMemory {
+    wires: Vec<f64>,
+    filled: FillKey,
+    series: Vec<([f64; 4], f64)>,
+}
+
+impl CircuitMemory {
+    /// The same with every algebraic node's last solutions forgotten (its
+    /// next solve starts as in a fresh run).
+    pub fn forgetting_solutions(mut self) -> Self {
+        for s in &mut self.series {
+            *s = ([f64::NAN; 4], f64::NAN);
+        }
+        self
+    }
+}
+
 /// Where the wire table was last evaluated (see [`Circuit::filled_at`]).
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 struct FillKey {
     valid: bool,
     t: f64,
@@ -414,6 +433,34 @@ impl Circuit {
     pub fn wires_at(&self, t: f64, x: &[f64]) -> Wires {
         self.fill(t, x);
         self.wires.borrow().clone()
+    }
+
+    /// What an evaluation leaves for the next to start from: the wire table,
+    /// where it was evaluated, and each algebraic node's last solutions
+    /// (where its next solve starts). Reading outputs between a solve's
+    /// steps takes it before and puts it back after
+    /// ([`Circuit::restore_memory`]), so that the steps evaluate as if
+    /// nothing had been read: a run is the same whenever its outputs are
+    /// read.
+    pub fn memory(&self) -> CircuitMemory {
+        CircuitMemory {
+            wires: self.wires.borrow().v.clone(),
+            filled: self.filled.borrow().clone(),
+            series: self.groups.iter().map(SeriesGroup::memory).collect(),
+        }
+    }
+
+    /// Puts back what [`Circuit::memory`] took (of this circuit, or of one
+    /// built alike: a memory of another shape is ignored).
+    pub fn restore_memory(&self, m: CircuitMemory) {
+        if m.wires.len() != self.wires.borrow().v.len() || m.series.len() != self.groups.len() {
+            return;
+        }
+        self.wires.borrow_mut().v = m.wires;
+        *self.filled.borrow_mut() = m.filled;
+        for (g, s) in self.groups.iter().zip(m.series) {
+            g.restore(s);
+        }
     }
 
     /// Evaluates every wire at `(t, x)` and copies the values of `wires` into `out`.

@@ -143,6 +143,6 @@ pub mod valve_rig;
 mod wires;
 
 pub use circuit::{
-    Acc, AnyWire, BuildError, Causality, Circuit, Component, HydraulicNode, MechanicalNode,
-    Netlist, PowerTerms, Probe, ReadWire, Tangents, Wire, Wires,
+    Acc, AnyWire, BuildError, Causality, Circuit, CircuitMemory, Component, HydraulicNode,
+    MechanicalNode, Netlist, PowerTerms, Probe, ReadWire, Tangents, Wire, Wires,
 };

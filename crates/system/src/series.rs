@@ -137,6 +137,17 @@ impl SeriesGroup {
         &self.writes
     }
 
+    /// The last solutions and slope, where the next solve starts.
+    pub(crate) fn memory(&self) -> ([f64; 4], f64) {
+        (self.history.get(), self.slope.get())
+    }
+
+    /// Puts back what [`SeriesGroup::memory`] took.
+    pub(crate) fn restore(&self, (history, slope): ([f64; 4], f64)) {
+        self.history.set(history);
+        self.slope.set(slope);
+    }
+
     /// Forgets the last solution and slope (a run from a given state solves
     /// the same way whatever ran before).
     pub(crate) fn forget(&self) {

@@ -4,7 +4,7 @@
 //! [`Simulation::run_streaming_states`](crate::simulation::Simulation::run_streaming_states)).
 
 use super::{initial, Channel, Run, RunOptions, SimError, ORDER};
-use crate::circuit::{AnyWire, Circuit, Probe};
+use crate::circuit::{AnyWire, Circuit, CircuitMemory, Probe};
 
 /// The probes of a circuit as a run's channels, in the measured-data order
 /// (command, position, velocity, p1, p2, then the others in component
@@ -17,6 +17,10 @@ pub struct ProbeSet {
     /// The wire of each channel, in channel order.
     order: Vec<usize>,
     row: Vec<f64>,
+    /// What the reads left in the circuit, put back for the next reads:
+    /// the reads go on from their own last solutions, not the solve's,
+    /// so that they read the same whenever they are made (`None`: none yet).
+    memory: Option<CircuitMemory>,
     /// The components whose `publish` sets every probed wire, when each is
     /// a stored effort: the probes are then read without evaluating the
     /// circuit ([`Circuit::read_published`]).
@@ -81,6 +85,7 @@ impl ProbeSet {
                 .collect(),
             order,
             row: vec![0.0; probes.len()],
+            memory: None,
             publishers,
         }
     }
@@ -121,6 +126,15 @@ impl ProbeSet {
         if self.wires.is_empty() {
             return;
         }
+        // the reads leave the circuit as they found it (a solve may go on),
+        // and go on from where the last reads ended (the first from a fresh
+        // start), whenever they are made
+        let solving = c.memory();
+        let reading = self
+            .memory
+            .take()
+            .unwrap_or_else(|| solving.clone().forgetting_solutions());
+        c.restore_memory(reading);
         for (k, &tk) in t.iter().enumerate() {
             let xk = &x[k * dim..(k + 1) * dim];
             match &self.publishers {
@@ -131,6 +145,8 @@ impl ProbeSet {
                 ch.values.push(self.row[i]);
             }
         }
+        self.memory = Some(c.memory());
+        c.restore_memory(solving);
     }
 }
 

@@ -350,6 +350,7 @@ impl Circuit {
                 {
                     p.unit = u;
                 }
+                p.path = format!("{}.{}", c.name(), p.name);
                 p
             })
         });

@@ -25,9 +25,7 @@ use thiserror::Error;
 
 mod physical;
 mod probes;
-pub use physical::{
-    chamber_channel, Cause, Unphysical, ABSURD_PRESSURE_PA, LIQUID_TENSION_LIMIT_PA,
-};
+pub use physical::{chamber_of, Cause, Unphysical, ABSURD_PRESSURE_PA, LIQUID_TENSION_LIMIT_PA};
 pub use probes::{ProbeReader, ProbeSet};
 
 /// Why a run failed.
@@ -197,6 +195,9 @@ pub struct Channel {
     pub name: String,
     /// SI unit.
     pub unit: &'static str,
+    /// The probe it reads, `<component>.<probe>` ([`Probe::path`](crate::Probe::path)):
+    /// what the channel is, whatever its column is called.
+    pub probe: String,
     /// Values at [`Run::time`].
     pub values: Vec<f64>,
 }
@@ -253,16 +254,13 @@ impl Run {
             .sum()
     }
 
-    /// Lowest value of the chamber pressure channels \[Pa\]: `p1`, `p2` and
-    /// every cylinder's `<cylinder>.p1`, `<cylinder>.p2`; infinite when the
-    /// outputs hold none.
+    /// Lowest value of the chamber pressure channels \[Pa\]: every
+    /// cylinder's `p1`, `p2` probes, whatever their columns are called
+    /// ([`chamber_of`]); infinite when the outputs hold none.
     pub fn min_chamber_pressure(&self) -> f64 {
         self.channels
             .iter()
-            .filter(|c| {
-                let probe = c.name.rsplit('.').next().unwrap_or(&c.name);
-                probe == "p1" || probe == "p2"
-            })
+            .filter(|c| c.unit == "Pa" && chamber_of(&c.probe).is_some())
             .flat_map(|c| c.values.iter().copied())
             .fold(f64::INFINITY, f64::min)
     }

@@ -991,3 +991,32 @@ fn a_flat_spelled_parameter_prints_and_sets_where_it_is() {
     let cd = p.iter().find(|p| p.path == "valve.orifice.cd").unwrap();
     assert_eq!(cd.value, Some(0.6));
 }
+
+/// A chamber pressure is known by the probe it reads, whatever its column
+/// is called: a second cylinder drained through orifices, its `p1` shown as
+/// `pd1`, is pulled far below vacuum by the first, and the run says so
+/// (`Run::unphysical`, `Run::min_chamber_pressure`) naming the damper.
+#[test]
+fn a_renamed_chamber_pressure_is_still_a_chamber_pressure() {
+    let mut v = load("fixtures/rigs/leaney-moog.json");
+    add_damper(&mut v, 0.52, None);
+    v["outputs"]["pd1"] = "damper.p1".into();
+    let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-3).collect();
+    let run = rig::simulate(
+        &v,
+        Signal::Constant { value: 0.5 },
+        &t,
+        &RunOptions::default(),
+    )
+    .unwrap();
+    let pd1 = run.channels.iter().find(|c| c.name == "pd1").unwrap();
+    assert_eq!(pd1.probe, "damper.p1");
+    assert!(
+        run.min_chamber_pressure() < -1e6,
+        "{}",
+        run.min_chamber_pressure()
+    );
+    let u = run.unphysical().expect("a chamber far below vacuum");
+    assert_eq!(u.chamber_of.as_deref(), Some("damper"));
+    assert!(u.what.starts_with("pd1 = "), "{}", u.what);
+}

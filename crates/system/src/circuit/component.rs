@@ -37,13 +37,19 @@ pub struct Probe {
     pub unit: &'static str,
     /// The wire it reads.
     pub wire: AnyWire,
+    /// What it is, whatever its column is called: `<component>.<probe>`
+    /// (`damper.p1`) as [`Circuit::probes`](super::Circuit::probes) lists
+    /// it; the bare name from [`Probe::of`].
+    pub path: String,
 }
 
 impl Probe {
     /// A probe named `name` on a typed wire, in the wire's SI unit.
     pub fn of<Q: Quantity>(name: impl Into<String>, wire: Wire<Q>) -> Self {
+        let name = name.into();
         Self {
-            name: name.into(),
+            path: name.clone(),
+            name,
             unit: Q::UNIT,
             wire: wire.raw(),
         }

@@ -68,16 +68,14 @@ impl Unphysical {
     }
 }
 
-/// The cylinder whose chamber pressure a channel is: `p1`, `p2` (the
-/// presets' `cylinder`) or `<cylinder>.p1`, `<cylinder>.p2`.
-pub fn chamber_channel(name: &str) -> Option<&str> {
-    match name {
-        "p1" | "p2" => Some("cylinder"),
-        _ => name
-            .strip_suffix(".p1")
-            .or_else(|| name.strip_suffix(".p2"))
-            .filter(|c| !c.is_empty()),
-    }
+/// The cylinder whose chamber pressure probe `<component>.p1` or
+/// `<component>.p2` is ([`Channel::probe`](super::Channel::probe): whatever
+/// the column is called, `p1` on a preset, `pd1` where a netlist renames it).
+pub fn chamber_of(probe: &str) -> Option<&str> {
+    probe
+        .strip_suffix(".p1")
+        .or_else(|| probe.strip_suffix(".p2"))
+        .filter(|c| !c.is_empty())
 }
 
 impl Run {
@@ -85,7 +83,7 @@ impl Run {
     /// channel, a chamber pressure below [`ABSURD_PRESSURE_PA`]), if any.
     pub fn unphysical(&self) -> Option<Unphysical> {
         self.channels.iter().find_map(|c| {
-            let chamber = c.unit == "Pa" && chamber_channel(&c.name).is_some();
+            let chamber = c.unit == "Pa" && chamber_of(&c.probe).is_some();
             let floor = if chamber {
                 ABSURD_PRESSURE_PA
             } else {
@@ -104,7 +102,7 @@ impl Run {
             let v = c.values[k];
             Some(Unphysical {
                 what: format!("{} = {v:e} {} at t = {} s", c.name, c.unit, self.time[k]),
-                chamber_of: chamber_channel(&c.name)
+                chamber_of: chamber_of(&c.probe)
                     .filter(|_| chamber && v.is_finite())
                     .map(str::to_string),
                 value: v,
@@ -119,22 +117,32 @@ mod tests {
     use super::*;
     use crate::run::Channel;
 
-    fn run(name: &str, unit: &'static str, values: Vec<f64>) -> Run {
+    /// A run of one channel `name` reading probe `probe`.
+    fn run_of(name: &str, probe: &str, unit: &'static str, values: Vec<f64>) -> Run {
         Run {
             time: (0..values.len()).map(|k| k as f64 * 0.1).collect(),
             channels: vec![Channel {
                 name: name.into(),
                 unit,
+                probe: probe.into(),
                 values,
             }],
             ..Run::default()
         }
     }
 
+    /// A run of one channel named after its probe.
+    fn run(probe: &str, unit: &'static str, values: Vec<f64>) -> Run {
+        run_of(probe, probe, unit, values)
+    }
+
     #[test]
     fn a_blow_up_a_tension_and_a_good_run_are_told_apart() {
         // within ten times the depth of vacuum: physical enough
-        assert_eq!(run("p1", "Pa", vec![1e5, -5e5, 2e6]).unphysical(), None);
+        assert_eq!(
+            run("cylinder.p1", "Pa", vec![1e5, -5e5, 2e6]).unphysical(),
+            None
+        );
         // far below vacuum, finite and moderate: the liquid's tension
         let u = run("damper.p2", "Pa", vec![1e5, -4e6])
             .unphysical()
@@ -151,7 +159,11 @@ mod tests {
         );
         // the same from a fixed step: the step is too long
         assert_eq!(u.cause(Solver::Exponential), Cause::StepTooLong);
-        let u = run("p1", "Pa", vec![-1e9]).unphysical().unwrap();
+        // a renamed column is still the chamber it reads
+        let u = run_of("p1", "cylinder.p1", "Pa", vec![-1e9])
+            .unphysical()
+            .unwrap();
+        assert_eq!(u.chamber_of.as_deref(), Some("cylinder"));
         assert!(!u.is_tension());
         assert_eq!(u.cause(Solver::Dp45), Cause::Unstable);
         // a non-finite value in any channel; a pressure that is not a

@@ -12,8 +12,8 @@ use crate::circuit::{AnyWire, Circuit, CircuitMemory, Probe};
 #[derive(Clone, Debug)]
 pub struct ProbeSet {
     wires: Vec<AnyWire>,
-    /// Name and unit of each channel, in channel order.
-    names: Vec<(String, &'static str)>,
+    /// Name, unit and probe path of each channel, in channel order.
+    names: Vec<(String, &'static str, String)>,
     /// The wire of each channel, in channel order.
     order: Vec<usize>,
     row: Vec<f64>,
@@ -81,7 +81,13 @@ impl ProbeSet {
             wires: probes.iter().map(|p| p.wire).collect(),
             names: order
                 .iter()
-                .map(|&i| (probes[i].name.clone(), probes[i].unit))
+                .map(|&i| {
+                    (
+                        probes[i].name.clone(),
+                        probes[i].unit,
+                        probes[i].path.clone(),
+                    )
+                })
                 .collect(),
             order,
             row: vec![0.0; probes.len()],
@@ -107,7 +113,7 @@ impl ProbeSet {
     pub fn read_channels(&mut self, c: &Circuit, t: &[f64], x: &[f64], out: &mut Vec<Channel>) {
         let dim = if t.is_empty() { 0 } else { x.len() / t.len() };
         out.truncate(self.names.len());
-        for (j, (name, unit)) in self.names.iter().enumerate() {
+        for (j, (name, unit, probe)) in self.names.iter().enumerate() {
             if out.get(j).is_some_and(|ch| ch.name == *name) {
                 out[j].values.clear();
                 continue;
@@ -115,6 +121,7 @@ impl ProbeSet {
             let ch = Channel {
                 name: name.clone(),
                 unit,
+                probe: probe.clone(),
                 values: Vec::with_capacity(t.len()),
             };
             if j < out.len() {

@@ -233,9 +233,10 @@ fn stored_channels_read_alone_are_the_full_runs_on_every_preset() {
 
 #[test]
 fn min_chamber_pressure_reads_every_cylinders_chambers_and_nothing_else() {
-    let channel = |name: &str, values: Vec<f64>| Channel {
-        name: name.into(),
+    let channel = |probe: &str, values: Vec<f64>| Channel {
+        name: format!("column of {probe}"),
         unit: "Pa",
+        probe: probe.into(),
         values,
     };
     let mut r = Run {
@@ -248,7 +249,7 @@ fn min_chamber_pressure_reads_every_cylinders_chambers_and_nothing_else() {
         ..Run::default()
     };
     assert_eq!(r.min_chamber_pressure(), -4e4);
-    r.channels.push(channel("p1", vec![-5e4, 0.0]));
+    r.channels.push(channel("cylinder.p1", vec![-5e4, 0.0]));
     assert_eq!(r.min_chamber_pressure(), -5e4);
     r.channels.clear();
     assert_eq!(r.min_chamber_pressure(), f64::INFINITY);

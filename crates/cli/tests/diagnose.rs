@@ -138,6 +138,26 @@ fn a_window_wider_than_the_record_is_refused() {
         );
         assert_one_line_error(r, &["half-width (window) of 100000", most]);
     }
+    // a steady-state bench does not smooth: a window is refused, not ignored
+    let report = dir.path().join("report.json");
+    let out = bin()
+        .args(["diagnose", "--rig"])
+        .arg(fixtures().join("wang-table-5-3.steady.rig.json"))
+        .arg("--data")
+        .arg(fixtures().join("wang-table-5-3.steady.csv"))
+        .arg("--report")
+        .arg(&report)
+        .args(["--window", "5"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(!report.exists());
+    let last = err.trim_end().lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("hydrocyl: error: ") && last.contains("leave out the smoother half-width"),
+        "{err}"
+    );
 }
 
 /// Negative option values reach their range checks (one line, exit 2).

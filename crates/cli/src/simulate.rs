@@ -52,7 +52,7 @@ use crate::progress::Progress;
 use crate::writer::{Block, Maker, Rows, Writer};
 use hydrocyl_identify::bench::FrictionBench;
 use hydrocyl_system::rig;
-use hydrocyl_system::run::{Cause, ProbeReader, Run, RunOptions, Solver};
+use hydrocyl_system::run::{Cause, ProbeReader, Run, RunOptions, Setting, Solver};
 use hydrocyl_system::signal::{Signal, StreamedTable};
 use hydrocyl_system::simulation::Simulation;
 use std::path::{Path, PathBuf};
@@ -341,23 +341,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .map_err(|e| CliError::Input(format!("rig: {e}")))?;
         return crate::console::print(&format!("{text}\n"));
     }
-    let solver = Solver::parse(&args.solver).ok_or_else(|| {
-        CliError::Input(format!(
-            "--solver: unknown method `{}` (use auto, dp45, rosenbrock, rk4 or exponential)",
-            args.solver
-        ))
-    })?;
-    if !(args.rtol > 0.0 && args.rtol < 1.0) {
-        return Err(CliError::Input(format!(
-            "--rtol {}: must be in (0, 1), e.g. 1e-6",
-            args.rtol
-        )));
-    }
-    if !(args.rk4_step > 0.0 && args.rk4_step.is_finite()) {
-        return Err(CliError::Input(format!(
-            "--rk4-step {}: must be positive, e.g. 2e-5",
-            args.rk4_step
-        )));
+    let solver = Solver::parse_or_why(&args.solver)
+        .map_err(|why| CliError::Input(format!("--solver: {why}")))?;
+    for (flag, setting, value) in [
+        ("--rtol", Setting::Rtol, args.rtol),
+        ("--rk4-step", Setting::Rk4Step, args.rk4_step),
+    ] {
+        setting
+            .check(value)
+            .map_err(|rule| CliError::Input(format!("{flag} {value}: {rule}")))?;
     }
     let (Some(cmd_path), Some(out)) = (args.command, args.out) else {
         return Err(CliError::Input("--command and --out are required".into()));

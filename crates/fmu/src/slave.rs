@@ -17,7 +17,7 @@ use crate::variables::{
 use hydrocyl_system::external::ExternalInput;
 use hydrocyl_system::netlist::{self, registry};
 use hydrocyl_system::rig::{self, RigError};
-use hydrocyl_system::run::RunOptions;
+use hydrocyl_system::run::{RunOptions, Setting};
 use hydrocyl_system::simulation::Simulation;
 use hydrocyl_system::AnyWire;
 use serde_json::Value;
@@ -440,11 +440,9 @@ impl Slave {
                                 .join(", ")
                         ),
                     ),
-                    SolverParam::Rtol => (value > 0.0 && value < 1.0, "must be in (0, 1)".into()),
-                    SolverParam::HMax | SolverParam::Rk4Step => (
-                        value.is_finite() && value > 0.0,
-                        "must be finite and > 0 [s]".into(),
-                    ),
+                    SolverParam::Rtol => setting_rule(Setting::Rtol, value),
+                    SolverParam::HMax => setting_rule(Setting::HMax, value),
+                    SolverParam::Rk4Step => setting_rule(Setting::Rk4Step, value),
                 };
                 if !ok {
                     return Err(format!("parameter `{name}` = {value} rejected: {rule}"));
@@ -586,6 +584,11 @@ impl Slave {
     pub fn fail(&mut self) {
         self.phase = Phase::Failed;
     }
+}
+
+/// Whether a solver parameter's `value` meets `setting`'s rule, and the rule.
+fn setting_rule(setting: Setting, value: f64) -> (bool, String) {
+    (setting.holds(value), setting.rule().into())
 }
 
 /// The rules a rig parameter's value must meet on its own, whatever the

@@ -7,7 +7,7 @@ use crate::errors::{Failure, Outcome};
 use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
 use hydrocyl_integrators::SolveError;
 use hydrocyl_system::rig::{self, RigError};
-use hydrocyl_system::run::{Cause, Run, RunOptions, SimError, Solver};
+use hydrocyl_system::run::{Cause, Run, RunOptions, Setting, SimError, Solver};
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::simulation::Simulation;
 use serde_json::Value;
@@ -21,23 +21,18 @@ pub fn options(
     h_max: Option<f64>,
     ledger: bool,
 ) -> Outcome<RunOptions> {
-    let solver = Solver::parse(solver).ok_or_else(|| {
-        Failure::Input(format!(
-            "solver: unknown method `{solver}` (use auto, dp45, rosenbrock, rk4 or exponential)"
-        ))
-    })?;
-    if !(rtol > 0.0 && rtol < 1.0) {
-        return Err(Failure::Input(format!("rtol: {rtol} is not in (0, 1)")));
-    }
-    if !(rk4_step > 0.0 && rk4_step.is_finite()) {
-        return Err(Failure::Input(format!(
-            "rk4_step: {rk4_step} is not positive"
-        )));
-    }
+    let solver =
+        Solver::parse_or_why(solver).map_err(|why| Failure::Input(format!("solver: {why}")))?;
     let defaults = RunOptions::default();
     let h_max = h_max.unwrap_or(defaults.h_max);
-    if !(h_max > 0.0 && h_max.is_finite()) {
-        return Err(Failure::Input(format!("h_max: {h_max} is not positive")));
+    for (name, setting, value) in [
+        ("rtol", Setting::Rtol, rtol),
+        ("rk4_step", Setting::Rk4Step, rk4_step),
+        ("h_max", Setting::HMax, h_max),
+    ] {
+        setting
+            .check(value)
+            .map_err(|rule| Failure::Input(format!("{name}: {value} {rule}")))?;
     }
     Ok(RunOptions {
         solver,

@@ -18,15 +18,17 @@
 use crate::circuit::{BuildError, Circuit};
 use crate::signal::StreamedTable;
 use hydrocyl_integrators::{
-    solve, solve_streaming, Method, OdeSystem as _, Options, SolveError, Stats, Stream, StreamIo,
+    solve, solve_streaming, OdeSystem as _, Options, SolveError, Stats, Stream, StreamIo,
 };
 use std::time::{Duration, Instant};
 use thiserror::Error;
 
 mod physical;
 mod probes;
+mod settings;
 pub use physical::{chamber_of, Cause, Unphysical, ABSURD_PRESSURE_PA, LIQUID_TENSION_LIMIT_PA};
 pub use probes::{ProbeReader, ProbeSet};
+pub use settings::{Setting, Solver};
 
 /// Why a run failed.
 #[derive(Debug, Error)]
@@ -45,77 +47,6 @@ pub enum SimError {
     /// Bad run settings.
     #[error("run settings: {0}")]
     Settings(String),
-}
-
-/// The integration method, by the names the CLI accepts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Solver {
-    /// Automatic (default): Dormand–Prince 5(4) while the problem is not
-    /// stiff, Rosenbrock while it is, switched by the stiffness the run shows
-    /// ([`Method::Auto`]; the choice is in [`Stats::stiff_steps`] and
-    /// [`Stats::switches`]).
-    Auto,
-    /// Dormand–Prince 5(4) (Simulink's ode45, the thesis's solver).
-    Dp45,
-    /// Stiff Rosenbrock.
-    Rosenbrock,
-    /// Fixed-step RK4 (step `RunOptions::rk4_step`).
-    Rk4,
-    /// Exponential Rosenbrock–Euler ([`Method::Exponential`]): fixed steps
-    /// of at most `RunOptions::rk4_step` landing on every output time; a
-    /// stiff mode linear over a step (LuGre's bristle) exactly, the output
-    /// smooth in the parameters (a fit's finite differences).
-    Exponential,
-}
-
-impl Solver {
-    /// The integrator crate's method.
-    pub fn method(self) -> Method {
-        match self {
-            Solver::Auto => Method::Auto,
-            Solver::Dp45 => Method::DormandPrince45,
-            Solver::Rosenbrock => Method::Rosenbrock,
-            Solver::Rk4 => Method::Rk4,
-            Solver::Exponential => Method::Exponential,
-        }
-    }
-    /// Whether it takes fixed steps of `RunOptions::rk4_step` (at most).
-    pub fn fixed_step(self) -> bool {
-        matches!(self, Solver::Rk4 | Solver::Exponential)
-    }
-    /// The CLI name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Solver::Auto => "auto",
-            Solver::Dp45 => "dp45",
-            Solver::Rosenbrock => "rosenbrock",
-            Solver::Rk4 => "rk4",
-            Solver::Exponential => "exponential",
-        }
-    }
-    /// Parses a CLI name (`auto`, `dp45`, `rosenbrock`, `rk4`, `exponential`).
-    pub fn parse(s: &str) -> Option<Self> {
-        match s {
-            "auto" => Some(Solver::Auto),
-            "dp45" => Some(Solver::Dp45),
-            "rosenbrock" => Some(Solver::Rosenbrock),
-            "rk4" => Some(Solver::Rk4),
-            "exponential" => Some(Solver::Exponential),
-            _ => None,
-        }
-    }
-}
-
-impl From<Method> for Solver {
-    fn from(m: Method) -> Self {
-        match m {
-            Method::Auto => Solver::Auto,
-            Method::DormandPrince45 => Solver::Dp45,
-            Method::Rosenbrock => Solver::Rosenbrock,
-            Method::Rk4 => Solver::Rk4,
-            Method::Exponential => Solver::Exponential,
-        }
-    }
 }
 
 /// Settings of a run.
@@ -307,13 +238,16 @@ pub(crate) fn run(
     })
 }
 
-/// The relative tolerance must be in (0, 1).
+/// Each setting meets its rule ([`Setting`]).
 fn check_options(opts: &RunOptions) -> Result<(), SimError> {
-    if !(opts.rtol > 0.0 && opts.rtol < 1.0) {
-        return Err(SimError::Settings(format!(
-            "rtol must be in (0, 1), got {}",
-            opts.rtol
-        )));
+    for (name, setting, value) in [
+        ("rtol", Setting::Rtol, opts.rtol),
+        ("h_max", Setting::HMax, opts.h_max),
+        ("rk4_step", Setting::Rk4Step, opts.rk4_step),
+    ] {
+        setting
+            .check(value)
+            .map_err(|rule| SimError::Settings(format!("{name} = {value}: {rule}")))?;
     }
     Ok(())
 }

@@ -1,0 +1,159 @@
+//! The settings a user gives a run by name — the method ([`Solver`]) and the
+//! numbers ([`Setting`]) — with their rules stated once, for every front end
+//! that takes them: the CLI's flags, the Python package's arguments, the
+//! FMU's solver parameters and [`RunOptions`](super::RunOptions) itself.
+
+use hydrocyl_integrators::Method;
+
+/// The integration method, by the names the CLI accepts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Solver {
+    /// Automatic (default): Dormand–Prince 5(4) while the problem is not
+    /// stiff, Rosenbrock while it is, switched by the stiffness the run shows
+    /// ([`Method::Auto`]; the choice is in
+    /// [`Stats::stiff_steps`](hydrocyl_integrators::Stats::stiff_steps) and
+    /// [`Stats::switches`](hydrocyl_integrators::Stats::switches)).
+    Auto,
+    /// Dormand–Prince 5(4) (Simulink's ode45, the thesis's solver).
+    Dp45,
+    /// Stiff Rosenbrock.
+    Rosenbrock,
+    /// Fixed-step RK4 (step `RunOptions::rk4_step`).
+    Rk4,
+    /// Exponential Rosenbrock–Euler ([`Method::Exponential`]): fixed steps
+    /// of at most `RunOptions::rk4_step` landing on every output time; a
+    /// stiff mode linear over a step (LuGre's bristle) exactly, the output
+    /// smooth in the parameters (a fit's finite differences).
+    Exponential,
+}
+
+impl Solver {
+    /// Every method, in the order the names are listed to a user.
+    pub const ALL: [Solver; 5] = [
+        Solver::Auto,
+        Solver::Dp45,
+        Solver::Rosenbrock,
+        Solver::Rk4,
+        Solver::Exponential,
+    ];
+
+    /// The integrator crate's method.
+    pub fn method(self) -> Method {
+        match self {
+            Solver::Auto => Method::Auto,
+            Solver::Dp45 => Method::DormandPrince45,
+            Solver::Rosenbrock => Method::Rosenbrock,
+            Solver::Rk4 => Method::Rk4,
+            Solver::Exponential => Method::Exponential,
+        }
+    }
+    /// Whether it takes fixed steps of `RunOptions::rk4_step` (at most).
+    pub fn fixed_step(self) -> bool {
+        matches!(self, Solver::Rk4 | Solver::Exponential)
+    }
+    /// The CLI name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Solver::Auto => "auto",
+            Solver::Dp45 => "dp45",
+            Solver::Rosenbrock => "rosenbrock",
+            Solver::Rk4 => "rk4",
+            Solver::Exponential => "exponential",
+        }
+    }
+    /// Parses a CLI name (`auto`, `dp45`, `rosenbrock`, `rk4`, `exponential`).
+    pub fn parse(s: &str) -> Option<Self> {
+        Solver::ALL.into_iter().find(|m| m.name() == s)
+    }
+    /// [`Solver::parse`], or why not: "unknown method `euler` (use auto,
+    /// dp45, rosenbrock, rk4 or exponential)".
+    pub fn parse_or_why(s: &str) -> Result<Self, String> {
+        Solver::parse(s).ok_or_else(|| {
+            let names: Vec<&str> = Solver::ALL.iter().map(|m| m.name()).collect();
+            let (last, rest) = names.split_last().expect("methods");
+            format!("unknown method `{s}` (use {} or {last})", rest.join(", "))
+        })
+    }
+}
+
+impl From<Method> for Solver {
+    fn from(m: Method) -> Self {
+        match m {
+            Method::Auto => Solver::Auto,
+            Method::DormandPrince45 => Solver::Dp45,
+            Method::Rosenbrock => Solver::Rosenbrock,
+            Method::Rk4 => Solver::Rk4,
+            Method::Exponential => Solver::Exponential,
+        }
+    }
+}
+
+/// A number a user sets a run with, and the rule it must meet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Setting {
+    /// The relative tolerance ([`RunOptions::rtol`](super::RunOptions::rtol)).
+    Rtol,
+    /// The largest step \[s\] ([`RunOptions::h_max`](super::RunOptions::h_max)).
+    HMax,
+    /// The fixed step \[s\]
+    /// ([`RunOptions::rk4_step`](super::RunOptions::rk4_step)).
+    Rk4Step,
+}
+
+impl Setting {
+    /// The rule, as a user reads it after the value: "must be in (0, 1),
+    /// e.g. 1e-6".
+    pub fn rule(self) -> &'static str {
+        match self {
+            Setting::Rtol => "must be in (0, 1), e.g. 1e-6",
+            Setting::HMax => "must be finite and > 0 [s], e.g. 1e-2",
+            Setting::Rk4Step => "must be finite and > 0 [s], e.g. 2e-5",
+        }
+    }
+    /// Whether `value` meets the rule.
+    pub fn holds(self, value: f64) -> bool {
+        match self {
+            Setting::Rtol => value > 0.0 && value < 1.0,
+            Setting::HMax | Setting::Rk4Step => value > 0.0 && value.is_finite(),
+        }
+    }
+    /// `value`, or the rule it breaks ([`Setting::rule`]).
+    pub fn check(self, value: f64) -> Result<f64, &'static str> {
+        if self.holds(value) {
+            Ok(value)
+        } else {
+            Err(self.rule())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_method_parses_by_its_name_and_a_wrong_name_lists_them() {
+        for m in Solver::ALL {
+            assert_eq!(Solver::parse(m.name()), Some(m));
+            assert_eq!(Solver::from(m.method()), m);
+        }
+        assert_eq!(
+            Solver::parse_or_why("euler").unwrap_err(),
+            "unknown method `euler` (use auto, dp45, rosenbrock, rk4 or exponential)"
+        );
+    }
+
+    #[test]
+    fn settings_refuse_what_their_rule_refuses() {
+        for v in [0.0, 1.0, -1e-6, f64::NAN] {
+            assert_eq!(Setting::Rtol.check(v), Err(Setting::Rtol.rule()));
+        }
+        assert_eq!(Setting::Rtol.check(1e-6), Ok(1e-6));
+        for s in [Setting::HMax, Setting::Rk4Step] {
+            for v in [0.0, -1.0, f64::INFINITY, f64::NAN] {
+                assert!(s.check(v).is_err(), "{s:?} {v}");
+            }
+            assert_eq!(s.check(3.0), Ok(3.0));
+        }
+    }
+}

@@ -331,11 +331,23 @@ fn sgn(v: f64) -> i8 {
 
 /// Event bookkeeping: values at the start of the current step and whether
 /// each function is armed (its last value was a trustworthy non-zero sign).
+///
+/// A function that sits exactly on zero is not armed, so that the restart
+/// after its event cannot find the same crossing again. The one exception is
+/// a function that triggered an event whose handler *edited the state* and
+/// sits exactly on zero after the edit (a mass clamped onto its stop): its
+/// zero is the handler's, not the crossing's, and it is armed to *leave*
+/// zero (`from_zero`): the first time it takes a sign, that is a crossing in
+/// that direction, located where it leaves zero (or where it crosses back
+/// after a detour to the other side). Without it, a mass released from its
+/// stop at a tie of forces that drifts back through the stop within the
+/// restart's first step would pass the stop unseen.
 struct EventState {
     g_prev: Vec<f64>,
     g_new: Vec<f64>,
     g_tmp: Vec<f64>,
     armed: Vec<bool>,
+    from_zero: Vec<bool>,
     /// `|g|` at the ends of the final bracket of each triggered function.
     bracket_mag: Vec<f64>,
     triggered: Vec<bool>,
@@ -416,6 +428,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
         g_new: vec![0.0; n_ev],
         g_tmp: vec![0.0; n_ev],
         armed: vec![false; n_ev],
+        from_zero: vec![false; n_ev],
         bracket_mag: vec![0.0; n_ev],
         triggered: vec![false; n_ev],
         x_tmp: vec![0.0; n],
@@ -618,9 +631,19 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
             for i in 0..n_ev {
                 ev.triggered[i] = false;
                 let (gp, gn) = (ev.g_prev[i], ev.g_new[i]);
-                if !(ev.armed[i] && sgn(gp) != 0 && sgn(gn) != sgn(gp)) {
+                let leaves_zero = ev.from_zero[i] && gp == 0.0 && sgn(gn) != 0;
+                if !(leaves_zero || (ev.armed[i] && sgn(gp) != 0 && sgn(gn) != sgn(gp))) {
                     continue;
                 }
+                // leaving zero: zero counts as the side it leaves
+                let side = if gn > 0.0 { -1.0 } else { 1.0 };
+                let off_zero = move |g: f64| {
+                    if leaves_zero && g == 0.0 {
+                        side * f64::MIN_POSITIVE
+                    } else {
+                        g
+                    }
+                };
                 let br = if gn == 0.0 {
                     Bracket {
                         a: t_new,
@@ -635,7 +658,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                     locate_root(
                         Bracket {
                             a: t,
-                            ga: gp,
+                            ga: off_zero(gp),
                             b: t_new,
                             gb: gn,
                         },
@@ -644,7 +667,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                             let theta = ((tau - t) / h).clamp(0.0, 1.0);
                             stepper_ref.dense(theta, x_tmp);
                             sys_ref.events(tau, x_tmp, g_tmp);
-                            g_tmp[i]
+                            off_zero(g_tmp[i])
                         },
                     )
                 };
@@ -679,6 +702,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                     std::mem::swap(&mut ev.g_prev, &mut ev.g_new);
                     for i in 0..n_ev {
                         ev.armed[i] = ev.g_prev[i] != 0.0;
+                        ev.from_zero[i] &= ev.g_prev[i] == 0.0;
                     }
                 }
                 h = h_next;
@@ -711,13 +735,18 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                 x.copy_from_slice(&x_ev);
                 for i in 0..n_ev {
                     let gp = ev.g_prev[i];
-                    let crossed = ev.armed[i]
-                        && sgn(gp) != 0
-                        && sgn(ev.g_new[i]) != sgn(gp)
-                        && sgn(ev.g_tmp[i]) != sgn(gp);
+                    let (gn, gt) = (ev.g_new[i], ev.g_tmp[i]);
+                    let left_zero =
+                        ev.from_zero[i] && gp == 0.0 && sgn(gn) != 0 && sgn(gt) == sgn(gn);
+                    let crossed = left_zero
+                        || (ev.armed[i]
+                            && sgn(gp) != 0
+                            && sgn(gn) != sgn(gp)
+                            && sgn(gt) != sgn(gp));
                     ev.triggered[i] = crossed;
                     if crossed {
-                        let dir = if gp < 0.0 {
+                        let rising = if left_zero { gn > 0.0 } else { gp < 0.0 };
+                        let dir = if rising {
                             Crossing::Rising
                         } else {
                             Crossing::Falling
@@ -753,6 +782,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                 for i in 0..n_ev {
                     let g = ev.g_prev[i];
                     ev.armed[i] = g != 0.0 && !(ev.triggered[i] && g.abs() <= ev.bracket_mag[i]);
+                    ev.from_zero[i] = g == 0.0 && (ev.from_zero[i] || (ev.triggered[i] && edited));
                 }
                 fresh = true;
                 // the handler may have changed the system's inputs

@@ -213,10 +213,12 @@ impl Component for Mass {
         if w.get(self.rod.hold) > 0.0 {
             x[1] = 0.0;
         }
-        // held at a stop only while the force at rest pushes into it
+        // held at a stop while the force at rest pushes into it, released
+        // when it pulls away; at an exact tie it stays, and its release
+        // function (the force, exactly 0) is armed to leave zero: pulling
+        // away releases it then (the event driver's `from_zero`)
         let f = self.net_force(w);
-        if (self.mode == StopMode::AtMin && f >= 0.0) || (self.mode == StopMode::AtMax && f <= 0.0)
-        {
+        if (self.mode == StopMode::AtMin && f > 0.0) || (self.mode == StopMode::AtMax && f < 0.0) {
             self.mode = StopMode::Free;
         }
     }

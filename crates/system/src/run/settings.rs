@@ -106,7 +106,7 @@ impl Setting {
     pub fn rule(self) -> &'static str {
         match self {
             Setting::Rtol => "must be in (0, 1), e.g. 1e-6",
-            Setting::HMax => "must be finite and > 0 [s], e.g. 1e-2",
+            Setting::HMax => "must be > 0 [s] (inf: no bound), e.g. 1e-2",
             Setting::Rk4Step => "must be finite and > 0 [s], e.g. 2e-5",
         }
     }
@@ -114,7 +114,8 @@ impl Setting {
     pub fn holds(self, value: f64) -> bool {
         match self {
             Setting::Rtol => value > 0.0 && value < 1.0,
-            Setting::HMax | Setting::Rk4Step => value > 0.0 && value.is_finite(),
+            Setting::HMax => value > 0.0,
+            Setting::Rk4Step => value > 0.0 && value.is_finite(),
         }
     }
     /// `value`, or the rule it breaks ([`Setting::rule`]).
@@ -150,10 +151,13 @@ mod tests {
         }
         assert_eq!(Setting::Rtol.check(1e-6), Ok(1e-6));
         for s in [Setting::HMax, Setting::Rk4Step] {
-            for v in [0.0, -1.0, f64::INFINITY, f64::NAN] {
+            for v in [0.0, -1.0, f64::NAN] {
                 assert!(s.check(v).is_err(), "{s:?} {v}");
             }
             assert_eq!(s.check(3.0), Ok(3.0));
         }
+        // a largest step may be unbounded, a fixed step may not
+        assert!(Setting::HMax.check(f64::INFINITY).is_ok());
+        assert!(Setting::Rk4Step.check(f64::INFINITY).is_err());
     }
 }

@@ -118,8 +118,9 @@ class Run:
     def ledger(self) -> Optional[dict[str, Any]]:
         """Energy ledger over the run (``ledger=True``), else None: energies
         in J (``energy_in_j``, ``cylinder_out_j``, ``losses_j`` by
-        component, ...), ``error``/``storage_error`` as fractions of the
-        energy in, ``efficiency``."""
+        component (a plastic impact at a stroke end is the mass's loss),
+        ``moving_walls_j``, ...), ``error``/``storage_error`` as fractions
+        of the energy in, ``efficiency``."""
     def __getitem__(self, name: str) -> npt.NDArray[np.float64]: ...
     def __contains__(self, name: str) -> bool: ...
     def __iter__(self) -> Iterator[str]:

@@ -1,8 +1,10 @@
 //! The energy ledger of one run: energy in, out to the load, each loss by
 //! component, change in storage, and the balance error.
 //!
-//! The assembler integrates four quadratures per component
-//! ([`Circuit::set_ledger`]): ∫source, ∫dissipated, ∫storage, ∫load dt \[J\].
+//! The assembler integrates five quadratures per component
+//! ([`Circuit::set_ledger`]): ∫source, ∫dissipated, ∫storage, ∫load dt \[J\],
+//! and ∫moved dt, the stored energy carried by moving walls
+//! ([`PowerTerms::moved`](hydrocyl_system::circuit::PowerTerms::moved)).
 //! Over a window `[t0, t1]` of output samples the ledger takes their
 //! differences and closes
 //!
@@ -14,9 +16,11 @@
 //! balance) and the change of the stored energy recomputed from the states at
 //! the window's ends (`½ V p²/B` per volume, `½ (m + c) v²` for the load with
 //! the friction's acceleration term `c` as added mass, `½ σ0 z²` per bristle).
-//! Their difference is [`Ledger::storage_error`], an independent check of the
-//! integration: a state edited by an event without the ledger seeing it (a
-//! plastic impact at a stroke end) shows there.
+//! They differ by what the chambers' moving walls carry
+//! ([`Ledger::moving_walls_j`]); what is left is [`Ledger::storage_error`],
+//! an independent check of the integration. An event that edits a state (a
+//! plastic impact at a stroke end) moves the stored energy it removes to the
+//! component's losses (the impact's loss is booked under the mass).
 
 use crate::error::EnergyError;
 use hydrocyl_system::circuit::LEDGER_TERMS;
@@ -57,10 +61,17 @@ pub struct Ledger {
     pub storage: Vec<Term>,
     /// Change of the stored energy recomputed from the end states \[J\].
     pub stored_change_from_states_j: f64,
+    /// The part of that change the storage power does not contain: the
+    /// energy density of each chamber times its volume change, `∫ ½ p²/B dV`
+    /// without entrained air \[J\]. The linear fluid model stores
+    /// `p V/B dp` (what closes the balance); its stored energy as a function
+    /// of the state, `½ V p²/B`, also moves with the walls.
+    pub moving_walls_j: f64,
     /// Balance residual `E_in − E_load − Σ E_loss − Σ storage` as a fraction
     /// of `E_in` \[-\].
     pub error: f64,
-    /// `(Σ storage − stored_change_from_states)` as a fraction of `E_in` \[-\].
+    /// `(Σ storage + moving_walls − stored_change_from_states)` as a fraction
+    /// of `E_in` \[-\]: the integration's error alone.
     pub storage_error: f64,
     /// The components whose model form does not conserve energy
     /// ([`Component::energy_consistent`](hydrocyl_system::Component::energy_consistent)):
@@ -173,10 +184,11 @@ pub fn ledger(
     let mut sources = Vec::new();
     let mut losses = Vec::new();
     let mut storage = Vec::new();
-    let (mut e_in, mut e_load, mut e_cyl) = (0.0, 0.0, 0.0);
+    let (mut e_in, mut e_load, mut e_cyl, mut e_moved) = (0.0, 0.0, 0.0, 0.0);
     let names: Vec<String> = circuit.components().map(|c| c.name().to_string()).collect();
     for (i, name) in names.iter().enumerate() {
         let (src, diss, sto, load) = (d(i, 0), d(i, 1), d(i, 2), d(i, 3));
+        e_moved += d(i, 4);
         e_in += src;
         e_load += load;
         if rod.components.contains(name) {
@@ -208,7 +220,7 @@ pub fn ledger(
     storage.retain(|t| t.energy_j.abs() > tiny);
     let sum_loss: f64 = losses.iter().map(|t| t.energy_j).sum();
     let sum_sto: f64 = storage.iter().map(|t| t.energy_j).sum();
-    let stored = |k: usize| stored_energy(circuit, run.time[k], run.state(k), rod);
+    let stored = |k: usize| stored_energy(circuit, run.time[k], run.state(k));
     let from_states = stored(k1) - stored(k0);
     Ok(Ledger {
         window_s: (run.time[k0], run.time[k1]),
@@ -219,8 +231,9 @@ pub fn ledger(
         losses,
         storage,
         stored_change_from_states_j: from_states,
+        moving_walls_j: e_moved,
         error: (e_in - e_load - sum_loss - sum_sto) / e_in,
-        storage_error: (sum_sto - from_states) / e_in,
+        storage_error: (sum_sto + e_moved - from_states) / e_in,
         not_energy_consistent: circuit
             .components()
             .filter(|c| !c.energy_consistent())
@@ -230,17 +243,10 @@ pub fn ledger(
 }
 
 /// Energy stored in the circuit at `(t, x)` \[J\]: every component's
-/// `stored`, plus `½ c v²` of the added mass `c` on the rod (the friction's
-/// acceleration term, booked with the kinetic energy).
-pub fn stored_energy(circuit: &Circuit, t: f64, x: &[f64], rod: &RodSide) -> f64 {
-    let terms: f64 = circuit.power_terms(t, x).iter().map(|p| p.stored).sum();
-    let w = circuit.wires_at(t, x);
-    let wire = |k: &str| circuit.find_wire(&format!("mech:{}:{k}", rod.node));
-    let added = match (wire("m"), wire("v")) {
-        (Some(m), Some(v)) => 0.5 * w.get(m) * w.get(v) * w.get(v),
-        _ => 0.0,
-    };
-    terms + added
+/// `stored` (the mass's and the bench drive's `½ (m + c) v²` with the
+/// friction's acceleration term `c` as added mass).
+pub fn stored_energy(circuit: &Circuit, t: f64, x: &[f64]) -> f64 {
+    circuit.power_terms(t, x).iter().map(|p| p.stored).sum()
 }
 
 /// `∫ y dt` by the trapezoidal rule over samples `k0..=k1` \[unit of y · s\].

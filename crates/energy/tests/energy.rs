@@ -114,6 +114,97 @@ mod model_forms {
     }
 }
 
+mod events_and_moving_walls {
+    use super::*;
+    use hydrocyl_energy::ledger::Ledger;
+    use hydrocyl_system::run::Run;
+    use hydrocyl_system::signal::Signal;
+
+    /// `preset` with `sets`, on a constant command, at `rtol`, with its ledger.
+    fn ledger_of(preset: &str, sets: &[&str], u: f64, t_end: f64, rtol: f64) -> (Run, Ledger) {
+        let mut v = hydrocyl_system::rig::preset(preset).unwrap();
+        for s in sets {
+            hydrocyl_system::rig::apply_set(&mut v, s).unwrap();
+        }
+        let t: Vec<f64> = (0..=(t_end * 1e3) as usize)
+            .map(|k| k as f64 * 1e-3)
+            .collect();
+        let mut sim = Simulation::new(&v, Signal::Constant { value: u })
+            .unwrap()
+            .options(RunOptions {
+                rtol,
+                ledger: true,
+                ..RunOptions::dp45()
+            });
+        let run = sim.run(&t).unwrap();
+        let l = ledger(sim.circuit(), &run, 0, t.len() - 1, &RodSide::default()).unwrap();
+        (run, l)
+    }
+
+    /// A plastic impact at the stroke end: the kinetic energy it destroys is
+    /// a loss of the mass (the impact energy the mass reports), the load
+    /// stores nothing once at rest, and the storage check stays at the
+    /// integration's error.
+    #[test]
+    fn a_plastic_impact_is_booked_as_the_mass_loss() {
+        let (run, l) = ledger_of(
+            "leaney-moog",
+            &["cylinder.initial.position=0.1"],
+            1.0,
+            1.0,
+            1e-9,
+        );
+        let diag = |k: &str| run.diagnostics.iter().find(|d| d.0 == k).unwrap().1;
+        let impact = diag("load.stop_impact_energy_j");
+        // ½ m v² at the full-spool speed (0.6036 m/s, 100 kg)
+        assert!(impact > 18.0 && impact < 18.5, "{impact}");
+        assert!(
+            (l.loss("load") - impact).abs() < 1e-9 * impact,
+            "{} vs {impact}",
+            l.loss("load")
+        );
+        let at_rest: f64 = l
+            .storage
+            .iter()
+            .filter(|t| t.name == "load")
+            .map(|t| t.energy_j)
+            .sum();
+        assert!(at_rest.abs() < 1e-6, "{:?}", l.storage);
+        assert!(l.error.abs() < 1e-12, "{}", l.error);
+        assert!(l.storage_error.abs() < 1e-9, "{}", l.storage_error);
+    }
+
+    /// A chamber whose wall moves: the stored energy `½ V p²/B` changes by
+    /// `∫ ½ p²/B dV` besides the storage power; the ledger's moving-walls
+    /// term equals that integral (trapezoids over the output), and the
+    /// storage check is then the integration's error: it falls with the
+    /// tolerance, whatever the bulk modulus.
+    #[test]
+    fn the_storage_check_measures_the_integration_on_moving_chambers() {
+        for b in [7e8, 1e8] {
+            let mut errors = Vec::new();
+            for rtol in [1e-6, 1e-9] {
+                let set = format!("cylinder.bulk_modulus={b}");
+                let (run, l) = ledger_of("leaney-moog", &[&set], 0.3, 0.4, rtol);
+                let ch = |k: &str| run.channel(k).unwrap();
+                let (p1, p2, v) = (ch("p1"), ch("p2"), ch("velocity"));
+                let (a1, a2) = (1.143e-3, 5.8e-4);
+                let y: Vec<f64> = (0..v.len())
+                    .map(|k| 0.5 / b * (p1[k] * p1[k] * a1 - p2[k] * p2[k] * a2) * v[k])
+                    .collect();
+                let by_hand = hydrocyl_energy::ledger::trapezoid(&run.time, &y, 0, v.len() - 1);
+                assert!(
+                    (l.moving_walls_j - by_hand).abs() < 1e-4 * l.moving_walls_j.abs(),
+                    "B = {b}: {} vs {by_hand}",
+                    l.moving_walls_j
+                );
+                errors.push(l.storage_error.abs());
+            }
+            assert!(errors[0] < 1e-6 && errors[1] < 1e-9, "B = {b}: {errors:?}");
+        }
+    }
+}
+
 mod bad_input {
     use super::*;
 

@@ -44,6 +44,7 @@ fn ledger_dict<'py>(py: Python<'py>, l: &Ledger) -> PyResult<Bound<'py, PyDict>>
     d.set_item("losses_j", terms(py, &l.losses)?)?;
     d.set_item("storage_j", terms(py, &l.storage)?)?;
     d.set_item("stored_change_from_states_j", l.stored_change_from_states_j)?;
+    d.set_item("moving_walls_j", l.moving_walls_j)?;
     d.set_item("error", l.error)?;
     d.set_item("storage_error", l.storage_error)?;
     d.set_item("efficiency", l.efficiency())?;

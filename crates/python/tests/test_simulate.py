@@ -74,6 +74,21 @@ def test_ledger_closes_and_is_absent_unless_asked(step):
     assert sum(led["losses_j"].values()) < led["energy_in_j"]
 
 
+def test_a_plastic_impact_is_the_mass_loss_in_the_ledger():
+    # the piston runs into its stroke end at full spool: the kinetic energy the
+    # impact destroys is the load's loss, and the load stores nothing at rest
+    t = np.linspace(0.0, 1.0, 1001)
+    rig = hydrocyl.Rig.load("leaney-moog")
+    rig.set("cylinder.initial.position", 0.1)
+    run = rig.simulate(t, np.ones_like(t), ledger=True, rtol=1e-9)
+    led = run.ledger
+    impact = run.diagnostics["load.stop_impact_energy_j"]
+    assert led["losses_j"]["load"] == pytest.approx(impact, rel=1e-9)
+    assert abs(led["storage_j"].get("load", 0.0)) < 1e-6
+    assert abs(led["storage_error"]) < 1e-9
+    assert "moving_walls_j" in led
+
+
 def test_to_pandas_uses_pandas_when_there_and_says_so_when_not(step, monkeypatch):
     t, u = step
     run = hydrocyl.Rig.load("leaney-moog").simulate(t, u)

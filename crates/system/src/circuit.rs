@@ -145,8 +145,9 @@ impl std::fmt::Debug for Circuit {
     }
 }
 
-/// Number of ledger quadratures per component: ∫source, ∫dissipated, ∫storage, ∫load.
-pub const LEDGER_TERMS: usize = 4;
+/// Number of ledger quadratures per component: ∫source, ∫dissipated,
+/// ∫storage, ∫load, ∫moved ([`PowerTerms::moved`]).
+pub const LEDGER_TERMS: usize = 5;
 
 impl Circuit {
     /// Assembles components: binds each to the netlist, checks that every
@@ -603,6 +604,26 @@ impl Circuit {
     }
 }
 
+impl Circuit {
+    /// The energy an event took out of the states it edited (a plastic
+    /// impact's kinetic energy), moved in the ledger from the component's
+    /// storage to its losses: the integrated storage then still equals the
+    /// stored energy of the states, and the balance still closes.
+    fn book_event_loss(&self, t: f64, x: &mut [f64], states: &[f64], before: &[PowerTerms]) {
+        let after = self.power_terms(t, x);
+        let o = self.ledger_offset();
+        for (i, r) in self.offsets.windows(2).enumerate() {
+            if x[r[0]..r[1]] != states[r[0]..r[1]] {
+                let lost = before[i].stored - after[i].stored;
+                let k = o + LEDGER_TERMS * i;
+                x[k + 1] += lost;
+                x[k + 2] -= lost;
+            }
+        }
+        self.filled.borrow_mut().valid = false;
+    }
+}
+
 impl OdeSystem for Circuit {
     fn dim(&self) -> usize {
         self.n_states
@@ -655,6 +676,7 @@ impl OdeSystem for Circuit {
                 dx[k + 1] = p.dissipated;
                 dx[k + 2] = p.storage;
                 dx[k + 3] = p.load;
+                dx[k + 4] = p.moved;
             }
         }
     }
@@ -701,6 +723,9 @@ impl OdeSystem for Circuit {
             return EventAction::Continue;
         };
         let r = self.offsets[i]..self.offsets[i + 1];
+        let before = self
+            .ledger
+            .then(|| (x[..self.n_states].to_vec(), self.power_terms(t, x)));
         let action = self.comps[i].on_event(t, &mut x[r], &w, which - self.ev_offsets[i], dir);
         self.fill(t, x);
         let w = self.wires.borrow().clone();
@@ -709,6 +734,9 @@ impl OdeSystem for Circuit {
         }
         // modes and states changed after the last evaluation
         self.filled.borrow_mut().valid = false;
+        if let Some((states, terms)) = before {
+            self.book_event_loss(t, x, &states, &terms);
+        }
         action
     }
 }

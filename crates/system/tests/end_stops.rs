@@ -62,7 +62,11 @@ fn a_drive_at_constant_speed_stays_on_its_stop_under_every_method() {
             let r = run(&rig, 0.0, m, 2.0);
             let x = position(&r);
             let top = x.iter().cloned().fold(f64::MIN, f64::max);
-            assert!(top <= 0.26 + 1e-12, "{} F = {force}: x reached {top}", m.name());
+            assert!(
+                top <= 0.26 + 1e-12,
+                "{} F = {force}: x reached {top}",
+                m.name()
+            );
             assert!((x[x.len() - 1] - 0.26).abs() < 1e-12, "{}", m.name());
         }
     }
@@ -83,10 +87,19 @@ fn the_valve_rig_without_friction_stays_on_both_stops() {
             let r = run(&rig, u, m, 1.0);
             let x = position(&r);
             let beyond = x.iter().map(|v| v.abs()).fold(0.0, f64::max);
-            assert!(beyond <= 0.26 + 1e-12, "{} u = {u}: |x| reached {beyond}", m.name());
+            assert!(
+                beyond <= 0.26 + 1e-12,
+                "{} u = {u}: |x| reached {beyond}",
+                m.name()
+            );
             assert!((x[x.len() - 1] - end).abs() < 1e-12, "{} u = {u}", m.name());
             for p in ["p1", "p2"] {
-                let low = r.channel(p).unwrap().iter().cloned().fold(f64::MAX, f64::min);
+                let low = r
+                    .channel(p)
+                    .unwrap()
+                    .iter()
+                    .cloned()
+                    .fold(f64::MAX, f64::min);
                 assert!(low > -1e5, "{} u = {u}: {p} fell to {low} Pa", m.name());
             }
         }
@@ -111,7 +124,12 @@ fn a_stop_releases_the_mass_when_the_drive_reverses() {
             .run(&t)
             .unwrap();
         let x = position(&r);
-        assert!((x[600] - 0.26).abs() < 1e-12, "{}: {} at 0.6 s", m.name(), x[600]);
+        assert!(
+            (x[600] - 0.26).abs() < 1e-12,
+            "{}: {} at 0.6 s",
+            m.name(),
+            x[600]
+        );
         assert!(x[1500] < 0.0, "{}: {} at 1.5 s", m.name(), x[1500]);
     }
 }

@@ -4,6 +4,7 @@
 //! the limit of no air, and the analytic Jacobian against differences.
 
 use hydrocyl_integrators::OdeSystem;
+use hydrocyl_system::circuit::LEDGER_TERMS;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{Run, RunOptions, Solver};
 use hydrocyl_system::signal::Signal;
@@ -160,8 +161,8 @@ fn the_ledger_closes_and_the_stored_energy_is_the_compression_work() {
     let o = c.ledger_offset();
     let pump = c.component_index("pump").unwrap();
     let vol = c.component_index("vol").unwrap();
-    let source = last[o + 4 * pump];
-    let storage = last[o + 4 * vol + 2];
+    let source = last[o + LEDGER_TERMS * pump];
+    let storage = last[o + LEDGER_TERMS * vol + 2];
     assert!(
         (source - storage).abs() < 1e-8 * source.abs(),
         "{source} vs {storage}"

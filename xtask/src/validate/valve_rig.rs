@@ -14,6 +14,7 @@ use crate::report::Section;
 use hydrocyl_friction::FrictionInput;
 use hydrocyl_ports::{Force, Pressure, Velocity};
 use hydrocyl_studies::chapter3::{self, Case, Comparison, COMPARED};
+use hydrocyl_system::circuit::LEDGER_TERMS;
 use hydrocyl_system::run::{nrmse, Run, RunOptions, Solver};
 use hydrocyl_system::simulation::Simulation;
 use hydrocyl_system::valve_rig::ValveRig;
@@ -416,7 +417,7 @@ fn balances(s: &mut Section) {
     let n = c.components().count();
     let (mut src, mut out) = (0.0, 0.0);
     for i in 0..n {
-        let k = o + 4 * i;
+        let k = o + LEDGER_TERMS * i;
         src += last[k];
         out += last[k + 1] + last[k + 2] + last[k + 3];
     }
@@ -427,11 +428,11 @@ fn balances(s: &mut Section) {
         "<= 1e-3".into(),
         rel <= 1e-3,
     );
-    let eff_out = last[o + 4 * (n - 2) + 3];
+    let eff_out = last[o + LEDGER_TERMS * (n - 2) + 3];
     s.note(&format!(
         "square: energy from supply {src:.1} J, to external load {eff_out:.1} J (no external force), dissipated in valve {:.1} J, friction {:.1} J",
-        last[o + 4 * c.component_index("valve").unwrap_or(0) + 1],
-        last[o + 4 * c.component_index("friction").unwrap_or(0) + 1]
+        last[o + LEDGER_TERMS * c.component_index("valve").unwrap_or(0) + 1],
+        last[o + LEDGER_TERMS * c.component_index("friction").unwrap_or(0) + 1]
     ));
 }
 

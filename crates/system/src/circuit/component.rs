@@ -23,9 +23,16 @@ pub struct PowerTerms {
     pub storage: f64,
     /// Power delivered as work to the outside (an external load force) \[W\].
     pub load: f64,
-    /// Energy stored now (`½ V p²/B`, `½ m v²`, `½ σ0 z²`) \[J\] — for reports;
-    /// the ledger integrates `storage`, which is exact for the model used.
+    /// Energy stored now (`½ V p²/B`, `½ (m + c) v²`, `½ σ0 z²`) \[J\] — for
+    /// reports and the ledger's storage check; the ledger integrates
+    /// `storage`, which is exact for the model used.
     pub stored: f64,
+    /// Rate at which `stored` changes because a storage's volume moves, which
+    /// `storage` does not contain \[W\]: a chamber's energy density times
+    /// `dV/dt` (the linear fluid model `ṗ = B/V (Q − V̇)` stores `p V/B ṗ`;
+    /// the state function `½ V p²/B` also changes by `½ p²/B V̇`). Not a
+    /// power of the balance: only the storage check adds it.
+    pub moved: f64,
 }
 
 /// A named output of a component, read from a wire after a solve.

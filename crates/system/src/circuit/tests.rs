@@ -154,8 +154,8 @@ fn volume_filled_through_an_orifice_conserves_mass_and_reaches_supply() {
     // energy: source = dissipated + storage (volume), each integrated
     let o = c.ledger_offset();
     let src = last[o];
-    let diss = last[o + 4 + 1];
-    let stored = last[o + 8 + 2];
+    let diss = last[o + LEDGER_TERMS + 1];
+    let stored = last[o + 2 * LEDGER_TERMS + 2];
     assert!(
         (src - diss - stored).abs() < 1e-6 * src,
         "{src} {diss} {stored}"

@@ -264,7 +264,15 @@ impl Component for TwoChamberCylinder {
         let (ql, qe1, qe2) = self.cylinder.leakage(p1, p2);
         p.storage = x[0] * v1 / b1 * dx[0] + x[1] * v2 / b2 * dx[1];
         p.dissipated = ql.si() * (x[0] - x[1]) + qe1.si() * x[0] + qe2.si() * x[1];
-        p.stored = self.air.stored_energy(b, x[0], v1) + self.air.stored_energy(b, x[1], v2);
+        let (e1, e2) = (
+            self.air.stored_energy(b, x[0], v1),
+            self.air.stored_energy(b, x[1], v2),
+        );
+        p.stored = e1 + e2;
+        // the walls move: V1 grows by A1 v, V2 shrinks by A2 v (the stored
+        // energy is proportional to the volume at a given pressure)
+        let v = w.get(self.rod.velocity).si();
+        p.moved = e1 / v1 * self.cylinder.area_1.si() * v - e2 / v2 * self.cylinder.area_2.si() * v;
     }
     fn n_quadratures(&self) -> usize {
         4

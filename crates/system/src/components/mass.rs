@@ -180,7 +180,7 @@ impl Component for Mass {
         &mut self,
         _t: f64,
         x: &mut [f64],
-        _w: &Wires,
+        w: &Wires,
         which: usize,
         dir: Crossing,
     ) -> EventAction {
@@ -195,7 +195,8 @@ impl Component for Mass {
                 // plastic impact: clamp to the end and stop; `after_event`
                 // decides, with the forces at rest, whether it is held there
                 self.impacts += 1;
-                self.impact_energy += 0.5 * self.mass * x[1] * x[1];
+                let m = self.mass + w.get(self.rod.added_mass).si();
+                self.impact_energy += 0.5 * m * x[1] * x[1];
                 x[1] = 0.0;
                 if which == 0 {
                     x[0] = s.min.si();
@@ -242,7 +243,7 @@ impl Component for Mass {
         // the external force opposes extension: the load's port
         let load = MechanicalPort::new(Force::new(self.external_force), Velocity::new(x[1]));
         p.load = load.power().si();
-        p.stored = 0.5 * self.mass * x[1] * x[1];
+        p.stored = 0.5 * (self.mass + w.get(self.rod.added_mass).si()) * x[1] * x[1];
     }
     /// The stop mode changes only the derivatives: the wires are the state's.
     fn events_change_evaluation(&self) -> bool {

@@ -133,7 +133,7 @@ impl Component for ImposedMotion {
         // moving mass (with the friction's added mass) stores m v a
         p.source = self.drive_force(t, w) * v;
         p.storage = (self.mass + w.get(self.rod.added_mass).si()) * v * a;
-        p.stored = 0.5 * self.mass * v * v;
+        p.stored = 0.5 * (self.mass + w.get(self.rod.added_mass).si()) * v * v;
     }
     fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), String> {
         check_param("imposed_motion", name, value)?;

@@ -1,8 +1,9 @@
 //! The hybrid pump-controlled drive's components (chapter 6): the identified
 //! servomotor–pump (section 6.2.1), relief valves (eqs 6.6–6.10), check
-//! valves (eqs 6.11–6.13), the pilot-operated DDDC four-way valve (eqs
-//! 6.2–6.5) and the NCCC needle valve with its reverse check (eqs
-//! 6.14–6.19), joined in series by an `algebraic_node`.
+//! valves (section 4.1; the thesis gives no check-valve law), the
+//! pilot-operated DDDC four-way valve (eqs 6.1–6.5) and the NCCC needle valve
+//! with its reverse check (section 6.2.2.3: eq 6.1 with the opening of eq
+//! 6.11), joined in series by an `algebraic_node`.
 
 use super::super::registry::{param, ComponentType, Default::*, Instance, ParamSpec, Range, Role};
 use super::hydraulic::orifice_params;
@@ -178,7 +179,7 @@ pub const TYPES: &[ComponentType] = &[
     },
     ComponentType {
         name: "check_valve",
-        summary: "spring-loaded check valve, inlet → outlet (eqs 6.11–6.13)",
+        summary: "spring-loaded check valve, inlet → outlet (the anti-cavitation check valves of section 4.1; the thesis gives no check-valve law: law and defaults assumed)",
         ports: &[
             port("inlet", HYD, Role::Reads, false, "inlet"),
             port("outlet", HYD, Role::Reads, false, "outlet"),
@@ -225,7 +226,7 @@ pub const TYPES: &[ComponentType] = &[
     },
     ComponentType {
         name: "needle_valve",
-        summary: "NCCC needle valve with its reverse-flow check, inlet → outlet (eqs 6.14–6.19)",
+        summary: "NCCC needle valve with its reverse-flow check, inlet → outlet, Q = Cd Avn √(2/ρ) √Δp (section 6.2.2.3: eq 6.1 with the opening area of eq 6.11, Table 6-1)",
         ports: &[
             port("inlet", HYD, Role::Reads, false, "inlet (metered flow inlet → outlet)"),
             port("outlet", HYD, Role::Reads, false, "outlet (the reverse check opens outlet → inlet)"),

@@ -193,7 +193,7 @@ pub const TYPES: &[ComponentType] = &[
     },
     ComponentType {
         name: "servo_needle_valve",
-        summary: "needle valve (eqs 6.14–6.19) whose opening follows the command: Avn = clamp(A_0 + g₊ u⁺ + g₋ u⁻, A_0, A_max) (section 9.2)",
+        summary: "needle valve (eq 6.1 with the opening area Avn of eq 6.11) whose opening follows the command: Avn = clamp(A_0 + g₊ u⁺ + g₋ u⁻, A_0, A_max) (section 9.2)",
         ports: &[
             port("command", SIG, Role::Reads, false, "the velocity command u [V]"),
             port("inlet", HYD, Role::Reads, false, "inlet (metered flow inlet → outlet)"),

@@ -26,7 +26,10 @@ use thiserror::Error;
 mod physical;
 mod probes;
 mod settings;
-pub use physical::{chamber_of, Cause, Unphysical, ABSURD_PRESSURE_PA, LIQUID_TENSION_LIMIT_PA};
+pub use physical::{
+    chamber_of, chamber_types_with_air, Cause, Unphysical, ABSURD_PRESSURE_PA, AIR_PARAMETER,
+    LIQUID_TENSION_LIMIT_PA,
+};
 pub use probes::{ProbeReader, ProbeSet};
 pub use settings::{Setting, Solver};
 

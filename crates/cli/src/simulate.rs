@@ -317,23 +317,44 @@ enum Input {
     Stream(StreamedTable, command_stream::Chunks),
 }
 
-/// Adds the remedy to a step-limit failure: an explicit method is told to
-/// use rosenbrock; `auto` (which switches to it itself) and rosenbrock are
-/// told that the run is too long or too stiff for the step limit.
-fn solver_hint(e: rig::RigError, solver: &str) -> CliError {
+/// Adds the remedy to a step-budget failure (the integrator says "the step
+/// budget ran out"): a fixed step is told how many steps it needs over the
+/// run's `span` \[s\]; an explicit method is told to use rosenbrock; `auto`
+/// (which switches to it itself) and rosenbrock are told that the run is too
+/// long or too stiff for the budget.
+fn solver_hint(e: rig::RigError, solver: Solver, rk4_step: f64, span: f64) -> CliError {
     let m = e.to_string();
-    if !m.contains("steps before t") {
+    if !m.contains("the step budget ran out") {
         return CliError::Input(m);
     }
-    if matches!(solver, "auto" | "rosenbrock") {
-        CliError::Input(format!(
-            "{m}: the run is too long or too stiff for the step limit (--solver {solver}); shorten the command file, or check that its time column is in seconds"
-        ))
+    CliError::Input(if solver.fixed_step() {
+        format!("{m}: {}", steps_needed(rk4_step, span))
+    } else if matches!(solver, Solver::Auto | Solver::Rosenbrock) {
+        format!(
+            "{m}: the run is too long or too stiff for the step budget (--solver {}); shorten the command file, or check that its time column is in seconds",
+            solver.name()
+        )
     } else {
-        CliError::Input(format!(
-            "{m}: the run is stiff for an explicit method; use --solver rosenbrock"
-        ))
-    }
+        format!("{m}: the run is stiff for an explicit method; use --solver rosenbrock")
+    })
+}
+
+/// How many steps `--rk4-step` takes over a run of `span` \[s\], and the
+/// remedy.
+fn steps_needed(rk4_step: f64, span: f64) -> String {
+    format!(
+        "--rk4-step {rk4_step:e} s over the run's {span} s takes at least {:.3e} steps; use a larger --rk4-step or --solver auto",
+        span / rk4_step
+    )
+}
+
+/// A fixed step that the step budget (`max` steps) cannot cover the run
+/// with, refused before the run.
+fn budget_message(rk4_step: f64, span: f64, max: usize) -> String {
+    format!(
+        "the step budget is {max} steps: {}",
+        steps_needed(rk4_step, span)
+    )
 }
 
 /// Runs `hydrocyl simulate`.
@@ -448,6 +469,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
     };
     crate::progress::mark("command read");
+    // a fixed step that cannot cover the run within the step budget is
+    // refused before the run, not after the budget's worth of steps
+    if solver.fixed_step() && (t1 - t0) / opts.rk4_step > opts.max_steps as f64 {
+        return Err(CliError::Input(budget_message(
+            opts.rk4_step,
+            t1 - t0,
+            opts.max_steps,
+        )));
+    }
     // the writer thread starts now: on a table, it builds a circuit of its
     // own to read the probes on while this thread builds the solving one
     let types = checked.component_types();
@@ -594,7 +624,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // solve's is its echo
     let (outputs, run) = match (streamed, failed, written) {
         (_, _, Err(e)) | (_, Some(e), _) => return Err(e),
-        (Err(e), None, _) => return Err(solver_hint(e, &args.solver)),
+        (Err(e), None, _) => return Err(solver_hint(e, solver, args.rk4_step, t1 - t0)),
         (Ok(r), None, Ok((o, p))) => {
             min_p = min_p.min(p);
             (o, r)

@@ -150,7 +150,14 @@ fn servo_needle(i: &Instance) -> Result<Box<dyn Component>, String> {
         gain_positive: i.get("gain_positive"),
         gain_negative: i.get("gain_negative"),
     };
-    law.validate()?;
+    law.validate().map_err(|why| {
+        // the one relation between two parameters is area_max's
+        if law.area_max.is_finite() && law.area_max <= law.area_min {
+            crate::netlist::registry::error_at(&format!("components.{}.area_max", i.name), &why)
+        } else {
+            why
+        }
+    })?;
     let needle = NeedleValve::new(
         Area::new(law.area_min),
         i.get("effective_factor"),

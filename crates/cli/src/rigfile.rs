@@ -52,6 +52,16 @@ impl Checked {
         self.schematic.input_unit()
     }
 
+    /// The registry type of each component, by instance name
+    /// ([`crate::simulate::Types`]).
+    pub fn component_types(&self) -> crate::simulate::Types {
+        self.schematic
+            .instances
+            .iter()
+            .map(|i| (i.name.clone(), i.ty))
+            .collect()
+    }
+
     /// Every numeric parameter as `(path, value, unit)`.
     pub fn parameters(&self) -> Vec<rig::Parameter> {
         netlist::parameters_of(&self.schematic)

@@ -51,8 +51,11 @@ use crate::output::Outputs;
 use crate::progress::Progress;
 use crate::writer::{Block, Maker, Rows, Writer};
 use hydrocyl_identify::bench::FrictionBench;
+use hydrocyl_system::netlist::registry::ComponentType;
 use hydrocyl_system::rig;
-use hydrocyl_system::run::{Cause, ProbeReader, Run, RunOptions, Setting, Solver};
+use hydrocyl_system::run::{
+    chamber_types_with_air, Cause, ProbeReader, Run, RunOptions, Setting, Solver, AIR_PARAMETER,
+};
 use hydrocyl_system::signal::{Signal, StreamedTable};
 use hydrocyl_system::simulation::Simulation;
 use std::path::{Path, PathBuf};
@@ -229,26 +232,51 @@ fn check_initial_pressures(rig: &crate::rigfile::Checked) -> Result<(), CliError
     Ok(())
 }
 
+/// The registry type of each component of the rig, by instance name: what
+/// a remedy may propose to `--set` on a component is looked up in it.
+pub(crate) type Types = std::sync::Arc<[(String, &'static ComponentType)]>;
+
 /// Checks the solution for the signs of an unstable integration (a
 /// non-finite value, a chamber pressure far below vacuum:
-/// [`Run::unphysical`]) and names the fix.
-pub(crate) fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result<(), CliError> {
+/// [`Run::unphysical`]) and names the fix; a parameter it proposes to set
+/// is one the component's type has (`types`).
+pub(crate) fn check_solution(
+    run: &Run,
+    solver: Solver,
+    rk4_step: f64,
+    types: &[(String, &'static ComponentType)],
+) -> Result<(), CliError> {
     let Some(u) = run.unphysical() else {
         return Ok(());
     };
     let what = &u.what;
-    let message = match u.cause(solver) {
+    let type_of = |c: &str| types.iter().find(|(n, _)| n == c).map(|(_, t)| *t);
+    let message = match u.cause(solver, type_of) {
         // a finite chamber pressure far below vacuum: the same with any
         // solver and tolerance when the liquid has no cavitation model
-        Cause::Cavitation { cylinder } => format!(
-            "a chamber pressure fell far below absolute vacuum ({what}): the oil, a liquid of constant bulk modulus, has left its range (the chamber cavitates); give it entrained air (--set {cylinder}.air_fraction=0.005, docs/hybrid.md), or if the {} run is unstable instead, try a smaller --rtol{}",
-            solver.name(),
-            if matches!(solver, Solver::Rosenbrock) {
-                ""
-            } else {
-                " or --solver rosenbrock"
-            }
-        ),
+        Cause::Cavitation {
+            cylinder,
+            air,
+            type_name,
+        } => {
+            let remedy = match (air, type_name) {
+                (Some(p), _) => format!("give it entrained air (--set {p}=0.005, docs/hybrid.md)"),
+                (None, ty) => format!(
+                    "`{cylinder}`{} has no entrained-air parameter, so its chambers cannot be given air here (the component types that have `{AIR_PARAMETER}`: {})",
+                    ty.map(|t| format!(" (a `{t}`)")).unwrap_or_default(),
+                    chamber_types_with_air().join(", ")
+                ),
+            };
+            format!(
+                "a chamber pressure fell far below absolute vacuum ({what}): the oil, a liquid of constant bulk modulus, has left its range (the chamber cavitates); {remedy}; or if the {} run is unstable instead, try a smaller --rtol{}",
+                solver.name(),
+                if matches!(solver, Solver::Rosenbrock) {
+                    ""
+                } else {
+                    " or --solver rosenbrock"
+                }
+            )
+        }
         Cause::StepTooLong => format!(
             "the {} solution is unstable ({what}); --rk4-step {rk4_step} is too large for this rig: use a smaller step or --solver auto",
             solver.name()
@@ -259,6 +287,13 @@ pub(crate) fn check_solution(run: &Run, solver: Solver, rk4_step: f64) -> Result
         ),
     };
     Err(CliError::Input(message))
+}
+
+/// A pressure to the nearest pascal, for messages: a value that rounds to
+/// zero is `0` (never `-0`, which `{:.0}` makes of −0.4 Pa).
+fn whole_pascals(p: f64) -> String {
+    let r = p.round();
+    format!("{:.0}", if r == 0.0 { 0.0 } else { r })
 }
 
 /// Warns when a normalised valve command leaves ±1 (`outside` samples, the
@@ -282,23 +317,44 @@ enum Input {
     Stream(StreamedTable, command_stream::Chunks),
 }
 
-/// Adds the remedy to a step-limit failure: an explicit method is told to
-/// use rosenbrock; `auto` (which switches to it itself) and rosenbrock are
-/// told that the run is too long or too stiff for the step limit.
-fn solver_hint(e: rig::RigError, solver: &str) -> CliError {
+/// Adds the remedy to a step-budget failure (the integrator says "the step
+/// budget ran out"): a fixed step is told how many steps it needs over the
+/// run's `span` \[s\]; an explicit method is told to use rosenbrock; `auto`
+/// (which switches to it itself) and rosenbrock are told that the run is too
+/// long or too stiff for the budget.
+fn solver_hint(e: rig::RigError, solver: Solver, rk4_step: f64, span: f64) -> CliError {
     let m = e.to_string();
-    if !m.contains("steps before t") {
+    if !m.contains("the step budget ran out") {
         return CliError::Input(m);
     }
-    if matches!(solver, "auto" | "rosenbrock") {
-        CliError::Input(format!(
-            "{m}: the run is too long or too stiff for the step limit (--solver {solver}); shorten the command file, or check that its time column is in seconds"
-        ))
+    CliError::Input(if solver.fixed_step() {
+        format!("{m}: {}", steps_needed(rk4_step, span))
+    } else if matches!(solver, Solver::Auto | Solver::Rosenbrock) {
+        format!(
+            "{m}: the run is too long or too stiff for the step budget (--solver {}); shorten the command file, or check that its time column is in seconds",
+            solver.name()
+        )
     } else {
-        CliError::Input(format!(
-            "{m}: the run is stiff for an explicit method; use --solver rosenbrock"
-        ))
-    }
+        format!("{m}: the run is stiff for an explicit method; use --solver rosenbrock")
+    })
+}
+
+/// How many steps `--rk4-step` takes over a run of `span` \[s\], and the
+/// remedy.
+fn steps_needed(rk4_step: f64, span: f64) -> String {
+    format!(
+        "--rk4-step {rk4_step:e} s over the run's {span} s takes at least {:.3e} steps; use a larger --rk4-step or --solver auto",
+        span / rk4_step
+    )
+}
+
+/// A fixed step that the step budget (`max` steps) cannot cover the run
+/// with, refused before the run.
+fn budget_message(rk4_step: f64, span: f64, max: usize) -> String {
+    format!(
+        "the step budget is {max} steps: {}",
+        steps_needed(rk4_step, span)
+    )
 }
 
 /// Runs `hydrocyl simulate`.
@@ -413,8 +469,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
     };
     crate::progress::mark("command read");
+    // a fixed step that cannot cover the run within the step budget is
+    // refused before the run, not after the budget's worth of steps
+    if solver.fixed_step() && (t1 - t0) / opts.rk4_step > opts.max_steps as f64 {
+        return Err(CliError::Input(budget_message(
+            opts.rk4_step,
+            t1 - t0,
+            opts.max_steps,
+        )));
+    }
     // the writer thread starts now: on a table, it builds a circuit of its
     // own to read the probes on while this thread builds the solving one
+    let types = checked.component_types();
     let checked = std::sync::Arc::new(checked);
     let o = outputs;
     let (c, w, table) = match &input {
@@ -473,6 +539,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             w.rows(Rows::States {
                 solver,
                 rk4_step: args.rk4_step,
+                types: types.clone(),
             });
             let build = || -> Result<Maker, CliError> {
                 reader()?.ok_or_else(|| CliError::Input("no probe reader".into()))
@@ -512,7 +579,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         _ => {
             let streamed = {
                 let mut sink = |block: &Run| -> Result<(), String> {
-                    let r = check_solution(block, solver, args.rk4_step).and_then(|()| {
+                    let r = check_solution(block, solver, args.rk4_step, &types).and_then(|()| {
                         if !w.has_rows() {
                             let mut header = column_headers(block).join(",").into_bytes();
                             header.push(b'\n');
@@ -557,7 +624,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // solve's is its echo
     let (outputs, run) = match (streamed, failed, written) {
         (_, _, Err(e)) | (_, Some(e), _) => return Err(e),
-        (Err(e), None, _) => return Err(solver_hint(e, &args.solver)),
+        (Err(e), None, _) => return Err(solver_hint(e, solver, args.rk4_step, t1 - t0)),
         (Ok(r), None, Ok((o, p))) => {
             min_p = min_p.min(p);
             (o, r)
@@ -583,7 +650,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
         run.stats.rhs_evals,
         if cav > 0 {
             let lowest = if min_p.is_finite() {
-                format!("lowest sampled cylinder chamber pressure {min_p:.0} Pa")
+                format!(
+                    "lowest sampled cylinder chamber pressure {} Pa",
+                    whole_pascals(min_p)
+                )
             } else {
                 "no chamber pressure among the outputs".to_string()
             };
@@ -594,4 +664,17 @@ pub fn run(args: Args) -> Result<(), CliError> {
     );
     let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::whole_pascals;
+
+    #[test]
+    fn a_pressure_that_rounds_to_zero_is_never_minus_zero() {
+        assert_eq!(whole_pascals(-0.00082), "0");
+        assert_eq!(whole_pascals(-0.0), "0");
+        assert_eq!(whole_pascals(-215_000.4), "-215000");
+        assert_eq!(whole_pascals(1.6), "2");
+    }
 }

@@ -46,6 +46,8 @@ pub enum Rows {
         solver: Solver,
         /// rk4's step, for the same.
         rk4_step: f64,
+        /// The rig's component types, for the same.
+        types: crate::simulate::Types,
     },
 }
 
@@ -87,10 +89,17 @@ impl Maker {
                 hydrocyl_identify::plaincsv::append_rows(&columns, out);
                 Ok(f64::INFINITY)
             }
-            (Rows::States { solver, rk4_step }, Some(r)) => {
+            (
+                Rows::States {
+                    solver,
+                    rk4_step,
+                    types,
+                },
+                Some(r),
+            ) => {
                 let run = &mut self.run;
                 r.read_channels(&block.time, &block.values, run);
-                crate::simulate::check_solution(run, *solver, *rk4_step)?;
+                crate::simulate::check_solution(run, *solver, *rk4_step, types)?;
                 if seq == 0 {
                     out.extend_from_slice(
                         crate::simulate::column_headers(run).join(",").as_bytes(),

@@ -939,3 +939,97 @@ fn a_number_that_is_not_finite_is_named() {
     }
     assert!(!out.exists());
 }
+
+/// A ±0.3 square wave of 1 s half-periods sampled every millisecond for
+/// `seconds` (the tester's `sq.csv`).
+fn square_03(seconds: usize) -> Vec<(f64, f64)> {
+    (0..=seconds * 1000)
+        .map(|k| {
+            let t = k as f64 * 1e-3;
+            (t, if (k / 1000) % 2 == 0 { 0.3 } else { -0.3 })
+        })
+        .collect()
+}
+
+#[test]
+fn cavitation_on_a_generalised_cylinder_proposes_no_parameter_it_lacks() {
+    // the generalised one-pressure actuator has no entrained-air
+    // parameter: the remedy must not tell the user to set one
+    let dir = tempfile::tempdir().unwrap();
+    let cmd = write_command(dir.path(), "sq.csv", &square_03(3));
+    let out = dir.path().join("g.csv");
+    let st = hydrocyl()
+        .args(["simulate", "--rig", "leaney-moog-generalised", "--command"])
+        .arg(&cmd)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert_eq!(st.status.code(), Some(2), "{err}");
+    assert!(!out.exists());
+    assert!(err.contains("cavitates"), "{err}");
+    assert!(!err.contains("--set cylinder.air_fraction"), "{err}");
+    assert!(
+        err.contains("`cylinder` (a `generalised_cylinder`) has no entrained-air parameter"),
+        "{err}"
+    );
+}
+
+/// `hydrocyl simulate --rig <rig> --command <rows> <extra>`: its stderr,
+/// which must report success.
+fn summary(rig: &str, rows: &[(f64, f64)], extra: &[&str]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let cmd = write_command(dir.path(), "cmd.csv", rows);
+    let st = simulate_ok(rig, &cmd, &dir.path().join("out.csv"), extra);
+    String::from_utf8_lossy(&st.stderr).to_string()
+}
+
+#[test]
+fn sub_pascal_solver_noise_below_the_cavitation_pressure_is_not_cavitation() {
+    // a closed chamber at tank pressure (0 Pa, the cavitation pressure)
+    // dithers at −8e-4 Pa: not an entry, and never a `-0 Pa` minimum
+    let err = summary("wang-valve-c10", &square_03(3), &[]);
+    assert!(err.contains("no cavitation"), "{err}");
+    assert!(!err.contains("-0 Pa"), "{err}");
+    // −7e-68 Pa from rosenbrock on a chamber at rest at tank pressure
+    let step: Vec<(f64, f64)> = (0..=2000).map(|k| (k as f64 * 1e-3, 1.0)).collect();
+    let err = summary(
+        "leaney-moog",
+        &step,
+        &[
+            "--solver",
+            "rosenbrock",
+            "--set",
+            "cylinder.initial.position=0.2",
+        ],
+    );
+    assert!(err.contains("no cavitation"), "{err}");
+}
+
+#[test]
+fn a_line_volume_exactly_at_absolute_vacuum_is_not_below_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let rig = dir.path().join("relief.json");
+    std::fs::write(
+        &rig,
+        r#"{"kind":"netlist","name":"relief-test",
+ "components":{
+  "supply":{"type":"pressure_source","pressure":1.0e7},
+  "tank":{"type":"pressure_source","pressure":0.0},
+  "o1":{"type":"orifice","area":1.0e-6,"cd":0.6,"density":870.0},
+  "line":{"type":"volume","volume":1e-5,"bulk_modulus":7e8},
+  "rv":{"type":"relief_valve","cracking":2e6,"full_open":8e6,"kv":3e-8}
+ },
+ "connections":[["supply.port","o1.a"],["o1.b","line.port","rv.inlet"],["rv.outlet","tank.port"]]
+}"#,
+    )
+    .unwrap();
+    let step: Vec<(f64, f64)> = (0..=2000).map(|k| (k as f64 * 1e-3, 1.0)).collect();
+    let err = summary(
+        rig.to_str().unwrap(),
+        &step,
+        &["--set", "supply.pressure=-101325"],
+    );
+    assert!(err.contains("no cavitation"), "{err}");
+}

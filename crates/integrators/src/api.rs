@@ -260,7 +260,7 @@ pub enum SolveError {
         h: f64,
     },
     /// `Options::max_steps` was reached.
-    #[error("more than {max} steps before t = {t} s")]
+    #[error("the step budget ran out: more than {max} steps before t = {t} s")]
     TooManySteps {
         /// Time reached.
         t: f64,

@@ -7,7 +7,9 @@ use crate::errors::{Failure, Outcome};
 use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
 use hydrocyl_integrators::SolveError;
 use hydrocyl_system::rig::{self, RigError};
-use hydrocyl_system::run::{Cause, Run, RunOptions, Setting, SimError, Solver};
+use hydrocyl_system::run::{
+    chamber_types_with_air, Cause, Run, RunOptions, Setting, SimError, Solver, AIR_PARAMETER,
+};
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::simulation::Simulation;
 use serde_json::Value;
@@ -95,12 +97,27 @@ fn unphysical(
     u: hydrocyl_system::run::Unphysical,
 ) -> Failure {
     let solver = opts.solver;
-    let message = match u.cause(solver) {
-        Cause::Cavitation { cylinder } => format!(
-            "a chamber pressure fell far below absolute vacuum ({}): the oil, a liquid of constant bulk modulus, has left its range (the chamber cavitates); give it entrained air (rig.set('{cylinder}.air_fraction', 0.005)), or if the {} run is unstable instead, try a smaller rtol",
-            u.what,
-            solver.name()
-        ),
+    // a parameter proposed to set is one the component's type has
+    let message = match u.cause(solver, |c| rig::component_type(value, c)) {
+        Cause::Cavitation {
+            cylinder,
+            air,
+            type_name,
+        } => {
+            let remedy = match air {
+                Some(p) => format!("give it entrained air (rig.set('{p}', 0.005))"),
+                None => format!(
+                    "'{cylinder}'{} has no entrained-air parameter, so its chambers cannot be given air here (the component types that have '{AIR_PARAMETER}': {})",
+                    type_name.map(|t| format!(" (a '{t}')")).unwrap_or_default(),
+                    chamber_types_with_air().join(", ")
+                ),
+            };
+            format!(
+                "a chamber pressure fell far below absolute vacuum ({}): the oil, a liquid of constant bulk modulus, has left its range (the chamber cavitates); {remedy}; or if the {} run is unstable instead, try a smaller rtol",
+                u.what,
+                solver.name()
+            )
+        }
         Cause::StepTooLong => format!(
             "the {} solution is unstable ({}): rk4_step {} is too large for this rig: use a smaller step or solver='auto'",
             solver.name(),

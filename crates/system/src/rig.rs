@@ -336,6 +336,19 @@ pub fn circuit(v: &Value, command: Signal) -> Result<crate::Circuit, RigError> {
     (kind_of(&v)?.circuit)(&v, command)
 }
 
+/// The registry type of component `name` in a rig value of any kind (an
+/// older kind read as its netlist), `None` when it has no such component:
+/// what a message may propose to set on the component is looked up in it
+/// ([`ComponentType::param`](crate::netlist::registry::ComponentType::param)).
+pub fn component_type(
+    v: &Value,
+    name: &str,
+) -> Option<&'static crate::netlist::registry::ComponentType> {
+    let v = migrated(v).ok()?;
+    let ty = v.get("components")?.get(name)?.get("type")?.as_str()?;
+    crate::netlist::registry::lookup(ty)
+}
+
 /// One numeric parameter of a rig: its path (as `--set` takes it) and value.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Parameter {

@@ -26,7 +26,10 @@ use thiserror::Error;
 mod physical;
 mod probes;
 mod settings;
-pub use physical::{chamber_of, Cause, Unphysical, ABSURD_PRESSURE_PA, LIQUID_TENSION_LIMIT_PA};
+pub use physical::{
+    chamber_of, chamber_types_with_air, Cause, Unphysical, ABSURD_PRESSURE_PA, AIR_PARAMETER,
+    LIQUID_TENSION_LIMIT_PA,
+};
 pub use probes::{ProbeReader, ProbeSet};
 pub use settings::{Setting, Solver};
 
@@ -37,16 +40,78 @@ pub enum SimError {
     #[error(transparent)]
     Build(#[from] BuildError),
     /// The integrator failed (tolerance not met, non-finite state, ...).
-    #[error("solver {method}: {source}")]
+    #[error("solver {method}: {source}{state}")]
     Solve {
         /// The method used.
         method: &'static str,
         /// The solver's error.
         source: SolveError,
+        /// The state it is about, by name ([`SimError::solve`]): `
+        /// (state 1 is `valve.spool`)`, or at the start the fastest state;
+        /// empty when the error names no state.
+        state: String,
     },
     /// Bad run settings.
     #[error("run settings: {0}")]
     Settings(String),
+}
+
+impl SimError {
+    /// A solver failure of `circuit` started at `(t0, x0)`, with the state
+    /// it is about named: a non-finite state by its name, a failure at the
+    /// start (a step that fell to nothing, a non-finite value at `t0`) by
+    /// the state whose rate, relative to its scale, is the largest there —
+    /// the one a parameter out of its physical range (a vanishing mass, an
+    /// absurd bias) sets.
+    pub fn solve(
+        method: &'static str,
+        source: SolveError,
+        circuit: &Circuit,
+        t0: f64,
+        x0: &[f64],
+    ) -> Self {
+        let names = circuit.state_names();
+        let name = |i: usize| names.get(i).map_or("?", String::as_str);
+        let at_start = |t: f64| t <= t0 && x0.len() == circuit.n_states();
+        let fastest = || {
+            let mut dx = vec![0.0; x0.len()];
+            circuit.rhs(t0, x0, &mut dx);
+            let scale = circuit.atol(1.0);
+            let rate = |i: usize| {
+                let r = (dx[i] / scale[i]).abs();
+                if r.is_nan() {
+                    f64::INFINITY
+                } else {
+                    r
+                }
+            };
+            (0..dx.len())
+                .max_by(|&a, &b| rate(a).total_cmp(&rate(b)))
+                .map(|i| (i, dx[i]))
+        };
+        let hint = "; a parameter that sets its rate is out of its physical range";
+        let state = match &source {
+            SolveError::NonFinite { index, t } if at_start(*t) => {
+                format!(" (state {index} is `{}`{hint})", name(*index))
+            }
+            SolveError::NonFinite { index, .. } => {
+                format!(" (state {index} is `{}`)", name(*index))
+            }
+            SolveError::StepTooSmall { t, .. } if at_start(*t) => match fastest() {
+                Some((i, d)) => format!(
+                    " (the fastest state at the start is `{}`, d/dt = {d:e}{hint})",
+                    name(i)
+                ),
+                None => String::new(),
+            },
+            _ => String::new(),
+        };
+        SimError::Solve {
+            method,
+            source,
+            state,
+        }
+    }
 }
 
 /// Settings of a run.
@@ -215,12 +280,8 @@ pub(crate) fn run(
     let (t0, t_end) = (t_eval[0], t_eval[t_eval.len() - 1]);
     let sopts = opts.solver_options(circuit, t_eval.to_vec());
     let start = Instant::now();
-    let sol = solve(opts.solver.method(), circuit, t0, &x, t_end, &sopts).map_err(|source| {
-        SimError::Solve {
-            method: opts.solver.name(),
-            source,
-        }
-    })?;
+    let sol = solve(opts.solver.method(), circuit, t0, &x, t_end, &sopts)
+        .map_err(|source| SimError::solve(opts.solver.name(), source, circuit, t0, &x))?;
     let wall = start.elapsed();
     // probes → channels
     let mut channels = Vec::new();
@@ -660,10 +721,7 @@ fn stream(
     )
     .map_err(|source| match source {
         SolveError::Interrupted { why, .. } => SimError::Settings(why),
-        source => SimError::Solve {
-            method: opts.solver.name(),
-            source,
-        },
+        source => SimError::solve(opts.solver.name(), source, circuit, t0, &x),
     })?;
     Ok(Run {
         time: Vec::new(),

@@ -377,11 +377,7 @@ impl Simulation {
         let sol =
             solve(method.method(), &mut self.circuit, t, x, t_end, &opts).map_err(|source| {
                 RigError::Sim(
-                    SimError::Solve {
-                        method: method.name(),
-                        source,
-                    }
-                    .to_string(),
+                    SimError::solve(method.name(), source, &self.circuit, t, x).to_string(),
                 )
             })?;
         match (sol.t.last(), sol.last()) {

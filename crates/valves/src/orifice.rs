@@ -1,4 +1,4 @@
-//! The generic sharp-edged orifice (thesis eqs 2.4–2.9, 6.12–6.19): the turbulent
+//! The generic sharp-edged orifice (thesis eqs 2.6–2.9, 6.1, 6.13, 6.14): the turbulent
 //! orifice law `Q = Cd A sqrt(2 |Δp| / ρ) sgn(Δp)`, regularised near `Δp = 0`.
 //!
 //! ## Regularisation

@@ -105,9 +105,9 @@ impl ReliefValve {
         if full_open.si() <= cracking.si() {
             return Err(ParameterError {
                 component: "relief valve",
-                name: "full_open",
-                value: full_open.si(),
-                reason: "must be greater than the cracking pressure",
+                name: "cracking",
+                value: cracking.si(),
+                reason: "must be below the full-open pressure difference `full_open` (P_m)",
             });
         }
         Ok(Self {
@@ -332,7 +332,8 @@ mod tests {
     fn rejects_bad_parameters() {
         let e = ReliefValve::new(Pressure::from_bar(100.0), RBAE_KV, Pressure::from_bar(50.0))
             .unwrap_err();
-        assert_eq!(e.name, "full_open");
+        // the relation is the cracking pressure's (below full_open)
+        assert_eq!(e.name, "cracking");
         assert!(ReliefValve::new(Pressure::from_bar(-1.0), RBAE_KV, RBAE_PM).is_err());
         assert!(ReliefValve::new(Pressure::from_bar(1.0), 0.0, RBAE_PM).is_err());
         assert!(

@@ -8,6 +8,16 @@ use hydrocyl_actuator::{Cylinder, EntrainedAir};
 use hydrocyl_integrators::{Crossing, EventAction};
 use hydrocyl_ports::Pressure;
 
+/// How far below its threshold a chamber pressure (or a volume's, below
+/// absolute vacuum) must fall for an entry to count \[Pa\]: the default
+/// solver's absolute tolerance on a pressure state (rtol 1e-6 × the 1 MPa
+/// scale of chamber and volume pressures). Within it of the threshold a
+/// pressure is the solver's noise (a closed chamber at tank pressure
+/// dithering at −1e-3 Pa, or sitting exactly at vacuum), not an entry; a
+/// real entry goes kPa deep. The switching function of an entry is
+/// `p − (threshold − margin)`, the same whatever the run's tolerance.
+pub const CAVITATION_MARGIN_PA: f64 = 1.0;
+
 /// Cavitation bookkeeping of a chamber.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Cavitation {
@@ -28,8 +38,8 @@ impl Cavitation {
 /// chamber nodes A (cap side, p1) and B (rod side, p2), pushes the rod.
 ///
 /// Cavitation is **reported**, not hidden: a switching function per chamber
-/// crosses zero when its pressure falls below `cavitation_pressure`, and the
-/// entries are counted ([`Component::diagnostics`] `cavitation_entries_1/2`).
+/// crosses zero when its pressure falls below `cavitation_pressure` (by more
+/// than [`CAVITATION_MARGIN_PA`]), and the entries are counted ([`Component::diagnostics`] `cavitation_entries_1/2`).
 /// With no entrained air (`air` = [`EntrainedAir::NONE`], constant B) the
 /// fluid model is not changed below it, so a run with entries has left the
 /// model's range there; with air the chambers' bulk modulus is
@@ -235,8 +245,9 @@ impl Component for TwoChamberCylinder {
         2
     }
     fn events(&self, _t: f64, x: &[f64], _w: &Wires, g: &mut [f64]) {
-        g[0] = x[0] - self.cavitation_pressure;
-        g[1] = x[1] - self.cavitation_pressure;
+        let floor = self.cavitation_pressure - CAVITATION_MARGIN_PA;
+        g[0] = x[0] - floor;
+        g[1] = x[1] - floor;
     }
     fn on_event(
         &mut self,

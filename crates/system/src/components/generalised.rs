@@ -215,8 +215,9 @@ impl Component for GeneralisedCylinder {
         2
     }
     fn events(&self, _t: f64, _x: &[f64], w: &Wires, g: &mut [f64]) {
-        g[0] = w.get(self.a.pressure).si() - self.cavitation_pressure;
-        g[1] = w.get(self.b.pressure).si() - self.cavitation_pressure;
+        let floor = self.cavitation_pressure - super::CAVITATION_MARGIN_PA;
+        g[0] = w.get(self.a.pressure).si() - floor;
+        g[1] = w.get(self.b.pressure).si() - floor;
     }
     fn on_event(
         &mut self,

@@ -31,7 +31,7 @@ mod spool;
 mod volume;
 
 pub use controller::{PositionController, PositionLaw};
-pub use cylinder::{CylinderNodes, TwoChamberCylinder};
+pub use cylinder::{CylinderNodes, TwoChamberCylinder, CAVITATION_MARGIN_PA};
 pub use four_way::{FourWayNodes, FourWayValve};
 pub use friction::Friction;
 pub use generalised::{GeneralisedCylinder, XMethod};

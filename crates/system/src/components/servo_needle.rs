@@ -1,4 +1,4 @@
-//! A servo needle valve: the NCCC needle valve (eqs 6.14–6.19) whose opening
+//! A servo needle valve: the NCCC needle valve (eq 6.1 with the opening of eq 6.11) whose opening
 //! follows the velocity command instead of being set by hand (thesis section
 //! 9.2: "the opening of the needle valve should be adjusted with the speed").
 //!

@@ -12,7 +12,8 @@ use hydrocyl_ports::{HydraulicPort, Pressure};
 /// air ([`hydrocyl_actuator::fluid`]).
 ///
 /// A pressure below absolute vacuum is **reported**, not hidden: a switching
-/// function crosses zero there and the entries are counted
+/// function crosses zero [`CAVITATION_MARGIN_PA`](super::CAVITATION_MARGIN_PA)
+/// below it (exactly at vacuum is not below it) and the entries are counted
 /// ([`Component::diagnostics`] `cavitation_entries`, which the run summary
 /// reads as it reads a cylinder chamber's); the constant-B liquid has left
 /// its range there (with entrained air the pressure stays above it).
@@ -122,7 +123,7 @@ impl Component for Volume {
         1
     }
     fn events(&self, _t: f64, x: &[f64], _w: &Wires, g: &mut [f64]) {
-        g[0] = x[0] - crate::rig::ABSOLUTE_VACUUM_GAUGE_PA;
+        g[0] = x[0] - (crate::rig::ABSOLUTE_VACUUM_GAUGE_PA - super::CAVITATION_MARGIN_PA);
     }
     fn on_event(
         &mut self,

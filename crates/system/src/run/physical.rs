@@ -4,7 +4,14 @@
 //! Python raises `SimulationError`).
 
 use super::{Run, Solver};
+use crate::netlist::registry::ComponentType;
 use crate::rig::ABSOLUTE_VACUUM_GAUGE_PA;
+
+/// The registry's name of the entrained-air parameter (volume fraction at
+/// atmospheric pressure) of the component types that model it: the remedy
+/// for a chamber of constant-B liquid cavitating, proposed only where the
+/// chamber's type has it ([`Cause::Cavitation`]).
+pub const AIR_PARAMETER: &str = "air_fraction";
 
 /// Pressures far below absolute vacuum (ten times its depth) or a
 /// non-finite value: the solution is not physical \[Pa\].
@@ -40,6 +47,14 @@ pub enum Cause {
     Cavitation {
         /// The cylinder whose chamber it is.
         cylinder: String,
+        /// The parameter path (`<cylinder>.air_fraction`) that gives the
+        /// cylinder's chambers entrained air, when its component type has
+        /// one ([`AIR_PARAMETER`]); `None` when it has none (or its type is
+        /// not known) and nothing may be proposed to set.
+        air: Option<String>,
+        /// The cylinder's component type (`generalised_cylinder`), when
+        /// known: the one the message says lacks the parameter.
+        type_name: Option<&'static str>,
     },
     /// A fixed-step method ([`Solver::fixed_step`]): its step is too long
     /// for the rig.
@@ -56,16 +71,40 @@ impl Unphysical {
         self.chamber_of.is_some() && self.value.is_finite() && self.value > LIQUID_TENSION_LIMIT_PA
     }
 
-    /// Its cause, from a run by `solver`.
-    pub fn cause(&self, solver: Solver) -> Cause {
+    /// Its cause, from a run by `solver`; `type_of` gives a component's
+    /// registry type by its instance name (the rig's schematic), so that a
+    /// remedy names only a parameter the component has.
+    pub fn cause(
+        &self,
+        solver: Solver,
+        type_of: impl Fn(&str) -> Option<&'static ComponentType>,
+    ) -> Cause {
         match &self.chamber_of {
-            Some(c) if !solver.fixed_step() && self.is_tension() => Cause::Cavitation {
-                cylinder: c.clone(),
-            },
+            Some(c) if !solver.fixed_step() && self.is_tension() => {
+                let ty = type_of(c);
+                Cause::Cavitation {
+                    cylinder: c.clone(),
+                    air: ty
+                        .and_then(|t| t.param(AIR_PARAMETER))
+                        .map(|p| format!("{c}.{}", p.name)),
+                    type_name: ty.map(|t| t.name),
+                }
+            }
             _ if solver.fixed_step() => Cause::StepTooLong,
             _ => Cause::Unstable,
         }
     }
+}
+
+/// The component types with chamber pressure probes (`p1`) that have the
+/// entrained-air parameter ([`AIR_PARAMETER`]), in catalog order: where a
+/// remedy for a chamber whose type has none can point.
+pub fn chamber_types_with_air() -> Vec<&'static str> {
+    crate::netlist::registry::types()
+        .iter()
+        .filter(|t| t.param(AIR_PARAMETER).is_some() && t.probes.iter().any(|(p, _)| *p == "p1"))
+        .map(|t| t.name)
+        .collect()
 }
 
 /// The cylinder whose chamber pressure probe `<component>.p1` or
@@ -150,22 +189,24 @@ mod tests {
         assert_eq!(u.chamber_of.as_deref(), Some("damper"));
         assert!(u.is_tension());
         assert_eq!(u.what, "damper.p2 = -4e6 Pa at t = 0.1 s");
-        // far beyond the tension limit: a blow-up
         assert_eq!(
-            u.cause(Solver::Auto),
+            u.cause(Solver::Auto, |_| None),
             Cause::Cavitation {
-                cylinder: "damper".into()
+                cylinder: "damper".into(),
+                air: None,
+                type_name: None,
             }
         );
         // the same from a fixed step: the step is too long
-        assert_eq!(u.cause(Solver::Exponential), Cause::StepTooLong);
+        assert_eq!(u.cause(Solver::Exponential, |_| None), Cause::StepTooLong);
         // a renamed column is still the chamber it reads
         let u = run_of("p1", "cylinder.p1", "Pa", vec![-1e9])
             .unphysical()
             .unwrap();
         assert_eq!(u.chamber_of.as_deref(), Some("cylinder"));
         assert!(!u.is_tension());
-        assert_eq!(u.cause(Solver::Dp45), Cause::Unstable);
+        // far beyond the tension limit: a blow-up
+        assert_eq!(u.cause(Solver::Dp45, |_| None), Cause::Unstable);
         // a non-finite value in any channel; a pressure that is not a
         // chamber's may be as low as it likes
         let u = run("position", "m", vec![0.0, f64::NAN])
@@ -173,5 +214,32 @@ mod tests {
             .unwrap();
         assert_eq!((u.chamber_of, u.what.contains("NaN")), (None, true));
         assert_eq!(run("ps", "Pa", vec![-1e7]).unphysical(), None);
+    }
+
+    #[test]
+    fn the_cavitation_remedy_names_air_only_where_the_chambers_type_has_it() {
+        use crate::netlist::registry::lookup;
+        let u = run("cylinder.p1", "Pa", vec![1e5, -4e6])
+            .unphysical()
+            .unwrap();
+        // the fundamental cylinder models entrained air
+        assert_eq!(
+            u.cause(Solver::Auto, |_| lookup("cylinder")),
+            Cause::Cavitation {
+                cylinder: "cylinder".into(),
+                air: Some("cylinder.air_fraction".into()),
+                type_name: Some("cylinder"),
+            }
+        );
+        assert_eq!(chamber_types_with_air(), ["cylinder"]);
+        // the generalised one does not: nothing to set is proposed
+        assert_eq!(
+            u.cause(Solver::Auto, |_| lookup("generalised_cylinder")),
+            Cause::Cavitation {
+                cylinder: "cylinder".into(),
+                air: None,
+                type_name: Some("generalised_cylinder"),
+            }
+        );
     }
 }

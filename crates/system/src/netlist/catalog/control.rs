@@ -15,9 +15,12 @@ fn controller(i: &Instance) -> Result<Box<dyn Component>, String> {
         output_max: i.get("output_max"),
     };
     if law.output_min >= law.output_max {
-        return Err(format!(
-            "output_min = {} must be below output_max = {}",
-            law.output_min, law.output_max
+        return Err(crate::netlist::registry::error_at(
+            &format!("components.{}.output_min", i.name),
+            &format!(
+                "output_min = {} must be below output_max = {}",
+                law.output_min, law.output_max
+            ),
         ));
     }
     let integral = i.initial("integral").unwrap_or(0.0);

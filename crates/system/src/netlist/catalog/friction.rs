@@ -364,28 +364,28 @@ pub const TYPES: &[ComponentType] = &[
     ),
     friction_type!(
         "friction_stribeck",
-        "static Stribeck friction with extending/retracting curves (eqs 2.36–2.40)",
+        "static Stribeck friction with extending/retracting curves (eq 2.40, g of eq 2.36)",
         &STRIBECK,
         Stribeck,
         FrictionLaw::Stribeck
     ),
     friction_type!(
         "friction_karnopp",
-        "Karnopp stick–slip friction (eq 2.39)",
+        "Karnopp stick–slip friction (section 2.4.2.1, which gives it no equation; slip on the Stribeck curve of eq 2.36)",
         &KARNOPP,
         Karnopp,
         FrictionLaw::Karnopp
     ),
     friction_type!(
         "friction_dahl",
-        "Dahl bristle friction (eq 2.34)",
+        "Dahl bristle friction (section 2.4.2.2, which gives it no equation; eq 2.34 with g(v) ≡ Fc)",
         &DAHL,
         Dahl,
         FrictionLaw::Dahl
     ),
     friction_type!(
         "friction_lugre",
-        "LuGre friction with directional Stribeck curves (eqs 2.35–2.37)",
+        "LuGre friction with directional Stribeck curves (eqs 2.34–2.36)",
         &LUGRE,
         LuGre,
         FrictionLaw::LuGre

@@ -1,31 +1,51 @@
 //! The hybrid pump-controlled drive's components (chapter 6): the identified
 //! servomotor–pump (section 6.2.1), relief valves (eqs 6.6–6.10), check
-//! valves (eqs 6.11–6.13), the pilot-operated DDDC four-way valve (eqs
-//! 6.2–6.5) and the NCCC needle valve with its reverse check (eqs
-//! 6.14–6.19), joined in series by an `algebraic_node`.
+//! valves (section 4.1; the thesis gives no check-valve law), the
+//! pilot-operated DDDC four-way valve (eqs 6.1–6.5) and the NCCC needle valve
+//! with its reverse check (section 6.2.2.3: eq 6.1 with the opening of eq
+//! 6.11), joined in series by an `algebraic_node`.
 
-use super::super::registry::{param, ComponentType, Default::*, Instance, ParamSpec, Range, Role};
+use super::super::registry::{
+    error_at, param, ComponentType, Default::*, Instance, ParamSpec, Range, Role,
+};
 use super::hydraulic::orifice_params;
 use super::{built, port, HYD, SIG};
 use crate::hybrid::components::{
     CheckComponent, NeedleComponent, PilotNodes, PilotValve, PumpComponent, ReliefComponent,
 };
 use hydrocyl_pump_motor::IdentifiedPump;
-use hydrocyl_valves::check::CheckValve;
+use hydrocyl_valves::check::{CheckValve, ParameterError};
 use hydrocyl_valves::needle::NeedleValve;
 use hydrocyl_valves::pilot_valve::PilotFourWay;
 use hydrocyl_valves::relief::ReliefValve;
 use serde::de::DeserializeOwned;
 
 /// A law from the instance's parameters under `prefix`, checked by `check`.
-fn law<T: DeserializeOwned, E: std::fmt::Display>(
+fn law<T: DeserializeOwned>(
     i: &Instance,
     prefix: &str,
-    check: impl Fn(&T) -> Result<(), E>,
+    check: impl Fn(&T) -> Result<(), ParameterError>,
 ) -> Result<T, String> {
     let t: T = i.law(prefix)?;
-    check(&t).map_err(|e| e.to_string())?;
+    check(&t).map_err(|e| param_error(i, prefix, &e))?;
     Ok(t)
+}
+
+/// A valve's parameter error named at the JSON path of the parameter it
+/// names (`components.rv.cracking`: a relation between two parameters is
+/// the one its message names first), when the type has that parameter
+/// under `prefix`; else at the component.
+fn param_error(i: &Instance, prefix: &str, e: &ParameterError) -> String {
+    let name = if prefix.is_empty() {
+        e.name.to_string()
+    } else {
+        format!("{prefix}.{}", e.name)
+    };
+    if i.ty.param(&name).is_some() {
+        error_at(&format!("components.{}.{name}", i.name), &e.to_string())
+    } else {
+        e.to_string()
+    }
 }
 
 macro_rules! check_params {
@@ -178,7 +198,7 @@ pub const TYPES: &[ComponentType] = &[
     },
     ComponentType {
         name: "check_valve",
-        summary: "spring-loaded check valve, inlet → outlet (eqs 6.11–6.13)",
+        summary: "spring-loaded check valve, inlet → outlet (the anti-cavitation check valves of section 4.1; the thesis gives no check-valve law: law and defaults assumed)",
         ports: &[
             port("inlet", HYD, Role::Reads, false, "inlet"),
             port("outlet", HYD, Role::Reads, false, "outlet"),
@@ -225,7 +245,7 @@ pub const TYPES: &[ComponentType] = &[
     },
     ComponentType {
         name: "needle_valve",
-        summary: "NCCC needle valve with its reverse-flow check, inlet → outlet (eqs 6.14–6.19)",
+        summary: "NCCC needle valve with its reverse-flow check, inlet → outlet, Q = Cd Avn √(2/ρ) √Δp (section 6.2.2.3: eq 6.1 with the opening area of eq 6.11, Table 6-1)",
         ports: &[
             port("inlet", HYD, Role::Reads, false, "inlet (metered flow inlet → outlet)"),
             port("outlet", HYD, Role::Reads, false, "outlet (the reverse check opens outlet → inlet)"),

@@ -1,5 +1,5 @@
 //! Generic hydraulic components: fixed-pressure sources, volumes (eq 2.10's
-//! mass balance on a fixed volume), fixed orifices (eqs 2.4–2.7) and a
+//! mass balance on a fixed volume), fixed orifices (eq 6.1, the metering terms of eqs 2.6–2.9) and a
 //! first-order pressure sensor.
 
 use super::super::registry::{
@@ -180,7 +180,7 @@ pub const TYPES: &[ComponentType] = &[
     },
     ComponentType {
         name: "orifice",
-        summary: "a fixed sharp-edged orifice, Q = Cd A √(2Δp/ρ) regularised (eqs 2.4–2.7)",
+        summary: "a fixed sharp-edged orifice, Q = Cd A √(2Δp/ρ) regularised (eq 6.1; the metering terms of eqs 2.6–2.9)",
         ports: &[
             port(
                 "a",

@@ -105,7 +105,21 @@ pub(crate) fn cylinder(i: &Instance) -> Result<Cylinder, String> {
         external_leakage_1: i.get("external_leakage_1"),
         external_leakage_2: i.get("external_leakage_2"),
     };
-    c.validate().map_err(|e| e.to_string())?;
+    c.validate().map_err(|e| match e {
+        // a chamber's length against the stroke: named at the length
+        hydrocyl_actuator::ActuatorError::EmptyChamber { chamber, .. } => {
+            crate::netlist::registry::error_at(
+                &format!("components.{}.chamber_length_{chamber}", i.name),
+                &e.to_string(),
+            )
+        }
+        // the rod side against the cap side: named at the rod side's area
+        hydrocyl_actuator::ActuatorError::AreaRatio { .. } => crate::netlist::registry::error_at(
+            &format!("components.{}.area_2", i.name),
+            &e.to_string(),
+        ),
+        e => e.to_string(),
+    })?;
     Ok(c)
 }
 

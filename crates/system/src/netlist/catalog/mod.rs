@@ -84,3 +84,36 @@ static ALL: LazyLock<Vec<ComponentType>> = LazyLock::new(|| {
 pub(super) fn all() -> &'static [ComponentType] {
     &ALL
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::registry::lookup;
+
+    /// The summary of component type `ty`.
+    fn summary(ty: &str) -> &'static str {
+        lookup(ty).unwrap().summary
+    }
+
+    /// The catalog cites the thesis equations each type implements: eqs
+    /// 6.12–6.15 are the hybrid drive's chamber equations and 6.16–6.19 its
+    /// force balance and integrators, not valve laws; the thesis gives no
+    /// check-valve law; the needle's area is eq 6.11 and its flow eq 6.1;
+    /// LuGre's bristle state is eq 2.34; eqs 2.4–2.5 are the servovalve's
+    /// amplifier, not an orifice.
+    #[test]
+    fn the_catalog_cites_the_thesis_equations_each_type_implements() {
+        let check = summary("check_valve");
+        assert!(check.contains("gives no check-valve law"), "{check}");
+        assert!(!check.contains("eq"), "{check}");
+        for needle in ["needle_valve", "servo_needle_valve"] {
+            let s = summary(needle);
+            assert!(s.contains("eq 6.1 ") && s.contains("eq 6.11"), "{s}");
+            assert!(!s.contains("6.14") && !s.contains("6.19"), "{s}");
+        }
+        assert!(summary("friction_lugre").contains("eqs 2.34–2.36"));
+        assert!(summary("orifice").contains("eq 6.1;"));
+        assert!(!summary("orifice").contains("2.4"));
+        assert!(!summary("friction_karnopp").contains("eq 2.39"));
+        assert!(summary("friction_dahl").contains("section 2.4.2.2"));
+    }
+}

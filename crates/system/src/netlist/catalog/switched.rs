@@ -150,7 +150,14 @@ fn servo_needle(i: &Instance) -> Result<Box<dyn Component>, String> {
         gain_positive: i.get("gain_positive"),
         gain_negative: i.get("gain_negative"),
     };
-    law.validate()?;
+    law.validate().map_err(|why| {
+        // the one relation between two parameters is area_max's
+        if law.area_max.is_finite() && law.area_max <= law.area_min {
+            crate::netlist::registry::error_at(&format!("components.{}.area_max", i.name), &why)
+        } else {
+            why
+        }
+    })?;
     let needle = NeedleValve::new(
         Area::new(law.area_min),
         i.get("effective_factor"),
@@ -193,7 +200,7 @@ pub const TYPES: &[ComponentType] = &[
     },
     ComponentType {
         name: "servo_needle_valve",
-        summary: "needle valve (eqs 6.14–6.19) whose opening follows the command: Avn = clamp(A_0 + g₊ u⁺ + g₋ u⁻, A_0, A_max) (section 9.2)",
+        summary: "needle valve (eq 6.1 with the opening area Avn of eq 6.11) whose opening follows the command: Avn = clamp(A_0 + g₊ u⁺ + g₋ u⁻, A_0, A_max) (section 9.2)",
         ports: &[
             port("command", SIG, Role::Reads, false, "the velocity command u [V]"),
             port("inlet", HYD, Role::Reads, false, "inlet (metered flow inlet → outlet)"),

@@ -192,8 +192,10 @@ def diagnose(
     min_share: float = 0.03,
     holdout: float = 0.3,
     window: Optional[int] = None,
-    effects: Optional[Sequence[str]] = None,
+    effects: Union[str, Sequence[str], None] = None,
 ) -> dict[str, Any]:
     """``hydrocyl diagnose`` on a valve rig and one measured record (CSV
     path or dict of arrays by column name, SI or with unit suffixes); the
-    report as a dict. ``window`` is at least 1."""
+    report as a dict. ``window`` is at least 1. ``effects``: the effect ids
+    the loop may add, a list or one string (split at commas, as the CLI's
+    ``--effects``); any other type is a TypeError naming ``effects``."""

@@ -238,7 +238,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         // an effect asked for that the loop neither added nor tried
         let seen = |id: &str| {
             report.effects_added.iter().any(|e| e.id == id)
-                || report.effects_rejected.iter().any(|e| e.id == id)
+                || report.effects_rejected.iter().any(|e| e.effect.id == id)
         };
         let untried: Vec<&str> = wanted
             .iter()
@@ -246,10 +246,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .filter(|w| !seen(w))
             .collect();
         if untried.len() == wanted.len() {
+            // each with the report's reason (already on in the declared rig,
+            // no balance for it, ...)
+            let why: Vec<String> = untried
+                .iter()
+                .map(|id| {
+                    report
+                        .effects_not_applicable
+                        .iter()
+                        .find(|n| n.id == *id)
+                        .map_or_else(|| id.to_string(), |n| format!("{id}: {}", n.why))
+                })
+                .collect();
             return Err(CliError::Input(format!(
-                "--effects {}: cannot be tried on this rig ({} rig; the effects it can try are listed without --effects)",
+                "--effects {}: cannot be tried on this rig ({} rig; the effects it can try are listed without --effects): {}",
                 untried.join(","),
-                report.rig_kind
+                report.rig_kind,
+                why.join("; ")
             )));
         }
     }

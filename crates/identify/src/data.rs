@@ -157,6 +157,18 @@ pub enum DataError {
         /// The missing column's name.
         column: String,
     },
+    /// A column the rig's column map names is not in the file.
+    #[error("{file}: row 1: missing column '{column}' (the rig's column map, `identify.columns.{signal}`; the file's headers: {headers})")]
+    MissingMappedColumn {
+        /// The file.
+        file: String,
+        /// The header the map names (as written in the map).
+        column: String,
+        /// The signal it was to hold.
+        signal: String,
+        /// The file's headers, comma separated.
+        headers: String,
+    },
     /// A column's unit is not accepted for its signal.
     #[error("{file}: row 1, column '{column}': unknown unit '{unit}' (accepted: {accepted})")]
     UnknownUnit {
@@ -360,6 +372,17 @@ fn map_columns(file: &str, headers: &[&str], map: &ColumnMap) -> Result<Columns,
             }
             None => ignored.push(h.to_string()),
         }
+    }
+    // A column the map names must be there: read by its own name instead,
+    // the record would say "missing column 'position'", not which header
+    // was looked for.
+    if let Some((sig, spec)) = map.0.iter().find(|(sig, _)| !seen.contains_key(sig)) {
+        return Err(DataError::MissingMappedColumn {
+            file: file.to_string(),
+            column: spec.clone(),
+            signal: sig.name().to_string(),
+            headers: headers.join(", "),
+        });
     }
     Ok(Columns {
         cols,
@@ -725,6 +748,25 @@ mod tests {
         assert!((r.time[1] - 0.01).abs() < 1e-15);
         assert!((r.get(Signal::P1).unwrap()[1] - 2e5).abs() < 1e-9);
         assert_eq!(r.ignored, vec!["force_N".to_string()]);
+    }
+
+    /// A column map naming a header the file lacks: the error names the
+    /// header looked for (it said "missing column 'position'").
+    #[test]
+    fn a_mapped_column_that_is_missing_is_named_by_its_header() {
+        let mut map = ColumnMap::default();
+        map.0.insert(Signal::Position, "pos [mm]".into());
+        let mut s = String::from("time [s],command,position [mm]\n");
+        for i in 0..10 {
+            s.push_str(&format!("{},0,{}\n", i, i));
+        }
+        let e = Record::parse("x.csv", &s, &map).unwrap_err().to_string();
+        assert!(
+            e.contains("x.csv")
+                && e.contains("missing column 'pos [mm]'")
+                && e.contains("identify.columns.position"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -131,9 +131,43 @@ pub struct EffectReport {
     pub heldout_share: f64,
     /// Change of BIC from adding it (negative: earns its place).
     pub delta_bic: f64,
-    /// Why it was rejected (absent for an added effect).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub reason: Option<String>,
+}
+
+/// An effect tried and rejected: its scores and, always, why (the type has
+/// no rejected effect without a reason).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RejectedEffect {
+    /// Its scores (the last round it was traced in).
+    #[serde(flatten)]
+    pub effect: EffectReport,
+    /// Why it was rejected: which part of the screen or of the acceptance
+    /// rule ([`crate::accept`]) it failed.
+    pub reason: String,
+}
+
+impl RejectedEffect {
+    /// `effect` rejected for `reason`.
+    pub fn new(effect: EffectReport, reason: impl Into<String>) -> Self {
+        Self {
+            effect,
+            reason: reason.into(),
+        }
+    }
+
+    /// A candidate not traced at all (no scores), and why.
+    pub fn untraced(id: EffectId, reason: impl Into<String>) -> Self {
+        Self::new(
+            EffectReport {
+                id: id.id().into(),
+                params: BTreeMap::new(),
+                ci95: BTreeMap::new(),
+                explained_share: 0.0,
+                heldout_share: 0.0,
+                delta_bic: 0.0,
+            },
+            reason,
+        )
+    }
 }
 
 /// An effect that applies to the rig, and where it acts.
@@ -200,8 +234,8 @@ pub struct Report {
     pub declared_refit: Vec<ParamReport>,
     /// Effects added, in order.
     pub effects_added: Vec<EffectReport>,
-    /// Effects tried and rejected (last round's scores).
-    pub effects_rejected: Vec<EffectReport>,
+    /// Effects tried and rejected (last round's scores), each with its reason.
+    pub effects_rejected: Vec<RejectedEffect>,
     /// Catalog effects not tried on this rig, each with the reason.
     pub effects_not_applicable: Vec<NotApplicable>,
     /// The effects that apply to the rig, with the `<component>.<parameter>`
@@ -328,6 +362,43 @@ pub struct Probe {
 }
 
 impl Report {
+    /// Where the report breaks "every catalog effect ends in exactly one of
+    /// `effects_added`, `effects_rejected` and `effects_not_applicable`"
+    /// (each of those with its reason): one line per effect listed in none or
+    /// in several. Empty for every report the loops write.
+    pub fn partition_errors(&self) -> Vec<String> {
+        EffectId::ALL
+            .iter()
+            .filter_map(|e| {
+                let id = e.id();
+                let lists: Vec<&str> = [
+                    (
+                        "effects_added",
+                        self.effects_added.iter().any(|a| a.id == id),
+                    ),
+                    (
+                        "effects_rejected",
+                        self.effects_rejected.iter().any(|r| r.effect.id == id),
+                    ),
+                    (
+                        "effects_not_applicable",
+                        self.effects_not_applicable.iter().any(|n| n.id == id),
+                    ),
+                ]
+                .into_iter()
+                .filter_map(|(name, hit)| hit.then_some(name))
+                .collect();
+                (lists.len() != 1).then(|| {
+                    if lists.is_empty() {
+                        format!("{id} is in none of the lists")
+                    } else {
+                        format!("{id} is in {}", lists.join(" and "))
+                    }
+                })
+            })
+            .collect()
+    }
+
     /// The human report: a table of NRMSE before/after and the effects.
     pub fn human(&self) -> String {
         use std::fmt::Write as _;
@@ -414,7 +485,7 @@ impl Report {
         }
         let _ = writeln!(s, "\neffects tried and rejected:");
         for e in &self.effects_rejected {
-            let _ = writeln!(s, "  {:<22} {}", e.id, e.reason.as_deref().unwrap_or(""));
+            let _ = writeln!(s, "  {:<22} {}", e.effect.id, e.reason);
         }
         if !self.effects_not_applicable.is_empty() {
             let _ = writeln!(s, "\neffects not applicable to this rig:");

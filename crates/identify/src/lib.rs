@@ -30,6 +30,7 @@
 //!   (`K (p1 − p2)² v`) and eq 5.12 (`K H a`).
 //! * [`valve`] — the valve rig of hydrocyl-system (`leaney-moog`):
 //!   output-error tracing of the effects its rig file exposes.
+//! * [`accept`] — the acceptance rule, one for every rig kind.
 //! * [`diagnose`] — the loop and the report; [`lm`] — refits with
 //!   confidence intervals; [`synth`] — generated records with planted effects.
 //!
@@ -51,6 +52,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod accept;
 pub mod bench;
 pub mod catalog;
 pub mod data;

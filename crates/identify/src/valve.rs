@@ -42,7 +42,7 @@ use crate::data::{Record, Signal};
 use crate::data_checks::{check_record, ProblemKind, RigFacts};
 use crate::diagnose::{
     nrmse, Applicable, DiagnoseError, DiagnoseOptions, EffectReport, NotApplicable, Probe,
-    RecordTrace, Report,
+    RecordTrace, RejectedEffect, Report,
 };
 use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, smooth_gcv, smooth_with};
@@ -124,6 +124,18 @@ fn not_applicable_why(id: EffectId, rig: &Model, opts: &DiagnoseOptions) -> Stri
     }
     match rig.applies(id) {
         Err(why) => why,
+        Ok(()) if id != EffectId::BulkModulus && is_on(rig, id) => {
+            let values: Vec<String> = id
+                .params()
+                .iter()
+                .filter_map(|q| get(rig, id, q.name).map(|v| format!("{} = {v:.4e}", q.name)))
+                .collect();
+            format!(
+                "already on in the declared rig ({}; {}): the loop adds only effects that are off",
+                values.join(", "),
+                rig.paths_of(id).join(", ")
+            )
+        }
         Ok(()) => "its parameters cannot be read on this rig".into(),
     }
 }
@@ -297,6 +309,9 @@ pub fn diagnose_rig_traced(
         .into_iter()
         .filter(|e| declared.applies(*e).is_ok())
         .filter(|e| e.params().iter().all(|q| get(&rig0, *e, q.name).is_some()))
+        // on in the declared rig: not a missing effect (bulk_modulus is
+        // always declared: tracing it refits B)
+        .filter(|e| *e == EffectId::BulkModulus || !is_on(&rig0, *e))
         .collect();
     // Noise floor of each compared channel as an NRMSE (the weights' floor
     // of 1e-4 of the range for noise-free records).
@@ -310,7 +325,7 @@ pub fn diagnose_rig_traced(
     let mut model = rig0.clone();
     let mut free: ParamList = Vec::new();
     let mut added: Vec<EffectReport> = Vec::new();
-    let mut last: BTreeMap<EffectId, EffectReport> = BTreeMap::new();
+    let mut last: BTreeMap<EffectId, RejectedEffect> = BTreeMap::new();
     let mut resembles: Option<Probe> = None;
     let total = opts.max_effects + 1;
     for round in 0..opts.max_effects {
@@ -335,18 +350,10 @@ pub fn diagnose_rig_traced(
                 todo.remove(k);
                 last.insert(
                     id,
-                    EffectReport {
-                        id: id.id().into(),
-                        params: BTreeMap::new(),
-                        ci95: BTreeMap::new(),
-                        explained_share: 0.0,
-                        heldout_share: 0.0,
-                        delta_bic: 0.0,
-                        reason: Some(
-                            "not traced: needs pressure_viscous's K (the term is K H a, eq 5.12)"
-                                .into(),
-                        ),
-                    },
+                    RejectedEffect::untraced(
+                        id,
+                        "not traced: needs pressure_viscous's K (the term is K H a, eq 5.12)",
+                    ),
                 );
             }
         }
@@ -357,7 +364,40 @@ pub fn diagnose_rig_traced(
             .collect();
         // The first step's simulations every candidate shares.
         let first = FirstStep::new(&model, &free, &pt, opts.holdout, Part::Train);
-        let trace_one = |job: &(EffectId, Model)| -> (Model, EffectReport, f64) {
+        // What the candidates are scored against: the round model traced
+        // like a candidate with nothing added (the effects already added and
+        // the initial position and velocity stepped on the training part
+        // alone). Each candidate is traced jointly with those, so against
+        // the round model itself (fitted on the whole record) every
+        // candidate was charged with what fitting on the training part alone
+        // costs on the rest: after two effects, one whose trace landed on
+        // its neutral value (τ = 0, Cl ≈ 0) "explained" −12 %.
+        let (rss_null, held_null) = {
+            let mut null = model.clone();
+            let no_screen = Screen {
+                rss: f64::INFINITY,
+                share: f64::NEG_INFINITY,
+            };
+            let traced = gauss_newton_trace(
+                &mut null,
+                &free,
+                &pt,
+                opts.holdout,
+                Part::Train,
+                first.as_ref(),
+                no_screen,
+            );
+            let (a, h) = match traced {
+                Ok(_) => rss_all_held(&null, &pt, opts.holdout),
+                Err(_) => (f64::INFINITY, f64::INFINITY),
+            };
+            if a.is_finite() && h.is_finite() {
+                (a, h)
+            } else {
+                (rss0, rss0_held)
+            }
+        };
+        let trace_one = |job: &(EffectId, Model)| -> (Model, EffectReport, Option<String>, f64) {
             let id = job.0;
             let params: ParamList = id.params().iter().map(|q| (id, q.name)).collect();
             // The candidate is traced together with the effects already added
@@ -388,11 +428,11 @@ pub fn diagnose_rig_traced(
                 Err(_) => rss(&trial, &pt, opts.holdout, Part::Train),
             };
             // A candidate screened out where the round model is its start
-            // scores what the round model scores (nothing to simulate).
+            // scores what nothing added scores (nothing to simulate).
             let unchanged =
                 screened.is_some() && first.as_ref().is_some_and(|f| f.applies_to(&trial));
             let (rss1, rss1_held) = if unchanged {
-                (rss0, rss0_held)
+                (rss_null, held_null)
             } else {
                 rss_all_held(&trial, &pt, opts.holdout)
             };
@@ -403,13 +443,13 @@ pub fn diagnose_rig_traced(
                 (0.0, 0.0, 0.0)
             } else {
                 (
-                    1.0 - rss1 / rss0.max(1e-300),
-                    1.0 - rss1_held / rss0_held.max(1e-300),
-                    neff * (rss1 / rss0.max(1e-300)).max(1e-300).ln()
+                    1.0 - rss1 / rss_null.max(1e-300),
+                    1.0 - rss1_held / held_null.max(1e-300),
+                    neff * (rss1 / rss_null.max(1e-300)).max(1e-300).ln()
                         + params.len() as f64 * neff.ln(),
                 )
             };
-            let mut rep = EffectReport {
+            let rep = EffectReport {
                 id: id.id().into(),
                 params: params
                     .iter()
@@ -419,25 +459,25 @@ pub fn diagnose_rig_traced(
                 explained_share: share,
                 heldout_share: held,
                 delta_bic: dbic,
-                reason: None,
             };
-            if let Err(e) = &res {
-                rep.reason = Some(format!("fit failed: {e}"));
+            let why = if let Err(e) = &res {
+                Some(format!("fit failed: {e}"))
             } else if let Some(lin) = screened {
-                rep.reason = Some(format!(
+                Some(format!(
                     "screened out: a linearised Gauss–Newton step explains {:.2} % of the training part (< {:.1} %), not traced further",
                     100.0 * lin,
                     100.0 * screen.share
-                ));
+                ))
             } else if sim_failed {
-                rep.reason = Some("the rig does not simulate at the traced values".into());
+                Some("the rig does not simulate at the traced values".into())
             } else if let Some(why) = opts.screen(share, held, dbic) {
-                rep.reason = Some(why);
+                Some(why)
             } else if negligible(id, &trial, declared) {
-                rep.reason =
-                    Some("fitted size negligible (indistinguishable from the declared rig)".into());
-            }
-            (trial, rep, rss_train)
+                Some("fitted size negligible (indistinguishable from the declared rig)".into())
+            } else {
+                None
+            };
+            (trial, rep, why, rss_train)
         };
         // The jobs are independent: trace them on the available cores
         // (results taken in catalog order, so the outcome does not depend on
@@ -451,41 +491,40 @@ pub fn diagnose_rig_traced(
             std::cmp::Reverse((model::is_law_edit(id), id.params().len()))
         });
         let queued: Vec<&(EffectId, Model)> = order.iter().map(|&i| &jobs[i]).collect();
-        let mut done: Vec<Option<(Model, EffectReport, f64)>> = jobs.iter().map(|_| None).collect();
+        type Traced = (Model, EffectReport, Option<String>, f64);
+        let mut done: Vec<Option<Traced>> = jobs.iter().map(|_| None).collect();
         for (i, r) in order
             .into_iter()
             .zip(trace_parallel(&queued, &|j| trace_one(j)))
         {
             done[i] = Some(r);
         }
-        let mut traced: Vec<Option<(EffectId, Model, EffectReport, f64)>> = done
+        let mut traced: Vec<Option<(EffectId, Traced)>> = done
             .into_iter()
             .zip(&jobs)
-            .map(|(d, (id, _))| d.map(|(t, r, x)| (*id, t, r, x)))
+            .map(|(d, (id, _))| d.map(|t| (*id, t)))
             .collect();
-        let mut chosen: Vec<(EffectId, Model, EffectReport)> = Vec::new();
+        // Candidates that explain a share worth having (best first); the
+        // others rejected with the reason.
+        let mut eligible: Vec<(EffectId, Model, EffectReport)> = Vec::new();
         for &id in &todo {
-            let mut pick: Option<(Model, EffectReport, f64)> = None;
+            let mut pick: Option<Traced> = None;
             for slot in traced.iter_mut() {
                 if slot.as_ref().is_some_and(|s| s.0 == id) {
-                    if let Some((_, t, r, x)) = slot.take() {
-                        if pick.as_ref().is_none_or(|p| x < p.2) {
-                            pick = Some((t, r, x));
+                    if let Some((_, t)) = slot.take() {
+                        if pick.as_ref().is_none_or(|p| t.3 < p.3) {
+                            pick = Some(t);
                         }
                     }
                 }
             }
-            if let Some((t, r, _)) = pick {
-                chosen.push((id, t, r));
+            match pick {
+                Some((trial, rep, None, _)) => eligible.push((id, trial, rep)),
+                Some((_, rep, Some(why), _)) => {
+                    last.insert(id, RejectedEffect::new(rep, why));
+                }
+                None => {}
             }
-        }
-        // Candidates that explain a share worth having, best first.
-        let mut eligible: Vec<(EffectId, Model, EffectReport)> = Vec::new();
-        for (id, trial, rep) in chosen {
-            if rep.reason.is_none() {
-                eligible.push((id, trial, rep.clone()));
-            }
-            last.insert(id, rep);
         }
         eligible.sort_by(|a, b| b.2.explained_share.total_cmp(&a.2.explained_share));
         let top = eligible.first().map(|(id, _, r)| (*id, r.explained_share));
@@ -502,14 +541,18 @@ pub fn diagnose_rig_traced(
             if pr.explained_share >= opts.min_share
                 && top.is_none_or(|(_, share)| pr.explained_share > share + opts.min_share)
             {
-                if let Some((id, _)) = top {
-                    if let Some(r) = last.get_mut(&id) {
-                        r.reason = Some(format!(
-                            "the residual is better explained by a {} ({:.1} %), which is not in the catalog",
-                            pr.what,
-                            100.0 * pr.explained_share
-                        ));
-                    }
+                for (id, _, rep) in eligible {
+                    last.insert(
+                        id,
+                        RejectedEffect::new(
+                            rep,
+                            format!(
+                                "the residual is better explained by a {} ({:.1} %), which is not in the catalog",
+                                pr.what,
+                                100.0 * pr.explained_share
+                            ),
+                        ),
+                    );
                 }
                 resembles = Some(pr);
                 break;
@@ -523,14 +566,22 @@ pub fn diagnose_rig_traced(
         // refit, which does not need them.
         let mut scores: Option<(BTreeMap<String, f64>, f64)> = None;
         let mut accepted: Option<(EffectId, Model, EffectReport, ParamList, lm::LmResult)> = None;
-        for (id, _, _) in eligible.iter().skip(MAX_REFITS_PER_ROUND) {
-            if let Some(r) = last.get_mut(id) {
-                r.reason = Some(format!(
-                    "not refitted: {MAX_REFITS_PER_ROUND} candidates explaining more were refitted first in its round"
-                ));
+        let mut pending = eligible.into_iter();
+        let mut refits = 0;
+        for (id, trial, rep) in pending.by_ref() {
+            if refits == MAX_REFITS_PER_ROUND {
+                last.insert(
+                    id,
+                    RejectedEffect::new(
+                        rep,
+                        format!(
+                            "not refitted: {MAX_REFITS_PER_ROUND} candidates explaining more were refitted first in its round"
+                        ),
+                    ),
+                );
+                continue;
             }
-        }
-        for (id, trial, rep) in eligible.into_iter().take(MAX_REFITS_PER_ROUND) {
+            refits += 1;
             progress(&format!("refit {}", id.id()), round + 1, total);
             let joint: ParamList = free
                 .iter()
@@ -559,7 +610,7 @@ pub fn diagnose_rig_traced(
                 holdout: opts.holdout,
             };
             let verdict = match polished {
-                Ok(res) => accept::verdict(id, &joint, &res, &refit, &base).map(|()| res),
+                Ok(res) => accept::verdict(id, &joint, &res, &refit, &model, &base).map(|()| res),
                 Err(e) => Err(format!("refit failed: {e}")),
             };
             match verdict {
@@ -568,9 +619,7 @@ pub fn diagnose_rig_traced(
                     break;
                 }
                 Err(why) => {
-                    if let Some(r) = last.get_mut(&id) {
-                        r.reason = Some(why);
-                    }
+                    last.insert(id, RejectedEffect::new(rep, why));
                 }
             }
         }
@@ -579,6 +628,22 @@ pub fn diagnose_rig_traced(
         let Some((id, refit, rep, joint, res)) = accepted else {
             break;
         };
+        // The candidates after it were not refitted: one explaining more
+        // earned its place (they are traced again next round, if any).
+        for (other, _, r) in pending {
+            last.insert(
+                other,
+                RejectedEffect::new(
+                    r,
+                    format!(
+                        "explains less than {}, added in round {} (the last round: at most {} effects are added)",
+                        id.id(),
+                        round + 1,
+                        opts.max_effects
+                    ),
+                ),
+            );
+        }
         model = refit;
         free = joint;
         last.remove(&id);
@@ -606,11 +671,14 @@ pub fn diagnose_rig_traced(
             }
             free.retain(|(e, _)| e != id);
             if let Some(pos) = added.iter().position(|a| a.id == id.id()) {
-                let mut rep = added.remove(pos);
-                rep.reason = Some(
-                    "added, then gave way: its refitted size became negligible once later effects were added".into(),
+                let rep = added.remove(pos);
+                last.insert(
+                    *id,
+                    RejectedEffect::new(
+                        rep,
+                        "added, then gave way: its refitted size became negligible once later effects were added",
+                    ),
                 );
-                last.insert(*id, rep);
             }
         }
         if !free.is_empty() {
@@ -691,12 +759,18 @@ pub fn diagnose_rig_traced(
             "output-error tracing: add the effect removing the largest share of the noise-weighted output-error SS if share >= {:.0} %, held-out share >= {:.1} % and BIC falls; refit all added parameters on the output error; keep it only if no compared channel's NRMSE rises by more than {:.0} % of its noise floor and the held-out part improves",
             100.0 * opts.min_share,
             50.0 * opts.min_share,
-            100.0 * accept::WORSEN_TOL
+            100.0 * crate::accept::WORSEN_TOL
         ),
         wall_times_s: clock.finish(),
         elapsed_s: start.elapsed().as_secs_f64(),
         simulations: p.count.load(std::sync::atomic::Ordering::Relaxed),
     };
+    // every catalog effect in exactly one list, with its reason
+    debug_assert!(
+        report.partition_errors().is_empty(),
+        "{:?}",
+        report.partition_errors()
+    );
     Ok(ValveOutcome {
         report,
         traces,

@@ -64,6 +64,22 @@ fn read_record(obj: &Bound<'_, PyAny>) -> PyResult<Record> {
     Record::read(&path).map_err(input)
 }
 
+/// The `effects` argument as ids: a string is one id, or several separated by
+/// commas (as `--effects`); a sequence of strings is a list of ids.
+fn effect_ids(obj: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
+    if let Ok(s) = obj.extract::<String>() {
+        return Ok(s.split(',').map(|id| id.trim().to_string()).collect());
+    }
+    obj.extract::<Vec<String>>().map_err(|_| {
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "effects: a list of effect ids or one id as a string, got {}",
+            obj.get_type()
+                .name()
+                .map_or_else(|_| "?".to_string(), |n| n.to_string())
+        ))
+    })
+}
+
 /// Diagnoses `rig` (the valve-cylinder circuit: its netlist, e.g. the
 /// `leaney-moog` preset, or a `valve-cylinder` rig file) against one measured `record` as
 /// `hydrocyl diagnose --rig ... --data ...` does and returns its report as
@@ -73,7 +89,10 @@ fn read_record(obj: &Bound<'_, PyAny>) -> PyResult<Record> {
 /// `record`: a CSV path or a dict of arrays by column name (measured-data
 /// format: `time` [s], `command`, `position` [m], optionally `velocity`,
 /// `p1`, `p2` [Pa gauge]; unit suffixes such as `p1 [bar]` convert).
-/// `min_share`, `holdout`, `window`, `effects` are the CLI's options.
+/// `min_share`, `holdout`, `window`, `effects` are the CLI's options;
+/// `effects` is a list of effect ids or one string, which is split at commas
+/// as the CLI's `--effects` is (`"internal_leakage"`, `"a,b"`); anything else
+/// is a TypeError naming the argument.
 /// The GIL is released while it runs. ValueError with the CLI's message
 /// for bad input.
 #[pyfunction]
@@ -85,7 +104,7 @@ pub fn diagnose<'py>(
     min_share: f64,
     holdout: f64,
     window: Option<i64>,
-    effects: Option<Vec<String>>,
+    effects: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let bad = |m: String| Err(PyValueError::new_err(m));
     if !(0.0..1.0).contains(&min_share) {
@@ -98,6 +117,7 @@ pub fn diagnose<'py>(
         Some(w) if w < 1 => return bad(format!("window {w}: must be at least 1")),
         w => w.and_then(|w| usize::try_from(w).ok()),
     };
+    let effects = effects.map(effect_ids).transpose()?;
     let candidates = effects
         .map(|ids| {
             ids.iter()

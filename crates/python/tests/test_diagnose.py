@@ -31,6 +31,16 @@ def test_diagnose_equals_the_cli_report(cli, repo, tmp_path, report):
     assert report["nrmse_after"]["position"] < report["nrmse_before"]["position"]
 
 
+def test_effects_as_one_string_is_a_one_element_list(repo, report):
+    got = hydrocyl.diagnose(hydrocyl.Rig.load("leaney-moog"), str(repo / RECORD), effects="internal_leakage")
+    assert comparable(got) == comparable(report)
+
+
+def test_effects_of_another_type_is_a_type_error_naming_it(repo):
+    with pytest.raises(TypeError, match="effects: a list of effect ids or one id as a string"):
+        hydrocyl.diagnose(hydrocyl.Rig.load("leaney-moog"), str(repo / RECORD), effects=3)
+
+
 def test_a_dict_record_gives_the_same_report(repo, report):
     path = repo / RECORD
     header = path.read_text().splitlines()[0].split(",")

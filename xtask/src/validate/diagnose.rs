@@ -237,6 +237,37 @@ fn timing_note(s: &mut Section, what: &str, seconds: f64) {
     ));
 }
 
+/// The acceptance rule on a real-data report: every added effect has an
+/// interval for each parameter (a parameter on a bound has none) and its
+/// size's interval excludes zero; the effects that break it, or "none".
+fn unaccepted(o: &Outcome) -> String {
+    let r = &o.report;
+    let fc = r
+        .declared_refit
+        .iter()
+        .find(|p| p.name == "Fc")
+        .map_or(o.rig.friction.coulomb, |p| p.fitted);
+    let bad: Vec<String> = r
+        .effects_added
+        .iter()
+        .filter(|e| {
+            let Some(id) = EffectId::from_id(&e.id) else {
+                return true;
+            };
+            let v = |n: &str| e.params.get(n).copied().unwrap_or(0.0);
+            let size = hydrocyl_identify::accept::size(id, v, |_| 0.0, fc);
+            let ci = e.ci95.get(size.name).copied().flatten();
+            e.ci95.values().any(Option::is_none) || ci.is_none_or(|c| size.value.abs() <= c)
+        })
+        .map(|e| e.id.clone())
+        .collect();
+    if bad.is_empty() {
+        "none".into()
+    } else {
+        bad.join(", ")
+    }
+}
+
 fn real_data(s: &mut Section) {
     let data = root().join("../shared/data");
     let emps = data.join("emps_friction_benchmark/DATA_EMPS.csv");
@@ -285,6 +316,13 @@ fn real_data(s: &mut Section) {
                     "-3.16 (IDIM-LS offset), within 0.5 N".into(),
                     (off + 3.1648).abs() < 0.5,
                 );
+                let bad = unaccepted(&o);
+                s.check(
+                    "EMPS: added effects pass the acceptance rule",
+                    bad.clone(),
+                    "none (every parameter with an interval, size's excludes zero)".into(),
+                    bad == "none",
+                );
                 s.note(&format!(
                     "EMPS: added {}; force NRMSE declared {:.4} -> refit {:.4} -> after {:.4}",
                     ids(&o),
@@ -320,8 +358,16 @@ fn real_data(s: &mut Section) {
                     "pressure_viscous among the added".into(),
                     found,
                 );
+                let bad = unaccepted(&o);
+                s.check(
+                    "TU Delft NAPN: added effects pass the acceptance rule",
+                    bad.clone(),
+                    "none (every parameter with an interval, size's excludes zero)".into(),
+                    bad == "none",
+                );
                 s.note(&format!(
-                    "TU Delft NAPN: force NRMSE declared {:.4} -> refit {:.4} -> after {:.4}; unexplained {:.0} %",
+                    "TU Delft NAPN: added {}; force NRMSE declared {:.4} -> refit {:.4} -> after {:.4}; unexplained {:.0} %",
+                    ids(&o),
                     r.nrmse_declared["force"],
                     r.nrmse_before["force"],
                     r.nrmse_after["force"],

@@ -623,6 +623,7 @@ mod tests {
             time: t.clone(),
             signals,
             ignored: vec![],
+            units: Default::default(),
         };
         let (mut p, _) = prepare(&rec, None, &[], m.stroke()).unwrap();
         p.rtol = 1e-8;

@@ -258,6 +258,23 @@ pub(super) fn with_initial(rig: &Model, p: &Prepared) -> Model {
             "initial.position",
             Value::from((u0 * xm).clamp(-xm, xm)),
         );
+        // A record that starts on a command step (a closed-loop record whose
+        // reference steps at its first sample) finds the spool where the
+        // motion before it left it, not at the new command: a piston at rest
+        // under a first command of 0.4 has a closed spool. Where the first
+        // samples' velocity is far from the steady velocity of the first
+        // command (by more than half of it and 5 % of full demand's, beyond
+        // the smoother's one-sided error at the first sample), the spool
+        // starts at the opening that velocity needs, and follows the initial
+        // velocity as it is fitted.
+        let gain = super::effects::rig_facts(&r).velocity_gain;
+        if let (Some(v0), Some(g)) = (p.v0, gain) {
+            let v_cmd = g * u0;
+            if (v0 - v_cmd).abs() > 0.5 * v_cmd.abs() + 0.05 * g {
+                r.spool_per_velocity = Some(xm / g);
+                r.set_v0(r.v0());
+            }
+        }
     }
     if r.roles.cylinder_type == "cylinder" {
         let c = r.roles.cylinder.clone();

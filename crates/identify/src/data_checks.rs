@@ -167,7 +167,7 @@ pub fn check_record(rec: &Record, facts: Option<&RigFacts>) -> Vec<DataProblem> 
     let resolutions: Vec<(Signal, Option<(f64, usize)>)> =
         present.iter().map(|(s, y)| (*s, resolution(y))).collect();
     for (s, y) in &present {
-        if let Some(p) = channel_problem(*s, y, facts, &resolutions) {
+        if let Some(p) = channel_problem(*s, &rec.time, y, facts, &resolutions) {
             out.push(p);
         }
     }
@@ -191,6 +191,7 @@ pub fn check_record(rec: &Record, facts: Option<&RigFacts>) -> Vec<DataProblem> 
 /// The first problem of one channel, if any.
 fn channel_problem(
     s: Signal,
+    t: &[f64],
     y: &[f64],
     facts: Option<&RigFacts>,
     resolutions: &[(Signal, Option<(f64, usize)>)],
@@ -209,7 +210,7 @@ fn channel_problem(
             format!("{name} reads {lo:.6e} {u} in every sample: a stuck or disconnected sensor? check the transducer, its wiring and the logged column"),
         ));
     }
-    let sigma = noise_sigma(y);
+    let sigma = noise_sigma(t, y);
     // Unit and range checks against the rig.
     if let Some(f) = facts {
         match s {

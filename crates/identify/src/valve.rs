@@ -646,7 +646,7 @@ pub fn diagnose_rig_traced(
     let mut noise_floor = BTreeMap::new();
     let mut noise_ss = 0.0;
     for (((ch, m), r), w) in p.meas.iter().zip(&p.ranges).zip(&p.weights) {
-        let sig = if *w == 0.0 { 0.0 } else { noise_sigma(m) };
+        let sig = if *w == 0.0 { 0.0 } else { noise_sigma(&p.t, m) };
         noise_floor.insert(ch.name().to_string(), sig / r);
         // Weighted residuals of pure noise have unit variance.
         if *w > 0.0 {

@@ -606,9 +606,9 @@ pub fn diagnose_bench(
     let noise_ss: f64 = sigs
         .iter()
         .map(|s| {
-            let var = noise_sigma(&s.force).powi(2)
-                + (rig.area1 * noise_sigma(&s.p1)).powi(2)
-                + (rig.area2 * noise_sigma(&s.p2)).powi(2);
+            let var = noise_sigma(&s.t, &s.force).powi(2)
+                + (rig.area1 * noise_sigma(&s.t, &s.p1)).powi(2)
+                + (rig.area2 * noise_sigma(&s.t, &s.p2)).powi(2);
             var * s.force.len() as f64
         })
         .sum();

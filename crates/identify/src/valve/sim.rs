@@ -176,7 +176,7 @@ pub(super) fn prepare(
             if *ch == Signal::Velocity && rec.get(Signal::Velocity).is_none() {
                 0.0
             } else {
-                1.0 / noise_sigma(y).max(1e-4 * r)
+                1.0 / noise_sigma(&rec.time, y).max(1e-4 * r)
             }
         })
         .collect();
@@ -195,7 +195,11 @@ pub(super) fn prepare(
     };
     let (p10, p20) = (p0(Signal::P1), p0(Signal::P2));
     let restarts = if position_ok {
-        stops::restarts(x, stroke, (5.0 * noise_sigma(x)).max(1e-4 * stroke))
+        stops::restarts(
+            x,
+            stroke,
+            (5.0 * noise_sigma(&rec.time, x)).max(1e-4 * stroke),
+        )
     } else {
         Vec::new()
     };

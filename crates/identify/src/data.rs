@@ -247,6 +247,17 @@ pub enum DataError {
         /// The previous row's time \[s\].
         prev: f64,
     },
+    /// A column's unit contradicts the rig (a `command [V]` on a rig whose
+    /// command is a normalised spool demand; seconds under `time [ms]`).
+    #[error("{file}: row 1, column '{column}': {reason}")]
+    UnitContradictsRig {
+        /// The file.
+        file: String,
+        /// The column header.
+        column: String,
+        /// What contradicts what, and what to check.
+        reason: String,
+    },
     /// Too few samples to do anything with.
     #[error("{file}: only {n} samples (at least {min} needed)")]
     TooShort {
@@ -277,6 +288,11 @@ pub struct Record {
     pub signals: BTreeMap<Signal, Vec<f64>>,
     /// Headers of the columns that are not signals (kept, not used).
     pub ignored: Vec<String>,
+    /// The unit each signal's column was written in (`ms`, `bar`, `V`, ...),
+    /// for the signals whose header (or column map) named one; the values
+    /// are already in SI. The data checks compare it with the rig's (a
+    /// `command [V]` on a rig whose command is a normalised spool demand).
+    pub units: BTreeMap<Signal, String>,
 }
 
 /// Splits `name [unit]` into name and unit.
@@ -300,6 +316,8 @@ struct Columns {
     seen: BTreeMap<Signal, usize>,
     /// Headers of the columns that are not signals.
     ignored: Vec<String>,
+    /// Signal → the unit its header named.
+    units: BTreeMap<Signal, String>,
 }
 
 /// Why a header of one cell is not comma-separated CSV, when the cell
@@ -334,6 +352,7 @@ fn map_columns(file: &str, headers: &[&str], map: &ColumnMap) -> Result<Columns,
     let mut cols: Vec<Option<(Signal, f64)>> = vec![None; headers.len()];
     let mut seen: BTreeMap<Signal, usize> = BTreeMap::new();
     let mut ignored = Vec::new();
+    let mut units = BTreeMap::new();
     // Mapped signals first: header name → (signal, unit).
     let mut mapped: BTreeMap<String, (Signal, Option<String>)> = BTreeMap::new();
     for (sig, spec) in &map.0 {
@@ -369,6 +388,9 @@ fn map_columns(file: &str, headers: &[&str], map: &ColumnMap) -> Result<Columns,
                     });
                 }
                 cols[j] = Some((sig, factor));
+                if let Some(u) = unit {
+                    units.insert(sig, u);
+                }
             }
             None => ignored.push(h.to_string()),
         }
@@ -388,6 +410,7 @@ fn map_columns(file: &str, headers: &[&str], map: &ColumnMap) -> Result<Columns,
         cols,
         seen,
         ignored,
+        units,
     })
 }
 
@@ -441,6 +464,7 @@ impl Record {
             cols,
             seen,
             ignored,
+            units,
         } = map_columns(file, &header_list, map)?;
         let time_col = match seen.get(&Signal::Time) {
             Some(&j) => j,
@@ -523,6 +547,7 @@ impl Record {
             time,
             signals,
             ignored,
+            units,
         })
     }
 
@@ -536,6 +561,7 @@ impl Record {
             cols,
             seen,
             ignored,
+            units,
         } = map_columns(file, &headers, map).ok()?;
         let time_col = *seen.get(&Signal::Time)?;
         let wanted: Vec<usize> = std::iter::once(time_col)
@@ -563,6 +589,7 @@ impl Record {
             time,
             signals,
             ignored,
+            units,
         })
     }
 
@@ -610,6 +637,7 @@ impl Record {
                 .map(|(k, v)| (*k, v[range.clone()].to_vec()))
                 .collect(),
             ignored: self.ignored.clone(),
+            units: self.units.clone(),
         }
     }
 }

@@ -13,7 +13,7 @@
 
 use serde::Serialize;
 
-use crate::data::{Record, Signal};
+use crate::data::{DataError, Record, Signal};
 use crate::smooth::noise_sigma;
 
 /// What the checks need to know about the rig (SI units).
@@ -27,6 +27,15 @@ pub struct RigFacts {
     /// \[m·s⁻¹ per unit command\] (the mean of the extending and retracting
     /// gains), if the rig has one.
     pub velocity_gain: Option<f64>,
+    /// Cap- and rod-side piston areas \[m²\], if the rig has a cylinder
+    /// whose areas it declares.
+    pub areas: Option<(f64, f64)>,
+    /// Moving mass on the rod \[kg\].
+    pub mass: f64,
+    /// The unit of the rig's `command`: `-` for a normalised spool demand
+    /// (valve rigs, and the controller's output of a closed-loop rig), `V`
+    /// for a drive voltage (pump rigs); `None` if the rig does not say.
+    pub command_unit: Option<&'static str>,
 }
 
 /// The kind of a data problem.
@@ -49,12 +58,18 @@ pub enum ProblemKind {
 /// One data problem (`data_problems` in the JSON report).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct DataProblem {
-    /// The channel left out of the fit (`position`, `p1`, ...).
+    /// The record it was found in (the file, as given).
+    pub file: String,
+    /// The channel (`position`, `p1`, ...).
     pub channel: String,
     /// What is wrong.
     pub kind: ProblemKind,
     /// One line: what was seen and what to check.
     pub message: String,
+    /// `true` when the channel is left out of the fit; `false` when it is
+    /// kept, and [`DataProblem::message`] says why (a friction bench's
+    /// pressure is an input of its model, not a compared channel).
+    pub left_out: bool,
 }
 
 /// Channels the checks look at (the measured ones; the command is the
@@ -79,6 +94,16 @@ const COARSER_THAN_NEIGHBOURS: f64 = 20.0;
 /// A measured command-to-velocity gain this many times off the rig's (either
 /// way) contradicts the units of the position.
 const GAIN_FACTOR: f64 = 20.0;
+/// The chamber pressures' force-balance coefficient this many times off 1
+/// (either way) contradicts their units (psi/bar 14.5, MPa/bar 10, kPa/psi
+/// 6.9).
+const BALANCE_FACTOR: f64 = 3.0;
+/// A channel at its extreme this many times longer than on any of the
+/// levels next to it is clipped (a quantised peak dwells at most 2.4 times
+/// as long on its top level).
+const CLIP_DWELL: f64 = 5.0;
+/// How many distinct levels next to an extreme [`inward_dwell`] looks at.
+const INWARD_LEVELS: usize = 3;
 
 fn range(y: &[f64]) -> (f64, f64) {
     y.iter()
@@ -122,9 +147,11 @@ fn unit(s: Signal) -> &'static str {
 
 fn problem(ch: Signal, kind: ProblemKind, message: String) -> DataProblem {
     DataProblem {
+        file: String::new(),
         channel: ch.name().into(),
         kind,
         message,
+        left_out: true,
     }
 }
 
@@ -140,7 +167,7 @@ pub fn check_record(rec: &Record, facts: Option<&RigFacts>) -> Vec<DataProblem> 
     let resolutions: Vec<(Signal, Option<(f64, usize)>)> =
         present.iter().map(|(s, y)| (*s, resolution(y))).collect();
     for (s, y) in &present {
-        if let Some(p) = channel_problem(*s, y, facts, &resolutions) {
+        if let Some(p) = channel_problem(*s, &rec.time, y, facts, &resolutions) {
             out.push(p);
         }
     }
@@ -151,6 +178,12 @@ pub fn check_record(rec: &Record, facts: Option<&RigFacts>) -> Vec<DataProblem> 
                 out.push(p);
             }
         }
+        if !bad(&out, Signal::P1) && !bad(&out, Signal::P2) {
+            out.extend(balance_problems(rec, f));
+        }
+    }
+    for p in &mut out {
+        p.file.clone_from(&rec.source);
     }
     out
 }
@@ -158,6 +191,7 @@ pub fn check_record(rec: &Record, facts: Option<&RigFacts>) -> Vec<DataProblem> 
 /// The first problem of one channel, if any.
 fn channel_problem(
     s: Signal,
+    t: &[f64],
     y: &[f64],
     facts: Option<&RigFacts>,
     resolutions: &[(Signal, Option<(f64, usize)>)],
@@ -176,7 +210,7 @@ fn channel_problem(
             format!("{name} reads {lo:.6e} {u} in every sample: a stuck or disconnected sensor? check the transducer, its wiring and the logged column"),
         ));
     }
-    let sigma = noise_sigma(y);
+    let sigma = noise_sigma(t, y);
     // Unit and range checks against the rig.
     if let Some(f) = facts {
         match s {
@@ -249,7 +283,11 @@ fn channel_problem(
         .and_then(|(_, r)| *r);
     let many_levels = coarse.is_some_and(|(_, levels)| levels as f64 >= COARSE_LEVELS);
     for (count, v, which) in [(at_hi, hi, "maximum"), (at_lo, lo, "minimum")] {
-        if many_levels && count >= (CLIP_SHARE * n).max(5.0) && !physical(v) {
+        if many_levels
+            && count >= (CLIP_SHARE * n).max(5.0)
+            && !physical(v)
+            && count > CLIP_DWELL * inward_dwell(y, v, r)
+        {
             return Some(problem(
                 s,
                 ProblemKind::Clipped,
@@ -276,6 +314,192 @@ fn channel_problem(
         }
     }
     None
+}
+
+/// The most samples at one of the [`INWARD_LEVELS`] distinct levels next
+/// to the extreme `v` (towards the inside of the range `r`): how long the
+/// signal dwells on a level near its extreme when nothing clips it (at
+/// least 1). A quantised sine dwells on its top level about as long as on
+/// the next ones (at most 2.4 times as long, for a peak just below a level's
+/// upper edge); a clipped signal sits on its extreme far longer than it
+/// takes to cross the levels below it.
+fn inward_dwell(y: &[f64], v: f64, r: f64) -> f64 {
+    let tol = 1e-9 * r;
+    let mut d: Vec<f64> = y
+        .iter()
+        .map(|x| (x - v).abs())
+        .filter(|d| *d > tol)
+        .collect();
+    d.sort_by(f64::total_cmp);
+    let mut counts: Vec<usize> = Vec::new();
+    let mut level = f64::NAN;
+    for x in d {
+        if counts.is_empty() || x - level > tol {
+            if counts.len() == INWARD_LEVELS {
+                break;
+            }
+            counts.push(0);
+            level = x;
+        }
+        if let Some(c) = counts.last_mut() {
+            *c += 1;
+        }
+    }
+    counts.into_iter().max().unwrap_or(0).max(1) as f64
+}
+
+/// Pressure channels that contradict the rig's force balance: with the
+/// piston off its stops, `p1 A1 − m a` must follow `p2 A2` (plus a constant
+/// load and friction, fitted alongside as `c + f tanh(v/5 mm/s) + b v`); a
+/// coefficient on `p2 A2` far from 1 means the two pressures are not in the
+/// same unit (bar under `[psi]` reads 14.5 times too low). Which of the two
+/// is wrong the balance cannot tell, so both are named (and left out).
+fn balance_problems(rec: &Record, f: &RigFacts) -> Vec<DataProblem> {
+    let Some((a1, a2)) = f.areas else {
+        return vec![];
+    };
+    let (Some(p1), Some(p2), Some(x)) = (
+        rec.get(Signal::P1),
+        rec.get(Signal::P2),
+        rec.get(Signal::Position),
+    ) else {
+        return vec![];
+    };
+    let t = &rec.time;
+    let n = t.len();
+    if n < 50 || !(a1 > 0.0 && a2 > 0.0) {
+        return vec![];
+    }
+    let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
+    let k = ((0.025 / dt).round() as usize).clamp(1, n / 4);
+    let mut xtx = nalgebra::Matrix4::<f64>::zeros();
+    let mut xty = nalgebra::Vector4::<f64>::zeros();
+    let mut rows: Vec<(nalgebra::Vector4<f64>, f64)> = Vec::new();
+    for i in k..n - k {
+        if x[i].abs() > 0.45 * f.stroke {
+            continue;
+        }
+        let (hm, hp) = (t[i] - t[i - k], t[i + k] - t[i]);
+        let v = (x[i + k] - x[i - k]) / (hm + hp);
+        let a = 2.0 * ((x[i + k] - x[i]) / hp - (x[i] - x[i - k]) / hm) / (hm + hp);
+        let row = nalgebra::Vector4::new(p2[i] * a2, 1.0, (v / 5e-3).tanh(), v);
+        let y = p1[i] * a1 - f.mass * a;
+        xtx += row * row.transpose();
+        xty += row * y;
+        rows.push((row, y));
+    }
+    let m = rows.len();
+    if m < 50 {
+        return vec![];
+    }
+    let Some(inv) = xtx.try_inverse() else {
+        return vec![];
+    };
+    let beta = inv * xty;
+    let rss: f64 = rows.iter().map(|(r, y)| (y - r.dot(&beta)).powi(2)).sum();
+    let se = (rss / (m - 4) as f64 * inv[(0, 0)]).max(0.0).sqrt();
+    let gain = beta[0];
+    // judged only where the record pins the coefficient down
+    if !(se < 0.1 && gain.is_finite()) || (1.0 / BALANCE_FACTOR..=BALANCE_FACTOR).contains(&gain) {
+        return vec![];
+    }
+    let unit_of = |s: Signal| rec.units.get(&s).map_or("Pa", String::as_str).to_string();
+    let (u1, u2) = (unit_of(Signal::P1), unit_of(Signal::P2));
+    [Signal::P1, Signal::P2]
+        .into_iter()
+        .map(|s| {
+            problem(
+                s,
+                ProblemKind::Units,
+                format!("p1 and p2 do not balance the piston: p1 A1 − m a ≈ {gain:.3} × p2 A2 (± {se:.2}; 1 on this rig, whatever the load and friction): one of the two columns (p1 in {u1}, p2 in {u2}) is in another unit than its header says; both left out"),
+            )
+        })
+        .collect()
+}
+
+/// A unit that contradicts the rig, as an error naming the file, row 1 and
+/// the column: a `command` written in volts on a rig whose command is a
+/// normalised spool demand (or the other way round), and a time axis whose
+/// unit makes the piston move far faster than the rig can (seconds under
+/// `[ms]`: 1000 times). `problems` are the record's data problems (a
+/// position already found in the wrong unit says nothing about time).
+pub fn unit_errors(rec: &Record, f: &RigFacts, problems: &[DataProblem]) -> Result<(), DataError> {
+    let column = |s: Signal| match rec.units.get(&s) {
+        Some(u) => format!("{} [{u}]", s.name()),
+        None => s.name().to_string(),
+    };
+    if let (Some(want), Some(got)) = (f.command_unit, rec.units.get(&Signal::Command)) {
+        let norm = |u: &str| {
+            if u == "1" {
+                "-".to_string()
+            } else {
+                u.to_string()
+            }
+        };
+        if norm(got) != norm(want) {
+            let what = |u: &str| match u {
+                "-" => "a normalised spool demand (unit `-`)",
+                "V" => "a drive voltage (unit `V`)",
+                _ => "in another unit",
+            };
+            return Err(DataError::UnitContradictsRig {
+                file: rec.source.clone(),
+                column: column(Signal::Command),
+                reason: format!(
+                    "the rig's command is {}, not {}: write the column as the rig takes it",
+                    what(want),
+                    what(got)
+                ),
+            });
+        }
+    }
+    let position_bad = problems
+        .iter()
+        .any(|p| p.channel == Signal::Position.name() && p.kind == ProblemKind::Units);
+    if position_bad {
+        return Ok(());
+    }
+    let (Some(g), Some(u), Some(x)) = (
+        f.velocity_gain,
+        rec.get(Signal::Command),
+        rec.get(Signal::Position),
+    ) else {
+        return Ok(());
+    };
+    let n = x.len();
+    if n < 50 || !(g.is_finite() && g > 0.0) {
+        return Ok(());
+    }
+    // the fastest the rig can move the piston on this record's command
+    let umax = u.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    let vmax = g * umax;
+    // block means (noise averaged out), about 50 blocks
+    let b = (n / 50).max(5);
+    let means: Vec<(f64, f64)> = rec
+        .time
+        .chunks(b)
+        .zip(x.chunks(b))
+        .map(|(tc, xc)| {
+            let l = tc.len() as f64;
+            (tc.iter().sum::<f64>() / l, xc.iter().sum::<f64>() / l)
+        })
+        .collect();
+    let fastest = means
+        .windows(2)
+        .map(|w| (w[1].1 - w[0].1).abs() / (w[1].0 - w[0].0))
+        .fold(0.0, f64::max);
+    if fastest > GAIN_FACTOR * vmax {
+        let span = rec.time[n - 1] - rec.time[0];
+        return Err(DataError::UnitContradictsRig {
+            file: rec.source.clone(),
+            column: column(Signal::Time),
+            reason: format!(
+                "the piston would move at {fastest:.3e} m/s, {:.0} times the rig's fastest ({vmax:.3e} m/s at this command), over a record of {span:.4e} s: check the unit of the time column (seconds written under [ms]?)",
+                fastest / vmax
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// The command-to-velocity gain of the record against the rig's: the sign
@@ -348,6 +572,7 @@ mod tests {
             time: (0..n).map(|i| i as f64 * 1e-3).collect(),
             signals: cols.iter().cloned().collect::<BTreeMap<_, _>>(),
             ignored: vec![],
+            units: Default::default(),
         }
     }
 
@@ -356,6 +581,9 @@ mod tests {
             stroke: 0.5,
             supply: 7e6,
             velocity_gain: Some(0.2),
+            areas: None,
+            mass: 100.0,
+            command_unit: Some("-"),
         }
     }
 

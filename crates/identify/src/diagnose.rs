@@ -423,13 +423,24 @@ impl Report {
         );
         let _ = writeln!(s, "initial state: {}", self.initial_state);
         if !self.data_problems.is_empty() {
-            let _ = writeln!(s, "\ndata problems (channel left out of the fit):");
+            let _ = writeln!(s, "\ndata problems:");
+            let several = self.records.len() > 1;
             for p in &self.data_problems {
                 let kind = serde_json::to_value(p.kind)
                     .ok()
                     .and_then(|v| v.as_str().map(str::to_string))
                     .unwrap_or_default();
-                let _ = writeln!(s, "  {:<10} {:<10} {}", p.channel, kind, p.message);
+                let done = if p.left_out { "left out" } else { "kept" };
+                let file = if several {
+                    format!("{}: ", p.file)
+                } else {
+                    String::new()
+                };
+                let _ = writeln!(
+                    s,
+                    "  {file}{:<10} {:<10} {:<8} {}",
+                    p.channel, kind, done, p.message
+                );
             }
         }
         let _ = writeln!(

@@ -295,19 +295,55 @@ pub fn smooth_gcv(t: &[f64], y: &[f64], order: usize, max_half: usize) -> Smooth
     s
 }
 
-/// A robust estimate of the white-noise standard deviation of `y` from its
-/// third differences (the MAD of Δ³y divided by √20 and by 0.6745).
-pub fn noise_sigma(y: &[f64]) -> f64 {
-    if y.len() < 5 {
+/// A robust estimate of the white-noise standard deviation of samples `y`
+/// taken at times `t` (uneven steps allowed), from their third divided
+/// differences: each four consecutive samples' `Σ cᵢ yᵢ` with `cᵢ = 1/Π_{j≠i}(tᵢ − tⱼ)`
+/// (zero on any cubic), normalised by `‖c‖` so that white noise of σ gives
+/// σ, and the MAD of those divided by 0.6745. On even steps (to 1e-6 of
+/// the median step) this is the third difference `Δ³y/√20`, computed as
+/// such; on uneven ones it stays blind to the signal,
+/// where differences in sample index see the signal's slope times the
+/// uneven steps (a 20 µm noise read 37 µm at ±45 % jitter, and 73 µm on 700
+/// of 2000 samples drawn at random).
+pub fn noise_sigma(t: &[f64], y: &[f64]) -> f64 {
+    let n = t.len().min(y.len());
+    if n < 5 {
         return 0.0;
     }
-    let mut d: Vec<f64> = y
-        .windows(4)
-        .map(|w| (w[3] - 3.0 * w[2] + 3.0 * w[1] - w[0]).abs())
+    if is_uniform(&t[..n]) {
+        // the same number, computed as it always was (the fits downstream
+        // land where they did to the last digit)
+        let mut d: Vec<f64> = y[..n]
+            .windows(4)
+            .map(|w| (w[3] - 3.0 * w[2] + 3.0 * w[1] - w[0]).abs())
+            .collect();
+        let mid = d.len() / 2;
+        let med = *d.select_nth_unstable_by(mid, f64::total_cmp).1;
+        return med / 0.6745 / 20f64.sqrt();
+    }
+    let mut d: Vec<f64> = (0..n - 3)
+        .map(|k| {
+            let (tt, yy) = (&t[k..k + 4], &y[k..k + 4]);
+            let (mut dot, mut norm) = (0.0, 0.0);
+            for i in 0..4 {
+                let c = 1.0
+                    / (0..4)
+                        .filter(|&j| j != i)
+                        .map(|j| tt[i] - tt[j])
+                        .product::<f64>();
+                dot += c * yy[i];
+                norm += c * c;
+            }
+            (dot / norm.sqrt()).abs()
+        })
+        .filter(|v| v.is_finite())
         .collect();
+    if d.is_empty() {
+        return 0.0;
+    }
     let mid = d.len() / 2;
     let med = *d.select_nth_unstable_by(mid, f64::total_cmp).1;
-    med / 0.6745 / 20f64.sqrt()
+    med / 0.6745
 }
 
 /// A deterministic pseudo-random standard-normal sequence (Box–Muller on a
@@ -401,7 +437,43 @@ mod tests {
         assert!(rel < 0.03, "smoothed {rel}, raw {rel_raw}");
         assert!(rel_raw > 3.0 * rel);
         // The noise estimate sees the planted level.
-        let sig = noise_sigma(&y);
+        let sig = noise_sigma(&t, &y);
         assert!((sig / 5e-4 - 1.0).abs() < 0.15, "{sig}");
+    }
+
+    #[test]
+    fn the_noise_estimate_does_not_depend_on_even_steps() {
+        // a piston-like position (tens of mm at 1 and 3.3 Hz) with 20 µm
+        // noise: on even steps, on steps jittered by ±45 %, and on 700 of
+        // the 2000 samples drawn at random
+        use std::f64::consts::PI;
+        let f = |t: f64| 0.04 * (2.0 * PI * t).sin() + 0.015 * (2.0 * PI * 3.3 * t).cos();
+        let n = 2001;
+        let e = gaussian_noise(n, 11);
+        let u = gaussian_noise(2 * n, 12);
+        let even: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
+        let mut jit: Vec<f64> = (0..n)
+            .map(|i| i as f64 * 1e-3 + 0.45e-3 * (u[i] / 3.0).clamp(-1.0, 1.0))
+            .collect();
+        jit[0] = 0.0;
+        jit.sort_by(f64::total_cmp);
+        let noisy =
+            |t: &[f64]| -> Vec<f64> { t.iter().zip(&e).map(|(t, e)| f(*t) + 2e-5 * e).collect() };
+        let (ye, yj) = (noisy(&even), noisy(&jit));
+        // 700 samples: keep sample i when its draw is among the lowest
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|a, b| u[n + a].total_cmp(&u[n + b]));
+        let mut keep: Vec<usize> = order[..700].to_vec();
+        keep.sort_unstable();
+        let ts: Vec<f64> = keep.iter().map(|&i| even[i]).collect();
+        let ys: Vec<f64> = keep.iter().map(|&i| ye[i]).collect();
+        for (what, t, y) in [
+            ("even", &even, &ye),
+            ("jittered", &jit, &yj),
+            ("subsampled", &ts, &ys),
+        ] {
+            let sig = noise_sigma(t, y);
+            assert!((sig / 2e-5 - 1.0).abs() < 0.15, "{what}: {sig}");
+        }
     }
 }

@@ -199,6 +199,7 @@ pub fn record(
         time: m.t,
         signals,
         ignored: vec![],
+        units: Default::default(),
     }
 }
 
@@ -417,6 +418,7 @@ pub fn valve_record_with(
         time: t,
         signals,
         ignored: vec![],
+        units: Default::default(),
     })
 }
 
@@ -531,5 +533,6 @@ pub fn netlist_record(
         time: t,
         signals,
         ignored: vec![],
+        units: Default::default(),
     })
 }

@@ -39,7 +39,7 @@ use hydrocyl_system::valve_rig::ValveRig;
 
 use crate::catalog::EffectId;
 use crate::data::{Record, Signal};
-use crate::data_checks::{check_record, ProblemKind, RigFacts};
+use crate::data_checks::{check_record, unit_errors, ProblemKind, RigFacts};
 use crate::diagnose::{
     nrmse, Applicable, DiagnoseError, DiagnoseOptions, EffectReport, NotApplicable, Probe,
     RecordTrace, RejectedEffect, Report,
@@ -239,7 +239,9 @@ pub fn diagnose_rig_traced(
         _ => {}
     }
     // Data problems first: each named channel is left out of the fit.
-    let data_problems = check_record(rec, Some(&rig_facts(declared)));
+    let facts = rig_facts(declared);
+    let data_problems = check_record(rec, Some(&facts));
+    unit_errors(rec, &facts, &data_problems)?;
     let mut excluded: Vec<Signal> = data_problems
         .iter()
         .filter_map(|p| Signal::from_name(&p.channel))
@@ -712,7 +714,7 @@ pub fn diagnose_rig_traced(
     let mut noise_floor = BTreeMap::new();
     let mut noise_ss = 0.0;
     for (((ch, m), r), w) in p.meas.iter().zip(&p.ranges).zip(&p.weights) {
-        let sig = if *w == 0.0 { 0.0 } else { noise_sigma(m) };
+        let sig = if *w == 0.0 { 0.0 } else { noise_sigma(&p.t, m) };
         noise_floor.insert(ch.name().to_string(), sig / r);
         // Weighted residuals of pure noise have unit variance.
         if *w > 0.0 {

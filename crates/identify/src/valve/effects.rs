@@ -442,9 +442,26 @@ pub fn rig_facts(rig: &Model) -> RigFacts {
             _ => None,
         }
     });
+    let cyl = &rig.roles.cylinder;
+    let areas = match (rig.param(cyl, "area_1"), rig.param(cyl, "area_2")) {
+        (Some(a1), Some(a2)) => Some((a1, a2)),
+        _ => None,
+    };
+    // the command a closed-loop rig's record carries is its controller's
+    // output, the valve's normalised demand; an open-loop rig's is its input
+    let command_unit = if rig.roles.controller.is_some() {
+        Some("-")
+    } else {
+        hydrocyl_system::netlist::schematic(&rig.net)
+            .ok()
+            .and_then(|s| s.input_unit())
+    };
     RigFacts {
         stroke: rig.stroke(),
         supply: rig.supply(),
         velocity_gain: gain,
+        areas,
+        mass: rig.mass(),
+        command_unit,
     }
 }

@@ -93,6 +93,13 @@ pub struct Model {
     pub lag: f64,
     /// Component roles (shared by every copy).
     pub roles: Arc<Roles>,
+    /// Where the record's first samples contradict a spool at the first
+    /// command (a record that starts on a command step), the spool starts
+    /// at the opening the initial velocity needs: this many metres of spool
+    /// per m/s, applied by [`Model::set_v0`] so that the spool follows the
+    /// fitted initial velocity. `None`: the spool starts at the first
+    /// command (`sim::with_initial`).
+    pub spool_per_velocity: Option<f64>,
 }
 
 fn components(net: &Value) -> Option<&Map<String, Value>> {
@@ -184,6 +191,7 @@ impl Model {
             net: net.clone(),
             lag: 0.0,
             roles: Arc::new(roles),
+            spool_per_velocity: None,
         })
     }
 
@@ -374,6 +382,10 @@ impl Model {
     pub fn set_v0(&mut self, v: f64) {
         let c = self.roles.cylinder.clone();
         self.set_param(&c, "initial.velocity", Value::from(v));
+        if let (Some(k), Some(s)) = (self.spool_per_velocity, self.roles.spool.clone()) {
+            let xm = self.spool_stroke();
+            self.set_param(&s, "initial.position", Value::from((k * v).clamp(-xm, xm)));
+        }
     }
 
     /// The highest pressure the circuit holds above its lowest source

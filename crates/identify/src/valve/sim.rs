@@ -176,7 +176,7 @@ pub(super) fn prepare(
             if *ch == Signal::Velocity && rec.get(Signal::Velocity).is_none() {
                 0.0
             } else {
-                1.0 / noise_sigma(y).max(1e-4 * r)
+                1.0 / noise_sigma(&rec.time, y).max(1e-4 * r)
             }
         })
         .collect();
@@ -195,7 +195,11 @@ pub(super) fn prepare(
     };
     let (p10, p20) = (p0(Signal::P1), p0(Signal::P2));
     let restarts = if position_ok {
-        stops::restarts(x, stroke, (5.0 * noise_sigma(x)).max(1e-4 * stroke))
+        stops::restarts(
+            x,
+            stroke,
+            (5.0 * noise_sigma(&rec.time, x)).max(1e-4 * stroke),
+        )
     } else {
         Vec::new()
     };
@@ -258,6 +262,23 @@ pub(super) fn with_initial(rig: &Model, p: &Prepared) -> Model {
             "initial.position",
             Value::from((u0 * xm).clamp(-xm, xm)),
         );
+        // A record that starts on a command step (a closed-loop record whose
+        // reference steps at its first sample) finds the spool where the
+        // motion before it left it, not at the new command: a piston at rest
+        // under a first command of 0.4 has a closed spool. Where the first
+        // samples' velocity is far from the steady velocity of the first
+        // command (by more than half of it and 5 % of full demand's, beyond
+        // the smoother's one-sided error at the first sample), the spool
+        // starts at the opening that velocity needs, and follows the initial
+        // velocity as it is fitted.
+        let gain = super::effects::rig_facts(&r).velocity_gain;
+        if let (Some(v0), Some(g)) = (p.v0, gain) {
+            let v_cmd = g * u0;
+            if (v0 - v_cmd).abs() > 0.5 * v_cmd.abs() + 0.05 * g {
+                r.spool_per_velocity = Some(xm / g);
+                r.set_v0(r.v0());
+            }
+        }
     }
     if r.roles.cylinder_type == "cylinder" {
         let c = r.roles.cylinder.clone();
@@ -623,6 +644,7 @@ mod tests {
             time: t.clone(),
             signals,
             ignored: vec![],
+            units: Default::default(),
         };
         let (mut p, _) = prepare(&rec, None, &[], m.stroke()).unwrap();
         p.rtol = 1e-8;

@@ -211,3 +211,72 @@ fn pressure_viscous_is_found_on_the_valve_rig() {
         .iter()
         .all(|e| !e.why.is_empty() && e.id != "pressure_viscous"));
 }
+
+#[test]
+fn bar_under_a_psi_header_is_named_by_the_force_balance() {
+    // p2 [psi] holding bar: 14.5 times too low, but within the supply
+    let rec = valve_record(&truth(&[]), 2000, 1e-3, 65).unwrap();
+    let rec = with(&rec, Signal::P2, |p| p / 1e5 * hydrocyl_ports::PSI_IN_PA);
+    let r = diagnose(&rec).unwrap();
+    assert_finite(&r);
+    assert_eq!(
+        problems(&r),
+        [
+            ("p1".to_string(), ProblemKind::Units),
+            ("p2".to_string(), ProblemKind::Units)
+        ]
+    );
+    assert!(r.data_problems.iter().all(|p| p.left_out));
+    assert!(r.effects_added.is_empty(), "{}", r.human());
+    // the position fit is what it is without the pressures
+    assert!(
+        r.nrmse_after["position"] < 1.1 * r.noise_floor["position"],
+        "{}",
+        r.human()
+    );
+}
+
+#[test]
+fn a_quantised_position_whose_peak_dwells_on_a_level_is_not_clipped() {
+    // 0.5 mm steps: a sine peak sits on its top level for a few % of the record
+    let rec = valve_record(&truth(&[]), 2000, 1e-3, 66).unwrap();
+    let rec = with(&rec, Signal::Position, |x| (x / 5e-4).round() * 5e-4);
+    let r = diagnose(&rec).unwrap();
+    assert!(
+        !problems(&r)
+            .iter()
+            .any(|(c, k)| c == "position" && *k == ProblemKind::Clipped),
+        "{}",
+        r.human()
+    );
+    assert!(r.nrmse_after.contains_key("position"), "{}", r.human());
+}
+
+#[test]
+fn seconds_under_a_millisecond_header_are_an_error_naming_the_time_column() {
+    // the header says [ms], the numbers are seconds: the record lasts 2 ms
+    let mut rec = valve_record(&truth(&[]), 2000, 1e-3, 67).unwrap();
+    rec.time.iter_mut().for_each(|t| *t *= 1e-3);
+    rec.units.insert(Signal::Time, "ms".into());
+    let e = diagnose(&rec).unwrap_err().to_string();
+    assert!(
+        e.contains("row 1, column 'time [ms]'") && e.contains("unit of the time column"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_command_in_volts_on_a_valve_rig_is_an_error_naming_the_column() {
+    let mut rec = valve_record(&truth(&[]), 2000, 1e-3, 68).unwrap();
+    rec.units.insert(Signal::Command, "V".into());
+    let e = diagnose(&rec).unwrap_err();
+    assert!(matches!(e, DiagnoseError::Data(_)), "{e}");
+    let e = e.to_string();
+    assert!(
+        e.contains("row 1, column 'command [V]'") && e.contains("normalised spool demand"),
+        "{e}"
+    );
+    // `-` (or `1`) is the valve rig's own
+    rec.units.insert(Signal::Command, "1".into());
+    assert!(diagnose(&rec).is_ok());
+}

@@ -140,3 +140,26 @@ fn an_internal_leak_is_found_under_a_pi_controller() {
     eprintln!("{}", r.human());
     check_found_within(&r, id, n, v, CLOSED_LOOP_BIAS);
 }
+
+#[test]
+fn a_record_that_starts_on_a_reference_step_fits_the_true_model_to_its_floor() {
+    // the reference steps to 40 mm at the first sample: the controller's
+    // first command is 0.4 while the piston, and so the spool, is at rest
+    let step = |t: f64| {
+        use std::f64::consts::PI;
+        0.04 * (PI * t + 0.01).sin().signum() + 0.01 * (2.0 * PI * 1.3 * t).sin()
+    };
+    let rec = valve_record_closed_loop(&declared(), 4000, 1e-3, 87, &step).unwrap();
+    assert!(rec.get(Signal::Command).unwrap()[0] > 0.3);
+    let r = diagnose(&rec);
+    assert!(r.effects_added.is_empty(), "{}", r.human());
+    for (ch, after) in &r.nrmse_after {
+        if let Some(floor) = r.noise_floor.get(ch).filter(|f| **f > 0.0) {
+            assert!(
+                after / floor < 1.1,
+                "{ch}: {after} vs floor {floor}\n{}",
+                r.human()
+            );
+        }
+    }
+}

@@ -147,3 +147,60 @@ fn out_of_catalog_delay_is_unexplained() {
     assert!(p.what.contains("delay"), "{}", show(&o));
     assert!((p.value - 0.01).abs() < 1.5e-3, "{}", show(&o));
 }
+
+#[test]
+fn a_pressure_twice_what_the_force_balance_implies_is_an_error_naming_the_file() {
+    // the bench's pressure is its model's input: doubled, the friction the
+    // record implies no longer opposes the motion
+    let truth = truth_with(&[]);
+    let mut rec = record(&truth, 4000, 1e-3, Noise::default(), Foreign::None, 71);
+    rec.source = "doubled.csv".into();
+    if let Some(p) = rec.signals.get_mut(&hydrocyl_identify::data::Signal::P2) {
+        p.iter_mut().for_each(|v| *v *= 2.0);
+    }
+    let e = diagnose_bench(
+        &declared_for(&[]),
+        &[rec],
+        &DiagnoseOptions::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with("doubled.csv: ") && e.contains("pressure force does not balance"),
+        "{e}"
+    );
+}
+
+#[test]
+fn bench_data_problems_name_their_record_and_say_the_pressure_is_kept() {
+    // p2 in 0.1 bar steps on two records: a quantised input, kept
+    let truth = truth_with(&[]);
+    let recs: Vec<_> = (0..2)
+        .map(|k| {
+            let mut r = record(&truth, 4000, 1e-3, Noise::default(), Foreign::None, 72 + k);
+            r.source = format!("rec{k}.csv");
+            if let Some(p) = r.signals.get_mut(&hydrocyl_identify::data::Signal::P2) {
+                p.iter_mut().for_each(|v| *v = (*v / 1e4).round() * 1e4);
+            }
+            r
+        })
+        .collect();
+    let o = diagnose_bench(
+        &declared_for(&[]),
+        &recs,
+        &DiagnoseOptions::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    let ps = &o.report.data_problems;
+    let files: Vec<&str> = ps.iter().map(|p| p.file.as_str()).collect();
+    assert_eq!(files, ["rec0.csv", "rec1.csv"], "{}", o.report.human());
+    assert!(ps.iter().all(|p| p.channel == "p2" && !p.left_out));
+    let text = o.report.human();
+    assert!(!text.contains("left out"), "{text}");
+    assert!(
+        text.contains("rec1.csv: p2") && text.contains("kept"),
+        "{text}"
+    );
+}

@@ -110,6 +110,11 @@ pub fn size(
 /// its floor.
 pub const WORSEN_TOL: f64 = 0.05;
 
+/// Most candidates refitted in one round of either loop (the best by traced
+/// share first); each refit is a full Levenberg–Marquardt fit. The others of
+/// the round are rejected as [`RejectedEffect::not_refitted`](crate::diagnose::RejectedEffect::not_refitted).
+pub const MAX_REFITS_PER_ROUND: usize = 3;
+
 /// What the rule compares a refitted candidate with: the model before it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scores {

@@ -154,6 +154,18 @@ impl RejectedEffect {
         }
     }
 
+    /// A candidate its round had no refit left for
+    /// ([`MAX_REFITS_PER_ROUND`](crate::accept::MAX_REFITS_PER_ROUND)).
+    pub fn not_refitted(effect: EffectReport) -> Self {
+        Self::new(
+            effect,
+            format!(
+                "not refitted: {} candidates explaining more were refitted first in its round",
+                crate::accept::MAX_REFITS_PER_ROUND
+            ),
+        )
+    }
+
     /// A candidate not traced at all (no scores), and why.
     pub fn untraced(id: EffectId, reason: impl Into<String>) -> Self {
         Self::new(

@@ -113,10 +113,6 @@ pub fn set<R: Effects + ?Sized>(rig: &mut R, id: EffectId, name: &str, v: f64) {
 /// share of `--min-share` is not traced further (see `gauss_newton_trace`).
 const SCREEN_SHARE: f64 = 1.0 / 3.0;
 
-/// Most candidates refitted in one round of the loop (the best by traced
-/// share first); each refit is a full Levenberg–Marquardt fit.
-const MAX_REFITS_PER_ROUND: usize = 3;
-
 /// Why effect `id` is not tried on this rig.
 fn not_applicable_why(id: EffectId, rig: &Model, opts: &DiagnoseOptions) -> String {
     if opts.candidates.as_ref().is_some_and(|c| !c.contains(&id)) {
@@ -571,16 +567,8 @@ pub fn diagnose_rig_traced(
         let mut pending = eligible.into_iter();
         let mut refits = 0;
         for (id, trial, rep) in pending.by_ref() {
-            if refits == MAX_REFITS_PER_ROUND {
-                last.insert(
-                    id,
-                    RejectedEffect::new(
-                        rep,
-                        format!(
-                            "not refitted: {MAX_REFITS_PER_ROUND} candidates explaining more were refitted first in its round"
-                        ),
-                    ),
-                );
+            if refits == crate::accept::MAX_REFITS_PER_ROUND {
+                last.insert(id, RejectedEffect::not_refitted(rep));
                 continue;
             }
             refits += 1;

@@ -6,10 +6,6 @@ use super::*;
 use crate::accept::{self, FittedParam, Refitted, Scores};
 use crate::bench::{BenchInputs, BenchRun};
 
-/// Most candidates refitted in one round (the best by traced share first);
-/// as on the valve rig.
-const MAX_REFITS_PER_ROUND: usize = 3;
-
 /// Why an effect the declared rig already has is not traced.
 fn declared_on_why(rig: &FrictionBench, e: EffectId) -> String {
     let values: Vec<String> = e
@@ -659,16 +655,8 @@ pub fn diagnose_bench(
         let mut pending = eligible.into_iter();
         let mut refits = 0;
         for (id, trial, rep) in pending.by_ref() {
-            if refits == MAX_REFITS_PER_ROUND {
-                rejected.insert(
-                    id,
-                    RejectedEffect::new(
-                        rep,
-                        format!(
-                            "not refitted: {MAX_REFITS_PER_ROUND} candidates explaining more were refitted first in its round"
-                        ),
-                    ),
-                );
+            if refits == accept::MAX_REFITS_PER_ROUND {
+                rejected.insert(id, RejectedEffect::not_refitted(rep));
                 continue;
             }
             refits += 1;

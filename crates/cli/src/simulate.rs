@@ -403,9 +403,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ("--rtol", Setting::Rtol, args.rtol),
         ("--rk4-step", Setting::Rk4Step, args.rk4_step),
     ] {
-        setting
-            .check(value)
-            .map_err(|rule| CliError::Input(format!("{flag} {value}: {rule}")))?;
+        setting.check_named(flag, value).map_err(CliError::Input)?;
     }
     let (Some(cmd_path), Some(out)) = (args.command, args.out) else {
         return Err(CliError::Input("--command and --out are required".into()));

@@ -348,6 +348,9 @@ struct EventState {
     g_tmp: Vec<f64>,
     armed: Vec<bool>,
     from_zero: Vec<bool>,
+    /// Whether the handler of this function's event (at the last event
+    /// time) edited the state.
+    edited_by: Vec<bool>,
     /// `|g|` at the ends of the final bracket of each triggered function.
     bracket_mag: Vec<f64>,
     triggered: Vec<bool>,
@@ -429,6 +432,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
         g_tmp: vec![0.0; n_ev],
         armed: vec![false; n_ev],
         from_zero: vec![false; n_ev],
+        edited_by: vec![false; n_ev],
         bracket_mag: vec![0.0; n_ev],
         triggered: vec![false; n_ev],
         x_tmp: vec![0.0; n],
@@ -757,9 +761,11 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                             dir,
                         });
                         stats.events += 1;
+                        ev.x_tmp.copy_from_slice(&x);
                         if sys.on_event(t_ev, &mut x, i, dir) == EventAction::Stop {
                             stop = true;
                         }
+                        ev.edited_by[i] = x != ev.x_tmp;
                     }
                 }
                 if let Some(i) = x.iter().position(|v| !v.is_finite()) {
@@ -782,7 +788,9 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                 for i in 0..n_ev {
                     let g = ev.g_prev[i];
                     ev.armed[i] = g != 0.0 && !(ev.triggered[i] && g.abs() <= ev.bracket_mag[i]);
-                    ev.from_zero[i] = g == 0.0 && (ev.from_zero[i] || (ev.triggered[i] && edited));
+                    ev.from_zero[i] =
+                        g == 0.0 && (ev.from_zero[i] || (ev.triggered[i] && ev.edited_by[i]));
+                    ev.edited_by[i] = false;
                 }
                 fresh = true;
                 // the handler may have changed the system's inputs

@@ -32,9 +32,7 @@ pub fn options(
         ("rk4_step", Setting::Rk4Step, rk4_step),
         ("h_max", Setting::HMax, h_max),
     ] {
-        setting
-            .check(value)
-            .map_err(|rule| Failure::Input(format!("{name}: {value} {rule}")))?;
+        setting.check_named(name, value).map_err(Failure::Input)?;
     }
     Ok(RunOptions {
         solver,

@@ -147,7 +147,11 @@ impl std::fmt::Debug for Circuit {
 
 /// Number of ledger quadratures per component: ∫source, ∫dissipated,
 /// ∫storage, ∫load, ∫moved ([`PowerTerms::moved`]).
-pub const LEDGER_TERMS: usize = 5;
+pub const LEDGER_TERMS: usize = LEDGER_TERM_NAMES.len();
+
+/// The ledger quadratures of a component, in their order in the state
+/// vector (named `<component>.energy_<term>`).
+pub const LEDGER_TERM_NAMES: [&str; 5] = ["source", "dissipated", "storage", "load", "moved"];
 
 impl Circuit {
     /// Assembles components: binds each to the netlist, checks that every
@@ -240,8 +244,8 @@ impl Circuit {
     }
 
     /// Turns the energy ledger on or off: [`LEDGER_TERMS`] quadratures per
-    /// component (∫source, ∫dissipated, ∫storage, ∫load dt \[J\]) appended
-    /// after the component quadratures.
+    /// component (∫source, ∫dissipated, ∫storage, ∫load, ∫moved dt \[J\])
+    /// appended after the component quadratures.
     pub fn set_ledger(&mut self, on: bool) {
         self.ledger = on;
     }
@@ -311,7 +315,7 @@ impl Circuit {
         }
         if self.ledger {
             for c in &self.comps {
-                for t in ["source", "dissipated", "storage", "load"] {
+                for t in LEDGER_TERM_NAMES {
                     v.push(format!("{}.energy_{t}", c.name()));
                 }
             }

@@ -79,7 +79,7 @@
 //! * **The energy ledger**: every component reports [`PowerTerms`] (source,
 //!   dissipated, storage rate, load, stored energy), balanced per component so
 //!   that `Σ source = Σ dissipated + Σ storage + Σ load` over a circuit;
-//!   [`Circuit::set_ledger`] appends four quadratures per component to the
+//!   [`Circuit::set_ledger`] appends five quadratures per component to the
 //!   state vector (loosely weighted in the error norm by [`Circuit::atol`]).
 //!
 //! A circuit from components, by hand (what a rig kind's builder does), run as

@@ -307,8 +307,8 @@ fn check_options(opts: &RunOptions) -> Result<(), SimError> {
         ("rk4_step", Setting::Rk4Step, opts.rk4_step),
     ] {
         setting
-            .check(value)
-            .map_err(|rule| SimError::Settings(format!("{name} = {value}: {rule}")))?;
+            .check_named(name, value)
+            .map_err(SimError::Settings)?;
     }
     Ok(())
 }

@@ -163,3 +163,24 @@ fn volume_filled_through_an_orifice_conserves_mass_and_reaches_supply() {
     // stored = V p²/(2B) for a constant volume
     assert!((stored - v * last[0] * last[0] / (2.0 * b)).abs() < 1e-6 * stored);
 }
+
+/// Every entry of the full state vector has a name, whatever is appended
+/// (component quadratures, the ledger's terms).
+#[test]
+fn every_entry_of_the_state_vector_is_named() {
+    use hydrocyl_integrators::OdeSystem;
+    let v = crate::rig::preset("leaney-moog").unwrap();
+    let mut c = crate::rig::circuit(&v, crate::signal::Signal::Constant { value: 0.1 }).unwrap();
+    for (quad, ledger) in [(false, false), (true, false), (false, true), (true, true)] {
+        c.set_quadratures(quad);
+        c.set_ledger(ledger);
+        let names = c.state_names();
+        assert_eq!(names.len(), c.dim(), "quadratures {quad}, ledger {ledger}");
+        if ledger {
+            assert_eq!(
+                names.last().unwrap(),
+                &format!("{}.energy_moved", c.components().last().unwrap().name())
+            );
+        }
+    }
+}

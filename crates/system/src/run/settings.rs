@@ -126,6 +126,13 @@ impl Setting {
             Err(self.rule())
         }
     }
+    /// `value`, or the message every front end gives, with the setting as
+    /// the front end names it: "`--rtol` 0: must be in (0, 1), e.g. 1e-6"
+    /// (`name` = `--rtol`; `rtol` in Python and in `RunOptions`).
+    pub fn check_named(self, name: &str, value: f64) -> Result<f64, String> {
+        self.check(value)
+            .map_err(|rule| format!("{name} {value}: {rule}"))
+    }
 }
 
 #[cfg(test)]

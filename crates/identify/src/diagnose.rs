@@ -166,6 +166,24 @@ impl RejectedEffect {
         )
     }
 
+    /// A candidate of the last round (0-based `round`) that was not
+    /// refitted because `added`, explaining more, earned its place there.
+    pub fn outranked(
+        effect: EffectReport,
+        added: EffectId,
+        round: usize,
+        max_effects: usize,
+    ) -> Self {
+        Self::new(
+            effect,
+            format!(
+                "explains less than {}, added in round {} (the last round: at most {max_effects} effects are added)",
+                added.id(),
+                round + 1
+            ),
+        )
+    }
+
     /// A candidate not traced at all (no scores), and why.
     pub fn untraced(id: EffectId, reason: impl Into<String>) -> Self {
         Self::new(

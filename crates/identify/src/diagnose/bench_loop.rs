@@ -716,15 +716,7 @@ pub fn diagnose_bench(
         for (other, _, r) in pending {
             rejected.insert(
                 other,
-                RejectedEffect::new(
-                    r,
-                    format!(
-                        "explains less than {}, added in round {} (the last round: at most {} effects are added)",
-                        id.id(),
-                        round + 1,
-                        opts.max_effects
-                    ),
-                ),
+                RejectedEffect::outranked(r, id, round, opts.max_effects),
             );
         }
         model = refitted;

@@ -116,11 +116,14 @@ class Run:
         """Component counters: cavitation entries, end-stop impacts, ..."""
     @property
     def ledger(self) -> Optional[dict[str, Any]]:
-        """Energy ledger over the run (``ledger=True``), else None: energies
-        in J (``energy_in_j``, ``cylinder_out_j``, ``losses_j`` by
-        component (a plastic impact at a stroke end is the mass's loss),
-        ``moving_walls_j``, ...), ``error``/``storage_error`` as fractions
-        of the energy in, ``efficiency``."""
+        """Energy ledger over the run (``ledger=True``), else None: the
+        object ``hydrocyl simulate --ledger`` writes, key for key. Energies
+        in J (``components_j``: each component's ``source``, ``dissipated``,
+        ``storage``, ``load``, ``moved``; ``totals_j``; ``energy_in_j``,
+        ``cylinder_out_j``, ``losses_j`` by component (a plastic impact at a
+        stroke end is the mass's loss), ``moving_walls_j``, ``closure_j``,
+        ...), ``closure_relative`` (= ``error``) and ``storage_error`` as
+        fractions of the energy in, ``efficiency``."""
     def __getitem__(self, name: str) -> npt.NDArray[np.float64]: ...
     def __contains__(self, name: str) -> bool: ...
     def __iter__(self) -> Iterator[str]:

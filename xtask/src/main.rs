@@ -4,6 +4,8 @@
 //!   exits non-zero when a check fails.
 //! * `xfactor` — Tables 3-3 and 3-4 recomputed, with the exact root-branch split.
 //! * `energy` — the chapter-8 efficiency matrix.
+//! * `commands` — writes `fixtures/commands/`, the thesis's experiments as
+//!   command files for `hydrocyl simulate`.
 //! * `bench` — speed ratios against reference runs in the same run.
 //! * `test` — `cargo test --workspace`, then the Python package's pytest suite
 //!   on a wheel built by maturin into a virtual environment.
@@ -13,6 +15,7 @@
 mod bench;
 mod bench_csv;
 mod bench_solve;
+mod commands;
 mod energy;
 mod energy_ch9;
 mod energy_relief;
@@ -46,6 +49,9 @@ enum Task {
     Xfactor,
     /// The chapter-8 energy-efficiency matrix of the valve and hybrid drives.
     Energy,
+    /// Write fixtures/commands/: the command files of the chapter-3, 7 and 8
+    /// experiments (from the studies' signal definitions) and their README.
+    Commands,
     /// Speed ratios against reference runs on this machine, in the same run,
     /// timed on the release build (the one users run: `cargo xtask bench`
     /// builds and runs it; `--dev` times the dev build instead).
@@ -91,6 +97,7 @@ fn main() {
         Task::Validate { only } => validate::run(only.as_deref()),
         Task::Xfactor => xfactor::run(),
         Task::Energy => energy::run(),
+        Task::Commands => commands::run(),
         Task::Bench {
             dev,
             only,

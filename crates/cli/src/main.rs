@@ -13,6 +13,7 @@ mod error;
 mod fmu;
 #[cfg(test)]
 mod fuzz;
+mod ledger;
 mod output;
 mod presets;
 mod progress;
@@ -39,7 +40,7 @@ enum Command {
     Xfactor(xfactor::Args),
     /// Simulate a rig on a command signal and write the measured-data CSV format.
     #[command(
-        override_usage = "hydrocyl simulate --rig <RIG> --command <COMMAND> --out <OUT> [OPTIONS]\n       hydrocyl simulate --rig <RIG> --print-rig [--set <PATH=VALUE>]...",
+        override_usage = "hydrocyl simulate --rig <RIG> --command <COMMAND> --out <OUT> [--ledger <FILE.json>] [OPTIONS]\n       hydrocyl simulate --rig <RIG> --print-rig [--set <PATH=VALUE>]...",
         after_help = simulate::COLUMNS_HELP
     )]
     Simulate(simulate::Args),

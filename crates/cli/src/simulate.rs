@@ -47,6 +47,7 @@
 use crate::command::{read_bytes, read_table, Ahead, CommandUnit};
 use crate::command_stream;
 use crate::error::CliError;
+use crate::ledger::Ends;
 use crate::output::Outputs;
 use crate::progress::Progress;
 use crate::writer::{Block, Maker, Rows, Writer};
@@ -114,6 +115,29 @@ pub struct Args {
         help = "Fixed step of rk4, and the longest step of exponential [s]"
     )]
     rk4_step: f64,
+    /// Also integrate the energy ledger and write it to this JSON file (put
+    /// in place with the CSV, checked before the run as --out is): per
+    /// component the integrated source, dissipated, storage, load and moved
+    /// energies [J] (`components_j`), their totals, the energy in, the load's
+    /// work, the losses and storage by component, and the closure
+    /// `energy_in - load - losses - storage` in J and as a fraction of the
+    /// energy in (`closure_j`, `closure_relative`), with the storage check
+    /// against the stored energy recomputed from the states (docs/energy.md;
+    /// the keys are those of Python's `run.ledger`). The run carries the
+    /// ledger's quadratures, so its CSV may differ in the last digits from a
+    /// run without it.
+    #[arg(long, value_name = "FILE.json")]
+    ledger: Option<PathBuf>,
+    /// The ledger's window starts at the first output time at or after this
+    /// [s] (default: the run's first; e.g. after a warm-up period, as
+    /// `cargo xtask energy` does).
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        requires = "ledger",
+        allow_negative_numbers = true
+    )]
+    ledger_from: Option<f64>,
     /// Print the rig (after --set) as JSON and exit.
     #[arg(long)]
     print_rig: bool,
@@ -181,6 +205,11 @@ fn run_bench(
     let (Some(input), Some(out)) = (&args.command, &args.out) else {
         return Err(CliError::Input("--command and --out are required".into()));
     };
+    if args.ledger.is_some() {
+        return Err(CliError::Input(
+            "--ledger: a friction-bench rig file imposes its motion and has no energy ledger; use a netlist of the bench (e.g. the tudelft-seal-25 preset)".into(),
+        ));
+    }
     let mut outputs = Outputs::new(&[("--command", input.as_path())]);
     let id = outputs.file("--out", out)?;
     let text = crate::bench_sim::simulate(bench, input)?;
@@ -419,11 +448,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let mut outputs = Outputs::new(&inputs);
     let id = outputs.file("--out", &out)?;
+    let ledger_id = match &args.ledger {
+        Some(p) => Some(outputs.file("--ledger", p)?),
+        None => None,
+    };
     crate::progress::mark("output created");
     let opts = RunOptions {
         solver,
         rtol: args.rtol,
         rk4_step: args.rk4_step,
+        ledger: ledger_id.is_some(),
         ..RunOptions::default()
     };
     // a long file is checked in a first pass and read during the run a
@@ -467,6 +501,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
     };
     crate::progress::mark("command read");
+    // the ledger's window: its two ends are kept from the streamed blocks
+    if let Some(from) = args.ledger_from {
+        if !(from.is_finite() && from < t1) {
+            return Err(CliError::Input(format!(
+                "--ledger-from {from}: must be a time before the command's last, {t1} s"
+            )));
+        }
+    }
+    let mut ends = ledger_id.map(|_| Ends::new(args.ledger_from.unwrap_or(f64::NEG_INFINITY)));
+    let ledger_signal = ends.as_ref().map(|_| signal.clone());
     // a fixed step that cannot cover the run within the step budget is
     // refused before the run, not after the budget's worth of steps
     if solver.fixed_step() && (t1 - t0) / opts.rk4_step > opts.max_steps as f64 {
@@ -544,6 +588,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
             };
             let streamed = {
                 let mut sink = |t: &[f64], x: &[f64]| -> Result<(), String> {
+                    if let Some(e) = ends.as_mut() {
+                        e.see(t, x);
+                    }
                     done += t.len();
                     bar.set("rows", done as u64, rows as u64);
                     let fill = |b: &mut Block| {
@@ -577,6 +624,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         _ => {
             let streamed = {
                 let mut sink = |block: &Run| -> Result<(), String> {
+                    if let Some(e) = ends.as_mut() {
+                        e.see(&block.time, &block.states);
+                    }
                     let r = check_solution(block, solver, args.rk4_step, &types).and_then(|()| {
                         if !w.has_rows() {
                             let mut header = column_headers(block).join(",").into_bytes();
@@ -620,7 +670,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     bar.finish();
     // the writer's error (a failed write, a bad solution) first: the
     // solve's is its echo
-    let (outputs, run) = match (streamed, failed, written) {
+    let (mut outputs, run) = match (streamed, failed, written) {
         (_, _, Err(e)) | (_, Some(e), _) => return Err(e),
         (Err(e), None, _) => return Err(solver_hint(e, solver, args.rk4_step, t1 - t0)),
         (Ok(r), None, Ok((o, p))) => {
@@ -629,6 +679,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
     };
     crate::progress::mark("writer finished");
+    // the ledger, on a circuit of the rig (it reads the structure and the
+    // two states): written with the CSV, or neither
+    let ledger_note = match (ledger_id, &ends, ledger_signal) {
+        (Some(lid), Some(e), Some(signal)) => {
+            let c = checked
+                .circuit(signal)
+                .map_err(|e| CliError::Input(e.to_string()))?;
+            let (text, note) = e.json(c)?;
+            outputs.write(lid, &text)?;
+            Some(note)
+        }
+        _ => None,
+    };
     outputs.commit(args.fsync)?;
     crate::progress::mark("output committed");
     if args.quiet {
@@ -661,6 +724,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
     );
     let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
+    if let (Some(note), Some(path)) = (ledger_note, &args.ledger) {
+        crate::console::note(format_args!("hydrocyl: {}: {note}", path.display()));
+    }
     Ok(())
 }
 

@@ -23,10 +23,11 @@
 //! component's losses (the impact's loss is booked under the mass).
 
 use crate::error::EnergyError;
-use hydrocyl_system::circuit::LEDGER_TERMS;
+use hydrocyl_system::circuit::{LEDGER_TERMS, LEDGER_TERM_NAMES};
 use hydrocyl_system::run::Run;
 use hydrocyl_system::Circuit;
 use serde::Serialize;
+use serde_json::{json, Map, Value};
 
 /// One named energy \[J\] over the window.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -35,6 +36,17 @@ pub struct Term {
     pub name: String,
     /// Energy over the window \[J\].
     pub energy_j: f64,
+}
+
+/// One component's integrated ledger quadratures over the window \[J\], in
+/// the order of [`LEDGER_TERM_NAMES`] (source, dissipated, storage, load,
+/// moved), none left out.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ComponentTerms {
+    /// The component's name.
+    pub name: String,
+    /// Its terms over the window \[J\].
+    pub energy_j: [f64; LEDGER_TERMS],
 }
 
 /// The ledger of one run over one window.
@@ -78,6 +90,9 @@ pub struct Ledger {
     /// with any here, `error` and `storage_error` measure the form, not the
     /// bookkeeping or the integration, and need not be small.
     pub not_energy_consistent: Vec<String>,
+    /// Every component's quadratures over the window, in circuit order (the
+    /// lists above are built from these).
+    pub components: Vec<ComponentTerms>,
 }
 
 impl Ledger {
@@ -94,6 +109,101 @@ impl Ledger {
     /// The efficiency of eqs 8.1–8.7: cylinder output over energy in \[-\].
     pub fn efficiency(&self) -> f64 {
         self.cylinder_out_j / self.energy_in_j
+    }
+
+    /// The balance residual `E_in − E_load − Σ E_loss − Σ storage` \[J\]
+    /// ([`Ledger::error`] times the energy in).
+    pub fn closure_j(&self) -> f64 {
+        self.energy_in_j - self.load_out_j - self.total_loss_j() - self.total_storage_j()
+    }
+
+    /// The storage check `Σ storage + moving_walls − ΔE_stored(states)`
+    /// \[J\] ([`Ledger::storage_error`] times the energy in).
+    pub fn storage_check_j(&self) -> f64 {
+        self.total_storage_j() + self.moving_walls_j - self.stored_change_from_states_j
+    }
+
+    /// The sum over the components of each of the [`LEDGER_TERM_NAMES`]
+    /// \[J\].
+    pub fn totals_j(&self) -> [f64; LEDGER_TERMS] {
+        let mut t = [0.0; LEDGER_TERMS];
+        for c in &self.components {
+            for (s, e) in t.iter_mut().zip(c.energy_j) {
+                *s += e;
+            }
+        }
+        t
+    }
+
+    /// The ledger as one JSON object, what `hydrocyl simulate --ledger`
+    /// writes and Python's `run.ledger` is (the same keys): every energy in
+    /// J under a key ending `_j` (in an object under such a key, each value),
+    /// times in s under `_s`, fractions of the energy in dimensionless (the
+    /// `units` entry says so):
+    ///
+    /// * `components_j`: each component's quadratures by
+    ///   [`LEDGER_TERM_NAMES`], `totals_j` their sums;
+    /// * `energy_in_j`, `sources_j`, `load_out_j`, `cylinder_out_j`,
+    ///   `losses_j`, `storage_j` (by component, negligible terms left out),
+    ///   `stored_change_from_states_j`, `moving_walls_j`;
+    /// * `closure_j` ([`Ledger::closure_j`]) and `closure_relative` (=
+    ///   `error`), `storage_check_j` ([`Ledger::storage_check_j`]) and
+    ///   `storage_check_relative` (= `storage_error`), `efficiency`;
+    /// * `not_energy_consistent`: the components over which the closure
+    ///   measures the model form, not the bookkeeping.
+    pub fn to_json(&self) -> Value {
+        let by_name = |ts: &[Term]| -> Value {
+            Value::Object(
+                ts.iter()
+                    .map(|t| (t.name.clone(), json!(t.energy_j)))
+                    .collect::<Map<_, _>>(),
+            )
+        };
+        let named = |v: &[f64; LEDGER_TERMS]| -> Value {
+            Value::Object(
+                LEDGER_TERM_NAMES
+                    .iter()
+                    .zip(v)
+                    .map(|(n, e)| (n.to_string(), json!(e)))
+                    .collect::<Map<_, _>>(),
+            )
+        };
+        let components: Map<_, _> = self
+            .components
+            .iter()
+            .map(|c| (c.name.clone(), named(&c.energy_j)))
+            .collect();
+        json!({
+            "units": {
+                "_j": "J (every value under a key ending _j)",
+                "_s": "s",
+                "closure_relative": "1 (fraction of energy_in_j)",
+                "storage_check_relative": "1 (fraction of energy_in_j)",
+                "error": "1 (fraction of energy_in_j)",
+                "storage_error": "1 (fraction of energy_in_j)",
+                "efficiency": "1 (cylinder_out_j / energy_in_j)",
+            },
+            "window_s": [self.window_s.0, self.window_s.1],
+            "term_names": LEDGER_TERM_NAMES,
+            "components_j": components,
+            "totals_j": named(&self.totals_j()),
+            "energy_in_j": self.energy_in_j,
+            "sources_j": by_name(&self.sources),
+            "load_out_j": self.load_out_j,
+            "cylinder_out_j": self.cylinder_out_j,
+            "losses_j": by_name(&self.losses),
+            "storage_j": by_name(&self.storage),
+            "stored_change_from_states_j": self.stored_change_from_states_j,
+            "moving_walls_j": self.moving_walls_j,
+            "closure_j": self.closure_j(),
+            "closure_relative": self.error,
+            "storage_check_j": self.storage_check_j(),
+            "storage_check_relative": self.storage_error,
+            "error": self.error,
+            "storage_error": self.storage_error,
+            "efficiency": self.efficiency(),
+            "not_energy_consistent": self.not_energy_consistent,
+        })
     }
 
     /// A loss by name \[J\] (0 when absent).
@@ -182,13 +292,19 @@ pub fn ledger(
         x1[k] - x0[k]
     };
     let mut sources = Vec::new();
+    let mut components = Vec::new();
     let mut losses = Vec::new();
     let mut storage = Vec::new();
     let (mut e_in, mut e_load, mut e_cyl, mut e_moved) = (0.0, 0.0, 0.0, 0.0);
     let names: Vec<String> = circuit.components().map(|c| c.name().to_string()).collect();
     for (i, name) in names.iter().enumerate() {
-        let (src, diss, sto, load) = (d(i, 0), d(i, 1), d(i, 2), d(i, 3));
-        e_moved += d(i, 4);
+        let terms: [f64; LEDGER_TERMS] = std::array::from_fn(|term| d(i, term));
+        components.push(ComponentTerms {
+            name: name.clone(),
+            energy_j: terms,
+        });
+        let [src, diss, sto, load, moved] = terms;
+        e_moved += moved;
         e_in += src;
         e_load += load;
         if rod.components.contains(name) {
@@ -239,7 +355,36 @@ pub fn ledger(
             .filter(|c| !c.energy_consistent())
             .map(|c| c.name().to_string())
             .collect(),
+        components,
     })
+}
+
+/// The ledger between two states of a run made with `RunOptions::ledger`
+/// on: `(t0, x0)` and `(t1, x1)`, full state vectors (the ledger's
+/// quadratures included), e.g. the first and last output of a streamed run
+/// that keeps no states between. `circuit` is the rig's, with its ledger on
+/// ([`Circuit::set_ledger`]); the result is [`ledger`]'s over those two
+/// samples of the whole run.
+pub fn ledger_between(
+    circuit: &Circuit,
+    (t0, x0): (f64, &[f64]),
+    (t1, x1): (f64, &[f64]),
+    rod: &RodSide,
+) -> Result<Ledger, EnergyError> {
+    if x0.len() != x1.len() {
+        return Err(EnergyError::Ledger(format!(
+            "the two states have {} and {} entries",
+            x0.len(),
+            x1.len()
+        )));
+    }
+    let run = Run {
+        time: vec![t0, t1],
+        states: [x0, x1].concat(),
+        dim: x0.len(),
+        ..Run::default()
+    };
+    ledger(circuit, &run, 0, 1, rod)
 }
 
 /// Energy stored in the circuit at `(t, x)` \[J\]: every component's

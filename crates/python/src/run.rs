@@ -2,9 +2,9 @@
 //! simulate` writes), solver statistics, component counters and the energy
 //! ledger.
 
-use crate::convert::{array, Named};
+use crate::convert::{array, json_to_py, Named};
 use crate::sim::Simulated;
-use hydrocyl_energy::ledger::{Ledger, Term};
+use hydrocyl_energy::ledger::Ledger;
 use numpy::PyArray1;
 use pyo3::exceptions::{PyImportError, PyValueError};
 use pyo3::prelude::*;
@@ -24,32 +24,10 @@ pub struct PyRun {
     ledger: Option<Result<Ledger, String>>,
 }
 
-/// `{name: energy [J]}` of ledger terms.
-fn terms<'py>(py: Python<'py>, ts: &[Term]) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    for t in ts {
-        d.set_item(&t.name, t.energy_j)?;
-    }
-    Ok(d)
-}
-
-/// The ledger as a dict (energies in J, fractions dimensionless).
-fn ledger_dict<'py>(py: Python<'py>, l: &Ledger) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("window_s", l.window_s)?;
-    d.set_item("energy_in_j", l.energy_in_j)?;
-    d.set_item("sources_j", terms(py, &l.sources)?)?;
-    d.set_item("load_out_j", l.load_out_j)?;
-    d.set_item("cylinder_out_j", l.cylinder_out_j)?;
-    d.set_item("losses_j", terms(py, &l.losses)?)?;
-    d.set_item("storage_j", terms(py, &l.storage)?)?;
-    d.set_item("stored_change_from_states_j", l.stored_change_from_states_j)?;
-    d.set_item("moving_walls_j", l.moving_walls_j)?;
-    d.set_item("error", l.error)?;
-    d.set_item("storage_error", l.storage_error)?;
-    d.set_item("efficiency", l.efficiency())?;
-    d.set_item("not_energy_consistent", l.not_energy_consistent.clone())?;
-    Ok(d)
+/// The ledger as a dict: [`Ledger::to_json`], the object `hydrocyl
+/// simulate --ledger` writes (energies in J, fractions dimensionless).
+fn ledger_dict<'py>(py: Python<'py>, l: &Ledger) -> PyResult<Bound<'py, PyAny>> {
+    json_to_py(py, &l.to_json())
 }
 
 impl PyRun {
@@ -143,14 +121,18 @@ impl PyRun {
     }
 
     /// The energy ledger over the whole run (`simulate(..., ledger=True)`),
-    /// else None: `energy_in_j`, `load_out_j`, `cylinder_out_j`,
+    /// else None: the object `hydrocyl simulate --ledger` writes
+    /// (`Ledger::to_json`): `components_j` (each component's `source`,
+    /// `dissipated`, `storage`, `load`, `moved` [J]) and `totals_j`,
+    /// `energy_in_j`, `load_out_j`, `cylinder_out_j`,
     /// `losses_j`/`sources_j`/`storage_j` by component [J],
-    /// `stored_change_from_states_j` [J], the balance `error` and
-    /// `storage_error` (fractions of the energy in) and `efficiency`
-    /// (cylinder output / energy in). ValueError when the run has no
-    /// energy in to account for.
+    /// `stored_change_from_states_j`, `moving_walls_j` [J], the balance
+    /// `closure_j` and `closure_relative` (= `error`), the
+    /// `storage_check_j` and `storage_check_relative` (= `storage_error`),
+    /// fractions of the energy in, and `efficiency` (cylinder output /
+    /// energy in). ValueError when the run has no energy in to account for.
     #[getter]
-    fn ledger<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+    fn ledger<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         match &self.ledger {
             None => Ok(None),
             Some(Ok(l)) => ledger_dict(py, l).map(Some),

@@ -475,7 +475,9 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
     })
 }
 
-fn wave_signal(wave: Wave, amplitude: f64, period_s: f64, bias: f64) -> Signal {
+/// The biased wave of a scenario: `bias ± amplitude` (a square's two levels,
+/// a sine's swing) with period `period_s`, starting with the extending half.
+pub fn wave_signal(wave: Wave, amplitude: f64, period_s: f64, bias: f64) -> Signal {
     match wave {
         Wave::Square => Signal::Square {
             amplitude,

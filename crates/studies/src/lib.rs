@@ -20,6 +20,9 @@
 //! * [`relief`] — the readings of relief valves 1 and 2 (eqs 6.6–6.10,
 //!   `rlv_1.m`: cracking pressure and slope, `P_m` by eq 6.8) and the cap the
 //!   pilot valve's shift pressure puts on the hybrid's efficiency.
+//! * [`commands`] — the command files of the chapter-3, 7 and 8 experiments
+//!   as `hydrocyl simulate` reads them (`fixtures/commands/`, `cargo xtask
+//!   commands`), with the command lines that run them.
 //! * [`chapter9`] — the further work of section 9.2 in simulation: the
 //!   solenoid four-way valve, the needle opening optimised per speed, a servo
 //!   needle valve and a closed position loop, each against the pilot-shifted
@@ -41,4 +44,5 @@ pub mod chapter3;
 pub mod chapter7;
 pub mod chapter8;
 pub mod chapter9;
+pub mod commands;
 pub mod relief;

@@ -235,7 +235,7 @@ fn scaled_params(rig: &Model) -> Vec<Scaled> {
     out
 }
 
-/// The screen's step in log-factor (a tenth above the value).
+/// The screen's step in log-factor (a tenth: the screen runs at 1/1.1 and 1.1 times the value).
 const SCREEN_STEP: f64 = 0.0953101798043249; // ln 1.1
 
 /// The grid in log-factor, on the side the screen found lower: √2, 2,

@@ -381,11 +381,20 @@ pub fn nrmse(measured: &[f64], simulated: &[f64]) -> f64 {
 /// a residual of foreign shape is not dressed up as the nearest catalog effect.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Probe {
-    /// Short name: `delay` or `spring`.
+    /// Short name: `delay` or `spring` (friction bench); `delay`, `mass`,
+    /// `coulomb`, `supply_pressure`, `p1_offset` or `p2_offset` (netlist
+    /// rigs: a transport delay of the command, a declared parameter other
+    /// than declared, a pressure sensor's zero error).
     pub kind: String,
-    /// What it is (`"time shift of the measured force"`, `"force proportional to position"`).
+    /// What it is, in words (`"time shift of the measured force"`, `"force
+    /// proportional to position"`, ``"load mass other than declared
+    /// (`load.mass` fits 40.0 kg, declared 20.0 kg)"``).
     pub what: String,
-    /// Its fitted size (delay \[s\] or stiffness \[N·m⁻¹\]).
+    /// Its fitted size, SI: delay \[s\], stiffness \[N·m⁻¹\], mass \[kg\],
+    /// Coulomb level \[N\] (of the first Coulomb parameter, where the
+    /// friction law has one per direction, all scaled by one factor),
+    /// supply pressure \[Pa\], or the offset \[Pa\] the pressure sensor
+    /// reads above the pressure.
     pub value: f64,
     /// Share of the residual it explains.
     pub explained_share: f64,

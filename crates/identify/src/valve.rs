@@ -51,6 +51,7 @@ mod accept;
 mod effects;
 mod fit;
 pub mod model;
+mod probes;
 mod sim;
 mod stops;
 
@@ -58,6 +59,7 @@ use effects::*;
 pub use effects::{is_on, rig_facts};
 use fit::*;
 pub use model::Model;
+use probes::best_probe;
 pub use sim::lag_samples;
 use sim::*;
 
@@ -530,8 +532,12 @@ pub fn diagnose_rig_traced(
         // it is not run where it could not win.
         let probe_can_win =
             opts.min_share <= 1.0 && top.is_none_or(|(_, share)| share + opts.min_share < 1.0);
+        // what a probe must explain to outrank the top candidate
+        let need = top.map_or(opts.min_share, |(_, share)| {
+            (share + opts.min_share).max(opts.min_share)
+        });
         let probe = if probe_can_win {
-            delay_probe(&model, &pt, opts.holdout, rss0)
+            best_probe(&model, &pt, opts.holdout, &r0, rss0, need)
         } else {
             None
         };

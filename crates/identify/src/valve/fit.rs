@@ -1,6 +1,6 @@
 //! Fitting on the valve rig: the Levenberg–Marquardt refit with the initial
 //! state as nuisance parameters, the cheap Gauss–Newton trace, the parallel
-//! runner and the out-of-catalog delay probe.
+//! runner (the out-of-catalog probes are in `probes.rs`).
 
 use super::*;
 use rayon::prelude::*;
@@ -639,38 +639,4 @@ pub(super) fn trace_parallel<I: Sync, T: Send>(
         }
     });
     slots.into_iter().flatten().collect()
-}
-
-/// Out-of-catalog probe: the command reaching the rig late by τ (a
-/// transport delay), τ on a grid up to 60 ms, scored against `rss0`, the
-/// weighted sum of squares of `rig` on the whole record.
-pub(super) fn delay_probe(rig: &Model, p: &Prepared, holdout: f64, rss0: f64) -> Option<Probe> {
-    if p.closed {
-        // the input is the reference, not the command the valve receives
-        return None;
-    }
-    const TAUS: [f64; 8] = [0.002, 0.005, 0.01, 0.015, 0.02, 0.03, 0.045, 0.06];
-    let shifted = |tau: &f64| {
-        let mut q = p.clone();
-        let mut input: Vec<f64> =
-            p.t.iter()
-                .map(|&t| crate::data::interp_linear(&p.t, &p.input, t - tau))
-                .collect();
-        input[0] = p.input[0];
-        q.input = input.into();
-        rss(rig, &q, holdout, Part::All)
-    };
-    let scores = trace_parallel(&TAUS, &shifted);
-    let mut best = (0.0, rss0);
-    for (tau, r) in TAUS.iter().zip(scores) {
-        if r < best.1 {
-            best = (*tau, r);
-        }
-    }
-    (best.0 > 0.0).then(|| Probe {
-        kind: "delay".into(),
-        what: "transport delay of the command".into(),
-        value: best.0,
-        explained_share: 1.0 - best.1 / rss0.max(1e-300),
-    })
 }

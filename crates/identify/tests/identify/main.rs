@@ -7,6 +7,7 @@ mod closed_loop;
 mod hybrid;
 mod model;
 mod planted;
+mod probes;
 mod valve;
 
 use hydrocyl_identify::catalog::EffectId;

@@ -1,0 +1,113 @@
+//! The loop's out-of-catalog probes on netlist rigs: a record simulated
+//! with one *declared* parameter other than declared (the load's mass, the
+//! friction's Coulomb level, the supply pressure) or with a pressure sensor
+//! reading off by a constant, diagnosed against the declared rig. None of
+//! these is a catalog effect: the residual must be reported unexplained,
+//! resembling the parameter, not dressed up as the nearest catalog effect.
+
+use hydrocyl_identify::data::{Record, Signal};
+use hydrocyl_identify::diagnose::{DiagnoseOptions, Report};
+use hydrocyl_identify::synth::{netlist_record, valve_command};
+use hydrocyl_identify::valve::{diagnose_rig, Model};
+use serde_json::Value;
+
+use crate::ids;
+
+fn preset(name: &str) -> Value {
+    hydrocyl_system::rig::preset(name).unwrap()
+}
+
+/// `net` with `<comp>.<param>` set to `v`.
+fn with(mut net: Value, comp: &str, param: &str, v: f64) -> Value {
+    net["components"][comp][param] = Value::from(v);
+    net
+}
+
+/// A 2 s, 1 kHz `leaney-moog` record of `truth` (the valve fixtures' command).
+fn valve_record(truth: &Value, seed: u64) -> Record {
+    netlist_record(truth, 2000, 1e-3, seed, &valve_command).unwrap()
+}
+
+fn diagnose(declared: &Value, rec: &Record) -> Report {
+    let r = diagnose_rig(
+        &Model::new(declared).unwrap(),
+        rec,
+        &DiagnoseOptions::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    eprintln!("{}", r.human());
+    r
+}
+
+/// No catalog effect added, and the probe named `kind` explains the
+/// residual with a value within `tol` (relative) of `value`.
+fn check_unexplained(r: &Report, kind: &str, value: f64, tol: f64) {
+    assert!(ids(r).is_empty(), "{}", r.human());
+    let p = r
+        .unexplained_resembles
+        .as_ref()
+        .unwrap_or_else(|| panic!("no probe names the shape\n{}", r.human()));
+    assert_eq!(p.kind, kind, "{}", r.human());
+    assert!(
+        (p.value - value).abs() <= tol * value.abs(),
+        "{kind} fits {} (planted {value})\n{}",
+        p.value,
+        r.human()
+    );
+}
+
+#[test]
+fn a_coulomb_level_other_than_declared_is_unexplained() {
+    // 150 N of Coulomb friction where the rig declares 50 N
+    let net = preset("leaney-moog");
+    let truth = with(net.clone(), "friction", "coulomb", 150.0);
+    let r = diagnose(&net, &valve_record(&truth, 71));
+    check_unexplained(&r, "coulomb", 150.0, 0.05);
+    assert!(r
+        .unexplained_resembles
+        .unwrap()
+        .what
+        .contains("friction.coulomb"));
+}
+
+#[test]
+fn a_supply_pressure_other_than_declared_is_unexplained() {
+    // 60 bar where the rig declares 70
+    let net = preset("leaney-moog");
+    let truth = with(net.clone(), "supply", "pressure", 6e6);
+    let r = diagnose(&net, &valve_record(&truth, 72));
+    check_unexplained(&r, "supply_pressure", 6e6, 0.02);
+}
+
+#[test]
+fn a_load_mass_other_than_declared_is_unexplained() {
+    // the hybrid rig's 20 kg load doubled (its friction has a K H a term:
+    // the catalog's `acceleration_friction` is the nearest shape)
+    let net = preset("wang-hybrid");
+    let truth = with(net.clone(), "load", "mass", 40.0);
+    let command = |t: f64| {
+        use std::f64::consts::PI;
+        3.0 * (2.0 * PI * 0.7 * t).sin() + 1.0 * (2.0 * PI * 1.9 * t).sin()
+    };
+    let rec = netlist_record(&truth, 1000, 2e-3, 73, &command).unwrap();
+    let r = diagnose(&net, &rec);
+    check_unexplained(&r, "mass", 40.0, 0.05);
+}
+
+#[test]
+fn a_pressure_sensor_offset_is_unexplained() {
+    // p1 reads 2 bar high, then (another record) p2 reads 1.5 bar low
+    let net = preset("leaney-moog");
+    for (ch, kind, offset, seed) in [
+        (Signal::P1, "p1_offset", 2e5, 74),
+        (Signal::P2, "p2_offset", -1.5e5, 75),
+    ] {
+        let mut rec = valve_record(&net, seed);
+        for v in rec.signals.get_mut(&ch).unwrap() {
+            *v += offset;
+        }
+        let r = diagnose(&net, &rec);
+        check_unexplained(&r, kind, offset, 0.05);
+    }
+}

@@ -284,6 +284,19 @@ pub enum SolveError {
     /// The inputs to the solver were invalid.
     #[error("invalid solver input: {0}")]
     InvalidInput(String),
+    /// Event after event without a step free of them
+    /// ([`MAX_EVENTS_IN_A_ROW`](crate::MAX_EVENTS_IN_A_ROW)): the
+    /// solution chatters, a step too long for a fixed-step method or a model
+    /// that switches without end, and time stalls.
+    #[error("{count} events in a row up to t = {t} s, none with a step free of events between them (event function {which} the last): the solution chatters (a step too long for the rig, or a model that switches without end)")]
+    EventStorm {
+        /// Time reached.
+        t: f64,
+        /// The last event function that triggered.
+        which: usize,
+        /// Events in a row.
+        count: usize,
+    },
     /// The caller of a streamed solve ([`crate::solve_streaming`]) stopped
     /// it (its output could not be written, its input could not be read).
     #[error("stopped at t = {t} s: {why}")]

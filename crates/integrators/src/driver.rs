@@ -177,6 +177,14 @@ const FAC_MAX: f64 = 10.0;
 /// Largest number of consecutive singular-matrix retries before giving up.
 const MAX_SINGULAR_RETRIES: usize = 8;
 
+/// Events in a row, each ending its step before the step's end, with no
+/// step free of events between them, after which a run stops with
+/// [`SolveError::EventStorm`]: time then advances by less and less (a fixed
+/// step far too long for the rig puts an event into every step's first few
+/// microseconds, for ever). No run that advances does this: between two
+/// events of a chattering valve there are steps free of them.
+pub const MAX_EVENTS_IN_A_ROW: usize = 10_000;
+
 struct ControlState {
     controller: Controller,
     err_prev: f64,
@@ -463,6 +471,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
     let mut fresh = true; // a fresh step-size estimate is needed
     let mut h = opts.h0.unwrap_or(0.0);
     let mut singular_retries = 0usize;
+    let mut events_in_a_row = 0usize;
     // The system's next breakpoint after `bp_from`: while nothing changes
     // the system (no event, no streamed input) it is still the next one
     // after any time before it, and is asked again only once passed.
@@ -685,6 +694,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
 
         match event_at {
             None => {
+                events_in_a_row = 0;
                 if opts.t_eval.is_some() {
                     emit_t_eval(
                         &stepper,
@@ -712,6 +722,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                 h = h_next;
             }
             Some(t_ev) => {
+                events_in_a_row += 1;
                 // State at the event from the dense output (exact step end if t_ev = t_new).
                 if t_ev >= t_new {
                     x_ev.copy_from_slice(&x_new);
@@ -771,6 +782,14 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                 if let Some(i) = x.iter().position(|v| !v.is_finite()) {
                     sol.stats = stats;
                     return Err(SolveError::NonFinite { t: t_ev, index: i });
+                }
+                if events_in_a_row >= MAX_EVENTS_IN_A_ROW {
+                    sol.stats = stats;
+                    return Err(SolveError::EventStorm {
+                        t: t_ev,
+                        which: ev.triggered.iter().rposition(|&b| b).unwrap_or(0),
+                        count: events_in_a_row,
+                    });
                 }
                 let edited = x.iter().zip(x_ev.iter()).any(|(a, b)| a != b);
                 if edited && opts.t_eval.is_none() {

@@ -171,6 +171,7 @@ mod rk4;
 mod rodas;
 mod stream;
 
+pub use driver::MAX_EVENTS_IN_A_ROW;
 pub use stream::{solve_streaming, Stream, StreamIo};
 
 /// Integrates `sys` from `(t0, x0)` to `t_end` with `method`.
@@ -187,7 +188,9 @@ pub use stream::{solve_streaming, Stream, StreamIo};
 /// NaN or infinite; [`SolveError::StepTooSmall`] when the controller needs a
 /// step below `h_min`; [`SolveError::TooManySteps`] beyond `max_steps`
 /// (accepted + rejected); [`SolveError::Singular`] when the Rosenbrock
-/// iteration matrix stays singular after halving the step.
+/// iteration matrix stays singular after halving the step;
+/// [`SolveError::EventStorm`] after [`MAX_EVENTS_IN_A_ROW`] events with no
+/// step free of them.
 pub fn solve<S: OdeSystem + ?Sized>(
     method: Method,
     sys: &mut S,

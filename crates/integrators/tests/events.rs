@@ -240,3 +240,57 @@ fn clamping_onto_the_root_and_switching_mode_gives_one_event() {
         assert_eq!(*sol.t.last().unwrap(), 3.0);
     }
 }
+
+/// `x' = −1` with an event at `x = 0` whose handler puts the state back a
+/// nanometre above it: a model that switches without end, one event every
+/// nanosecond, so that time all but stalls.
+struct Sticky;
+
+impl OdeSystem for Sticky {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn rhs(&self, _t: f64, _x: &[f64], dx: &mut [f64]) {
+        dx[0] = -1.0;
+    }
+    fn n_events(&self) -> usize {
+        1
+    }
+    fn events(&self, _t: f64, x: &[f64], g: &mut [f64]) {
+        g[0] = x[0];
+    }
+    fn on_event(&mut self, _t: f64, x: &mut [f64], _which: usize, _dir: Crossing) -> EventAction {
+        x[0] = 1e-9;
+        EventAction::Continue
+    }
+}
+
+/// Events that come without end, with no step free of them between (a
+/// fixed step far too long puts one at the start of every step), stop the
+/// run with `EventStorm` after `MAX_EVENTS_IN_A_ROW` of them instead of
+/// locating them for ever. The adaptive methods take free steps between the
+/// events here; their step budget ends the run.
+#[test]
+fn events_without_end_stop_the_run() {
+    use hydrocyl_integrators::{SolveError, MAX_EVENTS_IN_A_ROW};
+    for method in ALL {
+        let opts = Options {
+            max_steps: 200_000,
+            ..opts_for(method)
+        };
+        match solve(method, &mut Sticky, 0.0, &[0.5], 10.0, &opts) {
+            Err(SolveError::EventStorm { t, which, count }) => {
+                assert_eq!(method, Method::Rk4);
+                assert_eq!(which, 0);
+                assert_eq!(count, MAX_EVENTS_IN_A_ROW);
+                // the first event at t = 0.5, then one a nanosecond
+                assert!((0.5..0.5 + 1e-4).contains(&t), "stopped at {t}");
+            }
+            Err(SolveError::TooManySteps { t, .. }) => {
+                assert_ne!(method, Method::Rk4);
+                assert!(t < 0.6, "{method:?}: stopped at {t}");
+            }
+            other => panic!("{method:?}: expected the run to stop, got {other:?}"),
+        }
+    }
+}

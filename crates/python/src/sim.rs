@@ -163,6 +163,7 @@ fn failure_time(e: &SolveError) -> Option<f64> {
         | SolveError::TooManySteps { t, .. }
         | SolveError::NonFinite { t, .. }
         | SolveError::Singular { t }
+        | SolveError::EventStorm { t, .. }
         | SolveError::Interrupted { t, .. } => Some(*t),
         SolveError::InvalidInput(_) => None,
     }

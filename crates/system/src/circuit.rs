@@ -323,6 +323,14 @@ impl Circuit {
         v
     }
 
+    /// The component whose event function `which` (an index of
+    /// [`OdeSystem::events`]) is.
+    pub fn event_owner(&self, which: usize) -> Option<&str> {
+        (0..self.comps.len())
+            .find(|&i| which >= self.ev_offsets[i] && which < self.ev_offsets[i + 1])
+            .map(|i| self.comps[i].name())
+    }
+
     /// The default initial state of every component (quadratures zero).
     pub fn initial_state(&self) -> Vec<f64> {
         let mut x = vec![0.0; self.dim()];

@@ -97,6 +97,10 @@ impl SimError {
             SolveError::NonFinite { index, .. } => {
                 format!(" (state {index} is `{}`)", name(*index))
             }
+            SolveError::EventStorm { which, .. } => circuit
+                .event_owner(*which)
+                .map(|c| format!(" (the events are `{c}`'s)"))
+                .unwrap_or_default(),
             SolveError::StepTooSmall { t, .. } if at_start(*t) => match fastest() {
                 Some((i, d)) => format!(
                     " (the fastest state at the start is `{}`, d/dt = {d:e}{hint})",

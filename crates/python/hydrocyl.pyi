@@ -4,7 +4,8 @@ Rigs (presets or rig JSON files) edited by the same parameter paths as the
 CLI's ``--set``, runs as named numpy arrays in SI units (pressures in Pa
 gauge), batch runs on all cores, Leaney's X factor and the measured-data
 diagnosis. Bad input raises ValueError with the CLI's one-line message; a
-solver failure raises SimulationError.
+solver failure raises SimulationError; a run whose constant-B oil cavitates
+far below vacuum is returned with a CavitationWarning.
 """
 
 import os
@@ -33,6 +34,16 @@ class SimulationError(Exception):
     """Time the solver reached [s] (NaN if it could not be located)."""
     state: dict[str, float]
     """State at ``time``: state name -> value (SI)."""
+
+class CavitationWarning(UserWarning):
+    """A chamber pressure fell far below absolute vacuum (below -10 bar
+    gauge) in a run that did not blow up (no non-finite value, none below
+    the liquid's tension limit of -1000 bar): the oil, a liquid of constant
+    bulk modulus, has left its range from then on (the chamber cavitates).
+    The run is returned; the message names the chamber, its lowest pressure
+    and when, and the remedy (entrained air, ``<cylinder>.air_fraction``,
+    where the cylinder's type has it). Warned by ``Rig.simulate`` and, per
+    parameter set, ``simulate_batch``."""
 
 class Rig:
     """A rig: kind and parameters as in its JSON file (SI units, pressures
@@ -91,7 +102,11 @@ class Rig:
         demand (valve rigs) or drive voltage [V] (pump rigs). ``rk4_step``
         and ``h_max`` (default 0.01) in s. ``ledger=True`` adds
         ``run.ledger``. Releases the GIL; runs the rig as it is when called
-        (a ``set`` from another thread meanwhile does not change the run)."""
+        (a ``set`` from another thread meanwhile does not change the run).
+        SimulationError when the solver fails or the run blows up (a
+        non-finite value, a chamber pressure below -1000 bar); a chamber
+        far below vacuum short of that warns (CavitationWarning) and the
+        run is returned."""
 
 class Run:
     """One run: ``time`` [s] and channels in SI (``units``): ``command``,
@@ -182,7 +197,8 @@ def simulate_batch(
     SI) in parallel with the GIL released; results in set order,
     independent of ``threads`` (at least 1; default: all cores).
     ``channels`` (default: all) names the channels kept, and only they are
-    read in each run."""
+    read in each run. A set whose chamber falls far below vacuum without
+    blowing up is kept and warned of (CavitationWarning naming the set)."""
 
 def xfactor(gamma: float, travel: ArrayLike) -> npt.NDArray[np.float64]:
     """Leaney's X factor (dimensionless) for area ratio ``gamma`` = A1/A2

@@ -50,12 +50,13 @@ use crate::error::CliError;
 use crate::ledger::Ends;
 use crate::output::Outputs;
 use crate::progress::Progress;
-use crate::writer::{Block, Maker, Rows, Writer};
+use crate::writer::{Block, Lows, Maker, Rows, Writer};
 use hydrocyl_identify::bench::FrictionBench;
 use hydrocyl_system::netlist::registry::ComponentType;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{
-    chamber_types_with_air, Cause, ProbeReader, Run, RunOptions, Setting, Solver, AIR_PARAMETER,
+    chamber_types_with_air, AirRemedy, Cause, DeepCavitation, ProbeReader, Run, RunOptions,
+    Setting, Solver, AIR_PARAMETER,
 };
 use hydrocyl_system::signal::{Signal, StreamedTable};
 use hydrocyl_system::simulation::Simulation;
@@ -265,47 +266,24 @@ fn check_initial_pressures(rig: &crate::rigfile::Checked) -> Result<(), CliError
 /// a remedy may propose to `--set` on a component is looked up in it.
 pub(crate) type Types = std::sync::Arc<[(String, &'static ComponentType)]>;
 
-/// Checks the solution for the signs of an unstable integration (a
-/// non-finite value, a chamber pressure far below vacuum:
-/// [`Run::unphysical`]) and names the fix; a parameter it proposes to set
-/// is one the component's type has (`types`).
+/// Checks the solution (a run or a block of one) for the signs of an
+/// unstable integration (a non-finite value, a chamber pressure below the
+/// liquid's tension limit: [`Run::physical`]) and names the fix; otherwise
+/// where its constant-B liquid left its range (a chamber far below vacuum,
+/// [`Run::deep_cavitation`]), which the blocks of a run merge
+/// ([`DeepCavitation::merged`]) and [`cavitation_warning`] words once the
+/// whole run has passed.
 pub(crate) fn check_solution(
     run: &Run,
     solver: Solver,
     rk4_step: f64,
-    types: &[(String, &'static ComponentType)],
-) -> Result<(), CliError> {
-    let Some(u) = run.unphysical() else {
-        return Ok(());
+) -> Result<Option<DeepCavitation>, CliError> {
+    let u = match run.physical() {
+        Ok(deep) => return Ok(deep),
+        Err(u) => u,
     };
     let what = &u.what;
-    let type_of = |c: &str| types.iter().find(|(n, _)| n == c).map(|(_, t)| *t);
-    let message = match u.cause(solver, type_of) {
-        // a finite chamber pressure far below vacuum: the same with any
-        // solver and tolerance when the liquid has no cavitation model
-        Cause::Cavitation {
-            cylinder,
-            air,
-            type_name,
-        } => {
-            let remedy = match (air, type_name) {
-                (Some(p), _) => format!("give it entrained air (--set {p}=0.005, docs/hybrid.md)"),
-                (None, ty) => format!(
-                    "`{cylinder}`{} has no entrained-air parameter, so its chambers cannot be given air here (the component types that have `{AIR_PARAMETER}`: {})",
-                    ty.map(|t| format!(" (a `{t}`)")).unwrap_or_default(),
-                    chamber_types_with_air().join(", ")
-                ),
-            };
-            format!(
-                "a chamber pressure fell far below absolute vacuum ({what}): the oil, a liquid of constant bulk modulus, has left its range (the chamber cavitates); {remedy}; or if the {} run is unstable instead, try a smaller --rtol{}",
-                solver.name(),
-                if matches!(solver, Solver::Rosenbrock) {
-                    ""
-                } else {
-                    " or --solver rosenbrock"
-                }
-            )
-        }
+    let message = match u.cause(solver) {
         Cause::StepTooLong => format!(
             "the {} solution is unstable ({what}); --rk4-step {rk4_step} is too large for this rig: use a smaller step or --solver auto",
             solver.name()
@@ -316,6 +294,53 @@ pub(crate) fn check_solution(
         ),
     };
     Err(CliError::Input(message))
+}
+
+/// The one-line warning of a run whose chamber fell far below vacuum
+/// without blowing up ([`DeepCavitation`]): the chamber, its lowest pressure
+/// and when, from when on the constant-B liquid is outside its range, and
+/// the remedy; a parameter it proposes to set is one the component's type
+/// has (`types`). A fixed step is told how to find whether it is to blame.
+pub(crate) fn cavitation_warning(
+    d: &DeepCavitation,
+    solver: Solver,
+    rk4_step: f64,
+    types: &[(String, &'static ComponentType)],
+) -> String {
+    let type_of = |c: &str| types.iter().find(|(n, _)| n == c).map(|(_, t)| *t);
+    let AirRemedy {
+        cylinder,
+        air,
+        type_name,
+    } = d.remedy(type_of);
+    let remedy = match (air, type_name) {
+        (Some(p), _) => format!("give it entrained air (--set {p}=0.005, docs/hybrid.md)"),
+        (None, ty) => format!(
+            "`{cylinder}`{} has no entrained-air parameter, so its chambers cannot be given air here (the component types that have `{AIR_PARAMETER}`: {})",
+            ty.map(|t| format!(" (a `{t}`)")).unwrap_or_default(),
+            chamber_types_with_air().join(", ")
+        ),
+    };
+    let check = if solver.fixed_step() {
+        format!(
+            "; a smaller --rk4-step than {rk4_step} tells whether the {} step is to blame instead",
+            solver.name()
+        )
+    } else {
+        format!(
+            "; if the {} run is unstable instead, a smaller --rtol{} tells",
+            solver.name(),
+            if matches!(solver, Solver::Rosenbrock) {
+                ""
+            } else {
+                " or --solver rosenbrock"
+            }
+        )
+    };
+    format!(
+        "hydrocyl: warning: a chamber pressure fell far below absolute vacuum ({}): the oil, a liquid of constant bulk modulus, has left its range from then on (the chamber cavitates); {remedy}{check}",
+        d.what()
+    )
 }
 
 /// A pressure to the nearest pascal, for messages: a value that rounds to
@@ -578,7 +603,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut bar = Progress::new("simulate", rows as u64, args.progress, args.quiet);
     let mut failed: Option<CliError> = None;
     let mut done = 0usize;
-    let mut min_p = f64::INFINITY;
+    // the chamber pressures read on this thread (the channels' blocks)
+    let mut lows = Lows::default();
     // the solve's thread's maker, made when first needed: during the solve
     // (the writer far behind) on a third circuit, after it on the solving one
     let mut own: Option<Maker> = None;
@@ -587,7 +613,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
             w.rows(Rows::States {
                 solver,
                 rk4_step: args.rk4_step,
-                types: types.clone(),
             });
             let build = || -> Result<Maker, CliError> {
                 reader()?.ok_or_else(|| CliError::Input("no probe reader".into()))
@@ -633,7 +658,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
                     if let Some(e) = ends.as_mut() {
                         e.see(&block.time, &block.states);
                     }
-                    let r = check_solution(block, solver, args.rk4_step, &types).and_then(|()| {
+                    let r = check_solution(block, solver, args.rk4_step).and_then(|deep| {
+                        lows.add(Lows {
+                            min_p: block.min_chamber_pressure(),
+                            deep,
+                        });
                         if !w.has_rows() {
                             let mut header = column_headers(block).join(",").into_bytes();
                             header.push(b'\n');
@@ -653,7 +682,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
                         }
                     });
                     done += block.time.len();
-                    min_p = min_p.min(block.min_chamber_pressure());
                     bar.set("rows", done as u64, rows as u64);
                     r.map_err(|e| {
                         let m = e.to_string();
@@ -679,8 +707,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let (mut outputs, run) = match (streamed, failed, written) {
         (_, _, Err(e)) | (_, Some(e), _) => return Err(e),
         (Err(e), None, _) => return Err(solver_hint(e, solver, args.rk4_step, t1 - t0)),
-        (Ok(r), None, Ok((o, p))) => {
-            min_p = min_p.min(p);
+        (Ok(r), None, Ok((o, written_lows))) => {
+            lows.add(written_lows);
             (o, r)
         }
     };
@@ -703,6 +731,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if args.quiet {
         return Ok(());
     }
+    // the whole run has passed its checks (a run that fails later is an
+    // error and warns of nothing): once per run
+    if let Some(d) = &lows.deep {
+        crate::console::note(format_args!(
+            "{}",
+            cavitation_warning(d, solver, args.rk4_step, &types)
+        ));
+    }
+    let min_p = lows.min_p;
     let cav = run.cavitation_entries();
     // one write: stderr is not buffered
     let line = format!(

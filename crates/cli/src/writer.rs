@@ -9,7 +9,7 @@
 
 use crate::error::CliError;
 use crate::output::{OutputId, Outputs};
-use hydrocyl_system::run::{ProbeReader, Run, Solver};
+use hydrocyl_system::run::{DeepCavitation, ProbeReader, Run, Solver};
 use std::collections::{BTreeMap, VecDeque};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 
@@ -46,8 +46,6 @@ pub enum Rows {
         solver: Solver,
         /// rk4's step, for the same.
         rk4_step: f64,
-        /// The rig's component types, for the same.
-        types: crate::simulate::Types,
     },
 }
 
@@ -69,14 +67,14 @@ impl Maker {
     }
 
     /// Appends block `seq`'s rows to `out` (the header first for block 0);
-    /// the lowest chamber pressure it read.
+    /// what it read of the chamber pressures.
     fn piece(
         &mut self,
         rows: &Rows,
         seq: usize,
         block: &Block,
         out: &mut Vec<u8>,
-    ) -> Result<f64, CliError> {
+    ) -> Result<Lows, CliError> {
         let n = block.time.len().max(1);
         match (rows, self.reader.as_mut()) {
             (Rows::Channels(header), _) => {
@@ -87,19 +85,12 @@ impl Maker {
                     .chain(block.values.chunks_exact(n))
                     .collect();
                 hydrocyl_identify::plaincsv::append_rows(&columns, out);
-                Ok(f64::INFINITY)
+                Ok(Lows::default())
             }
-            (
-                Rows::States {
-                    solver,
-                    rk4_step,
-                    types,
-                },
-                Some(r),
-            ) => {
+            (Rows::States { solver, rk4_step }, Some(r)) => {
                 let run = &mut self.run;
                 r.read_channels(&block.time, &block.values, run);
-                crate::simulate::check_solution(run, *solver, *rk4_step, types)?;
+                let deep = crate::simulate::check_solution(run, *solver, *rk4_step)?;
                 if seq == 0 {
                     out.extend_from_slice(
                         crate::simulate::column_headers(run).join(",").as_bytes(),
@@ -111,12 +102,44 @@ impl Maker {
                     .map(Vec::as_slice)
                     .collect();
                 hydrocyl_identify::plaincsv::append_rows(&columns, out);
-                Ok(run.min_chamber_pressure())
+                Ok(Lows {
+                    min_p: run.min_chamber_pressure(),
+                    deep,
+                })
             }
             (Rows::States { .. }, None) => Err(CliError::Input(
                 "the output's probes have no reader on this thread".into(),
             )),
         }
+    }
+}
+
+/// What the blocks of a run read of its chamber pressures, merged in any
+/// order: the lowest \[Pa\] (infinite when none was read) and where the
+/// constant-B liquid left its range ([`DeepCavitation`], warned of once
+/// the whole run has passed its checks).
+#[derive(Clone, Debug)]
+pub struct Lows {
+    /// The lowest chamber pressure \[Pa\].
+    pub min_p: f64,
+    /// A chamber far below vacuum.
+    pub deep: Option<DeepCavitation>,
+}
+
+impl Default for Lows {
+    fn default() -> Self {
+        Lows {
+            min_p: f64::INFINITY,
+            deep: None,
+        }
+    }
+}
+
+impl Lows {
+    /// Adds those of another block.
+    pub fn add(&mut self, other: Lows) {
+        self.min_p = self.min_p.min(other.min_p);
+        self.deep = DeepCavitation::merged(self.deep.take(), other.deep);
     }
 }
 
@@ -139,7 +162,7 @@ struct Sink {
     ready: BTreeMap<usize, Vec<u8>>,
     /// The first failure, by block number (the earliest rows').
     error: Option<(usize, CliError)>,
-    min_p: f64,
+    lows: Lows,
     /// Texts written, for reuse.
     free: Vec<Vec<u8>>,
 }
@@ -213,7 +236,7 @@ impl Shared {
             Ok(p) => {
                 {
                     let mut s = lock(&self.sink);
-                    s.min_p = s.min_p.min(p);
+                    s.lows.add(p);
                     s.ready.insert(seq, text);
                 }
                 self.sink_cv.notify_all();
@@ -253,7 +276,7 @@ impl Writer {
             sink: Mutex::new(Sink {
                 ready: BTreeMap::new(),
                 error: None,
-                min_p: f64::INFINITY,
+                lows: Lows::default(),
                 free: Vec::new(),
             }),
             sink_cv: Condvar::new(),
@@ -403,14 +426,14 @@ impl Writer {
 
     /// Closes the work, makes the blocks still waiting together with the
     /// writer thread (with `own`, made by `build` when first needed), and
-    /// waits for the thread to write them all: the outputs back and the
-    /// lowest chamber pressure read, or the first error (the earliest
-    /// rows').
+    /// waits for the thread to write them all: the outputs back and what
+    /// was read of the chamber pressures ([`Lows`]), or the first error
+    /// (the earliest rows').
     pub fn finish(
         mut self,
         own: &mut Option<Maker>,
         build: &mut dyn FnMut() -> Result<Maker, CliError>,
-    ) -> Result<(Outputs, f64), CliError> {
+    ) -> Result<(Outputs, Lows), CliError> {
         lock(&self.shared.work).closed = true;
         self.shared.work_cv.notify_all();
         crate::progress::mark("solve's thread: helping");
@@ -438,7 +461,9 @@ impl Writer {
         match (written, error) {
             (Ok(_), Some((_, e))) => Err(e),
             (Ok((_, Err(e))), None) => Err(e),
-            (Ok((outputs, Ok(()))), None) => Ok((outputs, lock(&self.shared.sink).min_p)),
+            (Ok((outputs, Ok(()))), None) => {
+                Ok((outputs, std::mem::take(&mut lock(&self.shared.sink).lows)))
+            }
             (Err(_), _) => Err(CliError::Input("the output writer failed".into())),
         }
     }

@@ -56,11 +56,13 @@ impl Sets {
     }
 }
 
-/// What one run leaves: its channels (the selected ones) and statistics.
+/// What one run leaves: its channels (the selected ones), statistics and
+/// the warning of a chamber far below vacuum.
 struct Row {
     names: Vec<String>,
     values: Vec<Vec<f64>>,
     stats: [f64; 4],
+    cavitation: Option<String>,
 }
 
 fn one(
@@ -79,12 +81,17 @@ fn one(
     }
     // `simulate` reads, checks and assembles the rig once (its errors are
     // the same input failures a separate `rig::check` would give)
-    let Run {
-        channels,
-        stats,
-        wall,
+    let sim::Simulated {
+        run:
+            Run {
+                channels,
+                stats,
+                wall,
+                ..
+            },
+        cavitation,
         ..
-    } = sim::simulate(&v, cmd, t, opts).map_err(ctx)?.run;
+    } = sim::simulate(&v, cmd, t, opts).map_err(ctx)?;
     let mut names = Vec::new();
     let mut values = Vec::new();
     for c in channels {
@@ -102,6 +109,8 @@ fn one(
             stats.rhs_evals as f64,
             wall.as_secs_f64(),
         ],
+        cavitation: cavitation
+            .map(|w| format!("run {i} ({}): {w}", sets.assignments(i).join(", "))),
     })
 }
 
@@ -120,7 +129,9 @@ fn one(
 /// `on_error="raise"` (default) raises the error of the first failing set
 /// (ValueError for an invalid set, SimulationError for a solver failure,
 /// both naming the set); `on_error="nan"` fills its rows with NaN and
-/// reports it in `batch.ok` / `batch.errors`.
+/// reports it in `batch.ok` / `batch.errors`. A set whose chamber fell far
+/// below vacuum without blowing up is kept, with a
+/// `hydrocyl.CavitationWarning` naming it.
 #[pyfunction]
 #[pyo3(signature = (rig, t, u, params, *, solver = "auto", rtol = 1e-6, rk4_step = 2e-5, h_max = None, channels = None, threads = None, on_error = "raise"))]
 #[allow(clippy::too_many_arguments)]
@@ -264,9 +275,11 @@ fn stack(
     let mut data = vec![vec![f64::NAN; n * m]; names.len()];
     let mut stats = [(); 4].map(|_| vec![f64::NAN; n]);
     let mut errors = Vec::with_capacity(n);
+    let mut warnings = Vec::new();
     for (i, r) in rows.into_iter().enumerate() {
         match r {
             Ok(row) if row.names == names => {
+                warnings.extend(row.cavitation);
                 for (d, v) in data.iter_mut().zip(&row.values) {
                     d[i * m..(i + 1) * m].copy_from_slice(v);
                 }
@@ -303,6 +316,10 @@ fn stack(
     }
     let [steps, rejected, rhs, wall] = stats;
     let ok: Vec<bool> = errors.iter().map(Option::is_none).collect();
+    // the sets kept, in order, once the batch is sure to be returned
+    for w in &warnings {
+        crate::errors::warn_cavitation(py, w)?;
+    }
     Ok(PyBatch {
         time: array(py, t).unbind(),
         channels: Named { names, values },

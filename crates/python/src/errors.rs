@@ -1,9 +1,11 @@
 //! How failures cross into Python: bad input is a `ValueError` carrying the
 //! CLI's one-line message, a solver failure a [`SimulationError`] with the
 //! time and the state where it stopped, and a Rust panic (a bug) a
-//! `RuntimeError` — never an unwinding panic through the interpreter.
+//! `RuntimeError` — never an unwinding panic through the interpreter. A run
+//! that is kept but left its model's range warns with a
+//! [`CavitationWarning`] ([`warn_cavitation`]).
 
-use pyo3::exceptions::{PyException, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyException, PyRuntimeError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -16,6 +18,25 @@ pyo3::create_exception!(
      The message names the method, the time and the state where it stopped; \
      the attributes `time` [s] and `state` (dict: state name -> value, SI) hold them."
 );
+
+pyo3::create_exception!(
+    hydrocyl,
+    CavitationWarning,
+    PyUserWarning,
+    "A chamber pressure fell far below absolute vacuum (below -10 bar gauge) \
+     without the run blowing up: the oil, a liquid of constant bulk modulus, \
+     has left its range there (the chamber cavitates). The run is returned; \
+     the message names the chamber, its lowest pressure and the remedy \
+     (entrained air, where the cylinder's type has it)."
+);
+
+/// Warns with `message` as a [`CavitationWarning`] (an error when the
+/// warning filters make it one).
+pub fn warn_cavitation(py: Python<'_>, message: &str) -> PyResult<()> {
+    let message = std::ffi::CString::new(message.replace('\0', " "))
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    PyErr::warn(py, py.get_type::<CavitationWarning>().as_any(), &message, 1)
+}
 
 /// A failure on the Rust side, before it becomes a Python exception (kept
 /// free of Python objects so that it can leave a `detach`ed closure).

@@ -19,7 +19,9 @@
 //!
 //! Errors: ValueError with the CLI's one-line message for bad input,
 //! `hydrocyl.SimulationError` for a solver failure (time and state in the
-//! message), RuntimeError for a caught panic (a bug). The GIL is released
+//! message), RuntimeError for a caught panic (a bug); a run kept although a
+//! chamber's constant-B oil left its range warns with
+//! `hydrocyl.CavitationWarning`. The GIL is released
 //! while Rust runs; `simulate_batch` runs its parameter sets on rayon's
 //! threads. The type stubs are `hydrocyl.pyi` beside this crate's manifest;
 //! the pytest suite is `tests/` (`cargo xtask test` builds the wheel and
@@ -52,6 +54,10 @@ fn hydrocyl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add(
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),
+    )?;
+    m.add(
+        "CavitationWarning",
+        m.py().get_type::<errors::CavitationWarning>(),
     )?;
     m.add_class::<rig::Rig>()?;
     m.add_class::<run::PyRun>()?;

@@ -320,7 +320,10 @@ impl Rig {
     /// released while it runs.
     ///
     /// ValueError for bad input (the CLI's message); SimulationError when
-    /// the solver fails (time and state in the message).
+    /// the solver fails or the run blows up (time and state in the
+    /// message). A chamber pressure far below vacuum in a run that did not
+    /// blow up (the constant-B oil cavitating) warns with
+    /// `hydrocyl.CavitationWarning` and the run is returned.
     #[pyo3(signature = (t, u, *, solver = "auto", rtol = 1e-6, rk4_step = 2e-5, h_max = None, ledger = false))]
     #[allow(clippy::too_many_arguments)]
     fn simulate(
@@ -341,6 +344,9 @@ impl Rig {
             let cmd = sim::command(&t, &u)?;
             sim::simulate(&value, &cmd, &t, &opts)
         })?;
+        if let Some(w) = &out.cavitation {
+            crate::errors::warn_cavitation(py, w)?;
+        }
         PyRun::new(py, out)
     }
 }

@@ -8,7 +8,8 @@ use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
 use hydrocyl_integrators::SolveError;
 use hydrocyl_system::rig::{self, RigError};
 use hydrocyl_system::run::{
-    chamber_types_with_air, Cause, Run, RunOptions, Setting, SimError, Solver, AIR_PARAMETER,
+    chamber_types_with_air, AirRemedy, Cause, DeepCavitation, Run, RunOptions, Setting, SimError,
+    Solver, AIR_PARAMETER,
 };
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::simulation::Simulation;
@@ -64,6 +65,9 @@ pub struct Simulated {
     pub run: Run,
     /// The ledger (`None` unless `RunOptions::ledger`).
     pub ledger: Option<Result<Ledger, String>>,
+    /// The warning of a chamber far below vacuum
+    /// ([`Run::deep_cavitation`]), for a `CavitationWarning`.
+    pub cavitation: Option<String>,
 }
 
 /// Simulates the rig value (checked or not) on `command` sampled at `t`.
@@ -77,16 +81,62 @@ pub fn simulate(
         RigError::Sim(_) => locate_failure(value, command, t, opts, e.to_string()),
         other => Failure::Input(other.to_string()),
     })?;
-    if let Some(u) = run.unphysical() {
-        return Err(unphysical(value, command, opts, &run, u));
-    }
+    let cavitation = match run.physical() {
+        Err(u) => return Err(unphysical(value, command, opts, &run, u)),
+        Ok(deep) => deep.map(|d| cavitation_warning(value, opts, &d)),
+    };
     let ledger = opts.ledger.then(|| whole_run_ledger(value, command, &run));
-    Ok(Simulated { run, ledger })
+    Ok(Simulated {
+        run,
+        ledger,
+        cavitation,
+    })
 }
 
-/// A run that finished but is not physical ([`Run::unphysical`]) as a
-/// [`Failure::Solver`]: the CLI's diagnosis and remedy in Python's words,
-/// the time and the state of the first such sample.
+/// The warning of a run whose chamber fell far below vacuum without
+/// blowing up ([`DeepCavitation`]): the CLI's, in Python's words (a
+/// parameter proposed to set is one the component's type has).
+fn cavitation_warning(value: &Value, opts: &RunOptions, d: &DeepCavitation) -> String {
+    let solver = opts.solver;
+    let AirRemedy {
+        cylinder,
+        air,
+        type_name,
+    } = d.remedy(|c| rig::component_type(value, c));
+    let remedy = match air {
+        Some(p) => format!("give it entrained air (rig.set('{p}', 0.005))"),
+        None => format!(
+            "'{cylinder}'{} has no entrained-air parameter, so its chambers cannot be given air here (the component types that have '{AIR_PARAMETER}': {})",
+            type_name.map(|t| format!(" (a '{t}')")).unwrap_or_default(),
+            chamber_types_with_air().join(", ")
+        ),
+    };
+    let check = if solver.fixed_step() {
+        format!(
+            "; a smaller rk4_step than {} tells whether the {} step is to blame instead",
+            opts.rk4_step,
+            solver.name()
+        )
+    } else {
+        format!(
+            "; if the {} run is unstable instead, a smaller rtol{} tells",
+            solver.name(),
+            if matches!(solver, Solver::Rosenbrock) {
+                ""
+            } else {
+                " or solver='rosenbrock'"
+            }
+        )
+    };
+    format!(
+        "a chamber pressure fell far below absolute vacuum ({}): the oil, a liquid of constant bulk modulus, has left its range from then on (the chamber cavitates); {remedy}{check}",
+        d.what()
+    )
+}
+
+/// A run that finished but is not physical ([`Run::unphysical`]: a blow-up)
+/// as a [`Failure::Solver`]: the CLI's diagnosis and remedy in Python's
+/// words, the time and the state of the first such sample.
 fn unphysical(
     value: &Value,
     command: &Signal,
@@ -95,27 +145,7 @@ fn unphysical(
     u: hydrocyl_system::run::Unphysical,
 ) -> Failure {
     let solver = opts.solver;
-    // a parameter proposed to set is one the component's type has
-    let message = match u.cause(solver, |c| rig::component_type(value, c)) {
-        Cause::Cavitation {
-            cylinder,
-            air,
-            type_name,
-        } => {
-            let remedy = match air {
-                Some(p) => format!("give it entrained air (rig.set('{p}', 0.005))"),
-                None => format!(
-                    "'{cylinder}'{} has no entrained-air parameter, so its chambers cannot be given air here (the component types that have '{AIR_PARAMETER}': {})",
-                    type_name.map(|t| format!(" (a '{t}')")).unwrap_or_default(),
-                    chamber_types_with_air().join(", ")
-                ),
-            };
-            format!(
-                "a chamber pressure fell far below absolute vacuum ({}): the oil, a liquid of constant bulk modulus, has left its range (the chamber cavitates); {remedy}; or if the {} run is unstable instead, try a smaller rtol",
-                u.what,
-                solver.name()
-            )
-        }
+    let message = match u.cause(solver) {
         Cause::StepTooLong => format!(
             "the {} solution is unstable ({}): rk4_step {} is too large for this rig: use a smaller step or solver='auto'",
             solver.name(),

@@ -995,7 +995,7 @@ fn a_flat_spelled_parameter_prints_and_sets_where_it_is() {
 /// A chamber pressure is known by the probe it reads, whatever its column
 /// is called: a second cylinder drained through orifices, its `p1` shown as
 /// `pd1`, is pulled far below vacuum by the first, and the run says so
-/// (`Run::unphysical`, `Run::min_chamber_pressure`) naming the damper.
+/// (`Run::deep_cavitation`, `Run::min_chamber_pressure`) naming the damper.
 #[test]
 fn a_renamed_chamber_pressure_is_still_a_chamber_pressure() {
     let mut v = load("fixtures/rigs/leaney-moog.json");
@@ -1016,7 +1016,12 @@ fn a_renamed_chamber_pressure_is_still_a_chamber_pressure() {
         "{}",
         run.min_chamber_pressure()
     );
-    let u = run.unphysical().expect("a chamber far below vacuum");
-    assert_eq!(u.chamber_of.as_deref(), Some("damper"));
-    assert!(u.what.starts_with("pd1 = "), "{}", u.what);
+    assert_eq!(run.unphysical(), None);
+    let d = run.deep_cavitation().expect("a chamber far below vacuum");
+    assert_eq!(d.lowest.cylinder, "damper");
+    assert!(
+        d.what().starts_with("pd1 of `damper` fell below"),
+        "{}",
+        d.what()
+    );
 }

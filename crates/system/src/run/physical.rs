@@ -1,7 +1,10 @@
-//! Whether a run's solution is physical: the signs of an integration that
-//! blew up (a non-finite value, a chamber pressure far below absolute
-//! vacuum), found the same way for every client (the CLI names its remedy,
-//! Python raises `SimulationError`).
+//! Whether a run's solution is physical, found the same way for every
+//! client (the CLI words it with its flags, Python with its arguments):
+//! the signs of an integration that blew up (a non-finite value, a chamber
+//! pressure below the liquid's tension limit: [`Run::unphysical`], an
+//! error), and the known limit of the constant-bulk-modulus liquid, a
+//! chamber pulled far below absolute vacuum but not that far
+//! ([`Run::deep_cavitation`], a warning: the run is kept).
 
 use super::{Run, Solver};
 use crate::netlist::registry::ComponentType;
@@ -10,25 +13,27 @@ use crate::rig::ABSOLUTE_VACUUM_GAUGE_PA;
 /// The registry's name of the entrained-air parameter (volume fraction at
 /// atmospheric pressure) of the component types that model it: the remedy
 /// for a chamber of constant-B liquid cavitating, proposed only where the
-/// chamber's type has it ([`Cause::Cavitation`]).
+/// chamber's type has it ([`AirRemedy`]).
 pub const AIR_PARAMETER: &str = "air_fraction";
 
-/// Pressures far below absolute vacuum (ten times its depth) or a
-/// non-finite value: the solution is not physical \[Pa\].
+/// A chamber pressure below this (ten times the depth of absolute vacuum)
+/// is far outside the constant-B liquid's range: the chamber cavitates
+/// ([`Run::deep_cavitation`]) \[Pa\].
 pub const ABSURD_PRESSURE_PA: f64 = 10.0 * ABSOLUTE_VACUUM_GAUGE_PA;
 
-/// A chamber pressure between this and [`ABSURD_PRESSURE_PA`] from an
-/// error-controlled solver is read as the constant-B liquid cavitating
-/// (finite, the same with any tolerance); below it, as a blow-up \[Pa\].
+/// A chamber pressure between this and [`ABSURD_PRESSURE_PA`] is read as the
+/// constant-B liquid cavitating (finite, the same with any method and
+/// tolerance); below it, as a blow-up ([`Run::unphysical`]) \[Pa\].
 pub const LIQUID_TENSION_LIMIT_PA: f64 = -1.0e8;
 
-/// The first sample of a run that is not physical.
+/// The first sample of a run that is not physical: a non-finite value in
+/// any channel, or a chamber pressure below [`LIQUID_TENSION_LIMIT_PA`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Unphysical {
     /// `<channel> = <value> <unit> at t = <time> s`.
     pub what: String,
     /// The cylinder whose chamber pressure it is, when it is a chamber
-    /// pressure (finite, far below vacuum).
+    /// pressure (finite, below the tension limit).
     pub chamber_of: Option<String>,
     /// The value itself.
     pub value: f64,
@@ -40,22 +45,6 @@ pub struct Unphysical {
 /// client to word with its own names for the settings.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Cause {
-    /// An error-controlled solver met its tolerance on a finite, moderate
-    /// tension: the oil, a liquid of constant bulk modulus, has left its
-    /// range in a chamber of `cylinder` (give it entrained air), unless
-    /// the run is unstable after all (a smaller tolerance tells).
-    Cavitation {
-        /// The cylinder whose chamber it is.
-        cylinder: String,
-        /// The parameter path (`<cylinder>.air_fraction`) that gives the
-        /// cylinder's chambers entrained air, when its component type has
-        /// one ([`AIR_PARAMETER`]); `None` when it has none (or its type is
-        /// not known) and nothing may be proposed to set.
-        air: Option<String>,
-        /// The cylinder's component type (`generalised_cylinder`), when
-        /// known: the one the message says lacks the parameter.
-        type_name: Option<&'static str>,
-    },
     /// A fixed-step method ([`Solver::fixed_step`]): its step is too long
     /// for the rig.
     StepTooLong,
@@ -65,33 +54,111 @@ pub enum Cause {
 }
 
 impl Unphysical {
-    /// Whether it reads as the liquid's tension rather than a blow-up: a
-    /// finite chamber pressure above [`LIQUID_TENSION_LIMIT_PA`].
-    pub fn is_tension(&self) -> bool {
-        self.chamber_of.is_some() && self.value.is_finite() && self.value > LIQUID_TENSION_LIMIT_PA
+    /// Its cause, from a run by `solver`.
+    pub fn cause(&self, solver: Solver) -> Cause {
+        if solver.fixed_step() {
+            Cause::StepTooLong
+        } else {
+            Cause::Unstable
+        }
+    }
+}
+
+/// One chamber pressure sample far below vacuum: its channel, its
+/// cylinder, the value and the time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tension {
+    /// The channel (column) name: `p1`, or whatever a netlist calls it.
+    pub channel: String,
+    /// The cylinder whose chamber it is.
+    pub cylinder: String,
+    /// The pressure \[Pa\] (below [`ABSURD_PRESSURE_PA`], finite, above
+    /// [`LIQUID_TENSION_LIMIT_PA`]).
+    pub value: f64,
+    /// Its time \[s\].
+    pub time: f64,
+}
+
+/// A run whose chambers' constant-B liquid left its range, but which did not
+/// blow up: a chamber pressure below [`ABSURD_PRESSURE_PA`] in a run with no
+/// non-finite value and none below [`LIQUID_TENSION_LIMIT_PA`]
+/// ([`Run::deep_cavitation`]). Not an error: the liquid model's known limit,
+/// for a client to warn of. Blocks of one run merge into the run's
+/// ([`DeepCavitation::merge`], in any order).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeepCavitation {
+    /// The earliest sample far below vacuum: from its time on the run is
+    /// outside the liquid model's range.
+    pub first: Tension,
+    /// The lowest chamber pressure of the run.
+    pub lowest: Tension,
+}
+
+/// The remedy for a chamber of constant-B liquid cavitating: entrained
+/// air, where the chamber's component type has it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct AirRemedy {
+    /// The cylinder whose chamber it is.
+    pub cylinder: String,
+    /// The parameter path (`<cylinder>.air_fraction`) that gives the
+    /// cylinder's chambers entrained air, when its component type has one
+    /// ([`AIR_PARAMETER`]); `None` when it has none (or its type is not
+    /// known) and nothing may be proposed to set.
+    pub air: Option<String>,
+    /// The cylinder's component type (`generalised_cylinder`), when known:
+    /// the one the message says lacks the parameter.
+    pub type_name: Option<&'static str>,
+}
+
+impl DeepCavitation {
+    /// The two of one run (blocks of it, in any order): the earlier first
+    /// sample and the lower lowest one.
+    pub fn merge(self, other: DeepCavitation) -> DeepCavitation {
+        let earlier = |a: Tension, b: Tension| if b.time < a.time { b } else { a };
+        let lower = |a: Tension, b: Tension| if b.value < a.value { b } else { a };
+        DeepCavitation {
+            first: earlier(self.first, other.first),
+            lowest: lower(self.lowest, other.lowest),
+        }
     }
 
-    /// Its cause, from a run by `solver`; `type_of` gives a component's
-    /// registry type by its instance name (the rig's schematic), so that a
-    /// remedy names only a parameter the component has.
-    pub fn cause(
-        &self,
-        solver: Solver,
-        type_of: impl Fn(&str) -> Option<&'static ComponentType>,
-    ) -> Cause {
-        match &self.chamber_of {
-            Some(c) if !solver.fixed_step() && self.is_tension() => {
-                let ty = type_of(c);
-                Cause::Cavitation {
-                    cylinder: c.clone(),
-                    air: ty
-                        .and_then(|t| t.param(AIR_PARAMETER))
-                        .map(|p| format!("{c}.{}", p.name)),
-                    type_name: ty.map(|t| t.name),
-                }
-            }
-            _ if solver.fixed_step() => Cause::StepTooLong,
-            _ => Cause::Unstable,
+    /// [`DeepCavitation::merge`] of two that may be absent.
+    pub fn merged(a: Option<Self>, b: Option<Self>) -> Option<Self> {
+        match (a, b) {
+            (Some(a), Some(b)) => Some(a.merge(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// The facts, for a message: `p1 of `cylinder` fell below -1.01325e6
+    /// Pa at t = 1.505 s, lowest -1.4885e6 Pa at t = 1.507 s` (the lowest
+    /// chamber named too when it is another).
+    pub fn what(&self) -> String {
+        let (f, l) = (&self.first, &self.lowest);
+        let other = if (&f.channel, &f.cylinder) == (&l.channel, &l.cylinder) {
+            String::new()
+        } else {
+            format!(" {} of `{}`", l.channel, l.cylinder)
+        };
+        format!(
+            "{} of `{}` fell below {ABSURD_PRESSURE_PA:e} Pa at t = {} s, lowest{other} {:.4e} Pa at t = {} s",
+            f.channel, f.cylinder, f.time, l.value, l.time
+        )
+    }
+
+    /// The remedy for the lowest chamber's cylinder; `type_of` gives a
+    /// component's registry type by its instance name (the rig's
+    /// schematic), so that a remedy names only a parameter the component
+    /// has.
+    pub fn remedy(&self, type_of: impl Fn(&str) -> Option<&'static ComponentType>) -> AirRemedy {
+        let c = &self.lowest.cylinder;
+        let ty = type_of(c);
+        AirRemedy {
+            cylinder: c.clone(),
+            air: ty
+                .and_then(|t| t.param(AIR_PARAMETER))
+                .map(|p| format!("{c}.{}", p.name)),
+            type_name: ty.map(|t| t.name),
         }
     }
 }
@@ -118,36 +185,94 @@ pub fn chamber_of(probe: &str) -> Option<&str> {
 }
 
 impl Run {
-    /// The first sample that is not physical (a non-finite value in any
-    /// channel, a chamber pressure below [`ABSURD_PRESSURE_PA`]), if any.
-    pub fn unphysical(&self) -> Option<Unphysical> {
-        self.channels.iter().find_map(|c| {
-            let chamber = c.unit == "Pa" && chamber_of(&c.probe).is_some();
-            let floor = if chamber {
-                ABSURD_PRESSURE_PA
+    /// Whether the run is physical, the one rule for every client: `Err`
+    /// with the earliest sample that is not ([`Run::unphysical`]: a
+    /// non-finite value in any channel, a chamber pressure below
+    /// [`LIQUID_TENSION_LIMIT_PA`], anywhere in the run), else whether its
+    /// constant-B liquid left its range ([`Run::deep_cavitation`]: a chamber
+    /// pressure below [`ABSURD_PRESSURE_PA`]). One pass over the channels.
+    pub fn physical(&self) -> Result<Option<DeepCavitation>, Unphysical> {
+        // the earliest bad sample: (sample, channel)
+        let mut bad: Option<(usize, usize)> = None;
+        let mut deep: Option<DeepCavitation> = None;
+        for (i, c) in self.channels.iter().enumerate() {
+            let cylinder = chamber_of(&c.probe).filter(|_| c.unit == "Pa");
+            let floor = if cylinder.is_some() {
+                LIQUID_TENSION_LIMIT_PA
             } else {
                 f64::NEG_INFINITY
             };
             // NaN and ±∞ fail the first test; no early exit inside a chunk,
             // so that the test is made on several values at once
             let ok = |v: f64| v.is_finite() & (v >= floor);
-            if c.values
+            if !c
+                .values
                 .chunks(16)
                 .all(|ch| ch.iter().fold(true, |a, &v| a & ok(v)))
             {
-                return None;
+                if let Some(k) = c.values.iter().position(|&v| !ok(v)) {
+                    if bad.is_none_or(|(b, _)| k < b) {
+                        bad = Some((k, i));
+                    }
+                }
             }
-            let k = c.values.iter().position(|&v| !ok(v))?;
-            let v = c.values[k];
-            Some(Unphysical {
-                what: format!("{} = {v:e} {} at t = {} s", c.name, c.unit, self.time[k]),
-                chamber_of: chamber_of(&c.probe)
-                    .filter(|_| chamber && v.is_finite())
-                    .map(str::to_string),
-                value: v,
-                sample: k,
-            })
-        })
+            let Some(cylinder) = cylinder else {
+                continue;
+            };
+            if bad.is_some()
+                || c.values.iter().copied().fold(f64::INFINITY, f64::min) >= ABSURD_PRESSURE_PA
+            {
+                continue;
+            }
+            let tension = |k: usize| Tension {
+                channel: c.name.clone(),
+                cylinder: cylinder.to_string(),
+                value: c.values[k],
+                time: self.time[k],
+            };
+            let Some(first) = c.values.iter().position(|&v| v < ABSURD_PRESSURE_PA) else {
+                continue;
+            };
+            let lowest =
+                (first..c.values.len())
+                    .fold(first, |m, k| if c.values[k] < c.values[m] { k } else { m });
+            let d = DeepCavitation {
+                first: tension(first),
+                lowest: tension(lowest),
+            };
+            deep = DeepCavitation::merged(deep, Some(d));
+        }
+        match bad {
+            Some((k, i)) => {
+                let c = &self.channels[i];
+                let v = c.values[k];
+                Err(Unphysical {
+                    what: format!("{} = {v:e} {} at t = {} s", c.name, c.unit, self.time[k]),
+                    chamber_of: chamber_of(&c.probe)
+                        .filter(|_| c.unit == "Pa" && v.is_finite())
+                        .map(str::to_string),
+                    value: v,
+                    sample: k,
+                })
+            }
+            None => Ok(deep),
+        }
+    }
+
+    /// The earliest sample that is not physical — a non-finite value in any
+    /// channel, a chamber pressure below [`LIQUID_TENSION_LIMIT_PA`] (a
+    /// blow-up) — if any: an error ([`Run::physical`]).
+    pub fn unphysical(&self) -> Option<Unphysical> {
+        self.physical().err()
+    }
+
+    /// Where a run that is physical ([`Run::unphysical`] is `None`) has a
+    /// chamber pressure below [`ABSURD_PRESSURE_PA`]: the constant-B liquid
+    /// has left its range (the chamber cavitates) from its first such sample
+    /// on. A warning, not an error ([`Run::physical`]); `None` for a run that
+    /// is not physical.
+    pub fn deep_cavitation(&self) -> Option<DeepCavitation> {
+        self.physical().ok().flatten()
     }
 }
 
@@ -156,76 +281,139 @@ mod tests {
     use super::*;
     use crate::run::Channel;
 
-    /// A run of one channel `name` reading probe `probe`.
-    fn run_of(name: &str, probe: &str, unit: &'static str, values: Vec<f64>) -> Run {
+    /// A channel `name` reading probe `probe`.
+    fn channel(name: &str, probe: &str, unit: &'static str, values: Vec<f64>) -> Channel {
+        Channel {
+            name: name.into(),
+            unit,
+            probe: probe.into(),
+            values,
+        }
+    }
+
+    /// A run of `channels`, sampled every 0.1 s.
+    fn run_with(channels: Vec<Channel>) -> Run {
+        let n = channels.first().map_or(0, |c| c.values.len());
         Run {
-            time: (0..values.len()).map(|k| k as f64 * 0.1).collect(),
-            channels: vec![Channel {
-                name: name.into(),
-                unit,
-                probe: probe.into(),
-                values,
-            }],
+            time: (0..n).map(|k| k as f64 * 0.1).collect(),
+            channels,
             ..Run::default()
         }
     }
 
     /// A run of one channel named after its probe.
     fn run(probe: &str, unit: &'static str, values: Vec<f64>) -> Run {
-        run_of(probe, probe, unit, values)
+        run_with(vec![channel(probe, probe, unit, values)])
     }
 
     #[test]
-    fn a_blow_up_a_tension_and_a_good_run_are_told_apart() {
-        // within ten times the depth of vacuum: physical enough
+    fn a_blow_up_a_deep_cavitation_and_a_good_run_are_told_apart() {
+        // within ten times the depth of vacuum: physical, no warning
+        let r = run("cylinder.p1", "Pa", vec![1e5, -5e5, 2e6]);
+        assert_eq!(r.physical(), Ok(None));
+        // far below vacuum, finite and above the tension limit: the
+        // liquid's known limit, a warning, not an error
+        let r = run("damper.p2", "Pa", vec![1e5, -4e6, -2e6, -9e6, 1e5]);
+        assert_eq!(r.unphysical(), None);
+        let d = r.deep_cavitation().unwrap();
         assert_eq!(
-            run("cylinder.p1", "Pa", vec![1e5, -5e5, 2e6]).unphysical(),
-            None
+            (d.first.time, d.first.value, d.lowest.time, d.lowest.value),
+            (0.1, -4e6, 0.30000000000000004, -9e6)
         );
-        // far below vacuum, finite and moderate: the liquid's tension
-        let u = run("damper.p2", "Pa", vec![1e5, -4e6])
-            .unphysical()
-            .unwrap();
-        assert_eq!(u.chamber_of.as_deref(), Some("damper"));
-        assert!(u.is_tension());
-        assert_eq!(u.what, "damper.p2 = -4e6 Pa at t = 0.1 s");
+        assert_eq!(d.lowest.cylinder, "damper");
         assert_eq!(
-            u.cause(Solver::Auto, |_| None),
-            Cause::Cavitation {
-                cylinder: "damper".into(),
-                air: None,
-                type_name: None,
-            }
+            d.what(),
+            "damper.p2 of `damper` fell below -1.01325e6 Pa at t = 0.1 s, lowest -9.0000e6 Pa at t = 0.30000000000000004 s"
         );
-        // the same from a fixed step: the step is too long
-        assert_eq!(u.cause(Solver::Exponential, |_| None), Cause::StepTooLong);
-        // a renamed column is still the chamber it reads
-        let u = run_of("p1", "cylinder.p1", "Pa", vec![-1e9])
-            .unphysical()
-            .unwrap();
+        // below the tension limit: a blow-up, whatever the solver
+        let r = run_with(vec![channel("p1", "cylinder.p1", "Pa", vec![-1e9])]);
+        let u = r.unphysical().unwrap();
         assert_eq!(u.chamber_of.as_deref(), Some("cylinder"));
-        assert!(!u.is_tension());
-        // far beyond the tension limit: a blow-up
-        assert_eq!(u.cause(Solver::Dp45, |_| None), Cause::Unstable);
+        assert_eq!(r.deep_cavitation(), None);
+        assert_eq!(u.cause(Solver::Dp45), Cause::Unstable);
+        assert_eq!(u.cause(Solver::Rk4), Cause::StepTooLong);
         // a non-finite value in any channel; a pressure that is not a
         // chamber's may be as low as it likes
         let u = run("position", "m", vec![0.0, f64::NAN])
             .unphysical()
             .unwrap();
         assert_eq!((u.chamber_of, u.what.contains("NaN")), (None, true));
-        assert_eq!(run("ps", "Pa", vec![-1e7]).unphysical(), None);
+        assert_eq!(run("ps", "Pa", vec![-1e9]).physical(), Ok(None));
+    }
+
+    #[test]
+    fn a_run_that_passes_through_tension_and_then_blows_up_is_an_error() {
+        // moderate tension first (in the pressure channel listed first),
+        // a NaN later in another: the whole run is checked, the NaN found
+        let r = run_with(vec![
+            channel("p1", "cylinder.p1", "Pa", vec![1e5, -4e6, -8e7, -5e7]),
+            channel("position", "cylinder.x", "m", vec![0.0, 0.1, 0.2, f64::NAN]),
+        ]);
+        let u = r.unphysical().unwrap();
+        assert_eq!((u.sample, u.value.is_nan()), (3, true));
+        assert_eq!(r.deep_cavitation(), None);
+        // the earliest bad sample of all the channels is the one named
+        let r = run_with(vec![
+            channel("position", "cylinder.x", "m", vec![0.0, 0.1, f64::INFINITY]),
+            channel("p1", "cylinder.p1", "Pa", vec![1e5, -2e8, -5e7]),
+        ]);
+        assert_eq!(r.unphysical().unwrap().sample, 1);
+    }
+
+    #[test]
+    fn the_blocks_of_a_run_merge_into_the_runs_deep_cavitation() {
+        let whole = run_with(vec![
+            channel(
+                "p1",
+                "cylinder.p1",
+                "Pa",
+                vec![1e5, -2e6, -3e6, 1e5, 1e5, 1e5],
+            ),
+            channel(
+                "p2",
+                "cylinder.p2",
+                "Pa",
+                vec![1e5, 1e5, 1e5, 1e5, -7e6, 1e5],
+            ),
+        ]);
+        let d = whole.deep_cavitation().unwrap();
+        assert_eq!((d.first.channel.as_str(), d.first.time), ("p1", 0.1));
+        assert_eq!((d.lowest.channel.as_str(), d.lowest.value), ("p2", -7e6));
+        assert_eq!(
+            d.what(),
+            "p1 of `cylinder` fell below -1.01325e6 Pa at t = 0.1 s, lowest p2 of `cylinder` -7.0000e6 Pa at t = 0.4 s"
+        );
+        // the same from two blocks, merged in either order
+        let block = |range: std::ops::Range<usize>| Run {
+            time: whole.time[range.clone()].to_vec(),
+            channels: whole
+                .channels
+                .iter()
+                .map(|c| Channel {
+                    values: c.values[range.clone()].to_vec(),
+                    ..c.clone()
+                })
+                .collect(),
+            ..Run::default()
+        };
+        let (a, b) = (block(0..3).deep_cavitation(), block(3..6).deep_cavitation());
+        assert_eq!(
+            DeepCavitation::merged(a.clone(), b.clone()),
+            Some(d.clone())
+        );
+        assert_eq!(DeepCavitation::merged(b, a), Some(d));
     }
 
     #[test]
     fn the_cavitation_remedy_names_air_only_where_the_chambers_type_has_it() {
         use crate::netlist::registry::lookup;
-        let u = run("cylinder.p1", "Pa", vec![1e5, -4e6])
-            .unphysical()
+        let d = run("cylinder.p1", "Pa", vec![1e5, -4e6])
+            .deep_cavitation()
             .unwrap();
         // the fundamental cylinder models entrained air
         assert_eq!(
-            u.cause(Solver::Auto, |_| lookup("cylinder")),
-            Cause::Cavitation {
+            d.remedy(|_| lookup("cylinder")),
+            AirRemedy {
                 cylinder: "cylinder".into(),
                 air: Some("cylinder.air_fraction".into()),
                 type_name: Some("cylinder"),
@@ -234,12 +422,14 @@ mod tests {
         assert_eq!(chamber_types_with_air(), ["cylinder"]);
         // the generalised one does not: nothing to set is proposed
         assert_eq!(
-            u.cause(Solver::Auto, |_| lookup("generalised_cylinder")),
-            Cause::Cavitation {
+            d.remedy(|_| lookup("generalised_cylinder")),
+            AirRemedy {
                 cylinder: "cylinder".into(),
                 air: None,
                 type_name: Some("generalised_cylinder"),
             }
         );
+        // nor where the type is not known
+        assert_eq!(d.remedy(|_| None).air, None);
     }
 }

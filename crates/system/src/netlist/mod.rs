@@ -420,6 +420,87 @@ mod tests {
         );
     }
 
+    /// A builder's error about one parameter, found where the steady
+    /// initial pressures are worked out (a chamber length not over half
+    /// the stroke), is named at that parameter, its message apart from
+    /// its path (not `…chamber_length_1chamber 1 volume …`); on a preset
+    /// the paths read as `--set` takes them, in a file as JSON paths.
+    #[test]
+    fn a_parameter_refused_for_the_steady_start_is_named_at_it() {
+        use crate::rig;
+        for name in ["leaney-moog", "leaney-moog-generalised"] {
+            let mut v = rig::preset(name).unwrap();
+            rig::apply_set(&mut v, "cylinder.chamber_length_1=0.2").unwrap();
+            let e = rig::check(&v).unwrap_err();
+            let rig::RigError::Invalid { path, why } = &e else {
+                panic!("{name}: {e}");
+            };
+            assert_eq!(path, "components.cylinder.chamber_length_1", "{name}");
+            assert!(why.starts_with("chamber 1 volume"), "{name}: {why}");
+            assert!(!why.contains('\u{1f}'), "{name}: {why:?}");
+            let shown = rig::at_line(e.clone(), name).to_string();
+            assert!(
+                shown.starts_with("rig `cylinder.chamber_length_1`: chamber 1 volume"),
+                "{shown}"
+            );
+            assert!(!shown.contains("components."), "{shown}");
+        }
+    }
+
+    /// A tank at or above the supply is named at the tank's pressure, the
+    /// supply named beside it: the cause, not the steady state it spoils.
+    #[test]
+    fn a_tank_above_the_supply_is_named_as_the_cause() {
+        use crate::rig;
+        for name in ["leaney-moog", "leaney-moog-generalised"] {
+            let mut v = rig::preset(name).unwrap();
+            rig::apply_set(&mut v, "tank.pressure=1e7").unwrap();
+            let e = rig::at_line(rig::check(&v).unwrap_err(), name).to_string();
+            assert!(
+                e.starts_with("rig `tank.pressure`: the tank pressure 10000000 Pa"),
+                "{e}"
+            );
+            assert!(
+                e.contains("supply pressure 7000000 Pa (supply.pressure"),
+                "{e}"
+            );
+            assert!(!e.contains("ps = -3000000"), "{e}");
+        }
+    }
+
+    /// On a preset (no file to look in) a range error and any other error
+    /// name the parameter as `--set` does; in a user's file as its JSON path.
+    #[test]
+    fn errors_name_set_paths_on_a_preset_and_json_paths_in_a_file() {
+        use crate::rig;
+        let mut v = rig::preset("leaney-moog").unwrap();
+        rig::apply_set(&mut v, "load.mass=-1").unwrap();
+        let e = rig::check(&v).unwrap_err();
+        assert!(
+            rig::at_line(e.clone(), "leaney-moog")
+                .to_string()
+                .starts_with("rig `load.mass`: -1 [kg] is out of range"),
+            "{e}"
+        );
+        let dir = std::env::temp_dir().join(format!("hydrocyl-setform-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("rig.json");
+        std::fs::write(&file, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+        let shown = rig::at_line(e, file.to_str().unwrap()).to_string();
+        assert!(shown.starts_with("rig `components.load.mass`"), "{shown}");
+        assert!(shown.contains("(line "), "{shown}");
+        std::fs::remove_dir_all(&dir).ok();
+        // a name that only starts like a component's is left alone
+        let e = rig::RigError::Invalid {
+            path: "components.load".into(),
+            why: "see components.loader.mass and components.load.mass".into(),
+        };
+        assert_eq!(
+            rig::set_form(e, &v).to_string(),
+            "rig `load`: see components.loader.mass and load.mass"
+        );
+    }
+
     /// `--set cylinder.…`/`load.…` on a friction bench without that
     /// component (emps has no cylinder; no bench has a load) names the
     /// drive's paths that hold the mass and the position; the seal benches'

@@ -501,6 +501,30 @@ mod tests {
         );
     }
 
+    /// `load.initial.position` on a preset whose cylinder gives the rod's
+    /// position: the error names both paths and the two ways on, and the
+    /// second (the cylinder's cleared) starts the rod where the load says.
+    #[test]
+    fn an_initial_position_given_twice_says_how_to_give_it_once() {
+        use crate::rig;
+        use crate::signal::Signal;
+        let mut v = rig::preset("leaney-moog").unwrap();
+        rig::apply_set(&mut v, "load.initial.position=0.05").unwrap();
+        let e = rig::at_line(rig::check(&v).unwrap_err(), "leaney-moog").to_string();
+        for part in [
+            "rig `load.initial.position`",
+            "cylinder.initial.position",
+            "`--set cylinder.initial.position=0.05`",
+            "`--set cylinder.initial.position=null`",
+        ] {
+            assert!(e.contains(part), "{part}: {e}");
+        }
+        rig::apply_set(&mut v, "cylinder.initial.position=null").unwrap();
+        let c = rig::circuit(&v, Signal::Constant { value: 0.0 }).unwrap();
+        let k = c.state_names().iter().position(|n| n == "load.x").unwrap();
+        assert_eq!(c.initial_state()[k], 0.05);
+    }
+
     /// `--set cylinder.…`/`load.…` on a friction bench without that
     /// component (emps has no cylinder; no bench has a load) names the
     /// drive's paths that hold the mass and the position; the seal benches'

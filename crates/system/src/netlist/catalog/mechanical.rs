@@ -286,11 +286,24 @@ pub const TYPES: &[ComponentType] = &[
             };
             let pick = |k: &str| {
                 let own = i.initial(k);
-                let given = i.hint("rod", &format!("initial.{k}"));
+                let key = format!("initial.{k}");
+                let given = i.hint("rod", &key);
                 match (own, given) {
-                    (Some(_), Some(_)) => Err(format!(
-                        "initial.{k} is given both here and on the cylinder at the rod; give it once"
-                    )),
+                    // named here, with the way on: the value on the
+                    // cylinder, or the cylinder's cleared
+                    (Some(a), Some(b)) => {
+                        let cylinder = i
+                            .hint_from
+                            .get(&("rod".to_string(), key.clone()))
+                            .cloned()
+                            .unwrap_or_else(|| "cylinder".into());
+                        Err(crate::netlist::registry::error_at(
+                            &format!("components.{}.{key}", i.name),
+                            &format!(
+                                "{a} is given here and {b} on the cylinder at the rod (components.{cylinder}.{key}); give it once: on the cylinder (`--set {cylinder}.{key}={a}`), or here with the cylinder's cleared (`--set {cylinder}.{key}=null`)"
+                            ),
+                        ))
+                    }
                     (a, b) => Ok(a.or(b).unwrap_or(0.0)),
                 }
             };

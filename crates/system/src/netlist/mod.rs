@@ -180,6 +180,11 @@ fn assemble_driven(s: &Schematic, drive: &[(String, Signal)]) -> Result<Circuit,
             c.set_probe_unit(&input.name, "command", unit);
         }
     }
+    // a command computed inside (a closed loop's controller) likewise, in
+    // the unit of what it drives (a pump's volts, a spool's demand)
+    for (name, unit) in s.command_units() {
+        c.set_probe_unit(name, "command", unit);
+    }
     let outputs = s.outputs.clone();
     let declared: Vec<(String, &[(&str, &str)])> = s
         .instances

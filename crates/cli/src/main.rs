@@ -16,6 +16,7 @@ mod fuzz;
 mod output;
 mod presets;
 mod progress;
+mod rating;
 mod rigfile;
 mod simulate;
 mod writer;

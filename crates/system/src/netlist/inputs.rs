@@ -11,6 +11,28 @@ use super::registry::Instance;
 /// rod's velocity).
 pub const INPUT_TYPES: [&str; 2] = ["command_input", "imposed_motion"];
 
+/// A rating of what the run's input drives ([`Schematic::input_rating`]):
+/// a pump's maximum speed, as the command that reaches it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InputRating {
+    /// The rated component (`pump`).
+    pub component: String,
+    /// Its steady speed per unit of command, `|K| / displacement`
+    /// \[rad·s⁻¹ per V\].
+    pub speed_per_command: f64,
+    /// Its maximum speed \[rad·s⁻¹\].
+    pub max_speed: f64,
+    /// The command magnitude that turns it at its maximum speed \[V\].
+    pub limit: f64,
+}
+
+impl InputRating {
+    /// The steady speed at command `u` \[rad·s⁻¹\].
+    pub fn speed(&self, u: f64) -> f64 {
+        u.abs() * self.speed_per_command
+    }
+}
+
 impl Schematic {
     /// The input components ([`INPUT_TYPES`]), in component order.
     pub fn inputs(&self) -> impl Iterator<Item = &Instance> {
@@ -78,6 +100,33 @@ impl Schematic {
             .find_map(|q| {
                 let doc = q.doc.strip_suffix(']')?;
                 doc.rfind('[').map(|o| &doc[o + 1..])
+            })
+    }
+
+    /// The rating the run's input is checked against, when the input drives
+    /// a pump directly (its `command` port on the input's node) and the
+    /// pump has a rating (`displacement` and `max_speed`): the command
+    /// magnitude at which the pump's steady flow `K u` turns it at its
+    /// maximum speed. `None` otherwise (no rating is known, or the pump
+    /// is driven by a controller whose output has its own limits).
+    pub fn input_rating(&self) -> Option<InputRating> {
+        let mut inputs = self.inputs();
+        let (input, None) = (inputs.next()?, inputs.next()) else {
+            return None;
+        };
+        let node = input.nodes.get("out")?;
+        self.instances
+            .iter()
+            .filter(|i| i.ty.name == "pump_identified" && i.nodes.get("command") == Some(node))
+            .find_map(|i| {
+                let (d, w) = (i.opt("displacement")?, i.opt("max_speed")?);
+                let per_volt = i.get("gain").abs() / d;
+                Some(InputRating {
+                    component: i.name.clone(),
+                    speed_per_command: per_volt,
+                    max_speed: w,
+                    limit: w / per_volt,
+                })
             })
     }
 

@@ -219,21 +219,27 @@ pub fn read_table(path: &Path, bytes: &[u8], unit: CommandUnit) -> Result<Table,
     table_of(&file, t, u, unit)
 }
 
+/// The samples `u` (at times `t`) beyond `limit` in magnitude, and the
+/// largest in magnitude with its time.
+pub fn beyond(t: &[f64], u: &[f64], limit: f64) -> (usize, (f64, f64)) {
+    let outside = u.iter().filter(|x| x.abs() > limit).count();
+    let peak = t
+        .iter()
+        .zip(u)
+        .fold((0.0, f64::NAN), |(p, tp), (&tk, &uk)| {
+            if uk.abs() > f64::abs(p) {
+                (uk, tk)
+            } else {
+                (p, tp)
+            }
+        });
+    (outside, peak)
+}
+
 /// The [`Table`] of file `file`'s samples `(t, u)`.
 fn table_of(file: &str, t: Vec<f64>, u: Vec<f64>, unit: CommandUnit) -> Result<Table, CliError> {
     let (outside, peak) = if unit == CommandUnit::Normalised {
-        let outside = u.iter().filter(|x| x.abs() > 1.0).count();
-        let peak = t
-            .iter()
-            .zip(&u)
-            .fold((0.0, f64::NAN), |(p, tp), (&tk, &uk)| {
-                if uk.abs() > f64::abs(p) {
-                    (uk, tk)
-                } else {
-                    (p, tp)
-                }
-            });
-        (outside, peak)
+        beyond(&t, &u, 1.0)
     } else {
         (0, (0.0, f64::NAN))
     };

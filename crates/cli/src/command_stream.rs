@@ -36,8 +36,8 @@ pub struct Scan {
     pub min: f64,
     /// Largest command.
     pub max: f64,
-    /// Commands outside ±1 (a normalised valve's stroke) and the largest
-    /// one in magnitude with its time.
+    /// Commands beyond the limit [`scan`] was given (±1, a normalised
+    /// valve's stroke; a pump's rating).
     pub outside: usize,
     /// The largest command in magnitude and its time.
     pub peak: (f64, f64),
@@ -198,7 +198,12 @@ impl CommandSource for Chunks {
 /// module doc): its [`Scan`] and a [`Chunks`] reader at its first row, or
 /// `None` when it is not plain (read it whole instead; that reports any
 /// error).
-pub fn scan(path: &Path, unit: CommandUnit) -> Result<Option<(Scan, Chunks)>, CliError> {
+/// Commands beyond `limit` in magnitude are counted ([`Scan::outside`]).
+pub fn scan(
+    path: &Path,
+    unit: CommandUnit,
+    limit: f64,
+) -> Result<Option<(Scan, Chunks)>, CliError> {
     let Some(mut c) = Chunks::open(path, unit)? else {
         return Ok(None);
     };
@@ -237,7 +242,7 @@ pub fn scan(path: &Path, unit: CommandUnit) -> Result<Option<(Scan, Chunks)>, Cl
         for (&tk, &uk) in t.iter().zip(u) {
             s.min = s.min.min(uk);
             s.max = s.max.max(uk);
-            if uk.abs() > 1.0 {
+            if uk.abs() > limit {
                 s.outside += 1;
             }
             if uk.abs() > s.peak.0.abs() {

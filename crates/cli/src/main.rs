@@ -17,6 +17,7 @@ mod ledger;
 mod output;
 mod presets;
 mod progress;
+mod rating;
 mod rigfile;
 mod simulate;
 mod writer;

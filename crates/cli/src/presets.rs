@@ -1,14 +1,22 @@
 //! `hydrocyl presets`: the built-in rigs `--rig` takes by name, one line
-//! each: name, kind and what it is.
+//! each: name, kind and what it is — on a terminal the description cut to
+//! fit a line (`--long`: whole), elsewhere (a pipe, a file) whole.
 
 use crate::error::CliError;
 use hydrocyl_system::rig;
+use std::io::IsTerminal as _;
 
-/// Arguments of `hydrocyl presets` (none).
+/// Arguments of `hydrocyl presets`.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Print each description whole on a terminal too (piped or redirected
+    /// output always has it whole; a terminal gets one short line per preset).
+    #[arg(long)]
+    long: bool,
+}
 
-/// The first sentence of `text`, at most ~100 characters.
+/// `text` without its closing full stop, at most ~100 characters (cut
+/// with `...`).
 fn one_line(text: &str) -> String {
     let first = text.trim_end_matches('.');
     if first.chars().count() > 100 {
@@ -19,8 +27,9 @@ fn one_line(text: &str) -> String {
     }
 }
 
-/// Every preset as `(name, kind, one-line description)`.
-pub fn all() -> Vec<(&'static str, String, String)> {
+/// Every preset as `(name, kind, description)`: the description whole, or
+/// cut to one short line ([`one_line`]) when `short`.
+pub fn all(short: bool) -> Vec<(&'static str, String, String)> {
     let describe = |v: &serde_json::Value| {
         let kind = v
             .get("kind")
@@ -30,7 +39,7 @@ pub fn all() -> Vec<(&'static str, String, String)> {
         let what = v
             .get("description")
             .and_then(|d| d.as_str())
-            .map(one_line)
+            .map(|d| if short { one_line(d) } else { d.to_string() })
             .unwrap_or_default();
         (kind, what)
     };
@@ -56,8 +65,9 @@ pub fn names() -> String {
 }
 
 /// Runs `hydrocyl presets`.
-pub fn run(_: Args) -> Result<(), CliError> {
-    let list = all();
+pub fn run(args: Args) -> Result<(), CliError> {
+    let short = !args.long && std::io::stdout().is_terminal();
+    let list = all(short);
     let w = list.iter().map(|p| p.0.len()).max().unwrap_or(0);
     let k = list.iter().map(|p| p.1.len()).max().unwrap_or(0);
     let lines: String = list

@@ -52,6 +52,12 @@ impl Checked {
         self.schematic.input_unit()
     }
 
+    /// The rating the run's input is checked against (a pump's maximum
+    /// speed, [`Schematic::input_rating`]).
+    pub fn input_rating(&self) -> Option<netlist::InputRating> {
+        self.schematic.input_rating()
+    }
+
     /// The registry type of each component, by instance name
     /// ([`crate::simulate::Types`]).
     pub fn component_types(&self) -> crate::simulate::Types {

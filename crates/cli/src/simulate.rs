@@ -497,14 +497,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Some(a) => a.table(unit)?,
         None => None,
     };
+    // a pump's rating is checked as a valve's stroke is (warned of, not limited)
+    let rating = checked.input_rating().filter(|_| unit == CommandUnit::Volt);
+    let limit = match &rating {
+        Some(r) => r.limit,
+        None => 1.0,
+    };
     let long = match table {
         Some(_) => None,
-        None => command_stream::scan(&cmd_path, unit)?,
+        None => command_stream::scan(&cmd_path, unit, limit)?,
     };
     let (rows, t0, t1, signal, mut input) = match (long, table) {
         (Some((scan, chunks)), _) => {
             if unit == CommandUnit::Normalised && !args.quiet {
                 warn_clamped(&cmd_path, scan.outside, scan.peak);
+            }
+            if let Some(r) = rating.as_ref().filter(|_| !args.quiet) {
+                crate::rating::warn(&cmd_path, r, scan.outside, scan.peak);
             }
             let table = StreamedTable::new(WINDOW);
             table.set_range(scan.min, scan.max);
@@ -525,6 +534,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
             };
             if unit == CommandUnit::Normalised && !args.quiet {
                 warn_clamped(&cmd_path, table.outside, table.peak);
+            }
+            if let Some(r) = rating.as_ref().filter(|_| !args.quiet) {
+                let (outside, peak) = crate::rating::beyond(&table.signal, r.limit);
+                crate::rating::warn(&cmd_path, r, outside, peak);
             }
             let t = &table.times;
             let (rows, t0, t1) = (t.len(), t[0], t[t.len() - 1]);

@@ -492,3 +492,25 @@ pub fn wave_signal(wave: Wave, amplitude: f64, period_s: f64, bias: f64) -> Sign
         },
     }
 }
+
+#[cfg(test)]
+mod tests {
+    /// The 20 kg gravity load is one number wherever it is said: 20 kg
+    /// times standard gravity [`super::G`] (the thesis gives no g), in
+    /// the `wang-valve-c10` preset's description and in docs/energy.md.
+    #[test]
+    fn the_gravity_load_is_said_one_way() {
+        let weight = format!("{:.1} N", 20.0 * super::G);
+        let preset = hydrocyl_system::rig::preset("wang-valve-c10").unwrap();
+        let description = preset["description"].as_str().unwrap();
+        let doc = include_str!("../../../docs/energy.md").replace("\n  ", " ");
+        for (place, text) in [("wang-valve-c10", description), ("docs/energy.md", &doc)] {
+            assert!(
+                text.contains(&format!("external_force = {weight}"))
+                    || text.contains(&format!("its weight, {weight}")),
+                "{place} does not say the gravity load as {weight}"
+            );
+            assert!(!text.contains("196.2"), "{place}");
+        }
+    }
+}

@@ -233,15 +233,61 @@ pub fn parse(text: &str, source: &str) -> Result<Value, RigError> {
 
 /// Adds the line of the error's JSON path in the rig file `source` (when
 /// `source` is a file, not a preset name, and the path is in it) to the
-/// message: `... (line 12 of rig.json)`.
+/// message: `... (line 12 of rig.json)`. On a preset, which the user knows
+/// by its `--set` paths (there is no file to look in), the paths of the
+/// error are written as `--set` takes them ([`set_form`]).
 pub fn at_line(e: RigError, source: &str) -> RigError {
-    if preset(source).is_some() {
-        return e;
+    if let Some(v) = preset(source) {
+        return set_form(e, &v);
     }
     let Ok(text) = std::fs::read_to_string(source) else {
         return e;
     };
     at_line_in(e, &text, source)
+}
+
+/// The error `e` about the netlist `rig` with its JSON paths of parameters
+/// (`components.load.mass`, `components.cylinder`) written as `--set` and
+/// [`parameters`] name them (`load.mass`, `cylinder`): in the path it is
+/// named at and in its message. Other paths (`connections[3]`, `kind`) are
+/// left as they are.
+pub fn set_form(e: RigError, rig: &Value) -> RigError {
+    let names: Vec<&str> = rig
+        .get("components")
+        .and_then(Value::as_object)
+        .map(|m| m.keys().map(String::as_str).collect())
+        .unwrap_or_default();
+    let rewrite = |text: &str| {
+        let mut out = String::with_capacity(text.len());
+        let mut rest = text;
+        while let Some(i) = rest.find("components.") {
+            let after = &rest[i + "components.".len()..];
+            let named = names.iter().find(|n| {
+                after.starts_with(**n)
+                    && !after[n.len()..]
+                        .starts_with(|c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+            });
+            out.push_str(&rest[..i]);
+            if named.is_none() {
+                out.push_str("components.");
+            }
+            rest = after;
+        }
+        out.push_str(rest);
+        out
+    };
+    match e {
+        RigError::Invalid { path, why } => RigError::Invalid {
+            path: rewrite(&path),
+            why: rewrite(&why),
+        },
+        RigError::OutOfRange { path, value, why } => RigError::OutOfRange {
+            path: rewrite(&path),
+            value,
+            why: rewrite(&why),
+        },
+        other => other,
+    }
 }
 
 /// [`at_line`] on the rig's text `text`, named `source` in the message.

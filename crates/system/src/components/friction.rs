@@ -20,6 +20,8 @@ pub struct Friction {
     /// The friction law.
     pub model: Box<dyn FrictionModel>,
     mode: FrictionMode,
+    /// The initial value of every internal state (a bristle's deflection z).
+    initial: f64,
     rod: MechanicalNode,
     p1: Option<Wire<Pressure>>,
     p2: Option<Wire<Pressure>>,
@@ -50,11 +52,19 @@ impl Friction {
             chambers: chambers.map(|(a, b)| (a.to_string(), b.to_string())),
             model,
             mode: FrictionMode::Slip,
+            initial: 0.0,
             rod: MechanicalNode::UNBOUND,
             p1: None,
             p2: None,
             force: Wire::UNBOUND,
         }
+    }
+
+    /// Starts the law's internal state (a bristle's deflection z \[m\])
+    /// at `z` instead of 0.
+    pub fn with_initial_state(mut self, z: f64) -> Self {
+        self.initial = z;
+        self
     }
 
     fn input(&self, w: &Wires) -> FrictionInput {
@@ -133,7 +143,7 @@ impl Component for Friction {
         s.fill(1.0e-4);
     }
     fn initial_state(&self, x: &mut [f64]) {
-        x.fill(0.0);
+        x.fill(self.initial);
     }
     fn evaluate(&self, _t: f64, x: &[f64], w: &mut Wires) {
         let input = self.input(w);

@@ -51,6 +51,8 @@ pub struct GeneralisedCylinder {
     rod: MechanicalNode,
     /// `dP_LE/dt` without the extra flows \[Pa·s⁻¹\] (no quantity type).
     dp: Wire<f64>,
+    /// The load pressure `P_LE`, the state, as a probe.
+    p_le: Wire<Pressure>,
     vte: Wire<hydrocyl_ports::Volume>,
     x_calls: Cell<u64>,
 }
@@ -86,6 +88,7 @@ impl GeneralisedCylinder {
             b: HydraulicNode::UNBOUND,
             rod: MechanicalNode::UNBOUND,
             dp: Wire::UNBOUND,
+            p_le: Wire::UNBOUND,
             vte: Wire::UNBOUND,
             x_calls: Cell::new(0),
         }
@@ -149,6 +152,7 @@ impl Component for GeneralisedCylinder {
         self.b = net.own_hydraulic(&self.ports[3], Causality::Algebraic)?;
         self.rod = net.mechanical(&self.rod_name);
         self.dp = net.private("dp_le");
+        self.p_le = net.private("p_le");
         self.vte = net.private("v_te");
         Ok(())
     }
@@ -175,6 +179,7 @@ impl Component for GeneralisedCylinder {
             Pressure::new(x[0]) * self.cylinder.effective_area(),
         );
         w.set(self.dp, s.dp_le);
+        w.set(self.p_le, Pressure::new(x[0]));
         w.set(
             self.vte,
             hydrocyl_ports::Volume::new(gen::effective_volume(
@@ -209,6 +214,7 @@ impl Component for GeneralisedCylinder {
         vec![
             Probe::of("p1", self.a.pressure),
             Probe::of("p2", self.b.pressure),
+            Probe::of("p_le", self.p_le),
         ]
     }
     fn n_events(&self) -> usize {

@@ -60,7 +60,14 @@ impl WangHybrid {
             serde_json::from_str(CIRCUIT).expect("the embedded netlist is valid JSON (tested)");
         let c = &mut v["components"];
         let tank = self.tank_pressure;
-        c["pump"] = component("pump_identified", &self.pump);
+        // the identified law into the file's pump, which keeps its rating
+        // (displacement, maximum speed: Table 4-2)
+        if let (Some(pump), Value::Object(law)) = (
+            c["pump"].as_object_mut(),
+            component("pump_identified", &self.pump),
+        ) {
+            pump.extend(law);
+        }
         for line in ["line_1", "line_2"] {
             c[line] = json!({
                 "type": "volume",

@@ -11,6 +11,28 @@ use super::registry::Instance;
 /// rod's velocity).
 pub const INPUT_TYPES: [&str; 2] = ["command_input", "imposed_motion"];
 
+/// A rating of what the run's input drives ([`Schematic::input_rating`]):
+/// a pump's maximum speed, as the command that reaches it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InputRating {
+    /// The rated component (`pump`).
+    pub component: String,
+    /// Its steady speed per unit of command, `|K| / displacement`
+    /// \[rad·s⁻¹ per V\].
+    pub speed_per_command: f64,
+    /// Its maximum speed \[rad·s⁻¹\].
+    pub max_speed: f64,
+    /// The command magnitude that turns it at its maximum speed \[V\].
+    pub limit: f64,
+}
+
+impl InputRating {
+    /// The steady speed at command `u` \[rad·s⁻¹\].
+    pub fn speed(&self, u: f64) -> f64 {
+        u.abs() * self.speed_per_command
+    }
+}
+
 impl Schematic {
     /// The input components ([`INPUT_TYPES`]), in component order.
     pub fn inputs(&self) -> impl Iterator<Item = &Instance> {
@@ -61,16 +83,68 @@ impl Schematic {
                 .find(|(p, _)| *p == "velocity")
                 .map(|(_, u)| *u);
         }
-        let (_, ports) = self.nodes.get(input.nodes.get("out")?)?;
+        self.unit_read_at(input, "out")
+    }
+
+    /// The unit in which the other components on the signal node at
+    /// `port` of `inst` read it: the first reading port whose declaration
+    /// ends in a unit (`command [V]`). `None` when the port is not
+    /// connected or no reader names a unit.
+    pub fn unit_read_at(&self, inst: &Instance, port: &str) -> Option<&'static str> {
+        let (_, ports) = self.nodes.get(inst.nodes.get(port)?)?;
         ports
             .iter()
             .filter_map(|p| p.split_once('.'))
-            .filter(|(c, _)| *c != input.name)
+            .filter(|(c, _)| *c != inst.name)
             .filter_map(|(c, port)| self.instance(c)?.ty.ports.iter().find(|q| q.name == port))
             .find_map(|q| {
                 let doc = q.doc.strip_suffix(']')?;
                 doc.rfind('[').map(|o| &doc[o + 1..])
             })
+    }
+
+    /// The rating the run's input is checked against, when the input drives
+    /// a pump directly (its `command` port on the input's node) and the
+    /// pump has a rating (`displacement` and `max_speed`): the command
+    /// magnitude at which the pump's steady flow `K u` turns it at its
+    /// maximum speed. `None` otherwise (no rating is known, or the pump
+    /// is driven by a controller whose output has its own limits).
+    pub fn input_rating(&self) -> Option<InputRating> {
+        let mut inputs = self.inputs();
+        let (input, None) = (inputs.next()?, inputs.next()) else {
+            return None;
+        };
+        let node = input.nodes.get("out")?;
+        self.instances
+            .iter()
+            .filter(|i| i.ty.name == "pump_identified" && i.nodes.get("command") == Some(node))
+            .find_map(|i| {
+                let (d, w) = (i.opt("displacement")?, i.opt("max_speed")?);
+                let per_volt = i.get("gain").abs() / d;
+                Some(InputRating {
+                    component: i.name.clone(),
+                    speed_per_command: per_volt,
+                    max_speed: w,
+                    limit: w / per_volt,
+                })
+            })
+    }
+
+    /// The units of the `command` probes of the components that compute a
+    /// command inside the circuit (a position controller owning its
+    /// `command` port): the unit its readers take it in (`V` for a pump,
+    /// `-` for a spool), as `(component, unit)`.
+    pub fn command_units(&self) -> Vec<(&str, &'static str)> {
+        self.instances
+            .iter()
+            .filter(|i| !INPUT_TYPES.contains(&i.ty.name))
+            .filter(|i| i.ty.probes.iter().any(|(p, _)| *p == "command"))
+            .filter(|i| {
+                i.ty.port("command")
+                    .is_some_and(|p| p.role == super::registry::Role::Owns)
+            })
+            .filter_map(|i| Some((i.name.as_str(), self.unit_read_at(i, "command")?)))
+            .collect()
     }
 }
 
@@ -99,6 +173,51 @@ mod tests {
             assert_eq!(s.inputs().count(), 1);
             assert_eq!((s.input_channel(), s.input_unit()), (None, Some("m/s")));
         }
+    }
+
+    /// Every rig file's `command` output is in the unit of what it drives:
+    /// a valve's normalised spool demand [-], a pump's drive voltage [V]
+    /// (the closed-loop hybrid's controller output too: ±10 V), a
+    /// bench drive's imposed velocity [m/s]; a closed loop's `reference`
+    /// is the position set-point [m].
+    #[test]
+    fn every_rig_files_command_is_in_the_unit_of_what_it_drives() {
+        let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/rigs"));
+        let expected = |name: &str| -> (&str, Option<&str>) {
+            match name {
+                "leaney-moog-closed-loop" => ("-", Some("m")),
+                "wang-hybrid-closed-loop" => ("V", Some("m")),
+                n if n.starts_with("leaney-moog") || n == "wang-valve-c10" => ("-", None),
+                n if n.starts_with("wang-hybrid") => ("V", None),
+                "tudelft-seal-25" | "tudelft-seal-257" | "emps" => ("m/s", None),
+                other => panic!("a rig file the test does not know: {other}"),
+            }
+        };
+        let mut seen = 0;
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().and_then(|e| e.to_str()) != Some("json") {
+                continue;
+            }
+            let name = path.file_stem().unwrap().to_str().unwrap().to_string();
+            let v = rig::parse(&std::fs::read_to_string(&path).unwrap(), &name).unwrap();
+            let c = rig::circuit(&v, crate::signal::Signal::Constant { value: 0.0 }).unwrap();
+            let units: Vec<(String, &str)> =
+                c.probes().into_iter().map(|p| (p.name, p.unit)).collect();
+            let unit = |col: &str| units.iter().find(|(n, _)| n == col).map(|(_, u)| *u);
+            let (command, reference) = expected(&name);
+            // a bench's input is its drive's velocity, shown as `command`
+            // or under the drive's own column
+            if command == "m/s" {
+                let s = crate::netlist::schematic(&v).unwrap();
+                assert_eq!(s.input_unit(), Some("m/s"), "{name}");
+            } else {
+                assert_eq!(unit("command"), Some(command), "{name}: command");
+            }
+            assert_eq!(unit("reference"), reference, "{name}: reference");
+            seen += 1;
+        }
+        assert!(seen >= 13, "{seen} rig files");
     }
 
     /// Two inputs, each driving its own first-order spool: each spool

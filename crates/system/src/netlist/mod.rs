@@ -55,7 +55,7 @@ use crate::run::{Run, RunOptions};
 use crate::signal::Signal;
 pub(crate) use catalog::friction_law_of as catalog_friction_law;
 pub(crate) use catalog::friction_terms_of as catalog_friction_terms;
-pub use inputs::INPUT_TYPES;
+pub use inputs::{InputRating, INPUT_TYPES};
 pub use reader::{read, NetlistError, Schematic};
 use serde_json::{Map, Value};
 
@@ -179,6 +179,11 @@ fn assemble_driven(s: &Schematic, drive: &[(String, Signal)]) -> Result<Circuit,
         if input.ty.probes.iter().any(|(p, _)| *p == "command") {
             c.set_probe_unit(&input.name, "command", unit);
         }
+    }
+    // a command computed inside (a closed loop's controller) likewise, in
+    // the unit of what it drives (a pump's volts, a spool's demand)
+    for (name, unit) in s.command_units() {
+        c.set_probe_unit(name, "command", unit);
     }
     let outputs = s.outputs.clone();
     let declared: Vec<(String, &[(&str, &str)])> = s
@@ -418,6 +423,111 @@ mod tests {
             e.contains("components.valve.orifice.cd") && e.contains("given twice"),
             "{e}"
         );
+    }
+
+    /// A builder's error about one parameter, found where the steady
+    /// initial pressures are worked out (a chamber length not over half
+    /// the stroke), is named at that parameter, its message apart from
+    /// its path (not `…chamber_length_1chamber 1 volume …`); on a preset
+    /// the paths read as `--set` takes them, in a file as JSON paths.
+    #[test]
+    fn a_parameter_refused_for_the_steady_start_is_named_at_it() {
+        use crate::rig;
+        for name in ["leaney-moog", "leaney-moog-generalised"] {
+            let mut v = rig::preset(name).unwrap();
+            rig::apply_set(&mut v, "cylinder.chamber_length_1=0.2").unwrap();
+            let e = rig::check(&v).unwrap_err();
+            let rig::RigError::Invalid { path, why } = &e else {
+                panic!("{name}: {e}");
+            };
+            assert_eq!(path, "components.cylinder.chamber_length_1", "{name}");
+            assert!(why.starts_with("chamber 1 volume"), "{name}: {why}");
+            assert!(!why.contains('\u{1f}'), "{name}: {why:?}");
+            let shown = rig::at_line(e.clone(), name).to_string();
+            assert!(
+                shown.starts_with("rig `cylinder.chamber_length_1`: chamber 1 volume"),
+                "{shown}"
+            );
+            assert!(!shown.contains("components."), "{shown}");
+        }
+    }
+
+    /// A tank at or above the supply is named at the tank's pressure, the
+    /// supply named beside it: the cause, not the steady state it spoils.
+    #[test]
+    fn a_tank_above_the_supply_is_named_as_the_cause() {
+        use crate::rig;
+        for name in ["leaney-moog", "leaney-moog-generalised"] {
+            let mut v = rig::preset(name).unwrap();
+            rig::apply_set(&mut v, "tank.pressure=1e7").unwrap();
+            let e = rig::at_line(rig::check(&v).unwrap_err(), name).to_string();
+            assert!(
+                e.starts_with("rig `tank.pressure`: the tank pressure 10000000 Pa"),
+                "{e}"
+            );
+            assert!(
+                e.contains("supply pressure 7000000 Pa (supply.pressure"),
+                "{e}"
+            );
+            assert!(!e.contains("ps = -3000000"), "{e}");
+        }
+    }
+
+    /// On a preset (no file to look in) a range error and any other error
+    /// name the parameter as `--set` does; in a user's file as its JSON path.
+    #[test]
+    fn errors_name_set_paths_on_a_preset_and_json_paths_in_a_file() {
+        use crate::rig;
+        let mut v = rig::preset("leaney-moog").unwrap();
+        rig::apply_set(&mut v, "load.mass=-1").unwrap();
+        let e = rig::check(&v).unwrap_err();
+        assert!(
+            rig::at_line(e.clone(), "leaney-moog")
+                .to_string()
+                .starts_with("rig `load.mass`: -1 [kg] is out of range"),
+            "{e}"
+        );
+        let dir = std::env::temp_dir().join(format!("hydrocyl-setform-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("rig.json");
+        std::fs::write(&file, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+        let shown = rig::at_line(e, file.to_str().unwrap()).to_string();
+        assert!(shown.starts_with("rig `components.load.mass`"), "{shown}");
+        assert!(shown.contains("(line "), "{shown}");
+        std::fs::remove_dir_all(&dir).ok();
+        // a name that only starts like a component's is left alone
+        let e = rig::RigError::Invalid {
+            path: "components.load".into(),
+            why: "see components.loader.mass and components.load.mass".into(),
+        };
+        assert_eq!(
+            rig::set_form(e, &v).to_string(),
+            "rig `load`: see components.loader.mass and load.mass"
+        );
+    }
+
+    /// `load.initial.position` on a preset whose cylinder gives the rod's
+    /// position: the error names both paths and the two ways on, and the
+    /// second (the cylinder's cleared) starts the rod where the load says.
+    #[test]
+    fn an_initial_position_given_twice_says_how_to_give_it_once() {
+        use crate::rig;
+        use crate::signal::Signal;
+        let mut v = rig::preset("leaney-moog").unwrap();
+        rig::apply_set(&mut v, "load.initial.position=0.05").unwrap();
+        let e = rig::at_line(rig::check(&v).unwrap_err(), "leaney-moog").to_string();
+        for part in [
+            "rig `load.initial.position`",
+            "cylinder.initial.position",
+            "`--set cylinder.initial.position=0.05`",
+            "`--set cylinder.initial.position=null`",
+        ] {
+            assert!(e.contains(part), "{part}: {e}");
+        }
+        rig::apply_set(&mut v, "cylinder.initial.position=null").unwrap();
+        let c = rig::circuit(&v, Signal::Constant { value: 0.0 }).unwrap();
+        let k = c.state_names().iter().position(|n| n == "load.x").unwrap();
+        assert_eq!(c.initial_state()[k], 0.05);
     }
 
     /// `--set cylinder.…`/`load.…` on a friction bench without that

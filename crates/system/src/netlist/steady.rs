@@ -7,7 +7,7 @@
 
 use super::catalog::{cylinder_of, friction_law_of, friction_terms_of, metering_of};
 use super::reader::{NetlistError, Schematic};
-use super::registry::{Instance, Role};
+use super::registry::{error_path, Instance, Role};
 use crate::valve_rig::{steady_pressures_at_rest, SteadyDrive};
 use hydrocyl_friction::{FrictionInput, FrictionModel, WithSealTerms};
 use hydrocyl_ports::{Pressure, Velocity};
@@ -19,6 +19,15 @@ fn owner<'a>(s: &'a Schematic, node: &str) -> Option<&'a Instance> {
             .iter()
             .any(|(p, n)| n == node && i.ty.port(p).is_some_and(|ps| ps.role == Role::Owns))
     })
+}
+
+/// A builder's error about `inst` ([`error_path`]: at the parameter it
+/// names, else at the component).
+fn refused(inst: &Instance) -> impl Fn(String) -> NetlistError + '_ {
+    |message| {
+        let (path, why) = error_path(&inst.name, message);
+        NetlistError { path, why }
+    }
 }
 
 fn fail<T>(inst: &Instance, state: &str, why: &str) -> Result<T, NetlistError> {
@@ -38,11 +47,21 @@ fn drive(
     let source = |port: &str| {
         owner(s, valve.node(port))
             .filter(|o| o.ty.name == "pressure_source")
-            .map(|o| o.get("pressure"))
+            .map(|o| (o.get("pressure"), o.name.as_str()))
     };
-    let (Some(supply), Some(tank)) = (source("P"), source("T")) else {
+    let (Some((supply, p_source)), Some((tank, t_source))) = (source("P"), source("T")) else {
         return fail(cyl, state, "the valve's P and T ports are not on pressure sources, so there is no steady state at rest to start from");
     };
+    // the cause, where it was given: the tank at or above the supply
+    if tank >= supply {
+        return Err(NetlistError {
+            path: format!("components.{t_source}.pressure"),
+            why: format!(
+                "the tank pressure {tank} Pa (on the T port of `{}`) is not below the supply pressure {supply} Pa (components.{p_source}.pressure, on its P port): with no pressure drop across the valve there is no steady state at rest to start components.{}.initial.{state} from; give the tank a pressure below the supply",
+                valve.name, cyl.name
+            ),
+        });
+    }
     let spool = owner(s, valve.node("spool"))
         .and_then(|o| o.initial("position"))
         .unwrap_or(0.0);
@@ -58,10 +77,7 @@ fn drive(
     let mut friction = 0.0;
     for f in s.instances.iter().filter(|i| i.node("rod") == rod) {
         if let Some(law) = friction_law_of(f) {
-            let law = law.map_err(|why| NetlistError {
-                path: format!("components.{}", f.name),
-                why,
-            })?;
+            let law = law.map_err(refused(f))?;
             let model = WithSealTerms {
                 inner: law,
                 terms: friction_terms_of(f),
@@ -72,14 +88,8 @@ fn drive(
         }
     }
     let d = SteadyDrive {
-        metering: metering_of(valve).map_err(|why| NetlistError {
-            path: format!("components.{}", valve.name),
-            why,
-        })?,
-        cylinder: cylinder_of(cyl).map_err(|why| NetlistError {
-            path: format!("components.{}", cyl.name),
-            why,
-        })?,
+        metering: metering_of(valve).map_err(refused(valve))?,
+        cylinder: cylinder_of(cyl).map_err(refused(cyl))?,
         supply,
         tank,
         droop_resistance: valve.opt("supply_resistance").unwrap_or(0.0),
@@ -122,10 +132,7 @@ pub fn fill(s: &mut Schematic) -> Result<(), NetlistError> {
             }
             "generalised_cylinder" if inst.initial("load_pressure").is_none() => {
                 let (p1, p2) = drive(s, inst, inst, "load_pressure")?;
-                let c = cylinder_of(inst).map_err(|why| NetlistError {
-                    path: format!("components.{}", inst.name),
-                    why,
-                })?;
+                let c = cylinder_of(inst).map_err(refused(inst))?;
                 let p_le =
                     c.force(Pressure::new(p1), Pressure::new(p2)).si() / c.effective_area().si();
                 s.instances[k]

@@ -51,7 +51,7 @@ pub const TYPES: &[ComponentType] = &[ComponentType {
     ports: &[
         port("reference", SIG, Role::Reads, false, "position set-point r [m]"),
         port("rod", MECH, Role::Reads, false, "the body whose position x it controls"),
-        port("command", SIG, Role::Owns, false, "the command u it writes [-]"),
+        port("command", SIG, Role::Owns, false, "the command u it writes, in the unit of what reads it (a spool's demand [-], a pump's volts [V])"),
     ],
     params: &[
         param("gain", "1/m", Required, Range::ANY, "proportional gain Kp"),

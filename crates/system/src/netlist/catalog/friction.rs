@@ -4,7 +4,7 @@
 //! and `B`. The parameter names are the law's field paths.
 
 use super::super::registry::{
-    param, ComponentType, Default::*, Instance, ParamSpec, PortSpec, Range, Role,
+    param, ComponentType, Default::*, Instance, ParamSpec, PortSpec, Range, Role, StateSpec,
 };
 use super::{built, join, port};
 use crate::circuit::Component;
@@ -301,7 +301,8 @@ fn build_with<T: DeserializeOwned>(
     } else {
         Box::new(WithSealTerms { inner: law, terms })
     };
-    built(Friction::new(&inst.name, inst.node("rod"), chambers, model))
+    let z0 = inst.initial("z").unwrap_or(0.0);
+    built(Friction::new(&inst.name, inst.node("rod"), chambers, model).with_initial_state(z0))
 }
 
 /// Wang's own seal term takes the component's `seal.dp_max*` bounds too.
@@ -338,14 +339,27 @@ pub(crate) fn law_of(inst: &Instance) -> Option<Result<FrictionLaw, String>> {
     })
 }
 
+/// The initial state of the laws with a bristle (Dahl, LuGre, Wang): the
+/// deflection z they start from (0, as before it could be given: at rest
+/// with the bristles relaxed).
+const BRISTLE: &[StateSpec] = &[StateSpec {
+    name: "z",
+    unit: "m",
+    default: Value(0.0),
+    doc: "initial bristle deflection z (the friction force starts at σ0 z)",
+}];
+
 macro_rules! friction_type {
     ($name:literal, $summary:literal, $params:expr, $law:ty, $variant:path) => {
+        friction_type!($name, $summary, $params, $law, $variant, &[])
+    };
+    ($name:literal, $summary:literal, $params:expr, $law:ty, $variant:path, $states:expr) => {
         ComponentType {
             name: $name,
             summary: $summary,
             ports: PORTS,
             params: $params,
-            states: &[],
+            states: $states,
             build: |i| build_with::<$law>(i, $variant),
             hints: None,
             probes: PROBES,
@@ -381,20 +395,80 @@ pub const TYPES: &[ComponentType] = &[
         "Dahl bristle friction (section 2.4.2.2, which gives it no equation; eq 2.34 with g(v) ≡ Fc)",
         &DAHL,
         Dahl,
-        FrictionLaw::Dahl
+        FrictionLaw::Dahl,
+        BRISTLE
     ),
     friction_type!(
         "friction_lugre",
         "LuGre friction with directional Stribeck curves (eqs 2.34–2.36)",
         &LUGRE,
         LuGre,
-        FrictionLaw::LuGre
+        FrictionLaw::LuGre,
+        BRISTLE
     ),
     friction_type!(
         "friction_wang",
         "Wang's LuGre friction with seal-pressure and acceleration terms (eq 5.14)",
         &WANG,
         Wang,
-        FrictionLaw::Wang
+        FrictionLaw::Wang,
+        BRISTLE
     ),
 ];
+
+#[cfg(test)]
+mod tests {
+    use crate::rig;
+    use crate::signal::Signal;
+    use hydrocyl_friction::{Dahl, FrictionLaw, LuGre, Wang};
+
+    /// The bristle's deflection of a rig's circuit at its start.
+    fn start_z(v: &serde_json::Value) -> f64 {
+        let c = rig::circuit(v, Signal::Constant { value: 0.0 }).unwrap();
+        let k = c
+            .state_names()
+            .iter()
+            .position(|n| n == "friction.z0")
+            .expect("a bristle state");
+        c.initial_state()[k]
+    }
+
+    /// Every law with a bristle takes `initial.z` (`--set
+    /// friction.initial.z=…`), lists it with the rig's parameters and
+    /// writes it out with `--print-rig`; by default it starts at 0, where
+    /// it started before it could be given.
+    #[test]
+    fn a_bristle_law_takes_its_initial_deflection() {
+        let laws = [
+            FrictionLaw::Dahl(Dahl::new(100.0, 1e6, 500.0).unwrap()),
+            FrictionLaw::LuGre(LuGre::table_5_11()),
+            FrictionLaw::Wang(Wang::table_5_8()),
+        ];
+        for law in laws {
+            let mut v = rig::preset("leaney-moog").unwrap();
+            v["components"]["friction"] = crate::valve_netlist::friction_component(&law).0;
+            let ty = v["components"]["friction"]["type"].clone();
+            assert_eq!(start_z(&v), 0.0, "{ty}");
+            let listed = rig::parameters(&v);
+            let z = listed
+                .iter()
+                .find(|p| p.path == "friction.initial.z")
+                .unwrap_or_else(|| panic!("{ty}: friction.initial.z is not listed"));
+            assert_eq!((z.value, z.unit), (Some(0.0), Some("m")), "{ty}");
+            let shown = crate::netlist::expanded(&v).unwrap();
+            assert_eq!(shown["components"]["friction"]["initial"]["z"], 0.0, "{ty}");
+            rig::apply_set(&mut v, "friction.initial.z=1e-6").unwrap();
+            assert_eq!(start_z(&v), 1e-6, "{ty}");
+        }
+        // the hybrid preset's Wang friction, as the user tried it
+        let mut v = rig::preset("wang-hybrid").unwrap();
+        rig::apply_set(&mut v, "friction.initial.z=1e-6").unwrap();
+        assert_eq!(start_z(&v), 1e-6);
+        // a law without a bristle has no such state
+        let mut v = rig::preset("leaney-moog").unwrap();
+        let e = rig::apply_set(&mut v, "friction.initial.z=1e-6")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("unknown rig parameter"), "{e}");
+    }
+}

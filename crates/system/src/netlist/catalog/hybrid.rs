@@ -165,10 +165,25 @@ pub const TYPES: &[ComponentType] = &[
             param("gain", "m^3/(s V)", Required, Range::POSITIVE, "steady flow per volt K"),
             param("natural_frequency", "rad/s", Required, Range::POSITIVE, "natural frequency ω_n"),
             param("damping", "-", Required, Range::POSITIVE, "damping ratio ζ"),
+            param("displacement", "m^3/rad", Absent, Range::POSITIVE, "pump displacement per radian of the shaft (2.05 cc/rev = 3.2627e-7 m^3/rad, Table 4-2); with max_speed, the rating a command is checked against"),
+            param("max_speed", "rad/s", Absent, Range::POSITIVE, "the motor's maximum speed (8000 rpm = 837.76 rad/s, Table 4-2): a command whose steady flow K u turns the pump faster, abs(K u) / displacement > max_speed, is warned of (not limited: a rating, not a stop); absent = no rating"),
         ],
         states: &[],
         build: |i| {
-            let p: IdentifiedPump = i.law("")?;
+            if i.opt("max_speed").is_some() && i.opt("displacement").is_none() {
+                return Err(error_at(
+                    &format!("components.{}.max_speed", i.name),
+                    &format!(
+                        "needs the pump's displacement (components.{}.displacement [m^3/rad]) to relate the speed to the flow",
+                        i.name
+                    ),
+                ));
+            }
+            let p = IdentifiedPump {
+                gain: i.get("gain"),
+                natural_frequency: i.get("natural_frequency"),
+                damping: i.get("damping"),
+            };
             built(PumpComponent::new(&i.name, p, i.node("command"), i.node("a"), i.node("b")))
         },
         hints: None,

@@ -240,7 +240,7 @@ pub const TYPES: &[ComponentType] = &[
         ],
         build: generalised,
         hints: Some(rod_hints),
-        probes: &[("p1", "Pa"), ("p2", "Pa")],
+        probes: &[("p1", "Pa"), ("p2", "Pa"), ("p_le", "Pa")],
     },
     ComponentType {
         name: "mass",
@@ -286,11 +286,24 @@ pub const TYPES: &[ComponentType] = &[
             };
             let pick = |k: &str| {
                 let own = i.initial(k);
-                let given = i.hint("rod", &format!("initial.{k}"));
+                let key = format!("initial.{k}");
+                let given = i.hint("rod", &key);
                 match (own, given) {
-                    (Some(_), Some(_)) => Err(format!(
-                        "initial.{k} is given both here and on the cylinder at the rod; give it once"
-                    )),
+                    // named here, with the way on: the value on the
+                    // cylinder, or the cylinder's cleared
+                    (Some(a), Some(b)) => {
+                        let cylinder = i
+                            .hint_from
+                            .get(&("rod".to_string(), key.clone()))
+                            .cloned()
+                            .unwrap_or_else(|| "cylinder".into());
+                        Err(crate::netlist::registry::error_at(
+                            &format!("components.{}.{key}", i.name),
+                            &format!(
+                                "{a} is given here and {b} on the cylinder at the rod (components.{cylinder}.{key}); give it once: on the cylinder (`--set {cylinder}.{key}={a}`), or here with the cylinder's cleared (`--set {cylinder}.{key}=null`)"
+                            ),
+                        ))
+                    }
                     (a, b) => Ok(a.or(b).unwrap_or(0.0)),
                 }
             };
@@ -316,3 +329,63 @@ pub const TYPES: &[ComponentType] = &[
         probes: &[("position", "m"), ("velocity", "m/s")],
     },
 ];
+
+#[cfg(test)]
+mod tests {
+    use crate::rig;
+    use crate::run::RunOptions;
+    use crate::signal::Signal;
+
+    /// The generalised cylinder outputs its own state, the load pressure
+    /// `p_le`, as the fundamental cylinder does: both forms' runs have the
+    /// same columns, and it equals the chambers' net force over the
+    /// effective area (eq 2.16) that the form sets p1, p2 from.
+    #[test]
+    fn the_generalised_cylinder_outputs_its_load_pressure() {
+        let t: Vec<f64> = (0..=100).map(|k| k as f64 * 1e-3).collect();
+        let command = Signal::Step {
+            time_s: 0.01,
+            before: 0.0,
+            after: 0.3,
+        };
+        let run = |name: &str| {
+            rig::simulate(
+                &rig::preset(name).unwrap(),
+                command.clone(),
+                &t,
+                &RunOptions::default(),
+            )
+            .unwrap()
+        };
+        let (gen, fund) = (run("leaney-moog-generalised"), run("leaney-moog"));
+        // the same columns (the measured-data ones first, `run::ORDER`;
+        // the others in component order, where `ps` is the supply's here
+        // and the valve's there)
+        let names = |r: &crate::run::Run| -> Vec<(String, &'static str)> {
+            let mut n: Vec<_> = r
+                .channels
+                .iter()
+                .map(|c| (c.name.clone(), c.unit))
+                .collect();
+            n[5..].sort();
+            n
+        };
+        assert_eq!(names(&gen), names(&fund));
+        assert!(names(&gen).contains(&("p_le".to_string(), "Pa")));
+        let ple = gen.channel("p_le").expect("a p_le column");
+        let v = rig::preset("leaney-moog-generalised").unwrap();
+        let c = &v["components"]["cylinder"];
+        let (a1, a2) = (c["area_1"].as_f64().unwrap(), c["area_2"].as_f64().unwrap());
+        let (p1, p2) = (gen.channel("p1").unwrap(), gen.channel("p2").unwrap());
+        for k in 0..t.len() {
+            let net = (p1[k] * a1 - p2[k] * a2) / (0.5 * (a1 + a2));
+            assert!(
+                (ple[k] - net).abs() <= 1e-9 * net.abs().max(1.0),
+                "t {}: p_le {} vs {net}",
+                t[k],
+                ple[k]
+            );
+        }
+        assert!(ple[t.len() - 1] != ple[0], "the load pressure moves");
+    }
+}

@@ -119,7 +119,7 @@ pub struct Args {
     /// Also integrate the energy ledger and write it to this JSON file (put
     /// in place with the CSV, checked before the run as --out is): per
     /// component the integrated source, dissipated, storage, load and moved
-    /// energies [J] (`components_j`), their totals, the energy in, the load's
+    /// energies in J (`components_j`), their totals, the energy in, the load's
     /// work, the losses and storage by component, and the closure
     /// `energy_in - load - losses - storage` in J and as a fraction of the
     /// energy in (`closure_j`, `closure_relative`), with the storage check
@@ -130,7 +130,7 @@ pub struct Args {
     #[arg(long, value_name = "FILE.json")]
     ledger: Option<PathBuf>,
     /// The ledger's window starts at the first output time at or after this
-    /// [s] (default: the run's first; e.g. after a warm-up period, as
+    /// time in s (default: the run's first; e.g. after a warm-up period, as
     /// `cargo xtask energy` does).
     #[arg(
         long,

@@ -99,7 +99,8 @@ impl Rig {
         for a in assignments {
             rig::apply_set(&mut v, a).map_err(input)?;
         }
-        rig::check(&v).map_err(input)?;
+        // the parameters were named as `--set` names them: so are the errors
+        rig::check(&v).map_err(|e| input(rig::set_form(e, &v)))?;
         *self.value.lock().unwrap_or_else(PoisonError::into_inner) = Arc::new(v);
         Ok(())
     }

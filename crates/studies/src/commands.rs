@@ -1,7 +1,7 @@
 //! The command files of the thesis's experiments, as `hydrocyl simulate`
 //! reads them (`fixtures/commands/`, written by `cargo xtask commands`):
-//! each study's own command signal ([`chapter3`], [`chapter7`],
-//! [`chapter8`]) sampled at its output times, with the preset, the `--set`s
+//! each study's own command signal ([`chapter3`],
+//! [`chapter7`](crate::chapter7), [`chapter8`]) sampled at its output times, with the preset, the `--set`s
 //! and the command line that run it, and what the run shows.
 //!
 //! A command file is a first-order-hold table (the CLI's command CSV): a

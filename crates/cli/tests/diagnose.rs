@@ -492,7 +492,8 @@ fn effects_asking_for_a_declared_effect_says_it_is_already_on() {
     );
 }
 
-/// After two effects are added, the rejected candidates were scored
+/// A test user's record (Coulomb friction 150 N, declared 50 N). After two
+/// effects were added, the rejected candidates were scored
 /// against the round model fitted on the whole record while they were
 /// traced (with the added effects) on the training part: `sensor_lag` at
 /// τ = 0 "explained" −11.8 %, `internal_leakage` at Cl = 6e-14 −12.0 %.
@@ -507,10 +508,20 @@ fn rejected_effects_at_their_neutral_value_explain_nothing() {
         data.as_os_str(),
     ]);
     assert_partition(&json);
-    assert!(
-        json["effects_added"].as_array().unwrap().len() >= 2,
+    // the record's friction is Coulomb 150 N against the preset's 50 N: the
+    // loop once added `pressure_viscous` and `external_force` for it; the
+    // declared-parameter probe now names it and nothing is added
+    assert_eq!(
+        json["effects_added"].as_array().unwrap().len(),
+        0,
         "{}",
         json["effects_added"]
+    );
+    let probe = &json["unexplained_resembles"];
+    assert_eq!(probe["kind"], "coulomb", "{probe}");
+    assert!(
+        (probe["value"].as_f64().unwrap() - 150.0).abs() < 5.0,
+        "{probe}"
     );
     let mut checked = 0;
     for r in json["effects_rejected"].as_array().unwrap() {

@@ -17,6 +17,8 @@ import numpy.typing as npt
 __version__: str
 PRESETS: list[str]
 """Names of the built-in rigs (``Rig.load(name)``)."""
+MAX_THREADS: int
+"""The largest ``threads`` that ``simulate_batch`` takes (1024)."""
 
 ArrayLike = npt.ArrayLike
 Solver = Literal["auto", "dp45", "rosenbrock", "rk4", "exponential"]
@@ -73,8 +75,12 @@ class Rig:
         """Sets several parameters, then checks the rig once;
         ``rig.update(rig.parameters())`` changes no value (defaults are written out)."""
     def get(self, path: str) -> Any:
-        """The value at a parameter path (number, string, None, or a
-        dict/list for an inner path)."""
+        """The value at a parameter path: a number, or None for ``null``; for
+        an inner path — a component (``"cylinder"``) or a group in one
+        (``"valve.orifice"``) — a dict of the parameters under it, nested as
+        their paths are (``rig.get("valve")["orifice"]["cd"] ==
+        rig.get("valve.orifice.cd")``). ValueError for a path the rig does
+        not have."""
     def parameters(self) -> dict[str, Optional[float]]:
         """Every numeric parameter, ``{path: value}`` (SI, defaults filled
         in; None for ``null``, e.g. an initial pressure the rig computes)."""
@@ -106,13 +112,16 @@ class Rig:
         SimulationError when the solver fails or the run blows up (a
         non-finite value, a chamber pressure below -1000 bar); a chamber
         far below vacuum short of that warns (CavitationWarning) and the
-        run is returned."""
+        run is returned. Ctrl-C (SIGINT) stops the run within a few tens
+        of milliseconds with KeyboardInterrupt."""
 
 class Run:
     """One run: ``time`` [s] and channels in SI (``units``): ``command``,
     ``position`` [m], ``velocity`` [m/s], ``p1``, ``p2`` [Pa gauge], then
     the rig's other outputs. ``run["position"]`` is a channel; iterating a
-    run gives the channel names, as a dict its keys."""
+    run gives the channel names, as a dict its keys. The arrays are the
+    run's own, not copies, and read-only (``flags.writeable`` is False).
+    A run pickles bit for bit (Dask process/distributed schedulers)."""
 
     @property
     def time(self) -> npt.NDArray[np.float64]: ...
@@ -151,7 +160,8 @@ class Run:
 class BatchRun:
     """Runs of ``simulate_batch``: per channel an ``(N, len(time))`` array,
     row i from parameter set i (SI units as in ``Run.units``). Iterating
-    gives the channel names; ``len`` is the number of runs."""
+    gives the channel names; ``len`` is the number of runs. The arrays are
+    read-only, as a ``Run``'s; a batch pickles bit for bit."""
 
     @property
     def time(self) -> npt.NDArray[np.float64]: ...
@@ -195,10 +205,13 @@ def simulate_batch(
 ) -> BatchRun:
     """Runs ``rig`` once per parameter set (``params``: path -> N values,
     SI) in parallel with the GIL released; results in set order,
-    independent of ``threads`` (at least 1; default: all cores).
-    ``channels`` (default: all) names the channels kept, and only they are
-    read in each run. A set whose chamber falls far below vacuum without
-    blowing up is kept and warned of (CavitationWarning naming the set)."""
+    independent of ``threads`` (1 to ``MAX_THREADS``, more is a ValueError;
+    default: all cores; at most one thread per run is started).
+    ``channels`` (default: all) is a list of the channel names kept (a
+    single str is a TypeError), and only they are read in each run. A set
+    whose chamber falls far below vacuum without blowing up is kept and
+    warned of (CavitationWarning naming the set). Ctrl-C (SIGINT) stops
+    every run with KeyboardInterrupt."""
 
 def xfactor(gamma: float, travel: ArrayLike) -> npt.NDArray[np.float64]:
     """Leaney's X factor (dimensionless) for area ratio ``gamma`` = A1/A2

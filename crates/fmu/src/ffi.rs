@@ -17,7 +17,7 @@ use crate::model_description::guid;
 use crate::slave::{Slave, Snapshot};
 use std::ffi::{c_char, c_int, c_uint, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// `fmi2Status`.
 pub type Status = c_int;
@@ -179,6 +179,37 @@ pub fn resource_dir(location: &str) -> Result<PathBuf, String> {
     Ok(PathBuf::from(std::ffi::OsString::from_vec(bytes)))
 }
 
+/// Why the GUID the host gives (the one in `modelDescription.xml`) is not
+/// that of this library's version and `rig`'s text: the GUID covers both,
+/// and the `generationTool` of the FMU's `modelDescription.xml` (beside its
+/// `resources` folder) names the version that packaged it. The same version
+/// as this library: the rig file differs from the one packaged (edited
+/// after the export); another: the version; no model description to read:
+/// either.
+fn why_guid_differs(rig: &Path) -> String {
+    let ours = env!("CARGO_PKG_VERSION");
+    let packaged = rig
+        .parent()
+        .and_then(Path::parent)
+        .and_then(|root| std::fs::read_to_string(root.join("modelDescription.xml")).ok())
+        .and_then(|xml| {
+            let at = xml.find("generationTool=\"hydrocyl ")? + "generationTool=\"hydrocyl ".len();
+            let end = xml[at..].find('"')?;
+            Some(xml[at..at + end].to_string())
+        });
+    match packaged {
+        Some(v) if v == ours => format!(
+            "resources/rig.json is not the rig this FMU was packaged with (the GUID covers the rig's text; the FMU and this library are both hydrocyl {ours}): a rig file edited after the export is refused; export the edited rig again (`hydrocyl fmu`), or set its parameters through the FMU's variables"
+        ),
+        Some(v) => format!(
+            "the FMU was packaged by hydrocyl {v} (modelDescription.xml), this library is hydrocyl {ours}; export the rig again with one version"
+        ),
+        None => format!(
+            "resources/rig.json differs from the rig the FMU was packaged with (edited after the export?), or the FMU was packaged by a hydrocyl version other than this library's ({ours}): the GUID covers both"
+        ),
+    }
+}
+
 fn instantiate(guid_given: &str, location: Option<&str>) -> Result<Slave, String> {
     let location = location.ok_or("no fmuResourceLocation: the rig is in resources/rig.json")?;
     let path = resource_dir(location)?.join("rig.json");
@@ -186,8 +217,9 @@ fn instantiate(guid_given: &str, location: Option<&str>) -> Result<Slave, String
     let expected = guid(&text);
     if guid_given != expected {
         return Err(format!(
-            "fmuGUID {guid_given} does not match this library and {} ({expected}): the FMU was packaged by another hydrocyl version",
-            path.display()
+            "fmuGUID {guid_given} does not match this library and {} ({expected}): {}",
+            path.display(),
+            why_guid_differs(&path)
         ));
     }
     let rig = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -729,4 +761,80 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
     _value: *mut *const c_char,
 ) -> Status {
     unsafe { with(c, "fmi2GetStringStatus", |_| Ok(DISCARD)) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An unpacked FMU of leaney-moog: its `resources/rig.json` as packaged
+    /// and, unless `tool` is None, a `modelDescription.xml` naming that
+    /// generation tool; returns the folder, the resource URI and the GUID.
+    fn unpacked(tool: Option<&str>) -> (tempfile::TempDir, String, String) {
+        let dir = tempfile::tempdir().unwrap();
+        let res = dir.path().join("resources");
+        std::fs::create_dir(&res).unwrap();
+        let text =
+            serde_json::to_string_pretty(&hydrocyl_system::rig::preset("leaney-moog").unwrap())
+                .unwrap();
+        std::fs::write(res.join("rig.json"), &text).unwrap();
+        let g = guid(&text);
+        if let Some(tool) = tool {
+            std::fs::write(
+                dir.path().join("modelDescription.xml"),
+                format!(r#"<fmiModelDescription fmiVersion="2.0" modelName="leaney-moog" guid="{g}" generationTool="{tool}">"#),
+            )
+            .unwrap();
+        }
+        let uri = format!("file://{}", res.display());
+        (dir, uri, g)
+    }
+
+    fn edit_rig(dir: &tempfile::TempDir) {
+        let path = dir.path().join("resources").join("rig.json");
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::write(&path, text.replace("100.0", "50.0")).unwrap();
+    }
+
+    #[test]
+    fn an_edited_rig_file_is_refused_as_such() {
+        let ours = format!("hydrocyl {}", env!("CARGO_PKG_VERSION"));
+        let (dir, uri, g) = unpacked(Some(&ours));
+        assert!(instantiate(&g, Some(&uri)).is_ok());
+        edit_rig(&dir);
+        let e = instantiate(&g, Some(&uri)).err().unwrap();
+        assert!(
+            e.contains("resources/rig.json is not the rig this FMU was packaged with"),
+            "{e}"
+        );
+        assert!(!e.contains("another hydrocyl version"), "{e}");
+    }
+
+    #[test]
+    fn another_version_is_named() {
+        let (_dir, uri, _) = unpacked(Some("hydrocyl 0.0.0-old"));
+        // the GUID in such an FMU is that version's
+        let e = instantiate("{00000000-0000-0000-0000-000000000001}", Some(&uri))
+            .err()
+            .unwrap();
+        assert!(
+            e.contains("packaged by hydrocyl 0.0.0-old")
+                && e.contains(&format!(
+                    "this library is hydrocyl {}",
+                    env!("CARGO_PKG_VERSION")
+                )),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn without_a_model_description_both_causes_are_named() {
+        let (dir, uri, g) = unpacked(None);
+        edit_rig(&dir);
+        let e = instantiate(&g, Some(&uri)).err().unwrap();
+        assert!(
+            e.contains("differs from the rig the FMU was packaged with") && e.contains("version"),
+            "{e}"
+        );
+    }
 }

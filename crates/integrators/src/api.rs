@@ -298,7 +298,8 @@ pub enum SolveError {
         count: usize,
     },
     /// The caller of a streamed solve ([`crate::solve_streaming`]) stopped
-    /// it (its output could not be written, its input could not be read).
+    /// it (its output could not be written, its input could not be read),
+    /// or the `stop` of [`crate::solve_stoppable`] said so.
     #[error("stopped at t = {t} s: {why}")]
     Interrupted {
         /// Time reached.

@@ -50,6 +50,33 @@ impl<S: ?Sized> Between<S> for Nothing {
     }
 }
 
+/// The plain solve, stopped when the caller's `stop` says so
+/// ([`crate::solve_stoppable`]); it never changes the system.
+pub(crate) struct Stop<'a>(pub &'a dyn Fn() -> bool);
+
+impl<S: ?Sized> Between<S> for Stop<'_> {
+    const LEAVES_SYSTEM: bool = true;
+
+    #[inline]
+    fn between(
+        &mut self,
+        _: &mut S,
+        t: f64,
+        _: &mut Cow<'_, [f64]>,
+        _: &mut usize,
+        _: &mut Solution,
+    ) -> Result<(), SolveError> {
+        if (self.0)() {
+            Err(SolveError::Interrupted {
+                t,
+                why: "stopped by the caller".into(),
+            })
+        } else {
+            Ok(())
+        }
+    }
+}
+
 /// One integration method: attempts a step, and after acceptance offers a
 /// continuous extension (dense output) over the accepted step.
 pub(crate) trait Stepper {

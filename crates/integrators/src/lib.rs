@@ -201,3 +201,24 @@ pub fn solve<S: OdeSystem + ?Sized>(
 ) -> Result<Solution, SolveError> {
     stream::dispatch(method, sys, t0, x0, t_end, opts, &mut driver::Nothing)
 }
+
+/// [`solve`] that asks `stop` before every step (and before the first
+/// output) whether to go on: the same steps and outputs as [`solve`], bit
+/// for bit, until `stop` returns `true`, when the solve ends with
+/// [`SolveError::Interrupted`] at the time reached. For a caller that must
+/// be able to cancel a long solve (an interactive interrupt); `stop` should
+/// be cheap (an atomic flag's load), being called once a step.
+///
+/// # Errors
+/// Those of [`solve`], and [`SolveError::Interrupted`] once `stop` says so.
+pub fn solve_stoppable<S: OdeSystem + ?Sized>(
+    method: Method,
+    sys: &mut S,
+    t0: f64,
+    x0: &[f64],
+    t_end: f64,
+    opts: &Options,
+    stop: &dyn Fn() -> bool,
+) -> Result<Solution, SolveError> {
+    stream::dispatch(method, sys, t0, x0, t_end, opts, &mut driver::Stop(stop))
+}

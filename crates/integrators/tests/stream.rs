@@ -172,3 +172,60 @@ fn a_late_output_time_stops_the_solve() {
     .unwrap_err();
     assert!(e.to_string().contains("output time 0.25"), "{e}");
 }
+
+#[test]
+fn a_stoppable_solve_equals_the_plain_one_until_it_is_stopped() {
+    use hydrocyl_integrators::{solve_stoppable, SolveError};
+    use std::cell::Cell;
+    let vdp = VanDerPol { mu: 5.0 };
+    let times: Vec<f64> = (0..=2000).map(|k| k as f64 * 1e-2).collect();
+    for method in [Method::DormandPrince45, Method::Rosenbrock, Method::Auto] {
+        let opts = Options {
+            rtol: 1e-7,
+            atol: vec![1e-9],
+            h_max: 0.05,
+            t_eval: Some(times.clone()),
+            ..Options::default()
+        };
+        let plain = solve(method, &mut vdp.clone(), 0.0, &[2.0, 0.0], 20.0, &opts).unwrap();
+        let asked = Cell::new(0usize);
+        let never = || {
+            asked.set(asked.get() + 1);
+            false
+        };
+        let same = solve_stoppable(
+            method,
+            &mut vdp.clone(),
+            0.0,
+            &[2.0, 0.0],
+            20.0,
+            &opts,
+            &never,
+        )
+        .unwrap();
+        assert_eq!(same.t, plain.t, "{method:?}");
+        assert_eq!(same.x, plain.x, "{method:?}");
+        assert_eq!(same.stats, plain.stats, "{method:?}");
+        // asked before the first output, before every step and at the end
+        assert!(asked.get() >= plain.stats.steps, "{method:?}");
+        let calls = Cell::new(0usize);
+        let after_ten = || {
+            calls.set(calls.get() + 1);
+            calls.get() > 10
+        };
+        let e = solve_stoppable(
+            method,
+            &mut vdp.clone(),
+            0.0,
+            &[2.0, 0.0],
+            20.0,
+            &opts,
+            &after_ten,
+        )
+        .unwrap_err();
+        match e {
+            SolveError::Interrupted { t, .. } => assert!(t > 0.0 && t < 20.0, "{method:?}: {t}"),
+            other => panic!("{method:?}: {other}"),
+        }
+    }
+}

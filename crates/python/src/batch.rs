@@ -3,32 +3,86 @@
 //! `(N, len(t))` arrays in parameter-set order, so they do not depend on
 //! the number of threads (each run is sequential and deterministic).
 
-use crate::convert::{array, count_arg, no_channel, vector, vector_arg, Named};
-use crate::errors::{detached, Failure, Outcome};
+use crate::convert::{array, count_arg, frozen, names_arg, no_channel, vector, vector_arg, Named};
+use crate::errors::{interruptible, stopped, Failure, Outcome, Stop};
 use crate::rig::Rig;
+use crate::run::state_array;
 use crate::sim;
 use hydrocyl_system::rig;
-use hydrocyl_system::run::Run;
+use hydrocyl_system::run::{ProbeSet, Run};
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyIterator, PyList};
+use pyo3::types::{PyDict, PyIterator, PyList, PyTuple};
 use rayon::prelude::*;
 use serde_json::Value;
 
 /// Runs of a batch: `time` [s] and per channel a `(N, len(time))` array
 /// (row i is parameter set i), the parameter sets, per-run statistics and,
 /// with `on_error="nan"`, which runs failed and why.
+///
+/// The arrays are read-only (numpy `flags.writeable` is False): they are
+/// the batch's own, handed out without copying. A batch pickles (for Dask
+/// and multiprocessing) and unpickles equal bit for bit.
 #[pyclass(module = "hydrocyl", name = "BatchRun", frozen)]
 pub struct PyBatch {
     time: Py<PyArray1<f64>>,
     channels: Named<PyArray2<f64>>,
-    params: Py<PyDict>,
-    stats: Vec<(&'static str, Py<PyArray1<f64>>)>,
+    params: Vec<(String, Py<PyArray1<f64>>)>,
+    stats: Vec<(String, Py<PyArray1<f64>>)>,
     ok: Py<PyArray1<bool>>,
     errors: Vec<Option<String>>,
     interval: (f64, f64),
+}
+
+/// The most threads `simulate_batch` takes: a larger `threads` is refused
+/// (`hydrocyl.MAX_THREADS`).
+pub const MAX_THREADS: usize = 1024;
+
+/// The `threads` argument: None (all cores), or a count from 1 to
+/// [`MAX_THREADS`]; otherwise a ValueError naming `threads`.
+fn threads_arg(x: Option<&Bound<'_, PyAny>>) -> PyResult<Option<usize>> {
+    let Some(x) = x.filter(|x| !x.is_none()) else {
+        return Ok(None);
+    };
+    let too_many = |what: String| {
+        PyValueError::new_err(format!(
+            "threads: {what} is more than {MAX_THREADS} threads (hydrocyl.MAX_THREADS); a batch uses at most one thread per run, and more threads than cores only add overhead"
+        ))
+    };
+    let n = match x.extract::<i64>() {
+        Ok(n) => n,
+        // an int beyond i64: far too many, or below 1
+        Err(_) if x.is_instance_of::<pyo3::types::PyInt>() => {
+            return Err(if x.gt(0)? {
+                too_many(x.str()?.to_string())
+            } else {
+                PyValueError::new_err(format!(
+                    "threads: {} is not a thread count (must be at least 1)",
+                    x.str()?
+                ))
+            });
+        }
+        Err(_) => {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "threads: expected an int or None, got a {}",
+                x.get_type().name()?
+            )))
+        }
+    };
+    let k = count_arg("threads", "thread count", Some(n))?;
+    match k {
+        Some(k) if k > MAX_THREADS => Err(too_many(k.to_string())),
+        k => Ok(k),
+    }
+}
+
+/// A pickled batch's state that is not one: a ValueError saying so.
+fn bad_state(what: &str) -> PyErr {
+    PyValueError::new_err(format!(
+        "not the pickled state of a hydrocyl.BatchRun: {what}"
+    ))
 }
 
 /// Seconds since the Unix epoch (Python's `time.time()` scale).
@@ -65,6 +119,7 @@ struct Row {
     cavitation: Option<String>,
 }
 
+#[allow(clippy::too_many_arguments)]
 fn one(
     base: &Value,
     sets: &Sets,
@@ -73,7 +128,12 @@ fn one(
     t: &[f64],
     opts: &hydrocyl_system::run::RunOptions,
     keep: Option<&[String]>,
+    stop: &Stop,
 ) -> Outcome<Row> {
+    // a batch being interrupted starts no more runs
+    if stopped(stop) {
+        return Err(Failure::Interrupted);
+    }
     let ctx = |e: Failure| e.context(&format!("run {i} ({})", sets.assignments(i).join(", ")));
     let mut v = base.clone();
     for a in sets.assignments(i) {
@@ -91,7 +151,10 @@ fn one(
             },
         cavitation,
         ..
-    } = sim::simulate(&v, cmd, t, opts).map_err(ctx)?;
+    } = sim::simulate(&v, cmd, t, opts, stop).map_err(|e| match e {
+        Failure::Interrupted => e,
+        e => ctx(e),
+    })?;
     let mut names = Vec::new();
     let mut values = Vec::new();
     for c in channels {
@@ -124,7 +187,11 @@ fn one(
 /// all) limits the channels returned.
 ///
 /// The runs are of `rig` as it is when called (a `set` from another thread
-/// meanwhile does not change them). `threads` is at least 1.
+/// meanwhile does not change them). `threads` is from 1 to
+/// `hydrocyl.MAX_THREADS` (1024; more is a ValueError); the batch uses
+/// `min(threads, N)` of them (one run is one thread's work). Ctrl-C
+/// (SIGINT) stops every run within a few tens of milliseconds with
+/// KeyboardInterrupt.
 ///
 /// `on_error="raise"` (default) raises the error of the first failing set
 /// (ValueError for an invalid set, SimulationError for a solver failure,
@@ -145,8 +212,8 @@ pub fn simulate_batch(
     rtol: f64,
     rk4_step: f64,
     h_max: Option<f64>,
-    channels: Option<Vec<String>>,
-    threads: Option<i64>,
+    channels: Option<&Bound<'_, PyAny>>,
+    threads: Option<&Bound<'_, PyAny>>,
     on_error: &str,
 ) -> PyResult<PyBatch> {
     let raise = match on_error {
@@ -158,7 +225,8 @@ pub fn simulate_batch(
             )))
         }
     };
-    let threads = count_arg("threads", "thread count", threads)?;
+    let threads = threads_arg(threads)?;
+    let channels = names_arg("channels", channels)?;
     let (t, u) = (vector_arg("t", t)?, vector_arg("u", u)?);
     let mut sets = Sets {
         paths: Vec::new(),
@@ -202,8 +270,10 @@ pub fn simulate_batch(
             }
         }
     }
+    // one run is one thread's work: no more threads than runs
+    let threads = threads.map(|k| k.min(sets.n));
     let sets = &sets;
-    let (rows, interval): (Vec<Outcome<Row>>, (f64, f64)) = detached(py, || {
+    let (rows, interval): (Vec<Outcome<Row>>, (f64, f64)) = interruptible(py, |stop| {
         let start = unix_now();
         let opts = hydrocyl_system::run::RunOptions {
             only_channels: channels.clone(),
@@ -213,7 +283,7 @@ pub fn simulate_batch(
         let work = || {
             (0..sets.n)
                 .into_par_iter()
-                .map(|i| crate::errors::guard(|| one(base, sets, i, &cmd, &t, &opts, keep)))
+                .map(|i| crate::errors::guard(|| one(base, sets, i, &cmd, &t, &opts, keep, stop)))
                 .collect::<Vec<_>>()
         };
         let rows = match threads {
@@ -240,7 +310,8 @@ fn channel_names(value: &Value, sets: &Sets, t: &[f64], u: &[f64]) -> Option<Vec
         rig::apply_set(&mut v, &a).ok()?;
     }
     let circuit = rig::circuit(&v, sim::command(t, u).ok()?).ok()?;
-    Some(circuit.probes().into_iter().map(|p| p.name).collect())
+    // in the order of a run's channels
+    Some(ProbeSet::of(&circuit).names().map(str::to_string).collect())
 }
 
 /// Stacks the rows into `(N, T)` arrays (failed rows NaN), or raises the
@@ -306,31 +377,32 @@ fn stack(
         .into_iter()
         .map(|d| {
             Array2::from_shape_vec((n, m), d)
-                .map(|a| a.into_pyarray(py).unbind())
                 .map_err(|e| PyValueError::new_err(e.to_string()))
+                .and_then(|a| frozen(a.into_pyarray(py)))
         })
         .collect::<PyResult<Vec<_>>>()?;
-    let params = PyDict::new(py);
-    for (p, c) in sets.paths.iter().zip(&sets.columns) {
-        params.set_item(p, array(py, c.clone()))?;
-    }
-    let [steps, rejected, rhs, wall] = stats;
+    let params = sets
+        .paths
+        .iter()
+        .zip(&sets.columns)
+        .map(|(p, c)| Ok((p.clone(), array(py, c.clone())?)))
+        .collect::<PyResult<Vec<_>>>()?;
     let ok: Vec<bool> = errors.iter().map(Option::is_none).collect();
+    let stats = ["steps", "rejected", "rhs_evals", "wall_s"]
+        .into_iter()
+        .zip(stats)
+        .map(|(k, v)| Ok((k.to_string(), array(py, v)?)))
+        .collect::<PyResult<Vec<_>>>()?;
     // the sets kept, in order, once the batch is sure to be returned
     for w in &warnings {
         crate::errors::warn_cavitation(py, w)?;
     }
     Ok(PyBatch {
-        time: array(py, t).unbind(),
+        time: array(py, t)?,
         channels: Named { names, values },
-        params: params.unbind(),
-        stats: vec![
-            ("steps", array(py, steps).unbind()),
-            ("rejected", array(py, rejected).unbind()),
-            ("rhs_evals", array(py, rhs).unbind()),
-            ("wall_s", array(py, wall).unbind()),
-        ],
-        ok: PyArray1::from_vec(py, ok).unbind(),
+        params,
+        stats,
+        ok: frozen(PyArray1::from_vec(py, ok))?,
         errors,
         interval: (f64::NAN, f64::NAN),
     })
@@ -356,10 +428,15 @@ impl PyBatch {
         self.channels.dict(py)
     }
 
-    /// The parameter sets: `{path: (N,) array}` as given.
+    /// The parameter sets: `{path: (N,) array}` as given (a new dict of
+    /// the batch's read-only arrays).
     #[getter]
-    fn params(&self, py: Python<'_>) -> Py<PyDict> {
-        self.params.clone_ref(py)
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, v) in &self.params {
+            d.set_item(k, v.clone_ref(py))?;
+        }
+        Ok(d)
     }
 
     /// Per-run solver statistics: `{steps, rejected, rhs_evals, wall_s}`,
@@ -414,6 +491,86 @@ impl PyBatch {
     /// the number of runs).
     fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyIterator>> {
         PyList::new(py, &self.channels.names)?.try_iter()
+    }
+
+    /// Pickles as its state ([`PyBatch::_from_state`]): the arrays (numpy
+    /// pickles them bit for bit), names, parameter sets, statistics,
+    /// errors and interval.
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let pairs = |v: &[(String, Py<PyArray1<f64>>)]| {
+            v.iter()
+                .map(|(k, a)| (k.clone(), a.clone_ref(py)))
+                .collect::<Vec<_>>()
+        };
+        let d = PyDict::new(py);
+        d.set_item("time", self.time.clone_ref(py))?;
+        d.set_item("names", &self.channels.names)?;
+        d.set_item(
+            "values",
+            PyList::new(py, self.channels.values.iter().map(|v| v.clone_ref(py)))?,
+        )?;
+        d.set_item("params", pairs(&self.params))?;
+        d.set_item("stats", pairs(&self.stats))?;
+        d.set_item("ok", self.ok.clone_ref(py))?;
+        d.set_item("errors", self.errors.clone())?;
+        d.set_item("interval_s", self.interval)?;
+        let ctor = py.get_type::<PyBatch>().getattr("_from_state")?;
+        Ok((ctor, PyTuple::new(py, [d])?))
+    }
+
+    /// A batch from the state its `__reduce__` gives (how a pickled batch
+    /// is restored); its arrays are made read-only again.
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyDict>) -> PyResult<Self> {
+        let py = state.py();
+        let item = |k: &str| {
+            state
+                .get_item(k)?
+                .ok_or_else(|| bad_state(&format!("no `{k}`")))
+        };
+        let time = state_array::<f64, numpy::Ix1>(&item("time")?, "time", bad_state)?;
+        let m = time.bind(py).len();
+        let errors: Vec<Option<String>> = item("errors")?.extract()?;
+        let n = errors.len();
+        let names: Vec<String> = item("names")?.extract()?;
+        let values = item("values")?
+            .try_iter()?
+            .map(|v| {
+                let a = state_array::<f64, numpy::Ix2>(&v?, "values", bad_state)?;
+                if a.bind(py).shape() != [n, m] {
+                    return Err(bad_state("a channel's shape is not (N, len(time))"));
+                }
+                Ok(a)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        if values.len() != names.len() {
+            return Err(bad_state("names and values differ in number"));
+        }
+        let pairs = |k: &str| -> PyResult<Vec<(String, Py<PyArray1<f64>>)>> {
+            item(k)?
+                .try_iter()?
+                .map(|p| {
+                    let (name, a): (String, Bound<'_, PyAny>) = p?.extract()?;
+                    Ok((name, state_array(&a, k, bad_state)?))
+                })
+                .collect()
+        };
+        let ok = state_array::<bool, numpy::Ix1>(&item("ok")?, "ok", bad_state)?;
+        if ok.bind(py).len() != n {
+            return Err(bad_state("`ok` and `errors` differ in length"));
+        }
+        Ok(Self {
+            time,
+            channels: Named { names, values },
+            params: pairs("params")?,
+            stats: pairs("stats")?,
+            ok,
+            errors,
+            interval: item("interval_s")?.extract()?,
+        })
     }
 
     fn __repr__(&self) -> String {

@@ -109,21 +109,109 @@ pub fn count_arg(name: &str, what: &str, n: Option<i64>) -> PyResult<Option<usiz
     .transpose()
 }
 
-/// A 1-D numpy array owning `v`.
-pub fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
-    PyArray1::from_vec(py, v)
+/// A names argument (`channels=["position", "p1"]`): a list, tuple or
+/// other iterable of strings, or None. A single string is refused, not
+/// read as its characters nor as one name, and anything else is a
+/// TypeError naming the argument: `channels: expected a list of names,
+/// got a str ('position'); write channels=['position']`.
+pub fn names_arg(name: &str, x: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<String>>> {
+    let Some(x) = x.filter(|x| !x.is_none()) else {
+        return Ok(None);
+    };
+    if x.is_instance_of::<PyString>() {
+        return Err(PyTypeError::new_err(format!(
+            "{name}: expected a list of names, got a str ({s}); write {name}=[{s}]",
+            s = x.repr()?
+        )));
+    }
+    let bad =
+        |got: String| PyTypeError::new_err(format!("{name}: expected a list of names, got {got}"));
+    let mut names = Vec::new();
+    for item in x.try_iter().map_err(|_| {
+        bad(format!(
+            "a {}",
+            x.get_type()
+                .name()
+                .map_or_else(|_| "?".into(), |n| n.to_string())
+        ))
+    })? {
+        let item = item?;
+        match item.cast::<PyString>() {
+            Ok(s) => names.push(s.to_string()),
+            Err(_) => {
+                return Err(bad(format!(
+                    "an element that is a {}, not a str",
+                    item.get_type().name()?
+                )))
+            }
+        }
+    }
+    Ok(Some(names))
+}
+
+/// Makes a numpy array read-only (`flags.writeable = False`): a result's
+/// arrays are handed out themselves, not copies, so that nobody may change
+/// what the next reader gets.
+pub fn frozen<T>(a: Bound<'_, T>) -> PyResult<Py<T>> {
+    a.as_any().getattr("flags")?.setattr("writeable", false)?;
+    Ok(a.unbind())
+}
+
+/// A read-only 1-D numpy array owning `v` ([`frozen`]).
+pub fn array(py: Python<'_>, v: Vec<f64>) -> PyResult<Py<PyArray1<f64>>> {
+    frozen(PyArray1::from_vec(py, v))
+}
+
+/// A JSON value from a Python object that [`json_to_py`] made (None, bool,
+/// int, float, str, list, dict with str keys); `None` for anything else,
+/// or a float that JSON cannot hold.
+pub fn py_to_json(x: &Bound<'_, PyAny>) -> Option<Value> {
+    if x.is_none() {
+        return Some(Value::Null);
+    }
+    if let Ok(b) = x.cast::<PyBool>() {
+        return Some(Value::Bool(b.is_true()));
+    }
+    if x.is_instance_of::<PyInt>() {
+        return x
+            .extract::<i64>()
+            .map(Value::from)
+            .or_else(|_| x.extract::<u64>().map(Value::from))
+            .ok();
+    }
+    if let Ok(f) = x.cast::<PyFloat>() {
+        return serde_json::Number::from_f64(f.value()).map(Value::Number);
+    }
+    if let Ok(s) = x.cast::<PyString>() {
+        return Some(Value::String(s.to_string()));
+    }
+    if let Ok(l) = x.cast::<PyList>() {
+        return l
+            .iter()
+            .map(|e| py_to_json(&e))
+            .collect::<Option<Vec<_>>>()
+            .map(Value::Array);
+    }
+    if let Ok(d) = x.cast::<PyDict>() {
+        let mut m = serde_json::Map::new();
+        for (k, v) in d.iter() {
+            m.insert(k.extract::<String>().ok()?, py_to_json(&v)?);
+        }
+        return Some(Value::Object(m));
+    }
+    None
 }
 
 /// Named arrays (the channels of a run or a batch), in order.
 pub struct Named<T> {
     /// Names, in order.
     pub names: Vec<String>,
-    /// One array per name.
+    /// One array per name (read-only: [`frozen`]).
     pub values: Vec<Py<T>>,
 }
 
 impl<T: pyo3::PyTypeInfo> Named<T> {
-    /// `{name: array}` (the arrays themselves, not copies).
+    /// `{name: array}` (the arrays themselves, not copies: read-only).
     pub fn dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         for (n, v) in self.names.iter().zip(&self.values) {

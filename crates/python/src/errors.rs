@@ -5,10 +5,16 @@
 //! that is kept but left its model's range warns with a
 //! [`CavitationWarning`] ([`warn_cavitation`]).
 
-use pyo3::exceptions::{PyException, PyRuntimeError, PyUserWarning, PyValueError};
+use pyo3::exceptions::{
+    PyException, PyKeyboardInterrupt, PyRuntimeError, PyUserWarning, PyValueError,
+};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError};
+use std::sync::Arc;
+use std::time::Duration;
 
 pyo3::create_exception!(
     hydrocyl,
@@ -56,6 +62,9 @@ pub enum Failure {
     },
     /// A panic caught at the boundary (a bug in hydrocyl).
     Panic(String),
+    /// The run was stopped by a signal (Ctrl-C): Python's own exception
+    /// (KeyboardInterrupt) is raised in its place ([`interruptible`]).
+    Interrupted,
 }
 
 impl Failure {
@@ -73,6 +82,7 @@ impl Failure {
                 state,
             },
             Failure::Panic(m) => Failure::Panic(format!("{what}: {m}")),
+            Failure::Interrupted => Failure::Interrupted,
         }
     }
 
@@ -81,6 +91,7 @@ impl Failure {
         match self {
             Failure::Input(m) | Failure::Panic(m) => m,
             Failure::Solver { message, .. } => message,
+            Failure::Interrupted => "interrupted",
         }
     }
 
@@ -88,6 +99,7 @@ impl Failure {
     pub fn into_pyerr(self, py: Python<'_>) -> PyErr {
         match self {
             Failure::Input(m) => PyValueError::new_err(m),
+            Failure::Interrupted => PyKeyboardInterrupt::new_err("interrupted"),
             Failure::Panic(m) => PyRuntimeError::new_err(format!(
                 "hydrocyl internal error (a bug, please report it): {m}"
             )),
@@ -133,4 +145,82 @@ pub fn guard<T>(f: impl FnOnce() -> Outcome<T>) -> Outcome<T> {
 /// guarded against panics, and turns a failure into its exception.
 pub fn detached<T: Send>(py: Python<'_>, f: impl FnOnce() -> Outcome<T> + Send) -> PyResult<T> {
     py.detach(|| guard(f)).map_err(|e| e.into_pyerr(py))
+}
+
+/// How often a run started by [`interruptible`] lets Python handle its
+/// signals (wall time).
+const SIGNAL_POLL: Duration = Duration::from_millis(25);
+
+/// Stack of the thread a run goes on: the main thread's usual 8 MiB.
+const RUN_STACK: usize = 8 << 20;
+
+/// The flag that stops a run ([`hydrocyl_system::simulation::Simulation::stop_on`]).
+pub type Stop = Arc<AtomicBool>;
+
+/// Whether `stop` has been set.
+pub fn stopped(stop: &Stop) -> bool {
+    stop.load(Ordering::Relaxed)
+}
+
+/// How an [`interruptible`] call ended.
+enum Ended<T> {
+    /// `f` returned.
+    Done(Outcome<T>),
+    /// A signal handler raised (KeyboardInterrupt for SIGINT); `f` was
+    /// stopped and has returned.
+    Signal(PyErr),
+}
+
+/// [`detached`] for a long run that Ctrl-C must be able to stop: `f` runs
+/// on a thread of its own with the GIL released, while the calling thread
+/// waits for it and every [`SIGNAL_POLL`] takes the GIL to let Python run
+/// its signal handlers (`PyErr_CheckSignals`, which does anything only on
+/// the main thread). When a handler raises (KeyboardInterrupt), `stop` is
+/// set, `f` — which passes it to its runs, read once a solver step — ends
+/// within a step, its thread is joined, and the handler's exception is
+/// raised: no thread is left running.
+pub fn interruptible<T: Send>(
+    py: Python<'_>,
+    f: impl FnOnce(&Stop) -> Outcome<T> + Send,
+) -> PyResult<T> {
+    let stop: Stop = Arc::new(AtomicBool::new(false));
+    let ended = py.detach(|| {
+        std::thread::scope(|s| {
+            let (tx, rx) = mpsc::channel();
+            let worker_stop = Arc::clone(&stop);
+            let spawned = std::thread::Builder::new()
+                .name("hydrocyl-run".into())
+                .stack_size(RUN_STACK)
+                .spawn_scoped(s, move || {
+                    let _ = tx.send(guard(|| f(&worker_stop)));
+                });
+            if let Err(e) = spawned {
+                return Ended::Done(Err(Failure::Panic(format!(
+                    "cannot start the run's thread: {e}"
+                ))));
+            }
+            loop {
+                match rx.recv_timeout(SIGNAL_POLL) {
+                    Ok(r) => return Ended::Done(r),
+                    Err(RecvTimeoutError::Disconnected) => {
+                        return Ended::Done(Err(Failure::Panic(
+                            "the run's thread ended without a result".into(),
+                        )))
+                    }
+                    Err(RecvTimeoutError::Timeout) => {
+                        if let Err(e) = Python::attach(|py| py.check_signals()) {
+                            stop.store(true, Ordering::Relaxed);
+                            // the scope joins the run's thread, which
+                            // returns at its next step
+                            return Ended::Signal(e);
+                        }
+                    }
+                }
+            }
+        })
+    });
+    match ended {
+        Ended::Done(r) => r.map_err(|e| e.into_pyerr(py)),
+        Ended::Signal(e) => Err(e),
+    }
 }

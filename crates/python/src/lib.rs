@@ -67,5 +67,6 @@ fn hydrocyl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(diagnose::diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
     m.add("PRESETS", rig::Rig::preset_names())?;
+    m.add("MAX_THREADS", batch::MAX_THREADS)?;
     Ok(())
 }

@@ -3,7 +3,7 @@
 //! edit, and simulated on a sampled command.
 
 use crate::convert::{json_to_py, set_text, vector_arg};
-use crate::errors::detached;
+use crate::errors::interruptible;
 use crate::run::PyRun;
 use crate::sim;
 use hydrocyl_system::{netlist, rig};
@@ -65,6 +65,38 @@ fn parameters_of(v: &Value) -> Vec<rig::Parameter> {
     rig::parameters(v)
 }
 
+/// The parameters under the inner path `path` (those whose path starts
+/// with `path.`) as one JSON object nested as their paths are, in
+/// parameter order (a group where its first parameter is):
+/// `{"area_1": ..., "initial": {"p1": null, ...}}` for
+/// `cylinder`. `None` when no parameter is under `path`.
+fn inner(params: &[rig::Parameter], path: &str) -> Option<Value> {
+    let prefix = format!("{path}.");
+    let mut root = serde_json::Map::new();
+    for p in params {
+        let Some(rest) = p.path.strip_prefix(&prefix) else {
+            continue;
+        };
+        let value = p.value.map_or(Value::Null, Value::from);
+        let mut segs: Vec<&str> = rest.split('.').collect();
+        let last = segs.pop().unwrap_or(rest);
+        let mut at = &mut root;
+        for seg in segs {
+            let entry = at
+                .entry(seg.to_string())
+                .or_insert_with(|| Value::Object(serde_json::Map::new()));
+            // a path under a parameter's own path cannot happen (a
+            // parameter is a number); should it, the rest stays one key
+            at = match entry {
+                Value::Object(m) => m,
+                _ => return None,
+            };
+        }
+        at.insert(last.to_string(), value);
+    }
+    (!root.is_empty()).then_some(Value::Object(root))
+}
+
 impl Rig {
     /// Names of the built-in presets.
     pub fn preset_names() -> Vec<&'static str> {
@@ -106,12 +138,19 @@ impl Rig {
     }
 
     /// The value at a parameter path: a parameter [`parameters_of`] lists
-    /// (every `--set` path of a netlist), else a JSON path of an older rig
-    /// kind (object keys, array indices); or the error `--set` gives for it.
+    /// (every `--set` path of a netlist); an inner path of those (a
+    /// component, `cylinder`, or a group in one, `cylinder.initial`) as the
+    /// object of its parameters ([`inner`]); else a JSON path of an older
+    /// rig kind (object keys, array indices); or the error `--set` gives
+    /// for it.
     fn at(&self, path: &str) -> Result<Value, rig::RigError> {
         let value = self.snapshot();
-        if let Some(p) = parameters_of(&value).into_iter().find(|p| p.path == path) {
+        let params = parameters_of(&value);
+        if let Some(p) = params.iter().find(|p| p.path == path) {
             return Ok(p.value.map_or(Value::Null, Value::from));
+        }
+        if let Some(v) = inner(&params, path) {
+            return Ok(v);
         }
         let mut cur = &*value;
         let netlist = self.kind() == netlist::KIND;
@@ -222,9 +261,14 @@ impl Rig {
         self.edit(&assignments)
     }
 
-    /// The value at a parameter path (a number, a string, None for a `null`
-    /// such as an initial pressure the rig computes, or a dict/list for an
-    /// inner path). ValueError for a path the rig does not have.
+    /// The value at a parameter path: a number, None for a `null` such as
+    /// an initial pressure the rig computes, or for an inner path — a
+    /// component (`"cylinder"`) or a group in one (`"valve.orifice"`,
+    /// `"cylinder.initial"`) — a dict of the parameters under it, nested as
+    /// their paths are (`rig.get("valve")["orifice"]["cd"] ==
+    /// rig.get("valve.orifice.cd")`; the values of `parameters()`). An older
+    /// rig kind's JSON path may also give a string or a list. ValueError for
+    /// a path the rig does not have.
     fn get<'py>(&self, py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyAny>> {
         json_to_py(py, &self.at(path).map_err(input)?)
     }
@@ -318,7 +362,8 @@ impl Rig {
     /// largest step [s] (default 0.01); `ledger=True` adds the energy ledger
     /// (`run.ledger`). The run is of the rig as it is when called (a `set`
     /// from another thread meanwhile does not change it); the GIL is
-    /// released while it runs.
+    /// released while it runs, and Ctrl-C (SIGINT) stops it within a few
+    /// tens of milliseconds with KeyboardInterrupt.
     ///
     /// ValueError for bad input (the CLI's message); SimulationError when
     /// the solver fails or the run blows up (time and state in the
@@ -340,10 +385,10 @@ impl Rig {
     ) -> PyResult<PyRun> {
         let (t, u) = (vector_arg("t", t)?, vector_arg("u", u)?);
         let value = self.snapshot();
-        let out = detached(py, || {
+        let out = interruptible(py, |stop| {
             let opts = sim::options(solver, rtol, rk4_step, h_max, ledger)?;
             let cmd = sim::command(&t, &u)?;
-            sim::simulate(&value, &cmd, &t, &opts)
+            sim::simulate(&value, &cmd, &t, &opts, stop)
         })?;
         if let Some(w) = &out.cavitation {
             crate::errors::warn_cavitation(py, w)?;

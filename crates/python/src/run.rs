@@ -2,32 +2,53 @@
 //! simulate` writes), solver statistics, component counters and the energy
 //! ledger.
 
-use crate::convert::{array, json_to_py, Named};
+use crate::convert::{array, frozen, json_to_py, py_to_json, Named};
 use crate::sim::Simulated;
 use hydrocyl_energy::ledger::Ledger;
-use numpy::PyArray1;
+use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyImportError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyIterator, PyList};
+use pyo3::types::{PyDict, PyIterator, PyList, PyTuple};
+use serde_json::Value;
 
 /// A run: `time` [s] and one array per channel, SI units (`units` names
 /// them): `command`, `position` [m], `velocity` [m/s], `p1`, `p2` [Pa gauge],
 /// then the rig's other outputs. `run["position"]` is a channel.
+///
+/// The arrays are read-only (numpy `flags.writeable` is False): they are
+/// the run's own, handed out without copying. A run pickles (for Dask and
+/// multiprocessing) and unpickles equal bit for bit.
 #[pyclass(module = "hydrocyl", name = "Run", frozen)]
 pub struct PyRun {
     time: Py<PyArray1<f64>>,
     n: usize,
     channels: Named<PyArray1<f64>>,
-    units: Vec<&'static str>,
-    stats: Vec<(&'static str, f64)>,
+    units: Vec<String>,
+    stats: Vec<(String, f64)>,
     diagnostics: Vec<(String, f64)>,
-    ledger: Option<Result<Ledger, String>>,
+    /// [`Ledger::to_json`], or why there is no ledger; `None` unless asked.
+    ledger: Option<Result<Value, String>>,
 }
 
-/// The ledger as a dict: [`Ledger::to_json`], the object `hydrocyl
-/// simulate --ledger` writes (energies in J, fractions dimensionless).
-fn ledger_dict<'py>(py: Python<'py>, l: &Ledger) -> PyResult<Bound<'py, PyAny>> {
-    json_to_py(py, &l.to_json())
+/// A pickled run's state that is not one: a ValueError saying so.
+fn bad_state(what: &str) -> PyErr {
+    PyValueError::new_err(format!("not the pickled state of a hydrocyl.Run: {what}"))
+}
+
+/// The array `x` of a pickled state (dimension `D`), copied into an array
+/// of the result's own, read-only as a fresh result's ([`frozen`]; an
+/// unpickled array may be a view of a writable buffer).
+pub fn state_array<T: numpy::Element, D: numpy::ndarray::Dimension>(
+    x: &Bound<'_, PyAny>,
+    what: &str,
+    bad: fn(&str) -> PyErr,
+) -> PyResult<Py<numpy::PyArray<T, D>>> {
+    let a = x.cast::<numpy::PyArray<T, D>>().map_err(|_| {
+        bad(&format!(
+            "`{what}` is not an array of the right type and shape"
+        ))
+    })?;
+    frozen(a.to_owned_array().into_pyarray(x.py()))
 }
 
 impl PyRun {
@@ -39,17 +60,17 @@ impl PyRun {
         let st = &r.stats;
         Ok(Self {
             n: r.time.len(),
-            time: array(py, r.time).unbind(),
-            units: r.channels.iter().map(|c| c.unit).collect(),
+            time: array(py, r.time)?,
+            units: r.channels.iter().map(|c| c.unit.to_string()).collect(),
             channels: Named {
                 names: r.channels.iter().map(|c| c.name.clone()).collect(),
                 values: r
                     .channels
                     .into_iter()
-                    .map(|c| array(py, c.values).unbind())
-                    .collect(),
+                    .map(|c| array(py, c.values))
+                    .collect::<PyResult<_>>()?,
             },
-            stats: vec![
+            stats: [
                 ("steps", st.steps as f64),
                 ("rejected", st.rejected as f64),
                 ("rhs_evals", st.rhs_evals as f64),
@@ -57,9 +78,11 @@ impl PyRun {
                 ("lu_decomps", st.lu_decomps as f64),
                 ("events", st.events as f64),
                 ("wall_s", r.wall.as_secs_f64()),
-            ],
+            ]
+            .map(|(k, v)| (k.to_string(), v))
+            .into(),
             diagnostics: r.diagnostics,
-            ledger: s.ledger,
+            ledger: s.ledger.map(|l| l.map(|l: Ledger| l.to_json())),
         })
     }
 }
@@ -78,7 +101,8 @@ impl PyRun {
         self.channels.names.clone()
     }
 
-    /// `{channel: numpy array}` (the arrays themselves, not copies).
+    /// `{channel: numpy array}` (the arrays themselves, not copies:
+    /// read-only).
     #[getter]
     fn channels<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         self.channels.dict(py)
@@ -89,7 +113,7 @@ impl PyRun {
     fn units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         for (n, u) in self.channels.names.iter().zip(&self.units) {
-            d.set_item(n, *u)?;
+            d.set_item(n, u)?;
         }
         Ok(d)
     }
@@ -100,7 +124,7 @@ impl PyRun {
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         for (k, v) in &self.stats {
-            if *k == "wall_s" {
+            if k == "wall_s" {
                 d.set_item(k, v)?;
             } else {
                 d.set_item(k, *v as u64)?;
@@ -135,7 +159,7 @@ impl PyRun {
     fn ledger<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         match &self.ledger {
             None => Ok(None),
-            Some(Ok(l)) => ledger_dict(py, l).map(Some),
+            Some(Ok(l)) => json_to_py(py, l).map(Some),
             Some(Err(e)) => Err(PyValueError::new_err(format!("ledger: {e}"))),
         }
     }
@@ -174,6 +198,79 @@ impl PyRun {
         d.set_item("time", self.time.clone_ref(py))?;
         d.update(self.channels.dict(py)?.as_mapping())?;
         pd.getattr("DataFrame")?.call1((d,))
+    }
+
+    /// Pickles as its state ([`PyRun::_from_state`]): the arrays (numpy
+    /// pickles them bit for bit), names, units, statistics, counters and
+    /// the ledger.
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let d = PyDict::new(py);
+        d.set_item("time", self.time.clone_ref(py))?;
+        d.set_item("names", &self.channels.names)?;
+        d.set_item(
+            "values",
+            PyList::new(py, self.channels.values.iter().map(|v| v.clone_ref(py)))?,
+        )?;
+        d.set_item("units", &self.units)?;
+        d.set_item("stats", self.stats.clone())?;
+        d.set_item("diagnostics", self.diagnostics.clone())?;
+        match &self.ledger {
+            None => d.set_item("ledger", py.None())?,
+            Some(Ok(l)) => d.set_item("ledger", ("ok", json_to_py(py, l)?))?,
+            Some(Err(e)) => d.set_item("ledger", ("error", e))?,
+        }
+        let ctor = py.get_type::<PyRun>().getattr("_from_state")?;
+        Ok((ctor, PyTuple::new(py, [d])?))
+    }
+
+    /// A run from the state its `__reduce__` gives (how a pickled run is
+    /// restored); its arrays are made read-only again.
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyDict>) -> PyResult<Self> {
+        let item = |k: &str| {
+            state
+                .get_item(k)?
+                .ok_or_else(|| bad_state(&format!("no `{k}`")))
+        };
+        let time = state_array::<f64, numpy::Ix1>(&item("time")?, "time", bad_state)?;
+        let n = time.bind(state.py()).len();
+        let names: Vec<String> = item("names")?.extract()?;
+        let values = item("values")?
+            .try_iter()?
+            .map(|v| {
+                let a = state_array::<f64, numpy::Ix1>(&v?, "values", bad_state)?;
+                if a.bind(state.py()).len() != n {
+                    return Err(bad_state("a channel's length differs from time's"));
+                }
+                Ok(a)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let units: Vec<String> = item("units")?.extract()?;
+        if values.len() != names.len() || units.len() != names.len() {
+            return Err(bad_state("names, values and units differ in number"));
+        }
+        let ledger = item("ledger")?;
+        let ledger = if ledger.is_none() {
+            None
+        } else {
+            let (tag, v): (String, Bound<'_, PyAny>) = ledger.extract()?;
+            Some(match tag.as_str() {
+                "ok" => Ok(py_to_json(&v).ok_or_else(|| bad_state("the ledger is not JSON"))?),
+                _ => Err(v.extract::<String>()?),
+            })
+        };
+        Ok(Self {
+            time,
+            n,
+            channels: Named { names, values },
+            units,
+            stats: item("stats")?.extract()?,
+            diagnostics: item("diagnostics")?.extract()?,
+            ledger,
+        })
     }
 
     fn __repr__(&self) -> String {

@@ -3,7 +3,7 @@
 //! piecewise-linear table over the output times, the energy ledger when
 //! asked for, and a solver failure located (time and state).
 
-use crate::errors::{Failure, Outcome};
+use crate::errors::{stopped, Failure, Outcome, Stop};
 use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
 use hydrocyl_integrators::SolveError;
 use hydrocyl_system::rig::{self, RigError};
@@ -14,6 +14,7 @@ use hydrocyl_system::run::{
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::simulation::Simulation;
 use serde_json::Value;
+use std::sync::Arc;
 
 /// The run settings `simulate` and `simulate_batch` take, checked with the
 /// CLI's rules and messages (named by the Python argument).
@@ -70,17 +71,25 @@ pub struct Simulated {
     pub cavitation: Option<String>,
 }
 
-/// Simulates the rig value (checked or not) on `command` sampled at `t`.
+/// Simulates the rig value (checked or not) on `command` sampled at `t`
+/// ([`rig::simulate`]), stopped by `stop` ([`Failure::Interrupted`]).
 pub fn simulate(
     value: &Value,
     command: &Signal,
     t: &[f64],
     opts: &RunOptions,
+    stop: &Stop,
 ) -> Outcome<Simulated> {
-    let run = rig::simulate(value, command.clone(), t, opts).map_err(|e| match e {
-        RigError::Sim(_) => locate_failure(value, command, t, opts, e.to_string()),
-        other => Failure::Input(other.to_string()),
-    })?;
+    if stopped(stop) {
+        return Err(Failure::Interrupted);
+    }
+    let run = Simulation::new(value, command.clone())
+        .and_then(|s| s.options(opts.clone()).stop_on(Arc::clone(stop)).run(t))
+        .map_err(|e| match e {
+            _ if stopped(stop) => Failure::Interrupted,
+            RigError::Sim(_) => locate_failure(value, command, t, opts, stop, e.to_string()),
+            other => Failure::Input(other.to_string()),
+        })?;
     let cavitation = match run.physical() {
         Err(u) => return Err(unphysical(value, command, opts, &run, u)),
         Ok(deep) => deep.map(|d| cavitation_warning(value, opts, &d)),
@@ -210,13 +219,14 @@ fn locate_failure(
     command: &Signal,
     t: &[f64],
     opts: &RunOptions,
+    stop: &Stop,
     message: String,
 ) -> Failure {
     let located = (|| {
         let sim = || {
             Simulation::new(value, command.clone())
                 .ok()
-                .map(|s| s.options(opts.clone()))
+                .map(|s| s.options(opts.clone()).stop_on(Arc::clone(stop)))
         };
         let mut first = sim()?;
         let x0 = first.initial().to_vec();
@@ -252,6 +262,9 @@ fn locate_failure(
             names.into_iter().take(n).zip(state).collect::<Vec<_>>(),
         ))
     })();
+    if stopped(stop) {
+        return Failure::Interrupted;
+    }
     let (time, state) = located.unwrap_or((f64::NAN, Vec::new()));
     let listed = state
         .iter()

@@ -235,3 +235,36 @@ def test_load_takes_a_path_like(repo):
     assert hydrocyl.Rig.load(pathlib.Path(path)) == hydrocyl.Rig.load(str(path))
     with pytest.raises(ValueError, match="not a preset"):
         hydrocyl.Rig.load(pathlib.Path("no-such-rig.json"))
+
+
+def flatten(prefix, value):
+    """{path: value} of a nested dict that `get` gave for `prefix`."""
+    if isinstance(value, dict):
+        out = {}
+        for k, v in value.items():
+            out.update(flatten(f"{prefix}.{k}", v))
+        return out
+    return {prefix: value}
+
+
+def test_get_on_an_inner_path_gives_its_parameters_as_a_dict():
+    for name in hydrocyl.PRESETS:
+        rig = hydrocyl.Rig.load(name)
+        ps = rig.parameters()
+        inner = {p.rsplit(".", k)[0] for p in ps for k in range(1, p.count(".") + 1)}
+        assert inner, name
+        for prefix in inner:
+            got = rig.get(prefix)
+            assert isinstance(got, dict), (name, prefix)
+            under = {p: v for p, v in ps.items() if p.startswith(prefix + ".")}
+            # every parameter under it, nested as the paths are
+            assert flatten(prefix, got) == under, (name, prefix)
+    rig = hydrocyl.Rig.load("leaney-moog")
+    cylinder = rig.get("cylinder")
+    assert cylinder["area_1"] == rig.get("cylinder.area_1")
+    assert cylinder["initial"]["p1"] is None and rig.get("cylinder.initial") == cylinder["initial"]
+    assert rig.get("valve.orifice") == {k: rig.get(f"valve.orifice.{k}") for k in ("cd", "density", "dp_transition")}
+    assert rig.get("valve")["orifice"]["cd"] == rig.get("valve.orifice.cd")
+    # a prefix of a name is not a path
+    with pytest.raises(ValueError, match="unknown rig parameter"):
+        rig.get("cyl")

@@ -18,7 +18,8 @@
 use crate::circuit::{BuildError, Circuit};
 use crate::signal::StreamedTable;
 use hydrocyl_integrators::{
-    solve, solve_streaming, OdeSystem as _, Options, SolveError, Stats, Stream, StreamIo,
+    solve, solve_stoppable, solve_streaming, OdeSystem as _, Options, SolveError, Stats, Stream,
+    StreamIo,
 };
 use std::time::{Duration, Instant};
 use thiserror::Error;
@@ -277,6 +278,20 @@ pub(crate) fn run(
     t_eval: &[f64],
     opts: &RunOptions,
 ) -> Result<Run, SimError> {
+    run_until(circuit, x0, t_eval, opts, None)
+}
+
+/// [`run`], and with `stop` the solve asks it before every step and ends
+/// with [`SolveError::Interrupted`] once it says so
+/// ([`hydrocyl_integrators::solve_stoppable`]); until then the outputs are
+/// the same.
+pub(crate) fn run_until(
+    circuit: &mut Circuit,
+    x0: &[f64],
+    t_eval: &[f64],
+    opts: &RunOptions,
+    stop: Option<&dyn Fn() -> bool>,
+) -> Result<Run, SimError> {
     check_times(t_eval)?;
     check_options(opts)?;
     let x = initial(circuit, x0, t_eval[0], opts)?;
@@ -284,8 +299,12 @@ pub(crate) fn run(
     let (t0, t_end) = (t_eval[0], t_eval[t_eval.len() - 1]);
     let sopts = opts.solver_options(circuit, t_eval.to_vec());
     let start = Instant::now();
-    let sol = solve(opts.solver.method(), circuit, t0, &x, t_end, &sopts)
-        .map_err(|source| SimError::solve(opts.solver.name(), source, circuit, t0, &x))?;
+    let method = opts.solver.method();
+    let sol = match stop {
+        None => solve(method, circuit, t0, &x, t_end, &sopts),
+        Some(stop) => solve_stoppable(method, circuit, t0, &x, t_end, &sopts, stop),
+    }
+    .map_err(|source| SimError::solve(opts.solver.name(), source, circuit, t0, &x))?;
     let wall = start.elapsed();
     // probes → channels
     let mut channels = Vec::new();

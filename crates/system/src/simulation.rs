@@ -51,6 +51,8 @@ use crate::signal::{Signal, StreamedTable};
 use crate::wires::AnyWire;
 use hydrocyl_integrators::{solve, OdeSystem};
 use serde_json::Value;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// One simulation: an assembled circuit, its initial state and the solver
 /// options. Build it from a rig value ([`Simulation::new`]) or from a circuit
@@ -63,6 +65,9 @@ pub struct Simulation {
     options: RunOptions,
     /// The time reached and the state there, while stepping.
     now: Option<(f64, Vec<f64>)>,
+    /// Set from outside to stop [`Simulation::run`] and
+    /// [`Simulation::try_run`] ([`Simulation::stop_on`]).
+    stop: Option<Arc<AtomicBool>>,
 }
 
 impl Simulation {
@@ -82,12 +87,25 @@ impl Simulation {
             initial,
             options: RunOptions::default(),
             now: None,
+            stop: None,
         }
     }
 
     /// Sets the solver options.
     pub fn options(mut self, options: RunOptions) -> Self {
         self.options = options;
+        self
+    }
+
+    /// Lets another thread stop [`Simulation::run`] and
+    /// [`Simulation::try_run`]: once `flag` is set, the run ends at its next
+    /// step with [`SimError::Solve`] holding
+    /// [`hydrocyl_integrators::SolveError::Interrupted`] (an interactive
+    /// interrupt of a long run: the Python package's KeyboardInterrupt).
+    /// The flag is read once a step; until it is set the run is the same, bit
+    /// for bit.
+    pub fn stop_on(mut self, flag: Arc<AtomicBool>) -> Self {
+        self.stop = Some(flag);
         self
     }
 
@@ -132,7 +150,16 @@ impl Simulation {
     /// [`hydrocyl_integrators::SolveError`] holds the time it failed at (what
     /// a caller that locates the failure reads).
     pub fn try_run(&mut self, t_eval: &[f64]) -> Result<Run, SimError> {
-        runner::run(&mut self.circuit, &self.initial, t_eval, &self.options)
+        match &self.stop {
+            None => runner::run(&mut self.circuit, &self.initial, t_eval, &self.options),
+            Some(flag) => runner::run_until(
+                &mut self.circuit,
+                &self.initial,
+                t_eval,
+                &self.options,
+                Some(&|| flag.load(Ordering::Relaxed)),
+            ),
+        }
     }
 
     /// [`Simulation::run`] for long records: the outputs go to `sink` in

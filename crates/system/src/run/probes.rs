@@ -59,6 +59,12 @@ impl ProbeSet {
         Ok(Self::of_probes(circuit, chosen))
     }
 
+    /// The channel names, in channel order (a run's: command, position,
+    /// velocity, p1, p2, then the others in component order).
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.names.iter().map(|(n, _, _)| n.as_str())
+    }
+
     fn of_probes(circuit: &Circuit, probes: Vec<Probe>) -> Self {
         let publishers = probes
             .iter()

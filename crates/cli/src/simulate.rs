@@ -55,8 +55,7 @@ use hydrocyl_identify::bench::FrictionBench;
 use hydrocyl_system::netlist::registry::ComponentType;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{
-    chamber_types_with_air, AirRemedy, Cause, DeepCavitation, ProbeReader, Run, RunOptions,
-    Setting, Solver, AIR_PARAMETER,
+    Cause, DeepCavitation, ProbeReader, Run, RunOptions, Setting, SettingWords, Solver,
 };
 use hydrocyl_system::signal::{Signal, StreamedTable};
 use hydrocyl_system::simulation::Simulation;
@@ -297,10 +296,9 @@ pub(crate) fn check_solution(
 }
 
 /// The one-line warning of a run whose chamber fell far below vacuum
-/// without blowing up ([`DeepCavitation`]): the chamber, its lowest pressure
-/// and when, from when on the constant-B liquid is outside its range, and
-/// the remedy; a parameter it proposes to set is one the component's type
-/// has (`types`). A fixed step is told how to find whether it is to blame.
+/// without blowing up ([`DeepCavitation::warning`] in the CLI's flags); a
+/// parameter it proposes to `--set` is one the component's type has
+/// (`types`).
 pub(crate) fn cavitation_warning(
     d: &DeepCavitation,
     solver: Solver,
@@ -308,38 +306,16 @@ pub(crate) fn cavitation_warning(
     types: &[(String, &'static ComponentType)],
 ) -> String {
     let type_of = |c: &str| types.iter().find(|(n, _)| n == c).map(|(_, t)| *t);
-    let AirRemedy {
-        cylinder,
-        air,
-        type_name,
-    } = d.remedy(type_of);
-    let remedy = match (air, type_name) {
-        (Some(p), _) => format!("give it entrained air (--set {p}=0.005, docs/hybrid.md)"),
-        (None, ty) => format!(
-            "`{cylinder}`{} has no entrained-air parameter, so its chambers cannot be given air here (the component types that have `{AIR_PARAMETER}`: {})",
-            ty.map(|t| format!(" (a `{t}`)")).unwrap_or_default(),
-            chamber_types_with_air().join(", ")
-        ),
-    };
-    let check = if solver.fixed_step() {
-        format!(
-            "; a smaller --rk4-step than {rk4_step} tells whether the {} step is to blame instead",
-            solver.name()
-        )
-    } else {
-        format!(
-            "; if the {} run is unstable instead, a smaller --rtol{} tells",
-            solver.name(),
-            if matches!(solver, Solver::Rosenbrock) {
-                ""
-            } else {
-                " or --solver rosenbrock"
-            }
-        )
+    let words = SettingWords {
+        set: |p| format!("--set {p}=0.005, docs/hybrid.md"),
+        rk4_step: "--rk4-step",
+        rtol: "--rtol",
+        stiff_solver: "--solver rosenbrock",
+        quote: '`',
     };
     format!(
-        "hydrocyl: warning: a chamber pressure fell far below absolute vacuum ({}): the oil, a liquid of constant bulk modulus, has left its range from then on (the chamber cavitates); {remedy}{check}",
-        d.what()
+        "hydrocyl: warning: {}",
+        d.warning(type_of, solver, rk4_step, &words)
     )
 }
 

@@ -8,8 +8,7 @@ use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
 use hydrocyl_integrators::SolveError;
 use hydrocyl_system::rig::{self, RigError};
 use hydrocyl_system::run::{
-    chamber_types_with_air, AirRemedy, Cause, DeepCavitation, Run, RunOptions, Setting, SimError,
-    Solver, AIR_PARAMETER,
+    Cause, DeepCavitation, Run, RunOptions, Setting, SettingWords, SimError, Solver,
 };
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::simulation::Simulation;
@@ -103,43 +102,21 @@ pub fn simulate(
 }
 
 /// The warning of a run whose chamber fell far below vacuum without
-/// blowing up ([`DeepCavitation`]): the CLI's, in Python's words (a
-/// parameter proposed to set is one the component's type has).
+/// blowing up ([`DeepCavitation::warning`] in Python's names; a parameter
+/// proposed to set is one the component's type has).
 fn cavitation_warning(value: &Value, opts: &RunOptions, d: &DeepCavitation) -> String {
-    let solver = opts.solver;
-    let AirRemedy {
-        cylinder,
-        air,
-        type_name,
-    } = d.remedy(|c| rig::component_type(value, c));
-    let remedy = match air {
-        Some(p) => format!("give it entrained air (rig.set('{p}', 0.005))"),
-        None => format!(
-            "'{cylinder}'{} has no entrained-air parameter, so its chambers cannot be given air here (the component types that have '{AIR_PARAMETER}': {})",
-            type_name.map(|t| format!(" (a '{t}')")).unwrap_or_default(),
-            chamber_types_with_air().join(", ")
-        ),
+    let words = SettingWords {
+        set: |p| format!("rig.set('{p}', 0.005)"),
+        rk4_step: "rk4_step",
+        rtol: "rtol",
+        stiff_solver: "solver='rosenbrock'",
+        quote: '\'',
     };
-    let check = if solver.fixed_step() {
-        format!(
-            "; a smaller rk4_step than {} tells whether the {} step is to blame instead",
-            opts.rk4_step,
-            solver.name()
-        )
-    } else {
-        format!(
-            "; if the {} run is unstable instead, a smaller rtol{} tells",
-            solver.name(),
-            if matches!(solver, Solver::Rosenbrock) {
-                ""
-            } else {
-                " or solver='rosenbrock'"
-            }
-        )
-    };
-    format!(
-        "a chamber pressure fell far below absolute vacuum ({}): the oil, a liquid of constant bulk modulus, has left its range from then on (the chamber cavitates); {remedy}{check}",
-        d.what()
+    d.warning(
+        |c| rig::component_type(value, c),
+        opts.solver,
+        opts.rk4_step,
+        &words,
     )
 }
 

@@ -28,8 +28,8 @@ mod physical;
 mod probes;
 mod settings;
 pub use physical::{
-    chamber_of, chamber_types_with_air, AirRemedy, Cause, DeepCavitation, Tension, Unphysical,
-    ABSURD_PRESSURE_PA, AIR_PARAMETER, LIQUID_TENSION_LIMIT_PA,
+    chamber_of, chamber_types_with_air, AirRemedy, Cause, DeepCavitation, SettingWords, Tension,
+    Unphysical, ABSURD_PRESSURE_PA, AIR_PARAMETER, LIQUID_TENSION_LIMIT_PA,
 };
 pub use probes::{ProbeReader, ProbeSet};
 pub use settings::{Setting, Solver};

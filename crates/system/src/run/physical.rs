@@ -163,6 +163,78 @@ impl DeepCavitation {
     }
 }
 
+/// How a client names the settings a warning proposes: the CLI its flags,
+/// Python its arguments ([`DeepCavitation::warning`]).
+#[derive(Clone, Copy, Debug)]
+pub struct SettingWords {
+    /// How to set the parameter at the path to 0.005, with where to read
+    /// more when the client has a place for it (`--set p=0.005,
+    /// docs/hybrid.md`).
+    pub set: fn(&str) -> String,
+    /// The fixed step's setting (`--rk4-step`).
+    pub rk4_step: &'static str,
+    /// The relative tolerance's setting (`--rtol`).
+    pub rtol: &'static str,
+    /// The switch to the stiff method (`--solver rosenbrock`).
+    pub stiff_solver: &'static str,
+    /// The quote a name is set in (`` ` ``).
+    pub quote: char,
+}
+
+impl DeepCavitation {
+    /// The warning of a run whose chamber fell far below vacuum without
+    /// blowing up, in one line and the client's `words`: the chamber, its
+    /// lowest pressure and when, from when on the constant-B liquid is out
+    /// of its range, the remedy ([`DeepCavitation::remedy`]: a parameter it
+    /// proposes to set is one the component's type has, `type_of`), and
+    /// how to tell whether the solver is to blame instead (`solver`; the
+    /// fixed step `rk4_step` \[s\] when it has one).
+    pub fn warning(
+        &self,
+        type_of: impl Fn(&str) -> Option<&'static ComponentType>,
+        solver: Solver,
+        rk4_step: f64,
+        words: &SettingWords,
+    ) -> String {
+        let q = words.quote;
+        let AirRemedy {
+            cylinder,
+            air,
+            type_name,
+        } = self.remedy(type_of);
+        let remedy = match air {
+            Some(p) => format!("give it entrained air ({})", (words.set)(&p)),
+            None => format!(
+                "{q}{cylinder}{q}{} has no entrained-air parameter, so its chambers cannot be given air here (the component types that have {q}{AIR_PARAMETER}{q}: {})",
+                type_name.map(|t| format!(" (a {q}{t}{q})")).unwrap_or_default(),
+                chamber_types_with_air().join(", ")
+            ),
+        };
+        let check = if solver.fixed_step() {
+            format!(
+                "; a smaller {} than {rk4_step} tells whether the {} step is to blame instead",
+                words.rk4_step,
+                solver.name()
+            )
+        } else {
+            format!(
+                "; if the {} run is unstable instead, a smaller {}{} tells",
+                solver.name(),
+                words.rtol,
+                if matches!(solver, Solver::Rosenbrock) {
+                    String::new()
+                } else {
+                    format!(" or {}", words.stiff_solver)
+                }
+            )
+        };
+        format!(
+            "a chamber pressure fell far below absolute vacuum ({}): the oil, a liquid of constant bulk modulus, has left its range from then on (the chamber cavitates); {remedy}{check}",
+            self.what()
+        )
+    }
+}
+
 /// The component types with chamber pressure probes (`p1`) that have the
 /// entrained-air parameter ([`AIR_PARAMETER`]), in catalog order: where a
 /// remedy for a chamber whose type has none can point.

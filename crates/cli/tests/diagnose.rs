@@ -547,3 +547,45 @@ fn rejected_effects_at_their_neutral_value_explain_nothing() {
         json["effects_rejected"]
     );
 }
+
+/// A record without a p2 column ran silently: the report now says, in JSON
+/// and in the table, that p2 is not compared; the exit code stays 0.
+#[test]
+fn a_record_without_p2_says_p2_is_not_compared() {
+    let dir = tempfile::tempdir().unwrap();
+    let full = std::fs::read_to_string(fixtures().join("valve-internal_leakage.csv")).unwrap();
+    // drop the p2 column (the last one), keep 1.5 s
+    let csv: String = full
+        .lines()
+        .take(1501)
+        .map(|l| format!("{}\n", &l[..l.rfind(',').unwrap()]))
+        .collect();
+    assert!(csv.starts_with("time [s],command,position [mm],p1 [bar]\n"));
+    let data = dir.path().join("no_p2.csv");
+    std::fs::write(&data, csv).unwrap();
+    let report = dir.path().join("r.json");
+    let out = bin()
+        .args(["diagnose", "--rig", "leaney-moog", "--data"])
+        .arg(&data)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("no p2 column") && text.contains("not compared"),
+        "{text}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let p = &json["data_problems"][0];
+    assert_eq!(p["channel"], "p2");
+    assert_eq!(p["kind"], "missing");
+    assert!(json["nrmse_after"].get("p2").is_none());
+}

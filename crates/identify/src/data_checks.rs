@@ -3,7 +3,10 @@
 //! unit that contradicts the rig (a position range beyond the stroke,
 //! pressures above the supply or below vacuum, or far below the supply, a
 //! command-to-velocity gain far from the rig's); a sign that contradicts
-//! the rig (command up, piston down).
+//! the rig (command up, piston down); gaps in the time axis. After the
+//! declared model's first run, [`pressure_scale_problems`] compares the
+//! pressures' scale with the model's, and [`missing_channels`] names the
+//! compared channels a record lacks.
 //!
 //! The checks read the record and a few facts about the rig ([`RigFacts`]),
 //! not the rig itself, so they do not depend on how a rig is declared. Each
@@ -15,6 +18,9 @@ use serde::Serialize;
 
 use crate::data::{DataError, Record, Signal};
 use crate::smooth::noise_sigma;
+
+mod coverage;
+pub use coverage::{missing_channels, pressure_scale_problems, GAP_FACTOR, SCALE_FACTOR};
 
 /// What the checks need to know about the rig (SI units).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,6 +59,11 @@ pub enum ProblemKind {
     Units,
     /// The sign contradicts the rig.
     Sign,
+    /// The time axis has gaps (steps far longer than the record's typical
+    /// step) that the input is interpolated across; the channels are kept.
+    Gap,
+    /// A channel the loop compares is not in the record: it is not compared.
+    Missing,
 }
 
 /// One data problem (`data_problems` in the JSON report).
@@ -171,6 +182,7 @@ pub fn check_record(rec: &Record, facts: Option<&RigFacts>) -> Vec<DataProblem> 
             out.push(p);
         }
     }
+    out.extend(coverage::gap_problem(rec));
     if let Some(f) = facts {
         let bad = |out: &[DataProblem], s: Signal| out.iter().any(|p| p.channel == s.name());
         if !bad(&out, Signal::Position) {

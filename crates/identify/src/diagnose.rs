@@ -258,7 +258,10 @@ pub struct Report {
     pub nrmse_before: BTreeMap<String, f64>,
     /// NRMSE per channel after.
     pub nrmse_after: BTreeMap<String, f64>,
-    /// NRMSE the sensor noise alone would give, per channel.
+    /// NRMSE the sensor noise alone would give, per channel: the noise's
+    /// σ ([`noise_sigma`], at least a quantised channel's step/√12) over the
+    /// channel's range. NaN (`null` in JSON, `n/a` in the table) where none
+    /// is measured: a velocity derived from the position.
     pub noise_floor: BTreeMap<String, f64>,
     /// Declared parameters refitted, with their final values.
     pub declared_refit: Vec<ParamReport>,

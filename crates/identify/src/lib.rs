@@ -21,7 +21,9 @@
 //!   position \[m\], velocity \[m·s⁻¹\], pressures \[Pa\], flow \[m³·s⁻¹\],
 //!   force \[N\]); errors name file, row and column; first-order hold.
 //! * [`data_checks`] — data problems named before any fit (constant,
-//!   clipped, quantised channels; units and signs that contradict the rig).
+//!   clipped, quantised channels; units and signs that contradict the rig,
+//!   pressures at a scale the declared model's contradicts; gaps in the
+//!   time axis; compared channels the record lacks).
 //! * [`smooth`] — Savitzky–Golay on uneven steps, window by GCV.
 //! * [`catalog`] — the effect catalog as data (ids, balances, parameters).
 //! * [`bench`](mod@bench) — the `friction-bench` rig: force balance

@@ -305,11 +305,58 @@ pub fn smooth_gcv(t: &[f64], y: &[f64], order: usize, max_half: usize) -> Smooth
 /// where differences in sample index see the signal's slope times the
 /// uneven steps (a 20 µm noise read 37 µm at ±45 % jitter, and 73 µm on 700
 /// of 2000 samples drawn at random).
+///
+/// The estimate is at least the quantisation's, `q/√12` with `q` the
+/// channel's step ([`quantisation_step`]): a converter's steps coarser than
+/// its noise leave most third differences at zero (a real record's
+/// position read 0 at 1,316 levels), and a zero floor is a zero tolerance.
 pub fn noise_sigma(t: &[f64], y: &[f64]) -> f64 {
     let n = t.len().min(y.len());
     if n < 5 {
         return 0.0;
     }
+    let q = quantisation_step(&y[..n]).map_or(0.0, |q| q / 12f64.sqrt());
+    white_noise_sigma(t, y, n).max(q)
+}
+
+/// Least share of the steps between neighbouring distinct levels that must
+/// be whole multiples of the smallest one for the channel to count as
+/// quantised.
+const QUANT_MULTIPLES: f64 = 0.9;
+
+/// The quantisation step of samples `y`, if they are quantised: the
+/// smallest step between their sorted distinct levels, taken only when
+/// values repeat (at most half as many levels as samples) and at least 90 %
+/// of the steps between neighbouring levels are whole multiples of it
+/// (within a tenth of it; levels closer than 1e-9 of the range are one, so
+/// the rounding of a unit conversion does not count as a step). A signal
+/// that does not visit every level still gives its step; samples of a
+/// continuous signal give `None`.
+pub fn quantisation_step(y: &[f64]) -> Option<f64> {
+    let mut v: Vec<f64> = y.iter().copied().filter(|x| x.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    let range = v.last()? - v.first()?;
+    if range <= 0.0 {
+        return None;
+    }
+    v.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * range);
+    if v.len() < 2 || 2 * v.len() > y.len() {
+        return None;
+    }
+    let steps: Vec<f64> = v.windows(2).map(|w| w[1] - w[0]).collect();
+    let q = steps.iter().copied().fold(f64::INFINITY, f64::min);
+    let whole = steps
+        .iter()
+        .filter(|s| {
+            let k = *s / q;
+            (k - k.round()).abs() <= 0.1
+        })
+        .count();
+    (whole as f64 >= QUANT_MULTIPLES * steps.len() as f64).then_some(q)
+}
+
+/// [`noise_sigma`] without the quantisation floor, on the first `n` samples.
+fn white_noise_sigma(t: &[f64], y: &[f64], n: usize) -> f64 {
     if is_uniform(&t[..n]) {
         // the same number, computed as it always was (the fits downstream
         // land where they did to the last digit)
@@ -475,5 +522,25 @@ mod tests {
             let sig = noise_sigma(t, y);
             assert!((sig / 2e-5 - 1.0).abs() < 0.15, "{what}: {sig}");
         }
+    }
+
+    #[test]
+    fn a_quantised_channel_has_at_least_its_quantisations_floor() {
+        // a slow ramp read by a converter of 1 µm steps, no other noise: the
+        // third differences are almost all zero, the floor is q/√12
+        let n = 3000;
+        let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
+        let y: Vec<f64> = t
+            .iter()
+            .map(|t| (1e-4 * (0.3 * t).sin() / 1e-6).round() * 1e-6)
+            .collect();
+        let q = quantisation_step(&y).unwrap();
+        assert!((q / 1e-6 - 1.0).abs() < 1e-6, "{q}");
+        let sig = noise_sigma(&t, &y);
+        assert!((sig / (1e-6 / 12f64.sqrt()) - 1.0).abs() < 1e-6, "{sig}");
+        // a continuous noisy signal is not quantised: its floor is its noise
+        let e = gaussian_noise(n, 5);
+        let z: Vec<f64> = t.iter().zip(&e).map(|(t, e)| t + 2e-5 * e).collect();
+        assert_eq!(quantisation_step(&z), None);
     }
 }

@@ -39,7 +39,9 @@ use hydrocyl_system::valve_rig::ValveRig;
 
 use crate::catalog::EffectId;
 use crate::data::{Record, Signal};
-use crate::data_checks::{check_record, unit_errors, ProblemKind, RigFacts};
+use crate::data_checks::{
+    check_record, missing_channels, pressure_scale_problems, unit_errors, ProblemKind, RigFacts,
+};
 use crate::diagnose::{
     nrmse, Applicable, DiagnoseError, DiagnoseOptions, EffectReport, NotApplicable, Probe,
     RecordTrace, RejectedEffect, Report,
@@ -236,61 +238,91 @@ pub fn diagnose_rig_traced(
         }
         _ => {}
     }
-    // Data problems first: each named channel is left out of the fit.
+    // Data problems first: each channel named and left out is not fitted.
     let facts = rig_facts(declared);
-    let data_problems = check_record(rec, Some(&facts));
+    let mut data_problems = check_record(rec, Some(&facts));
     unit_errors(rec, &facts, &data_problems)?;
-    let mut excluded: Vec<Signal> = data_problems
-        .iter()
-        .filter_map(|p| Signal::from_name(&p.channel))
-        .collect();
-    if data_problems.iter().any(|p| p.kind == ProblemKind::Sign) {
-        excluded.push(Signal::Velocity);
-    }
-    let (p, info) = prepare(rec, opts.half_window, &excluded, declared.stroke())?;
-    if p.weights.iter().all(|w| *w == 0.0) {
-        let why = if data_problems.is_empty() {
-            "no measured channel to compare (position, velocity, p1, p2)".to_string()
-        } else {
-            data_problems
-                .iter()
-                .map(|p| p.message.as_str())
-                .collect::<Vec<_>>()
-                .join("; ")
+    // the compared channels the record lacks (a position is required)
+    let compared: &[Signal] = match rec.get(Signal::Reference) {
+        Some(_) => &[Signal::P1, Signal::P2, Signal::Command],
+        None => &[Signal::P1, Signal::P2],
+    };
+    data_problems.extend(missing_channels(rec, compared));
+    // Twice at most: pressures whose scale contradicts the declared model's
+    // first run on this command are left out, and the record prepared again.
+    let mut scale_checked = false;
+    let (p, info, pt, mut rig0, sims_declared, initial_fit) = loop {
+        let mut excluded: Vec<Signal> = data_problems
+            .iter()
+            .filter(|p| p.left_out)
+            .filter_map(|p| Signal::from_name(&p.channel))
+            .collect();
+        if data_problems.iter().any(|p| p.kind == ProblemKind::Sign) {
+            excluded.push(Signal::Velocity);
+        }
+        let (p, info) = prepare(rec, opts.half_window, &excluded, declared.stroke())?;
+        if p.weights.iter().all(|w| *w == 0.0) {
+            let why = if data_problems.is_empty() {
+                "no measured channel to compare (position, velocity, p1, p2)".to_string()
+            } else {
+                data_problems
+                    .iter()
+                    .map(|p| p.message.as_str())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            };
+            return Err(DiagnoseError::Unusable {
+                file: rec.source.clone(),
+                why,
+            });
+        }
+        let rig0 = with_initial(declared, &p);
+        // Tracing compares candidates with each other, and the initial-state
+        // fit below only starts the refits: a looser integration tolerance is
+        // enough there. The refits use the tight one (a loose one puts
+        // integration noise into the finite-difference Jacobian, which narrows
+        // the confidence intervals below their coverage).
+        let pt = Prepared {
+            rtol: 1e-6,
+            ..p.clone()
         };
-        return Err(DiagnoseError::Unusable {
-            file: rec.source.clone(),
-            why,
-        });
-    }
-    let mut rig0 = with_initial(declared, &p);
+        // The declared model's own refit: the initial position and velocity
+        // only (the nuisance parameters of every later fit), so that what the
+        // effects are scored against is not an initial transient.
+        // (the declared model's own run alongside: it waits for nothing)
+        let (sims_declared, initial_fit) = {
+            let mut r = rig0.clone();
+            let (declared_run, fitted) = rayon::join(
+                || simulate(&rig0, &p),
+                || fit(&mut r, &Vec::new(), &pt, opts.holdout, Part::All),
+            );
+            (declared_run, fitted.map(|_| r))
+        };
+        let sims_declared = sims_declared
+            .map_err(|e| DiagnoseError::Rig(format!("declared model does not simulate: {e}")))?;
+        if !scale_checked {
+            scale_checked = true;
+            let sim: Vec<(Signal, &[f64])> = p
+                .meas
+                .iter()
+                .map(|(c, _)| *c)
+                .zip(sims_declared.iter().map(Vec::as_slice))
+                .collect();
+            let scale = pressure_scale_problems(rec, &sim);
+            if !scale.is_empty() {
+                data_problems.extend(scale);
+                continue;
+            }
+        }
+        break (p, info, pt, rig0, sims_declared, initial_fit);
+    };
     let mut warnings: Vec<String> = data_problems
         .iter()
-        .map(|p| format!("{} left out of the fit: {}", p.channel, p.message))
+        .map(|p| match p.left_out {
+            true => format!("{} left out of the fit: {}", p.channel, p.message),
+            false => format!("{}: {}", p.channel, p.message),
+        })
         .collect();
-    // Tracing compares candidates with each other, and the initial-state
-    // fit below only starts the refits: a looser integration tolerance is
-    // enough there. The refits use the tight one (a loose one puts
-    // integration noise into the finite-difference Jacobian, which narrows
-    // the confidence intervals below their coverage).
-    let pt = Prepared {
-        rtol: 1e-6,
-        ..p.clone()
-    };
-    // The declared model's own refit: the initial position and velocity
-    // only (the nuisance parameters of every later fit), so that what the
-    // effects are scored against is not an initial transient.
-    // (the declared model's own run alongside: it waits for nothing)
-    let (sims_declared, initial_fit) = {
-        let mut r = rig0.clone();
-        let (declared_run, fitted) = rayon::join(
-            || simulate(&rig0, &p),
-            || fit(&mut r, &Vec::new(), &pt, opts.holdout, Part::All),
-        );
-        (declared_run, fitted.map(|_| r))
-    };
-    let sims_declared = sims_declared
-        .map_err(|e| DiagnoseError::Rig(format!("declared model does not simulate: {e}")))?;
     let nrmse_declared = nrmse_of(&p, &sims_declared);
     match initial_fit {
         Ok(r) => rig0 = r,
@@ -700,7 +732,13 @@ pub fn diagnose_rig_traced(
     let mut noise_floor = BTreeMap::new();
     let mut noise_ss = 0.0;
     for (((ch, m), r), w) in p.meas.iter().zip(&p.ranges).zip(&p.weights) {
-        let sig = if *w == 0.0 { 0.0 } else { noise_sigma(&p.t, m) };
+        // none measured (NaN, `null` in JSON, n/a in the table) for a
+        // velocity derived from position
+        let sig = if *w == 0.0 {
+            f64::NAN
+        } else {
+            noise_sigma(&p.t, m)
+        };
         noise_floor.insert(ch.name().to_string(), sig / r);
         // Weighted residuals of pure noise have unit variance.
         if *w > 0.0 {

@@ -437,7 +437,14 @@ pub fn diagnose_bench(
                 why: p.message.clone(),
             });
         }
-        data_problems.extend(problems.into_iter().map(kept_on_bench));
+        // a problem already kept (a gap) keeps its own reason
+        data_problems.extend(problems.into_iter().map(|p| {
+            if p.left_out {
+                kept_on_bench(p)
+            } else {
+                p
+            }
+        }));
     }
     let mut sigs = Vec::new();
     let mut windows = Vec::new();

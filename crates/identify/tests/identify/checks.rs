@@ -34,8 +34,11 @@ fn diagnose(rec: &Record) -> Result<Report, DiagnoseError> {
 fn assert_finite(r: &Report) {
     fn walk(v: &serde_json::Value, path: &str) {
         match v {
+            // a velocity derived from the position has no noise floor
             serde_json::Value::Null => assert!(
-                path.ends_with("unexplained_resembles") || path.contains("effects_rejected"),
+                path.ends_with("unexplained_resembles")
+                    || path.contains("effects_rejected")
+                    || path == "report.noise_floor.velocity",
                 "null at {path}"
             ),
             serde_json::Value::Number(n) => {
@@ -119,6 +122,85 @@ fn pressures_in_pascal_under_a_bar_header_are_named() {
         ]
     );
     assert!(r.effects_added.is_empty(), "{}", r.human());
+}
+
+#[test]
+fn pressures_in_bar_under_a_kilopascal_header_are_named() {
+    // 100 times too low: above a thousandth of the supply, so only the
+    // declared model's pressures on the same command can tell
+    let rec = valve_record(&truth(&[]), 2000, 1e-3, 65).unwrap();
+    let rec = with(&rec, Signal::P1, |p| p * 1e-2);
+    let rec = with(&rec, Signal::P2, |p| p * 1e-2);
+    let r = diagnose(&rec).unwrap();
+    assert_finite(&r);
+    assert_eq!(
+        problems(&r),
+        [
+            ("p1".to_string(), ProblemKind::Units),
+            ("p2".to_string(), ProblemKind::Units)
+        ],
+        "{}",
+        r.human()
+    );
+    assert!(!r.nrmse_after.contains_key("p1"), "{}", r.human());
+    assert!(r.effects_added.is_empty(), "{}", r.human());
+    // the honest record has none, and its derived velocity no noise floor
+    let r = diagnose(&valve_record(&truth(&[]), 2000, 1e-3, 65).unwrap()).unwrap();
+    assert_eq!(problems(&r), [], "{}", r.human());
+    assert!(r.noise_floor["velocity"].is_nan(), "{}", r.human());
+    assert!(r
+        .human()
+        .lines()
+        .any(|l| l.starts_with("velocity") && l.ends_with("n/a")));
+}
+
+#[test]
+fn a_dropout_in_the_record_is_named_and_the_channels_kept() {
+    // a 1 kHz record with the rows from 1.2 s to 1.5 s removed
+    let rec = valve_record(&truth(&[]), 2000, 1e-3, 66).unwrap();
+    let keep: Vec<bool> = rec
+        .time
+        .iter()
+        .map(|t| !(*t > 1.2005 && *t < 1.4995))
+        .collect();
+    let mut cut = rec.clone();
+    let pick = |y: &[f64]| -> Vec<f64> {
+        y.iter()
+            .zip(&keep)
+            .filter(|(_, k)| **k)
+            .map(|(v, _)| *v)
+            .collect()
+    };
+    cut.time = pick(&rec.time);
+    for v in cut.signals.values_mut() {
+        *v = pick(v);
+    }
+    let r = diagnose(&cut).unwrap();
+    assert_finite(&r);
+    assert_eq!(problems(&r), [("time".to_string(), ProblemKind::Gap)]);
+    let gap = &r.data_problems[0];
+    assert!(!gap.left_out, "{gap:?}");
+    assert!(
+        gap.message.contains("from 1.2000 s to 1.5000 s") && gap.message.contains("interpolated")
+    );
+    for ch in ["position", "p1", "p2"] {
+        assert!(r.nrmse_after.contains_key(ch), "{ch}\n{}", r.human());
+    }
+}
+
+#[test]
+fn a_record_without_p2_says_p2_is_not_compared() {
+    let mut rec = valve_record(&truth(&[]), 2000, 1e-3, 67).unwrap();
+    rec.signals.remove(&Signal::P2);
+    let r = diagnose(&rec).unwrap();
+    assert_finite(&r);
+    assert_eq!(problems(&r), [("p2".to_string(), ProblemKind::Missing)]);
+    assert!(!r.nrmse_after.contains_key("p2"));
+    let text = r.human();
+    assert!(
+        text.contains("no p2 column") && text.contains("not compared"),
+        "{text}"
+    );
 }
 
 #[test]

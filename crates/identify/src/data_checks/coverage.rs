@@ -137,12 +137,12 @@ pub fn pressure_scale_problems(rec: &Record, simulated: &[(Signal, &[f64])]) -> 
         let said = format!("{name} reaches [{lo:.4e}, {hi:.4e}] Pa ({unit} in the header)");
         let msg = if sim >= TANK_SIDE * top && meas * SCALE_FACTOR < sim {
             Some(format!(
-                "{said}, {:.3e} times the declared model's level on this command ({sim:.3e} Pa): check the unit of the column (bar written under [kPa]?)",
+                "{said}, {:.3e} times the declared model's level on this command ({sim:.3e} Pa): check the unit of the column (bar written under [kPa]?), or whether the rig's supply pressure and load are this drive's",
                 meas / sim
             ))
         } else if meas - 5.0 * sigma > SCALE_FACTOR * sim.max(TANK_SIDE * top) {
             Some(format!(
-                "{said}, {:.3e} times the declared model's level on this command ({:.3e} Pa): check the unit of the column (kPa written under [bar]?)",
+                "{said}, {:.3e} times the declared model's level on this command ({:.3e} Pa): check the unit of the column (kPa written under [bar]?), or whether the rig's supply pressure and load are this drive's",
                 meas / sim.max(TANK_SIDE * top),
                 sim.max(TANK_SIDE * top)
             ))

@@ -14,8 +14,12 @@
 //! 2. its fitted *size* — the distance from "off" of the parameter that
 //!    says how much of the effect there is ([`size`]: the first parameter,
 //!    the larger leak of `external_leakage`, the hump `Fs − Fc` of
-//!    `stribeck`) — has a 95 % interval that excludes zero, and is not
-//!    negligible where the rig kind has a negligible size. The other
+//!    `stribeck`) — has a 95 % interval that excludes zero and stays
+//!    inside the parameter's physical range ([`valid_range`]: an interval
+//!    reaching negative B is no resolved size, however far it is from the
+//!    declared B), and is not negligible where the rig kind has a
+//!    negligible size ([`unresolved`]; the loop makes the same test again
+//!    on every added effect after its last joint refit). The other
 //!    parameters (`vs`, `alpha` of `stribeck`, `sigma1` of
 //!    `lugre_dynamics`, the smaller leak) are shape parameters: they are
 //!    held to rule 1 only;
@@ -27,9 +31,12 @@
 //! A candidate that fails is rejected with the part of the rule it failed as
 //! the reason.
 
+use std::cmp::Ordering;
 use std::collections::BTreeMap;
 
-use crate::catalog::EffectId;
+use hydrocyl_system::netlist::registry::{self, Range};
+
+use crate::catalog::{EffectId, Scale};
 
 /// One parameter of a refit, as the rule sees it.
 #[derive(Clone, Debug, PartialEq)]
@@ -215,6 +222,91 @@ pub fn worsened(
     None
 }
 
+/// The range of values parameter `name` of effect `id` can physically
+/// take: the registry's range of the component parameters the catalog
+/// writes it to (their intersection: `B > 0`, a leak coefficient `≥ 0`);
+/// for a parameter written to none (the friction-law edits, the sensor
+/// lag) or only as a factor on a declared value, the catalog's bounds.
+pub fn valid_range(id: EffectId, name: &str) -> Range {
+    let Some(spec) = id.params().iter().find(|q| q.name == name) else {
+        return Range::ANY;
+    };
+    // a `Factor` target's range is of the product, not of the catalog value
+    let ranges: Vec<Range> = spec
+        .targets
+        .iter()
+        .filter(|tg| tg.scale != Scale::Factor)
+        .filter_map(|tg| Some(registry::lookup(tg.ty)?.param(tg.param)?.range))
+        .collect();
+    if ranges.is_empty() {
+        return Range {
+            lo: spec.lower,
+            hi: spec.upper,
+            lo_open: false,
+            hi_open: false,
+        };
+    }
+    ranges.into_iter().fold(Range::ANY, |a, b| {
+        let (lo, lo_open) = match a.lo.total_cmp(&b.lo) {
+            Ordering::Greater => (a.lo, a.lo_open),
+            Ordering::Less => (b.lo, b.lo_open),
+            Ordering::Equal => (a.lo, a.lo_open || b.lo_open),
+        };
+        let (hi, hi_open) = match a.hi.total_cmp(&b.hi) {
+            Ordering::Less => (a.hi, a.hi_open),
+            Ordering::Greater => (b.hi, b.hi_open),
+            Ordering::Equal => (a.hi, a.hi_open || b.hi_open),
+        };
+        Range {
+            lo,
+            hi,
+            lo_open,
+            hi_open,
+        }
+    })
+}
+
+/// Rule 2's interval test: why the fitted `size` of effect `id` (among
+/// the refit's `params`) is not resolved, or `None` when it is. It is not
+/// when the size parameter has no 95 % interval, when the interval
+/// includes zero (the neutral value), or when it reaches past the
+/// parameter's [`valid_range`] (`B = 2.09e7 ± 2.46e7 Pa` reaches negative
+/// B though it excludes the declared 7e8). Made on every candidate at
+/// acceptance ([`verdict`]) and again on every added effect after the
+/// loop's last joint refit, which may have widened its interval.
+pub fn unresolved(id: EffectId, params: &[FittedParam], size: &Size) -> Option<String> {
+    let name = size.name;
+    let Some(q) = params
+        .iter()
+        .find(|q| q.effect == Some(id) && q.name == name)
+    else {
+        return Some(format!(
+            "{name} has no 95 % interval (not identifiable from this record)"
+        ));
+    };
+    let ci = q.ci95;
+    if !ci.is_finite() {
+        return Some(format!(
+            "{name} has no 95 % interval (not identifiable from this record)"
+        ));
+    }
+    let d = size.value;
+    if d.abs() <= ci {
+        return Some(format!(
+            "{name}'s 95 % interval includes zero (size {d:.3e} ± {ci:.3e})"
+        ));
+    }
+    let range = valid_range(id, name);
+    let v = q.value;
+    if !(range.contains(v - ci) && range.contains(v + ci)) {
+        return Some(format!(
+            "{name}'s 95 % interval reaches past its valid range {} ({name} = {v:.3e} ± {ci:.3e}): the size is not resolved",
+            range.describe()
+        ));
+    }
+    None
+}
+
 /// `Ok` if the refitted candidate earns its place; else which part of the
 /// rule it fails, as the reason. `after` scores the refitted model (rules 3
 /// and 4; a simulation, so only run when rules 1 and 2 pass).
@@ -222,22 +314,8 @@ pub fn verdict(c: &Refitted<'_>, after: impl FnOnce() -> Scores) -> Result<(), S
     if let Some(why) = on_bound(c) {
         return Err(why);
     }
-    let name = c.size.name;
-    let ci = c
-        .params
-        .iter()
-        .find(|q| q.effect == Some(c.id) && q.name == name)
-        .map_or(f64::NAN, |q| q.ci95);
-    if !ci.is_finite() {
-        return Err(format!(
-            "{name} has no 95 % interval (not identifiable from this record)"
-        ));
-    }
-    let d = c.size.value;
-    if d.abs() <= ci {
-        return Err(format!(
-            "{name}'s 95 % interval includes zero (size {d:.3e} ± {ci:.3e})"
-        ));
+    if let Some(why) = unresolved(c.id, c.params, &c.size) {
+        return Err(why);
     }
     if let Some(why) = &c.negligible {
         return Err(why.clone());
@@ -421,5 +499,69 @@ mod tests {
         ];
         let why = judge(EffectId::LugreDynamics, &none, 20.0).unwrap_err();
         assert!(why.starts_with("sigma0 has no 95 % interval"), "{why}");
+    }
+
+    /// t34 defect 5, the Festo record: `bulk_modulus` B = 2.09e7 ± 2.46e7 Pa
+    /// was added. Its size, measured from the declared 7e8, excludes zero,
+    /// but the interval reaches negative B: the size is not resolved.
+    #[test]
+    fn an_interval_reaching_past_the_valid_range_is_refused() {
+        let b = Some(EffectId::BulkModulus);
+        let declared = 7e8;
+        let judge_b = |value: f64, ci95: f64| {
+            let mut q = param(b, "B", value, ci95);
+            q.bounds = (1e7, 1e10);
+            q.at_bound = false;
+            q.neutral = declared;
+            let params = [q];
+            let before = Scores {
+                nrmse: map(&[("p1", 0.1)]),
+                held: 2.0,
+            };
+            let floors = map(&[("p1", 0.01)]);
+            let id = EffectId::BulkModulus;
+            verdict(
+                &Refitted {
+                    id,
+                    params: &params,
+                    size: size(id, |_| value, |_| declared, 0.0),
+                    negligible: None,
+                    before: &before,
+                    floors: &floors,
+                },
+                || Scores {
+                    nrmse: map(&[("p1", 0.05)]),
+                    held: 1.0,
+                },
+            )
+        };
+        let why = judge_b(2.09e7, 2.46e7).unwrap_err();
+        assert!(
+            why.starts_with("B's 95 % interval reaches past its valid range > 0"),
+            "{why}"
+        );
+        // resolved: the interval stays above zero
+        assert_eq!(judge_b(2.09e7, 0.5e7), Ok(()));
+        // the ranges are the registry's (B > 0, Cl ≥ 0); a law edit's the catalog's
+        assert_eq!(valid_range(EffectId::BulkModulus, "B").describe(), "> 0");
+        assert_eq!(
+            valid_range(EffectId::InternalLeakage, "Cl").describe(),
+            "≥ 0"
+        );
+        assert_eq!(valid_range(EffectId::Stribeck, "Fs").describe(), "≥ 0");
+    }
+
+    /// A leak is held to the same test: its interval reaching below zero
+    /// includes its neutral value (t34 defect 2: Cl = 7.23e-14 ± 2.64e-13).
+    #[test]
+    fn a_leak_whose_interval_includes_zero_is_unresolved() {
+        let l = Some(EffectId::InternalLeakage);
+        let ps = [param(l, "Cl", 7.23e-14, 2.64e-13)];
+        let id = EffectId::InternalLeakage;
+        let sz = size(id, |_| 7.23e-14, |_| 0.0, 0.0);
+        let why = unresolved(id, &ps, &sz).expect("unresolved");
+        assert!(why.starts_with("Cl's 95 % interval includes zero"), "{why}");
+        let ok = [param(l, "Cl", 7.23e-14, 2.0e-14)];
+        assert_eq!(unresolved(id, &ok, &sz), None);
     }
 }

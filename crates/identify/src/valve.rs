@@ -359,6 +359,8 @@ pub fn diagnose_rig_traced(
     let mut added: Vec<EffectReport> = Vec::new();
     let mut last: BTreeMap<EffectId, RejectedEffect> = BTreeMap::new();
     let mut resembles: Option<Probe> = None;
+    // the last joint refit of the added effects (the backward step's start)
+    let mut joint_res: Option<lm::LmResult> = None;
     let total = opts.max_effects + 1;
     for round in 0..opts.max_effects {
         progress(&format!("tracing, round {}", round + 1), round, total);
@@ -674,54 +676,29 @@ pub fn diagnose_rig_traced(
                 a.ci95.insert(n.to_string(), ci.is_finite().then_some(*ci));
             }
         }
+        joint_res = Some(res);
     }
     clock.lap("refits");
-    // Backward step: an effect whose refitted size became negligible once
-    // later effects were added was standing in for them; drop it and refit.
-    let stale: Vec<EffectId> = added
-        .iter()
-        .filter_map(|a| EffectId::from_id(&a.id))
-        .filter(|id| negligible(*id, &model, declared))
-        .collect();
-    if !stale.is_empty() {
-        for id in &stale {
-            for q in id.params() {
-                let v = accept::neutral(*id, q.name, declared);
-                set(&mut model, *id, q.name, v);
-            }
-            free.retain(|(e, _)| e != id);
-            if let Some(pos) = added.iter().position(|a| a.id == id.id()) {
-                let rep = added.remove(pos);
-                last.insert(
-                    *id,
-                    RejectedEffect::new(
-                        rep,
-                        "added, then gave way: its refitted size became negligible once later effects were added",
-                    ),
-                );
-            }
-        }
-        if !free.is_empty() {
-            let mut refit = model.clone();
-            let res = match refit_polished(&mut refit, &free, &p, opts.holdout) {
-                Ok(r) => {
-                    model = refit;
-                    r
-                }
-                Err(e) => {
-                    warnings.push(format!("refit after the backward step: {e}"));
-                    return Err(DiagnoseError::Fit {
-                        what: "refit after the backward step".into(),
-                        reason: e.to_string(),
-                    });
-                }
-            };
-            for ((eid, n), (x, ci)) in free.iter().zip(res.x.iter().zip(&res.ci95)) {
-                if let Some(a) = added.iter_mut().find(|a| a.id == eid.id()) {
-                    a.params.insert(n.to_string(), *x);
-                    a.ci95.insert(n.to_string(), ci.is_finite().then_some(*ci));
-                }
-            }
+    // Backward step: every added effect must still pass the rule's interval
+    // test after the last joint refit (a later effect may have taken over
+    // what it carried); the least resolved that fails is dropped and the
+    // rest refitted, until all pass.
+    let dropped = accept::backward(
+        &mut model,
+        &mut free,
+        joint_res,
+        &mut added,
+        declared,
+        &p,
+        opts.holdout,
+    )
+    .map_err(|e| DiagnoseError::Fit {
+        what: "refit after the backward step".into(),
+        reason: e.to_string(),
+    })?;
+    for d in dropped {
+        if let Some(id) = EffectId::from_id(&d.effect.id) {
+            last.insert(id, d);
         }
     }
     progress("report", total, total);
@@ -782,7 +759,7 @@ pub fn diagnose_rig_traced(
         warnings,
         noise_share: (noise_ss / rss_after.max(1e-300)).min(1.0),
         selection: format!(
-            "output-error tracing: add the effect removing the largest share of the noise-weighted output-error SS if share >= {:.0} %, held-out share >= {:.1} % and BIC falls; refit all added parameters on the output error; keep it only if no compared channel's NRMSE rises by more than {:.0} % of its noise floor and the held-out part improves",
+            "output-error tracing: add the effect removing the largest share of the noise-weighted output-error SS if share >= {:.0} %, held-out share >= {:.1} % and BIC falls; refit all added parameters on the output error; keep it only if its size's 95 % interval excludes zero and stays in the parameter's valid range, no parameter sits at a bound, no compared channel's NRMSE rises by more than {:.0} % of its noise floor and the held-out part improves; after the last joint refit, drop the least resolved added effect whose interval no longer passes and refit the rest, until all pass",
             100.0 * opts.min_share,
             50.0 * opts.min_share,
             100.0 * crate::accept::WORSEN_TOL

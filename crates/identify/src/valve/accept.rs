@@ -7,10 +7,13 @@ use std::collections::BTreeMap;
 
 use super::Model;
 
-use super::{bounds, get, mean_coulomb, negligible, nrmse_and_held, ParamList, Prepared};
+use super::{
+    bounds, get, mean_coulomb, negligible, nrmse_and_held, refit_polished, set, ParamList, Prepared,
+};
 use crate::accept::{self, FittedParam, Refitted, Scores};
 use crate::catalog::EffectId;
-use crate::lm::LmResult;
+use crate::diagnose::{EffectReport, RejectedEffect};
+use crate::lm::{self, LmResult};
 
 /// The neutral ("off") value of parameter `name` of effect `id`.
 pub(super) fn neutral(id: EffectId, name: &str, declared: &Model) -> f64 {
@@ -19,6 +22,115 @@ pub(super) fn neutral(id: EffectId, name: &str, declared: &Model) -> f64 {
         (EffectId::BulkModulus, _) => get(declared, id, name).unwrap_or(0.0),
         _ => 0.0,
     }
+}
+
+/// The refit's parameters as the rule sees them: `res` over `free` in
+/// `refit`; `candidate`: the effect being added and the model before it
+/// (the other effects' values before), `None` after the loop.
+fn fitted_params(
+    free: &ParamList,
+    res: &LmResult,
+    refit: &Model,
+    candidate: Option<(EffectId, &Model)>,
+    declared: &Model,
+) -> Vec<FittedParam> {
+    free.iter()
+        .enumerate()
+        .map(|(k, (eid, n))| FittedParam {
+            effect: Some(*eid),
+            name: n.to_string(),
+            value: res.x[k],
+            ci95: res.ci95.get(k).copied().unwrap_or(f64::NAN),
+            bounds: bounds(*eid, n, refit),
+            at_bound: res.at_bound.get(k).copied().unwrap_or(false),
+            neutral: neutral(*eid, n, declared),
+            before: candidate
+                .filter(|(id, _)| eid != id)
+                .and_then(|(_, round)| get(round, *eid, n)),
+        })
+        .collect()
+}
+
+/// The fitted size of effect `id` in `rig` ([`accept::size`]).
+fn size_of(id: EffectId, rig: &Model, declared: &Model) -> accept::Size {
+    accept::size(
+        id,
+        |n| get(rig, id, n).unwrap_or(0.0),
+        |n| neutral(id, n, declared),
+        mean_coulomb(rig),
+    )
+}
+
+/// The backward step after the loop's last joint refit (`res` over `free`
+/// in `model`, `p` the prepared record with `holdout` its held-out share):
+/// every added effect must still pass the rule's interval
+/// test ([`accept::unresolved`], the one made at acceptance) and not be
+/// negligible; a later effect may have taken over what an earlier one
+/// carried, and the joint refit widened its interval. Of those that fail,
+/// the least resolved (the smallest size in half-widths) is dropped: set
+/// to its neutral value and taken out of `free` and `added`, and the rest
+/// refitted; then checked again, until every one passes. Returns the
+/// dropped effects with the reason.
+pub(super) fn backward(
+    model: &mut Model,
+    free: &mut ParamList,
+    mut res: Option<LmResult>,
+    added: &mut Vec<EffectReport>,
+    declared: &Model,
+    p: &Prepared,
+    holdout: f64,
+) -> Result<Vec<RejectedEffect>, lm::LmError> {
+    let mut dropped = Vec::new();
+    while let Some(r) = res.take() {
+        let params = fitted_params(free, &r, model, None, declared);
+        // (failing effect, reason, size in half-widths)
+        let worst = added
+            .iter()
+            .filter_map(|a| EffectId::from_id(&a.id))
+            .filter_map(|id| {
+                let size = size_of(id, model, declared);
+                let why = if negligible(id, model, declared) {
+                    "its size became negligible (indistinguishable from the declared rig)".into()
+                } else {
+                    accept::unresolved(id, &params, &size)?
+                };
+                let ci = params
+                    .iter()
+                    .find(|q| q.effect == Some(id) && q.name == size.name)
+                    .map_or(f64::NAN, |q| q.ci95);
+                let z = (size.value / ci).abs();
+                Some((id, why, if z.is_finite() { z } else { 0.0 }))
+            })
+            .min_by(|a, b| a.2.total_cmp(&b.2));
+        let Some((id, why, _)) = worst else {
+            break;
+        };
+        for q in id.params() {
+            set(model, id, q.name, neutral(id, q.name, declared));
+        }
+        free.retain(|(e, _)| *e != id);
+        if let Some(pos) = added.iter().position(|a| a.id == id.id()) {
+            let rep = added.remove(pos);
+            dropped.push(RejectedEffect::new(
+                rep,
+                format!("added, then dropped after the last joint refit with the effects added after it: {why}"),
+            ));
+        }
+        if free.is_empty() {
+            break;
+        }
+        let mut refit = model.clone();
+        let r = refit_polished(&mut refit, free, p, holdout)?;
+        *model = refit;
+        for ((eid, n), (x, ci)) in free.iter().zip(r.x.iter().zip(&r.ci95)) {
+            if let Some(a) = added.iter_mut().find(|a| a.id == eid.id()) {
+                a.params.insert(n.to_string(), *x);
+                a.ci95.insert(n.to_string(), ci.is_finite().then_some(*ci));
+            }
+        }
+        res = Some(r);
+    }
+    Ok(dropped)
 }
 
 /// What the rule compares a candidate with: the model before it, its
@@ -50,26 +162,8 @@ pub(super) fn verdict(
     round: &Model,
     base: &Baseline<'_>,
 ) -> Result<(), String> {
-    let params: Vec<FittedParam> = free
-        .iter()
-        .enumerate()
-        .map(|(k, (eid, n))| FittedParam {
-            effect: Some(*eid),
-            name: n.to_string(),
-            value: res.x[k],
-            ci95: res.ci95.get(k).copied().unwrap_or(f64::NAN),
-            bounds: bounds(*eid, n, refit),
-            at_bound: res.at_bound.get(k).copied().unwrap_or(false),
-            neutral: neutral(*eid, n, base.declared),
-            before: (*eid != id).then(|| get(round, *eid, n)).flatten(),
-        })
-        .collect();
-    let size = accept::size(
-        id,
-        |n| get(refit, id, n).unwrap_or(0.0),
-        |n| neutral(id, n, base.declared),
-        mean_coulomb(refit),
-    );
+    let params = fitted_params(free, res, refit, Some((id, round)), base.declared);
+    let size = size_of(id, refit, base.declared);
     let negligible = negligible(id, refit, base.declared)
         .then(|| "fitted size negligible (indistinguishable from the declared rig)".to_string());
     accept::verdict(

@@ -16,6 +16,10 @@
 //!   squares it removes follow in closed form from the channel's weighted
 //!   residual (no simulation).
 //!
+//! A probe whose best fit sits at the edge of its searched range (a
+//! quarter or four times the value, a delay of 60 ms) says so in its words:
+//! the true value may lie beyond it, or the residual is something else.
+//!
 //! A scaled parameter is first screened by two simulations a tenth below
 //! and above its value ([`screen_share`]): the grid is run only where they
 //! say it could explain at least [`SCREEN_SHARE`] of what a probe needs to
@@ -54,9 +58,17 @@ fn delay_probe(rig: &Model, p: &Prepared, holdout: f64, rss0: f64) -> Option<Pro
             best = (*tau, r);
         }
     }
+    let longest = TAUS[TAUS.len() - 1];
     (best.0 > 0.0).then(|| Probe {
         kind: "delay".into(),
-        what: "transport delay of the command".into(),
+        what: if best.0 >= longest {
+            format!(
+                "transport delay of the command ({} ms, the longest delay searched; {EDGE})",
+                sig(1e3 * longest)
+            )
+        } else {
+            "transport delay of the command".into()
+        },
         value: best.0,
         explained_share: 1.0 - best.1 / rss0.max(1e-300),
     })
@@ -102,10 +114,21 @@ impl Scaled {
             .iter()
             .map(|(c, q, _)| format!("`{c}.{q}`"))
             .collect();
+        let limit = GRID[GRID.len() - 1];
+        let edge = if x.abs() >= limit - 1e-12 {
+            let side = if x > 0.0 {
+                "four times the model's value, the upper end"
+            } else {
+                "a quarter of the model's value, the lower end"
+            };
+            format!("; {side} of the range searched: {EDGE}")
+        } else {
+            String::new()
+        };
         Probe {
             kind: self.kind.into(),
             what: format!(
-                "{} other than declared ({} fits {}, declared {})",
+                "{} other than declared ({} fits {}, declared {}{edge})",
                 self.name,
                 names.join(", "),
                 list(x.exp()),
@@ -116,6 +139,11 @@ impl Scaled {
         }
     }
 }
+
+/// What a probe whose fit sits at the edge of its searched range adds to
+/// its words: the minimum may lie beyond the range, or the residual may be
+/// something else that the probe's shape only leans toward.
+const EDGE: &str = "the fit sits at the edge of the searched range, so the true value may lie beyond it, or the residual is something else";
 
 /// `x` with three significant digits (no exponent between 1e-3 and 1e6).
 fn sig(x: f64) -> String {

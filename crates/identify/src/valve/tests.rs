@@ -156,3 +156,83 @@ fn lag_of_samples_is_exact_for_a_ramp_and_identity_at_zero() {
     assert!(y[1] > 0.0 && y[1] < 1.0 && (y[199] - 1.0).abs() < 1e-6);
     assert!(lag_samples(&[], &[], 0.01).is_empty());
 }
+
+/// t34 defect 2: `internal_leakage` was added first and kept after later
+/// effects were added, though the last joint refit had widened its interval
+/// to include zero (Cl = 7.23e-14 ± 2.64e-13). The backward step makes the
+/// acceptance rule's interval test again on every added effect: the leak is
+/// dropped with the reason, the rest refitted and kept.
+#[test]
+fn an_added_effect_whose_interval_widened_to_include_zero_is_dropped() {
+    use crate::diagnose::EffectReport;
+    use crate::lm::LmResult;
+    use std::collections::BTreeMap;
+    let net = hydrocyl_system::rig::preset("leaney-moog").unwrap();
+    let declared = Model::new(&net).unwrap();
+    // the record has an external force of 400 N and no leak
+    let mut truth = declared.clone();
+    set(&mut truth, EffectId::ExternalForce, "F0", 400.0);
+    let rec =
+        crate::synth::netlist_record(&truth.net, 1000, 1e-3, 81, &crate::synth::valve_command)
+            .unwrap();
+    let (p, _) = super::sim::prepare(&rec, None, &[], declared.stroke()).unwrap();
+    // the loop's model after its last joint refit: the leak and the force
+    let mut model = super::sim::with_initial(&declared, &p);
+    set(&mut model, EffectId::InternalLeakage, "Cl", 7.23e-14);
+    set(&mut model, EffectId::ExternalForce, "F0", 400.0);
+    let mut free = vec![
+        (EffectId::InternalLeakage, "Cl"),
+        (EffectId::ExternalForce, "F0"),
+    ];
+    let res = LmResult {
+        x: vec![7.23e-14, 400.0, model.x0(), model.v0()],
+        ci95: vec![2.64e-13, 5.0, f64::NAN, f64::NAN],
+        rss: 1.0,
+        m: 4000,
+        iterations: 1,
+        evaluations: 1,
+        at_bound: vec![false; 4],
+    };
+    let report = |id: EffectId, name: &str, v: f64, ci: f64| EffectReport {
+        id: id.id().into(),
+        params: BTreeMap::from([(name.to_string(), v)]),
+        ci95: BTreeMap::from([(name.to_string(), Some(ci))]),
+        explained_share: 0.9,
+        heldout_share: 0.9,
+        delta_bic: -100.0,
+    };
+    let mut added = vec![
+        report(EffectId::InternalLeakage, "Cl", 7.23e-14, 2.64e-13),
+        report(EffectId::ExternalForce, "F0", 400.0, 5.0),
+    ];
+    let dropped = super::accept::backward(
+        &mut model,
+        &mut free,
+        Some(res),
+        &mut added,
+        &declared,
+        &p,
+        0.3,
+    )
+    .unwrap();
+    let ids: Vec<&str> = dropped.iter().map(|d| d.effect.id.as_str()).collect();
+    assert_eq!(ids, ["internal_leakage"]);
+    let why = &dropped[0].reason;
+    assert!(
+        why.starts_with("added, then dropped after the last joint refit")
+            && why.contains("Cl's 95 % interval includes zero"),
+        "{why}"
+    );
+    assert_eq!(get(&model, EffectId::InternalLeakage, "Cl"), Some(0.0));
+    assert_eq!(free, [(EffectId::ExternalForce, "F0")]);
+    // the force, refitted alone (its interval is the refit's, not the one
+    // it came with), stays: its interval excludes zero
+    assert_eq!(added.len(), 1);
+    let f0 = added[0].params["F0"];
+    let ci = added[0].ci95["F0"].unwrap();
+    assert_ne!(ci, 5.0);
+    assert!(
+        ci < 0.5 * f0.abs() && (f0 - 400.0).abs() <= 2.0 * ci.max(1.0),
+        "F0 = {f0} ± {ci}"
+    );
+}

@@ -404,6 +404,24 @@ pub struct Probe {
 }
 
 impl Report {
+    /// The compared channels whose NRMSE after is more than [`ABOVE_FLOOR`]
+    /// times their noise floor (where one is measured), with that ratio,
+    /// the highest first: what the share left (a share of the whole
+    /// residual, which a large start makes small) does not show.
+    pub fn above_noise_floor(&self) -> Vec<(String, f64)> {
+        let mut v: Vec<(String, f64)> = self
+            .nrmse_after
+            .iter()
+            .filter_map(|(ch, after)| {
+                let floor = *self.noise_floor.get(ch)?;
+                let r = after / floor;
+                (floor > 0.0 && r.is_finite() && r > ABOVE_FLOOR).then(|| (ch.clone(), r))
+            })
+            .collect();
+        v.sort_by(|a, b| b.1.total_cmp(&a.1));
+        v
+    }
+
     /// Where the report breaks "every catalog effect ends in exactly one of
     /// `effects_added`, `effects_rejected` and `effects_not_applicable`"
     /// (each of those with its reason): one line per effect listed in none or
@@ -564,6 +582,18 @@ impl Report {
                 ""
             }
         );
+        let above = self.above_noise_floor();
+        if !above.is_empty() {
+            let listed: Vec<String> = above
+                .iter()
+                .map(|(ch, r)| format!("{ch} {r:.1}x"))
+                .collect();
+            let _ = writeln!(
+                s,
+                "left above the noise floor after (NRMSE over the floor's): {} — the share above is of the whole record's residual; these channels are not explained down to their noise",
+                listed.join(", ")
+            );
+        }
         if let Some(p) = &self.unexplained_resembles {
             let _ = writeln!(
                 s,
@@ -585,6 +615,10 @@ impl Report {
         s
     }
 }
+
+/// A channel's NRMSE after over its noise floor beyond which the text
+/// report lists it as not explained down to its noise.
+pub const ABOVE_FLOOR: f64 = 1.5;
 
 /// The catalog name of a parameter (`K` of `pressure_viscous.K`).
 fn param_name(p: &ParamRef) -> &str {

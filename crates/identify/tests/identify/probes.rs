@@ -194,4 +194,19 @@ fn an_effect_whose_interval_widens_to_zero_in_the_last_refit_is_dropped() {
         "{}",
         r.human()
     );
+    // what is left of a one-sided dead zone is not noise: the report says
+    // which channels stay above their floor, whatever share of the large
+    // residual before is left
+    let above = r.above_noise_floor();
+    assert!(
+        above.iter().any(|(ch, x)| ch == "p2" && *x > 2.0),
+        "{above:?}\n{}",
+        r.human()
+    );
+    assert!(
+        r.human()
+            .contains("left above the noise floor after (NRMSE over the floor's): "),
+        "{}",
+        r.human()
+    );
 }

@@ -31,7 +31,6 @@
 //! A candidate that fails is rejected with the part of the rule it failed as
 //! the reason.
 
-use std::cmp::Ordering;
 use std::collections::BTreeMap;
 
 use hydrocyl_system::netlist::registry::{self, Range};
@@ -246,24 +245,7 @@ pub fn valid_range(id: EffectId, name: &str) -> Range {
             hi_open: false,
         };
     }
-    ranges.into_iter().fold(Range::ANY, |a, b| {
-        let (lo, lo_open) = match a.lo.total_cmp(&b.lo) {
-            Ordering::Greater => (a.lo, a.lo_open),
-            Ordering::Less => (b.lo, b.lo_open),
-            Ordering::Equal => (a.lo, a.lo_open || b.lo_open),
-        };
-        let (hi, hi_open) = match a.hi.total_cmp(&b.hi) {
-            Ordering::Less => (a.hi, a.hi_open),
-            Ordering::Greater => (b.hi, b.hi_open),
-            Ordering::Equal => (a.hi, a.hi_open || b.hi_open),
-        };
-        Range {
-            lo,
-            hi,
-            lo_open,
-            hi_open,
-        }
-    })
+    ranges.into_iter().fold(Range::ANY, Range::intersect)
 }
 
 /// Rule 2's interval test: why the fitted `size` of effect `id` (among

@@ -507,11 +507,7 @@ impl PyBatch {
         };
         let d = PyDict::new(py);
         d.set_item("time", self.time.clone_ref(py))?;
-        d.set_item("names", &self.channels.names)?;
-        d.set_item(
-            "values",
-            PyList::new(py, self.channels.values.iter().map(|v| v.clone_ref(py)))?,
-        )?;
+        self.channels.pickle_into(&d)?;
         d.set_item("params", pairs(&self.params))?;
         d.set_item("stats", pairs(&self.stats))?;
         d.set_item("ok", self.ok.clone_ref(py))?;

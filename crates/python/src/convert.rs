@@ -233,6 +233,17 @@ impl<T: pyo3::PyTypeInfo> Named<T> {
     pub fn contains(&self, name: &str) -> bool {
         self.names.iter().any(|n| n == name)
     }
+
+    /// Puts the names (`"names"`) and the arrays in order (`"values"`)
+    /// into a pickled state `d`.
+    pub fn pickle_into(&self, d: &Bound<'_, PyDict>) -> PyResult<()> {
+        let py = d.py();
+        d.set_item("names", &self.names)?;
+        d.set_item(
+            "values",
+            PyList::new(py, self.values.iter().map(|v| v.clone_ref(py)))?,
+        )
+    }
 }
 
 /// A `KeyError` naming the channels there are.

@@ -209,11 +209,7 @@ impl PyRun {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let d = PyDict::new(py);
         d.set_item("time", self.time.clone_ref(py))?;
-        d.set_item("names", &self.channels.names)?;
-        d.set_item(
-            "values",
-            PyList::new(py, self.channels.values.iter().map(|v| v.clone_ref(py)))?,
-        )?;
+        self.channels.pickle_into(&d)?;
         d.set_item("units", &self.units)?;
         d.set_item("stats", self.stats.clone())?;
         d.set_item("diagnostics", self.diagnostics.clone())?;

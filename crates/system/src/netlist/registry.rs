@@ -120,6 +120,28 @@ impl Range {
         hi_open: true,
     };
 
+    /// The values inside both (the higher lower bound, the lower upper
+    /// one; a bound both share is open when either has it open).
+    pub fn intersect(self, other: Range) -> Range {
+        use std::cmp::Ordering;
+        let (lo, lo_open) = match self.lo.total_cmp(&other.lo) {
+            Ordering::Greater => (self.lo, self.lo_open),
+            Ordering::Less => (other.lo, other.lo_open),
+            Ordering::Equal => (self.lo, self.lo_open || other.lo_open),
+        };
+        let (hi, hi_open) = match self.hi.total_cmp(&other.hi) {
+            Ordering::Less => (self.hi, self.hi_open),
+            Ordering::Greater => (other.hi, other.hi_open),
+            Ordering::Equal => (self.hi, self.hi_open || other.hi_open),
+        };
+        Range {
+            lo,
+            hi,
+            lo_open,
+            hi_open,
+        }
+    }
+
     /// Whether `v` is finite and inside.
     pub fn contains(&self, v: f64) -> bool {
         v.is_finite()

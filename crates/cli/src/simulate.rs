@@ -354,8 +354,10 @@ enum Input {
 /// long or too stiff for the budget.
 fn solver_hint(e: rig::RigError, solver: Solver, rk4_step: f64, span: f64) -> CliError {
     let m = e.to_string();
-    // SolveError::EventStorm's message: a fixed step is the likely cause
-    if m.contains("events in a row") && solver.fixed_step() {
+    // SolveError::EventStorm's and ::Chattering's messages: a fixed step is
+    // the likely cause
+    if (m.contains("events in a row") || m.contains("the solution chatters")) && solver.fixed_step()
+    {
         return CliError::Input(format!(
             "{m}; --rk4-step {rk4_step} is likely too large for this rig: use a smaller step or --solver auto"
         ));

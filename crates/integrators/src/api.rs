@@ -297,6 +297,28 @@ pub enum SolveError {
         /// Events in a row.
         count: usize,
     },
+    /// Most of the last [`PACE_WINDOW`](crate::PACE_WINDOW) steps ended on
+    /// an event, and at the pace they advanced time the run would need more
+    /// steps to reach its end than its budget (`Options::max_steps`) has
+    /// left: the solution chatters (a model that switches without end, a
+    /// valve or stop whose switching is faster than the tolerance resolves).
+    #[error("the solution chatters: {events} of the last {steps} steps ended on an event (event function {which} the last) and together advanced time by only {advanced:e} s up to t = {t} s; at that pace the run needs ~{needed:.1e} more steps, more than the {left} its step budget has left")]
+    Chattering {
+        /// Time reached.
+        t: f64,
+        /// The last event function that triggered.
+        which: usize,
+        /// Steps of the window that ended on an event.
+        events: usize,
+        /// Steps in the window.
+        steps: usize,
+        /// Time the window's steps advanced \[s\].
+        advanced: f64,
+        /// Steps needed to reach the end at the window's pace.
+        needed: f64,
+        /// Steps left in the budget.
+        left: usize,
+    },
     /// The caller of a streamed solve ([`crate::solve_streaming`]) stopped
     /// it (its output could not be written, its input could not be read),
     /// or the `stop` of [`crate::solve_stoppable`] said so.

@@ -7,6 +7,7 @@ use crate::api::{
 };
 use crate::checks::check_inputs;
 use crate::events::{locate_root, Bracket};
+use crate::pace::Pace;
 use std::borrow::Cow;
 
 /// What a solve does between its steps: nothing for [`crate::solve`]; a
@@ -203,14 +204,6 @@ const FAC_MIN: f64 = 0.2;
 const FAC_MAX: f64 = 10.0;
 /// Largest number of consecutive singular-matrix retries before giving up.
 const MAX_SINGULAR_RETRIES: usize = 8;
-
-/// Events in a row, each ending its step before the step's end, with no
-/// step free of events between them, after which a run stops with
-/// [`SolveError::EventStorm`]: time then advances by less and less (a fixed
-/// step far too long for the rig puts an event into every step's first few
-/// microseconds, for ever). No run that advances does this: between two
-/// events of a chattering valve there are steps free of them.
-pub const MAX_EVENTS_IN_A_ROW: usize = 10_000;
 
 struct ControlState {
     controller: Controller,
@@ -498,7 +491,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
     let mut fresh = true; // a fresh step-size estimate is needed
     let mut h = opts.h0.unwrap_or(0.0);
     let mut singular_retries = 0usize;
-    let mut events_in_a_row = 0usize;
+    let mut pace = Pace::new(t0);
     // The system's next breakpoint after `bp_from`: while nothing changes
     // the system (no event, no streamed input) it is still the next one
     // after any time before it, and is asked again only once passed.
@@ -515,6 +508,10 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                 t,
                 max: opts.max_steps,
             });
+        }
+        if let Err(e) = pace.check(t, t_end, opts.max_steps - (stats.steps + stats.rejected)) {
+            sol.stats = stats;
+            return Err(e);
         }
         if let Some(sw) = stepper.switch() {
             ctrl = ControlState::new(sw.controller);
@@ -721,7 +718,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
 
         match event_at {
             None => {
-                events_in_a_row = 0;
+                pace.free_step();
                 if opts.t_eval.is_some() {
                     emit_t_eval(
                         &stepper,
@@ -749,7 +746,6 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                 h = h_next;
             }
             Some(t_ev) => {
-                events_in_a_row += 1;
                 // State at the event from the dense output (exact step end if t_ev = t_new).
                 if t_ev >= t_new {
                     x_ev.copy_from_slice(&x_new);
@@ -810,13 +806,10 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
                     sol.stats = stats;
                     return Err(SolveError::NonFinite { t: t_ev, index: i });
                 }
-                if events_in_a_row >= MAX_EVENTS_IN_A_ROW {
+                let which = ev.triggered.iter().rposition(|&b| b).unwrap_or(0);
+                if let Err(e) = pace.event_step(t_ev, which) {
                     sol.stats = stats;
-                    return Err(SolveError::EventStorm {
-                        t: t_ev,
-                        which: ev.triggered.iter().rposition(|&b| b).unwrap_or(0),
-                        count: events_in_a_row,
-                    });
+                    return Err(e);
                 }
                 let edited = x.iter().zip(x_ev.iter()).any(|(a, b)| a != b);
                 if edited && opts.t_eval.is_none() {

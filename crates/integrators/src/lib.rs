@@ -166,12 +166,13 @@ pub mod events;
 pub mod expo;
 mod fdjac;
 pub mod linalg;
+mod pace;
 pub mod problems;
 mod rk4;
 mod rodas;
 mod stream;
 
-pub use driver::MAX_EVENTS_IN_A_ROW;
+pub use pace::{CHATTER_SHARE, MAX_EVENTS_IN_A_ROW, PACE_WINDOW};
 pub use stream::{solve_streaming, Stream, StreamIo};
 
 /// Integrates `sys` from `(t0, x0)` to `t_end` with `method`.
@@ -190,7 +191,9 @@ pub use stream::{solve_streaming, Stream, StreamIo};
 /// (accepted + rejected); [`SolveError::Singular`] when the Rosenbrock
 /// iteration matrix stays singular after halving the step;
 /// [`SolveError::EventStorm`] after [`MAX_EVENTS_IN_A_ROW`] events with no
-/// step free of them.
+/// step free of them; [`SolveError::Chattering`] when most of the last
+/// [`PACE_WINDOW`] steps ended on events and their pace cannot reach `t_end`
+/// within what is left of `max_steps`.
 pub fn solve<S: OdeSystem + ?Sized>(
     method: Method,
     sys: &mut S,

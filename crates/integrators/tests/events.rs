@@ -269,10 +269,11 @@ impl OdeSystem for Sticky {
 /// fixed step far too long puts one at the start of every step), stop the
 /// run with `EventStorm` after `MAX_EVENTS_IN_A_ROW` of them instead of
 /// locating them for ever. The adaptive methods take free steps between the
-/// events here; their step budget ends the run.
+/// events here; the pace of the first window of steps stops them with
+/// `Chattering` long before their step budget would.
 #[test]
 fn events_without_end_stop_the_run() {
-    use hydrocyl_integrators::{SolveError, MAX_EVENTS_IN_A_ROW};
+    use hydrocyl_integrators::{SolveError, CHATTER_SHARE, MAX_EVENTS_IN_A_ROW, PACE_WINDOW};
     for method in ALL {
         let opts = Options {
             max_steps: 200_000,
@@ -286,11 +287,77 @@ fn events_without_end_stop_the_run() {
                 // the first event at t = 0.5, then one a nanosecond
                 assert!((0.5..0.5 + 1e-4).contains(&t), "stopped at {t}");
             }
-            Err(SolveError::TooManySteps { t, .. }) => {
+            Err(SolveError::Chattering {
+                t,
+                which,
+                events,
+                steps,
+                needed,
+                left,
+                ..
+            }) => {
                 assert_ne!(method, Method::Rk4);
+                assert_eq!((which, steps), (0, PACE_WINDOW), "{method:?}");
+                assert!(events as f64 >= CHATTER_SHARE * steps as f64, "{method:?}");
+                assert!(needed > left as f64 && left < 200_000, "{method:?}");
                 assert!(t < 0.6, "{method:?}: stopped at {t}");
             }
             other => panic!("{method:?}: expected the run to stop, got {other:?}"),
         }
+    }
+}
+
+/// A relay: `x' = s` with `s` flipped each time `x` reaches `±a`, beside a
+/// state `y' = cos(ω t)` that sets the step size. Events come every 4 ms
+/// for 60 s, a good share of the steps end on one, and time advances at a
+/// pace the step budget covers: the run ends normally.
+struct Relay {
+    s: f64,
+}
+
+const RELAY_A: f64 = 0.002;
+
+impl OdeSystem for Relay {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs(&self, t: f64, _x: &[f64], dx: &mut [f64]) {
+        dx[0] = self.s;
+        dx[1] = (300.0 * t).cos();
+    }
+    fn n_events(&self) -> usize {
+        1
+    }
+    fn events(&self, _t: f64, x: &[f64], g: &mut [f64]) {
+        g[0] = RELAY_A - self.s * x[0];
+    }
+    fn on_event(&mut self, _t: f64, _x: &mut [f64], _which: usize, _dir: Crossing) -> EventAction {
+        self.s = -self.s;
+        EventAction::Continue
+    }
+}
+
+#[test]
+fn frequent_events_at_a_pace_the_budget_covers_do_not_stop_the_run() {
+    use hydrocyl_integrators::CHATTER_SHARE;
+    for method in [Method::DormandPrince45, Method::Rosenbrock] {
+        let opts = Options {
+            rtol: 1e-6,
+            atol: vec![1e-9, 1e-9],
+            ..opts_for(method)
+        };
+        let mut sys = Relay { s: 1.0 };
+        let sol = solve(method, &mut sys, 0.0, &[0.0, 0.0], 60.0, &opts)
+            .unwrap_or_else(|e| panic!("{method:?}: {e}"));
+        // the first flip at 2 ms, then one every 4 ms
+        let flips = sol.events.len() as f64;
+        assert!((flips - 15_000.0).abs() <= 2.0, "{method:?}: {flips}");
+        // DP45's steps are long enough that a third of them end on a flip:
+        // its pace is checked against the budget (Rosenbrock's, ~8 %, is not)
+        let share = flips / sol.stats.steps as f64;
+        if method == Method::DormandPrince45 {
+            assert!(share > CHATTER_SHARE, "events on {share} of the steps");
+        }
+        assert_eq!(*sol.t.last().unwrap(), 60.0);
     }
 }

@@ -180,6 +180,7 @@ fn failure_time(e: &SolveError) -> Option<f64> {
         | SolveError::NonFinite { t, .. }
         | SolveError::Singular { t }
         | SolveError::EventStorm { t, .. }
+        | SolveError::Chattering { t, .. }
         | SolveError::Interrupted { t, .. } => Some(*t),
         SolveError::InvalidInput(_) => None,
     }

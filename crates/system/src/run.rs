@@ -98,7 +98,7 @@ impl SimError {
             SolveError::NonFinite { index, .. } => {
                 format!(" (state {index} is `{}`)", name(*index))
             }
-            SolveError::EventStorm { which, .. } => circuit
+            SolveError::EventStorm { which, .. } | SolveError::Chattering { which, .. } => circuit
                 .event_owner(*which)
                 .map(|c| format!(" (the events are `{c}`'s)"))
                 .unwrap_or_default(),

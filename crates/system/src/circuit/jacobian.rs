@@ -64,7 +64,16 @@ impl Tangents {
     /// `∂target += c · ∂source` (the chain rule through a wire read).
     #[inline]
     pub fn chain(&mut self, target: impl Into<AnyWire>, c: f64, source: impl Into<AnyWire>) {
-        let (t, s) = (target.into().0, source.into().0);
+        self.chain_rows(target.into().0, c, source.into().0);
+    }
+
+    /// [`Tangents::chain`] on wire indices. Out of line on purpose: every
+    /// component's `evaluate_tangents` calls it many times, and one copy of
+    /// the row loop keeps the Jacobian's code small enough to stay in the
+    /// instruction cache beside the right-hand side's (inlined, the copies
+    /// pushed ~35 KB of code out of it on every step of the hybrid rig).
+    #[inline(never)]
+    fn chain_rows(&mut self, t: usize, c: f64, s: usize) {
         if c == 0.0 || t == s {
             // a wire never depends on itself in one evaluation
             return;
@@ -93,7 +102,8 @@ impl Tangents {
         self.rates_chain(self.offset + k, c, source.into());
     }
 
-    /// `rates[r] += c · ∂source`.
+    /// `rates[r] += c · ∂source` (out of line, as [`Tangents::chain_rows`]).
+    #[inline(never)]
     fn rates_chain(&mut self, r: usize, c: f64, source: AnyWire) {
         if c == 0.0 {
             return;

@@ -309,7 +309,7 @@ impl ValveRig {
             cyl
         };
         wired_as_the_preset(&s, fundamental, closed)?;
-        let law = crate::netlist::catalog_friction_law(friction)
+        let law = crate::netlist::typed_view_friction_law(friction)
             .expect("a friction_* type")
             .map_err(|why| bad(&format!("components.{}", friction.name), why))?;
         let lag = match (s.instance("sensor_A"), s.instance("sensor_B")) {

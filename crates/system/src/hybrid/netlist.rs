@@ -236,7 +236,7 @@ impl WangHybrid {
             },
             mass: load.get("mass"),
             external_force: load.get("external_force"),
-            friction: netlist::catalog_friction_law(friction)
+            friction: netlist::typed_view_friction_law(friction)
                 .expect("a friction_* type")
                 .map_err(|e| bad("components.friction", e))?,
             tank_pressure: tank,

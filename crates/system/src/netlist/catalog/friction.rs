@@ -319,6 +319,19 @@ fn bound_seal(law: FrictionLaw, inst: &Instance) -> FrictionLaw {
     }
 }
 
+/// The friction law of a typed view of the valve or hybrid rig (which holds
+/// no friction state): a bristle that starts deflected (`initial.z` other
+/// than 0) is refused rather than dropped, since the view starts it at 0.
+pub(crate) fn typed_view_law(inst: &Instance) -> Option<Result<FrictionLaw, String>> {
+    if let Some(z) = inst.initial("z").filter(|&z| z != 0.0) {
+        return Some(Err(format!(
+            "initial.z = {z} m: this study's view of the rig starts the bristle at z = 0 and would \
+             drop it (`hydrocyl simulate` runs it as given); leave initial.z at 0 here"
+        )));
+    }
+    law_of(inst)
+}
+
 /// The friction law of an instance of one of these types (`None` for
 /// another type).
 pub(crate) fn law_of(inst: &Instance) -> Option<Result<FrictionLaw, String>> {
@@ -464,6 +477,26 @@ mod tests {
         let mut v = rig::preset("wang-hybrid").unwrap();
         rig::apply_set(&mut v, "friction.initial.z=1e-6").unwrap();
         assert_eq!(start_z(&v), 1e-6);
+        // the typed views of the rigs, which carry no friction state, refuse
+        // a deflected start instead of dropping it
+        let e = crate::hybrid::WangHybrid::from_netlist(&v)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("components.friction") && e.contains("initial.z = 0.000001 m"),
+            "{e}"
+        );
+        let mut v = rig::preset("leaney-moog").unwrap();
+        v["components"]["friction"] = crate::valve_netlist::friction_component(&laws[1]).0;
+        assert!(crate::valve_rig::ValveRig::from_netlist(&v).is_ok());
+        rig::apply_set(&mut v, "friction.initial.z=1e-6").unwrap();
+        let e = crate::valve_rig::ValveRig::from_netlist(&v)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("components.friction") && e.contains("would drop it"),
+            "{e}"
+        );
         // a law without a bristle has no such state
         let mut v = rig::preset("leaney-moog").unwrap();
         let e = rig::apply_set(&mut v, "friction.initial.z=1e-6")

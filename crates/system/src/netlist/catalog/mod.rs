@@ -62,6 +62,7 @@ pub(super) fn built<C: Component + 'static>(c: C) -> Result<Box<dyn Component>, 
 
 pub(crate) use friction::law_of as friction_law_of;
 pub(crate) use friction::terms_of as friction_terms_of;
+pub(crate) use friction::typed_view_law as typed_view_friction_law;
 pub(super) use mechanical::cylinder as cylinder_of;
 pub(super) use servo::metering as metering_of;
 

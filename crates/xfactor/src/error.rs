@@ -48,7 +48,7 @@ pub enum XFactorError {
     },
     /// No steady state exists with both chamber pressures in [0, Ps]: the load
     /// is more than the supply can hold at this spool travel.
-    #[error("no steady state at travel {travel:?}: load force {force_n:?} N needs a chamber pressure outside [0, Ps] (Ps = {ps_pa:?} Pa)")]
+    #[error("no steady state at travel {travel:.4}: load force {force_n:.1} N needs a chamber pressure outside [0, Ps] (Ps = {ps_pa:.0} Pa)")]
     NoSteadyState {
         /// The normalised spool travel.
         travel: f64,
@@ -58,11 +58,38 @@ pub enum XFactorError {
         ps_pa: f64,
     },
     /// No X under this load keeps both chamber pressures in [0, Ps].
-    #[error("no steady state at travel {travel:?}: load pressure P_LE / Ps = {p_le_over_ps:?} needs a chamber pressure outside [0, Ps]")]
+    #[error("no steady state at travel {travel:.4}: load pressure P_LE / Ps = {p_le_over_ps:.4} needs a chamber pressure outside [0, Ps]")]
     LoadBeyondSupply {
         /// The normalised spool travel.
         travel: f64,
         /// The effective load pressure over the supply pressure.
         p_le_over_ps: f64,
     },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::XFactorError;
+
+    /// A user reads these: the figures are rounded to what they mean.
+    #[test]
+    fn steady_state_failures_print_rounded_figures() {
+        let e = XFactorError::NoSteadyState {
+            travel: -1.973_916_666_666_666_8,
+            force_n: 1234.5678,
+            ps_pa: 7.0e6,
+        };
+        assert_eq!(
+            e.to_string(),
+            "no steady state at travel -1.9739: load force 1234.6 N needs a chamber pressure \
+             outside [0, Ps] (Ps = 7000000 Pa)"
+        );
+        let e = XFactorError::LoadBeyondSupply {
+            travel: 0.333_333_333_333_333_3,
+            p_le_over_ps: 1.123_456_789,
+        };
+        assert!(e
+            .to_string()
+            .contains("travel 0.3333: load pressure P_LE / Ps = 1.1235 "));
+    }
 }

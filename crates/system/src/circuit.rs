@@ -80,6 +80,8 @@ pub struct Circuit {
     groups: Vec<SeriesGroup>,
     scratch: RefCell<Vec<f64>>,
     accumulators: Vec<usize>,
+    /// The components that [`Component::settle`] after each evaluation.
+    settlers: Vec<usize>,
     wires: RefCell<Wires>,
     n_states: usize,
     n_events: usize,
@@ -200,6 +202,7 @@ impl Circuit {
         ev_offsets.push(e);
         q_offsets.push(q);
         let analytic = comps.iter().all(|c| c.has_tangents());
+        let settlers = (0..n).filter(|&i| comps[i].settles()).collect();
         let mut publisher = vec![None; net.names.len()];
         for (&w, o) in &net.owners {
             if o.causality == crate::Causality::Stored {
@@ -214,6 +217,7 @@ impl Circuit {
             groups,
             scratch: RefCell::new(Vec::new()),
             accumulators: net.accumulators,
+            settlers,
             wires: RefCell::new(Wires {
                 v: vec![0.0; net.names.len()],
             }),
@@ -612,6 +616,9 @@ impl Circuit {
                     g.solve(t, &mut w, &mut self.scratch.borrow_mut(), eval, slope);
                 }
             }
+        }
+        for &i in &self.settlers {
+            self.comps[i].settle(t, xs(i), &mut w);
         }
     }
 }

@@ -166,6 +166,18 @@ pub trait Component {
     /// [`Tangents::quadrature_state`]).
     fn quadrature_tangents(&self, _t: f64, _x: &[f64], _w: &Wires, _d: &mut Tangents) {}
 
+    /// Whether the circuit calls [`settle`](Component::settle) after every
+    /// evaluation.
+    fn settles(&self) -> bool {
+        false
+    }
+
+    /// Called after every component has been evaluated (the accumulators
+    /// complete), to set private wires that only probes read from them: a
+    /// stuck friction's force is everything else acting on the rod. It may
+    /// not change a wire another component reads.
+    fn settle(&self, _t: f64, _x: &[f64], _w: &mut Wires) {}
+
     /// Whether [`evaluate`](Component::evaluate) must run after every other
     /// component's, to read complete accumulators (an imposed-motion source
     /// reporting the force it takes to impose its motion). Nothing may read

@@ -25,7 +25,11 @@ pub struct Friction {
     rod: MechanicalNode,
     p1: Option<Wire<Pressure>>,
     p2: Option<Wire<Pressure>>,
+    /// The friction force (the probe): the law's in slip, the drive in stick.
     force: Wire<Force>,
+    /// What this component added to the rod's force accumulator, negated:
+    /// the law's force in slip, 0 in stick.
+    added: Wire<Force>,
 }
 
 impl std::fmt::Debug for Friction {
@@ -57,6 +61,7 @@ impl Friction {
             p1: None,
             p2: None,
             force: Wire::UNBOUND,
+            added: Wire::UNBOUND,
         }
     }
 
@@ -80,7 +85,7 @@ impl Friction {
     /// once every component has been evaluated.
     fn drive(&self, w: &Wires) -> Force {
         // the accumulator holds −F (slip) or nothing (stick) from this component
-        w.get(self.rod.force) + w.get(self.force)
+        w.get(self.rod.force) + w.get(self.added)
     }
 }
 
@@ -129,6 +134,7 @@ impl Component for Friction {
             self.p2 = Some(net.hydraulic(&b).pressure);
         }
         self.force = net.private("force");
+        self.added = net.private("added");
         Ok(())
     }
     fn n_states(&self) -> usize {
@@ -149,10 +155,13 @@ impl Component for Friction {
         let input = self.input(w);
         if self.mode == FrictionMode::Stick {
             w.add(self.rod.hold, 1.0);
+            w.set(self.added, Force::ZERO);
+            // the drive, once every force on the rod is in (`settle`)
             w.set(self.force, Force::ZERO);
         } else {
             let f = self.model.force(&input, x);
             w.add(self.rod.force, -f);
+            w.set(self.added, f);
             w.set(self.force, f);
             w.add(
                 self.rod.added_mass,
@@ -162,6 +171,16 @@ impl Component for Friction {
     }
     fn derivatives(&self, _t: f64, x: &[f64], w: &Wires, dx: &mut [f64]) {
         self.model.state_derivative(&self.input(w), x, dx);
+    }
+    /// A law with modes (Karnopp's stick) reports, while stuck, the force
+    /// that holds the rod: everything else acting on it.
+    fn settles(&self) -> bool {
+        self.model.n_events() > 0
+    }
+    fn settle(&self, _t: f64, _x: &[f64], w: &mut Wires) {
+        if self.mode == FrictionMode::Stick {
+            w.set(self.force, self.drive(w));
+        }
     }
     fn n_events(&self) -> usize {
         self.model.n_events()

@@ -30,6 +30,10 @@ pub enum CommandUnit {
     /// An imposed velocity \[m/s\] (a friction bench's drive): `command`,
     /// `command [m/s]` or `command [mm/s]`.
     Velocity,
+    /// A position \[m\] the input sets directly (a spool position read by
+    /// a valve, no spool model between): `command`, `command [m]` or
+    /// `command [mm]`.
+    Position,
 }
 
 impl CommandUnit {
@@ -38,7 +42,7 @@ impl CommandUnit {
         match self {
             CommandUnit::Normalised => "-",
             CommandUnit::Volt => "V",
-            CommandUnit::Reference => "m",
+            CommandUnit::Reference | CommandUnit::Position => "m",
             CommandUnit::Velocity => "m/s",
         }
     }
@@ -59,8 +63,8 @@ impl CommandUnit {
             (CommandUnit::Normalised, Some("%")) => Some(0.01),
             (CommandUnit::Volt, Some("V")) => Some(1.0),
             (CommandUnit::Volt, Some("mV")) => Some(1e-3),
-            (CommandUnit::Reference, Some("m")) => Some(1.0),
-            (CommandUnit::Reference, Some("mm")) => Some(1e-3),
+            (CommandUnit::Reference | CommandUnit::Position, Some("m")) => Some(1.0),
+            (CommandUnit::Reference | CommandUnit::Position, Some("mm")) => Some(1e-3),
             (CommandUnit::Velocity, Some("m/s")) => Some(1.0),
             (CommandUnit::Velocity, Some("mm/s")) => Some(1e-3),
             _ => None,
@@ -73,6 +77,7 @@ impl CommandUnit {
             CommandUnit::Volt => "V or mV (a drive voltage)",
             CommandUnit::Reference => "m or mm (a position set-point)",
             CommandUnit::Velocity => "m/s or mm/s (the rod velocity the drive imposes)",
+            CommandUnit::Position => "m or mm (a position the input sets directly)",
         }
     }
 }

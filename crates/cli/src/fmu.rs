@@ -53,6 +53,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         return Err(CliError::Input("--rig and --out are required".into()));
     };
     let input = |e: &dyn std::fmt::Display| CliError::Input(e.to_string());
+    // the rig first: its errors are the user's to fix, whatever the library
+    let mut value = rig::load(&rig_arg).map_err(|e| input(&e))?;
+    for s in &args.set {
+        rig::apply_set(&mut value, s).map_err(|e| input(&e))?;
+    }
+    // errors name the file and line of their JSON path
+    rig::check(&value).map_err(|e| input(&rig::at_line(e, &rig_arg)))?;
     let library = find_library(args.library.as_deref()).map_err(|e| input(&e))?;
     // the FMU must not be written over an input: the rig file or the library
     let rig_file = (rig::preset(&rig_arg).is_none()).then(|| PathBuf::from(&rig_arg));
@@ -62,12 +69,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let mut outputs = Outputs::new(&inputs);
     let file = outputs.file("--out", &out)?;
-    let mut value = rig::load(&rig_arg).map_err(|e| input(&e))?;
-    for s in &args.set {
-        rig::apply_set(&mut value, s).map_err(|e| input(&e))?;
-    }
-    // errors name the file and line of their JSON path
-    rig::check(&value).map_err(|e| input(&rig::at_line(e, &rig_arg)))?;
     let name = if rig::preset(&rig_arg).is_some() {
         rig_arg.clone()
     } else {

@@ -90,8 +90,18 @@ fn main() {
     let r = run(cli);
     progress::mark("end");
     progress::print_marks();
-    if let Err(e) = r {
-        console::note(format_args!("hydrocyl: error: {e}"));
-        std::process::exit(2);
+    match r {
+        // the reader of a pipe stopped reading (`--out /dev/stdout | head`):
+        // end quietly, with the status a tool killed by SIGPIPE has
+        Err(error::CliError::Io { source, .. })
+            if source.kind() == std::io::ErrorKind::BrokenPipe =>
+        {
+            std::process::exit(141)
+        }
+        Err(e) => {
+            console::note(format_args!("hydrocyl: error: {e}"));
+            std::process::exit(2);
+        }
+        Ok(()) => {}
     }
 }

@@ -52,6 +52,12 @@ impl Checked {
         self.schematic.input_unit()
     }
 
+    /// Whether the run's input is a position set-point (a controller's
+    /// `reference` reads it, [`netlist::Schematic::input_is_set_point`]).
+    pub fn input_is_set_point(&self) -> bool {
+        self.schematic.input_is_set_point()
+    }
+
     /// The rating the run's input is checked against (a pump's maximum
     /// speed, [`Schematic::input_rating`]).
     pub fn input_rating(&self) -> Option<netlist::InputRating> {

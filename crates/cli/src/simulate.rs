@@ -225,11 +225,13 @@ fn run_bench(
 
 /// The unit of a rig's input, from the netlist (the port that reads it,
 /// [`crate::rigfile::Checked::input_unit`]): the position set-point of a
-/// closed-loop rig, a pump drive's voltage, a bench drive's imposed velocity,
-/// else a normalised spool demand.
+/// closed-loop rig, a position another port reads directly (a valve's
+/// spool), a pump drive's voltage, a bench drive's imposed velocity, else a
+/// normalised spool demand.
 fn command_unit(rig: &crate::rigfile::Checked) -> CommandUnit {
     match rig.input_unit() {
-        Some("m") => CommandUnit::Reference,
+        Some("m") if rig.input_is_set_point() => CommandUnit::Reference,
+        Some("m") => CommandUnit::Position,
         Some("V") => CommandUnit::Volt,
         Some("m/s") => CommandUnit::Velocity,
         _ => CommandUnit::Normalised,

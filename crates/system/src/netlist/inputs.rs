@@ -86,6 +86,23 @@ impl Schematic {
         self.unit_read_at(input, "out")
     }
 
+    /// Whether the run's one input is a position set-point: a `reference`
+    /// port (a position controller's) reads it. A closed-loop rig's record
+    /// then drives it from its `reference` column.
+    pub fn input_is_set_point(&self) -> bool {
+        let mut inputs = self.inputs();
+        let (Some(input), None) = (inputs.next(), inputs.next()) else {
+            return false;
+        };
+        let Some((_, ports)) = input.nodes.get("out").and_then(|n| self.nodes.get(n)) else {
+            return false;
+        };
+        ports
+            .iter()
+            .filter_map(|p| p.split_once('.'))
+            .any(|(c, port)| c != input.name && port == "reference")
+    }
+
     /// The unit in which the other components on the signal node at
     /// `port` of `inst` read it: the first reading port whose declaration
     /// ends in a unit (`command [V]`). `None` when the port is not
@@ -97,10 +114,7 @@ impl Schematic {
             .filter_map(|p| p.split_once('.'))
             .filter(|(c, _)| *c != inst.name)
             .filter_map(|(c, port)| self.instance(c)?.ty.ports.iter().find(|q| q.name == port))
-            .find_map(|q| {
-                let doc = q.doc.strip_suffix(']')?;
-                doc.rfind('[').map(|o| &doc[o + 1..])
-            })
+            .find_map(|q| q.unit())
     }
 
     /// The rating the run's input is checked against, when the input drives
@@ -161,12 +175,30 @@ mod tests {
         let s = schematic("leaney-moog-closed-loop");
         assert_eq!(s.input_channel().as_deref(), Some("reference"));
         assert_eq!(s.input_unit(), Some("m"));
+        assert!(s.input_is_set_point());
         let s = schematic("wang-hybrid");
         assert_eq!(s.input_channel().as_deref(), Some("command"));
         assert_eq!(s.input_unit(), Some("V"));
+        assert!(!s.input_is_set_point());
         let s = schematic("leaney-moog");
         assert_eq!(s.input_channel().as_deref(), Some("command"));
         assert_eq!(s.input_unit(), Some("-"));
+        // the command straight onto the valve's spool: a position [m], read
+        // from the `command` column, not a controller's set-point
+        let mut v = rig::preset("leaney-moog").unwrap();
+        v["components"].as_object_mut().unwrap().remove("spool");
+        v.as_object_mut().unwrap().remove("outputs");
+        v["connections"] = serde_json::json!([
+            ["command.out", "valve.spool"],
+            ["supply.port", "valve.P"],
+            ["tank.port", "valve.T"],
+            ["valve.A", "cylinder.A", "friction.A"],
+            ["valve.B", "cylinder.B", "friction.B"],
+            ["cylinder.rod", "load.rod", "friction.rod"]
+        ]);
+        let s = crate::netlist::schematic(&v).unwrap();
+        assert_eq!(s.input_unit(), Some("m"));
+        assert!(!s.input_is_set_point());
         // the friction benches' drive takes the rod's velocity; it shows no command
         for bench in ["emps", "tudelft-seal-25"] {
             let s = schematic(bench);

@@ -171,6 +171,20 @@ fn assemble_driven(s: &Schematic, drive: &[(String, Signal)]) -> Result<Circuit,
                 names.join(", ")
             ),
         },
+        // a signal joins two ports whose quantities differ (a plain command
+        // straight into a spool position [m]): named at the second reader
+        BuildError::UnitMismatch {
+            wire,
+            first,
+            second,
+            component,
+        } => RigError::Invalid {
+            path: format!("components.{component}"),
+            why: format!(
+                "reads the signal `{}` as a quantity in {second}, but its source gives it in {first}: connect it to a source in {second} (a command input gives a plain number; a spool makes a position from it)",
+                wire.strip_prefix("sig:").unwrap_or(&wire)
+            ),
+        },
         other => RigError::Build(other),
     })?;
     // the run's input is shown in the unit in which its readers take it
@@ -404,12 +418,8 @@ mod tests {
     fn check_refuses_a_signal_self_loop_and_a_parameter_given_twice() {
         let mut v = crate::rig::preset("leaney-moog-closed-loop").unwrap();
         let conns = v["connections"].as_array_mut().unwrap();
-        conns[0] = json!(["reference.out", "spare"]);
-        conns[1] = json!([
-            "controller.command",
-            "spool.command",
-            "controller.reference"
-        ]);
+        conns[0] = json!(["reference.out", "spool.command"]);
+        conns[1] = json!(["controller.command", "controller.reference"]);
         let e = crate::rig::check(&v).unwrap_err().to_string();
         assert!(
             e.contains("components.controller") && e.contains("algebraic loop"),
@@ -421,6 +431,48 @@ mod tests {
         let e = crate::rig::check(&v).unwrap_err().to_string();
         assert!(
             e.contains("components.valve.orifice.cd") && e.contains("given twice"),
+            "{e}"
+        );
+    }
+
+    /// One signal read in two units is refused where the connection brings
+    /// the second in: a spool's demand [-] and a pump's volts [V] are both
+    /// plain numbers to the assembler (the header took the first reader's
+    /// unit and the other read it silently), and a spool position [m] into
+    /// a pump was refused only at assembly, without a path.
+    #[test]
+    fn a_signal_read_in_two_units_is_refused_at_its_connection() {
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        v["components"]["pump"] = json!({ "type": "pump_identified", "gain": 1e-5, "natural_frequency": 50.0, "damping": 0.7 });
+        v["components"]["pump_line"] =
+            json!({ "type": "volume", "volume": 1e-4, "bulk_modulus": 1e9 });
+        let conns = v["connections"].as_array_mut().unwrap();
+        conns[0] = json!(["command.out", "spool.command", "pump.command"]);
+        conns.push(json!(["pump.a", "pump_line.port"]));
+        conns.push(json!(["pump.b", "tank.port"]));
+        let e = crate::rig::check(&v).unwrap_err().to_string();
+        assert!(
+            e.contains("connections[0]")
+                && e.contains("`pump.command` takes its signal in [V]")
+                && e.contains("`spool.command` on the same node in [-]"),
+            "{e}"
+        );
+        let conns = v["connections"].as_array_mut().unwrap();
+        conns[0] = json!(["command.out", "spool.command"]);
+        conns[1] = json!(["spool.spool", "valve.spool", "pump.command"]);
+        let e = crate::rig::check(&v).unwrap_err().to_string();
+        assert!(e.contains("connections[1]") && e.contains("[m]"), "{e}");
+        // a plain command straight onto a valve's spool position: the
+        // quantities differ where the ports declare no unit to compare;
+        // named at the reader, with the way out
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        v["components"].as_object_mut().unwrap().remove("spool");
+        v.as_object_mut().unwrap().remove("outputs");
+        v["connections"][0] = json!(["command.out", "valve.spool"]);
+        v["connections"].as_array_mut().unwrap().remove(1);
+        let e = crate::rig::check(&v).unwrap_err().to_string();
+        assert!(
+            e.contains("components.valve") && e.contains("signal `command.out` as a quantity in m"),
             "{e}"
         );
     }

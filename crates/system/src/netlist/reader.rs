@@ -121,7 +121,7 @@ fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistError> {
     if !valid_name(name) {
         return err(
             path,
-            "a component name is letters, digits, `_` and `-` (no dots)",
+            "a component name is ASCII letters, digits, `_` and `-` (no dots)",
         );
     }
     let Value::Object(obj) = v else {
@@ -557,7 +557,7 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                     named_at.entry(s.clone()).or_insert_with(|| at_k.clone());
                     End::Named(s.clone())
                 }
-                None => return err(at_k, "a node name is letters, digits, `_` and `-`"),
+                None => return err(at_k, "a node name is ASCII letters, digits, `_` and `-`"),
             };
             if here.contains(&e) {
                 return err(
@@ -640,6 +640,31 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                 ),
             );
         };
+        // a signal is read in one unit: a spool's demand [-] is not a pump's
+        // volts [V] (the type system sees two dimensionless numbers)
+        if domain == Domain::Signal {
+            let mut declared: Option<(String, &str)> = None;
+            for &m in members {
+                let End::Port(ci, p) = &ends[m] else { continue };
+                let inst = &instances[*ci];
+                let Some(unit) = inst.ty.port(p).and_then(|q| q.unit()) else {
+                    continue;
+                };
+                let label = format!("{}.{p}", inst.name);
+                match &declared {
+                    None => declared = Some((label, unit)),
+                    Some((first, u)) if *u != unit => {
+                        return err(
+                            first_use[m].clone(),
+                            format!(
+                                "`{label}` takes its signal in [{unit}] but `{first}` on the same node in [{u}]: a signal carries one unit (connect each to a source of its own)"
+                            ),
+                        );
+                    }
+                    Some(_) => {}
+                }
+            }
+        }
         let node = part.named.clone().unwrap_or_else(|| owner.clone());
         for &m in members {
             if let End::Port(ci, p) = &ends[m] {

@@ -58,6 +58,16 @@ pub struct PortSpec {
     pub doc: &'static str,
 }
 
+impl PortSpec {
+    /// The unit the port's declaration ends in (`command [V]` → `V`): the
+    /// unit in which a signal port reads or writes its node; `None` where
+    /// the declaration names none (a port that takes its readers' unit).
+    pub fn unit(&self) -> Option<&'static str> {
+        let doc = self.doc.strip_suffix(']')?;
+        doc.rfind('[').map(|o| &doc[o + 1..])
+    }
+}
+
 /// The default of a parameter or initial state.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Default {

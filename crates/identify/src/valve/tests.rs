@@ -200,6 +200,7 @@ fn an_added_effect_whose_interval_widened_to_include_zero_is_dropped() {
         explained_share: 0.9,
         heldout_share: 0.9,
         delta_bic: -100.0,
+        note: None,
     };
     let mut added = vec![
         report(EffectId::InternalLeakage, "Cl", 7.23e-14, 2.64e-13),

@@ -131,6 +131,12 @@ pub struct EffectReport {
     pub heldout_share: f64,
     /// Change of BIC from adding it (negative: earns its place).
     pub delta_bic: f64,
+    /// How it was added where that was not alone by the greedy forward
+    /// step: added together with another effect by the pair step (each
+    /// alone failed the acceptance rule), or in place of the greedy set
+    /// (absent from the JSON otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
 }
 
 /// An effect tried and rejected: its scores and, always, why (the type has
@@ -194,6 +200,7 @@ impl RejectedEffect {
                 explained_share: 0.0,
                 heldout_share: 0.0,
                 delta_bic: 0.0,
+                note: None,
             },
             reason,
         )
@@ -549,6 +556,9 @@ impl Report {
                 100.0 * e.heldout_share,
                 e.delta_bic
             );
+            if let Some(note) = &e.note {
+                let _ = writeln!(s, "      ({note})");
+            }
             for (k, v) in &e.params {
                 let ci = e.ci95.get(k).copied().flatten();
                 let _ = writeln!(s, "      {k} = {v:.5e} ± {}", fmt_ci(ci));

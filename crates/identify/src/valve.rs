@@ -53,7 +53,9 @@ mod accept;
 mod effects;
 mod fit;
 pub mod model;
+mod pairs;
 mod probes;
+mod report;
 mod sim;
 mod stops;
 
@@ -62,6 +64,7 @@ pub use effects::{is_on, rig_facts};
 use fit::*;
 pub use model::Model;
 use probes::best_probe;
+use report::{not_applicable_why, traces};
 pub use sim::lag_samples;
 use sim::*;
 
@@ -117,29 +120,6 @@ pub fn set<R: Effects + ?Sized>(rig: &mut R, id: EffectId, name: &str, v: f64) {
 /// share of `--min-share` is not traced further (see `gauss_newton_trace`).
 const SCREEN_SHARE: f64 = 1.0 / 3.0;
 
-/// Why effect `id` is not tried on this rig.
-fn not_applicable_why(id: EffectId, rig: &Model, opts: &DiagnoseOptions) -> String {
-    if opts.candidates.as_ref().is_some_and(|c| !c.contains(&id)) {
-        return "left out by --effects".into();
-    }
-    match rig.applies(id) {
-        Err(why) => why,
-        Ok(()) if id != EffectId::BulkModulus && is_on(rig, id) => {
-            let values: Vec<String> = id
-                .params()
-                .iter()
-                .filter_map(|q| get(rig, id, q.name).map(|v| format!("{} = {v:.4e}", q.name)))
-                .collect();
-            format!(
-                "already on in the declared rig ({}; {}): the loop adds only effects that are off",
-                values.join(", "),
-                rig.paths_of(id).join(", ")
-            )
-        }
-        Ok(()) => "its parameters cannot be read on this rig".into(),
-    }
-}
-
 /// Everything the loop on the valve rig produces: the report, the series for
 /// plots (one [`RecordTrace`] per compared channel: measured, the declared
 /// model after its initial-state fit, and the final model) and the final rig.
@@ -184,30 +164,6 @@ pub fn diagnose_rig(
     progress: &mut dyn FnMut(&str, usize, usize),
 ) -> Result<Report, DiagnoseError> {
     diagnose_rig_traced(declared, rec, opts, progress).map(|o| o.report)
-}
-
-/// Measured, before and after series of every compared channel, from the
-/// runs the report's NRMSEs were computed on (empty where a run failed).
-fn traces(rec: &Record, p: &Prepared, before: &[Vec<f64>], after: &[Vec<f64>]) -> Vec<RecordTrace> {
-    let velocity = p
-        .meas
-        .iter()
-        .find(|(ch, _)| *ch == Signal::Velocity)
-        .map_or_else(Vec::new, |(_, v)| v.clone());
-    p.meas
-        .iter()
-        .zip(before.iter().zip(after))
-        .map(|((ch, m), (b, a))| RecordTrace {
-            source: rec.source.clone(),
-            t: p.t.to_vec(),
-            velocity: velocity.clone(),
-            channel: ch.name().to_string(),
-            measured: m.clone(),
-            before: b.clone(),
-            after: a.clone(),
-            regressor: None,
-        })
-        .collect()
 }
 
 /// [`diagnose_rig`], also returning the measured and simulated series
@@ -323,15 +279,18 @@ pub fn diagnose_rig_traced(
             false => format!("{}: {}", p.channel, p.message),
         })
         .collect();
+    let floors = compared_floors(&p);
     let nrmse_declared = nrmse_of(&p, &sims_declared);
-    match initial_fit {
-        Ok(r) => rig0 = r,
-        Err(e) => warnings.push(format!(
-            "initial-state fit: {e}; the smoother's initial position and velocity are kept"
-        )),
-    }
+    // the fitted initial state, where it costs no channel (`initial_state`)
+    let (sims_before, initial_used) = initial_state(
+        &mut rig0,
+        initial_fit,
+        sims_declared,
+        &p,
+        &floors,
+        &mut warnings,
+    );
     clock.lap("checks, smoothing and initial-state fit");
-    let sims_before = simulate(&rig0, &p).unwrap_or_default();
     let nrmse_before = nrmse_of(&p, &sims_before);
     let rss_before = rss_of(&p, &sims_before, opts.holdout);
     let candidates: Vec<EffectId> = opts
@@ -345,15 +304,6 @@ pub fn diagnose_rig_traced(
         // always declared: tracing it refits B)
         .filter(|e| *e == EffectId::BulkModulus || !is_on(&rig0, *e))
         .collect();
-    // Noise floor of each compared channel as an NRMSE (the weights' floor
-    // of 1e-4 of the range for noise-free records).
-    let floors: BTreeMap<String, f64> = p
-        .meas
-        .iter()
-        .zip(p.ranges.iter().zip(&p.weights))
-        .filter(|(_, (_, w))| **w > 0.0)
-        .map(|((ch, _), (r, w))| (ch.name().to_string(), 1.0 / (w * r)))
-        .collect();
     let mut model = rig0.clone();
     let mut free: ParamList = Vec::new();
     let mut added: Vec<EffectReport> = Vec::new();
@@ -361,6 +311,9 @@ pub fn diagnose_rig_traced(
     let mut resembles: Option<Probe> = None;
     // the last joint refit of the added effects (the backward step's start)
     let mut joint_res: Option<lm::LmResult> = None;
+    // the first round's scores and pair pool (the compare after the forward
+    // step), unless that round already ran the pair step
+    let mut round0: Option<pairs::FirstRound> = None;
     let total = opts.max_effects + 1;
     for round in 0..opts.max_effects {
         progress(&format!("tracing, round {}", round + 1), round, total);
@@ -493,6 +446,7 @@ pub fn diagnose_rig_traced(
                 explained_share: share,
                 heldout_share: held,
                 delta_bic: dbic,
+                note: None,
             };
             let why = if let Err(e) = &res {
                 Some(format!("fit failed: {e}"))
@@ -541,6 +495,7 @@ pub fn diagnose_rig_traced(
         // Candidates that explain a share worth having (best first); the
         // others rejected with the reason.
         let mut eligible: Vec<(EffectId, Model, EffectReport)> = Vec::new();
+        let mut singles: Vec<(EffectId, f64)> = Vec::new();
         for &id in &todo {
             let mut pick: Option<Traced> = None;
             for slot in traced.iter_mut() {
@@ -551,6 +506,9 @@ pub fn diagnose_rig_traced(
                         }
                     }
                 }
+            }
+            if let Some(t) = &pick {
+                singles.push((id, t.1.explained_share));
             }
             match pick {
                 Some((trial, rep, None, _)) => eligible.push((id, trial, rep)),
@@ -575,11 +533,14 @@ pub fn diagnose_rig_traced(
         } else {
             None
         };
+        // A probe that outranks every candidate ends the loop, unless a pair
+        // of candidates explains more (the pair step below).
+        let mut probe_won: Option<Probe> = None;
         if let Some(pr) = probe {
             if pr.explained_share >= opts.min_share
                 && top.is_none_or(|(_, share)| pr.explained_share > share + opts.min_share)
             {
-                for (id, _, rep) in eligible {
+                for (id, _, rep) in eligible.drain(..) {
                     last.insert(
                         id,
                         RejectedEffect::new(
@@ -592,8 +553,7 @@ pub fn diagnose_rig_traced(
                         ),
                     );
                 }
-                resembles = Some(pr);
-                break;
+                probe_won = Some(pr);
             }
         }
         // The acceptance rule (`accept`): refit each candidate in turn with
@@ -655,8 +615,45 @@ pub fn diagnose_rig_traced(
         }
         // (booked here: the next lap is the next round's tracing)
         clock.lap("refits");
+        if round == 0 {
+            round0 = Some(pairs::FirstRound {
+                null: (rss_null, held_null),
+                neff,
+                singles: singles.clone(),
+            });
+        }
         let Some((id, refit, rep, joint, res)) = accepted else {
-            break;
+            // No single effect: the best candidates in pairs (`pairs.rs`),
+            // which must explain more than a probe that outranked them all.
+            let need = probe_won
+                .as_ref()
+                .map_or(opts.min_share, |pr| pr.explained_share);
+            resembles = probe_won;
+            if added.len() + 2 > opts.max_effects {
+                break;
+            }
+            let r = pairs::Round {
+                model: &model,
+                free: &free,
+                pt: &pt,
+                p: &p,
+                opts,
+                declared,
+                floors: &floors,
+                null: (rss_null, held_null),
+                neff,
+                first: first.as_ref(),
+            };
+            let stepped = pairs::step(&r, &singles, need, &mut last, &mut added, &mut |s| {
+                progress(s, round + 1, total)
+            });
+            clock.lap("pair step");
+            let Some((m, f, res)) = stepped else {
+                break;
+            };
+            (model, free, joint_res) = (m, f, Some(res));
+            (round0, resembles) = (None, None);
+            continue;
         };
         // The candidates after it were not refitted: one explaining more
         // earned its place (they are traced again next round, if any).
@@ -670,12 +667,7 @@ pub fn diagnose_rig_traced(
         free = joint;
         last.remove(&id);
         added.push(rep);
-        for ((eid, n), (x, ci)) in free.iter().zip(res.x.iter().zip(&res.ci95)) {
-            if let Some(a) = added.iter_mut().find(|a| a.id == eid.id()) {
-                a.params.insert(n.to_string(), *x);
-                a.ci95.insert(n.to_string(), ci.is_finite().then_some(*ci));
-            }
-        }
+        pairs::book(&mut added, &free, &res);
         joint_res = Some(res);
     }
     clock.lap("refits");
@@ -701,27 +693,44 @@ pub fn diagnose_rig_traced(
             last.insert(id, d);
         }
     }
-    progress("report", total, total);
     clock.lap("backward step");
-    let sims_after = simulate(&model, &p).unwrap_or_default();
-    let nrmse_after = nrmse_of(&p, &sims_after);
-    let rss_after = rss_of(&p, &sims_after, opts.holdout);
-    let mut noise_floor = BTreeMap::new();
-    let mut noise_ss = 0.0;
-    for (((ch, m), r), w) in p.meas.iter().zip(&p.ranges).zip(&p.weights) {
-        // none measured (NaN, `null` in JSON, n/a in the table) for a
-        // velocity derived from position
-        let sig = if *w == 0.0 {
-            f64::NAN
-        } else {
-            noise_sigma(&p.t, m)
+    let mut sims_after = simulate(&model, &p).unwrap_or_default();
+    let mut rss_after = rss_of(&p, &sims_after, opts.holdout);
+    let (noise_floor, noise_ss) = noise_floors(&p);
+    // The forward step's set against the best pair from the declared model,
+    // where what is left is well above the noise (`pairs::compare`).
+    if let Some(first0) =
+        round0.filter(|_| !added.is_empty() && noise_ss < pairs::COMPARE_NOISE_SHARE * rss_after)
+    {
+        let r = pairs::Round {
+            model: &rig0,
+            free: &Vec::new(),
+            pt: &pt,
+            p: &p,
+            opts,
+            declared,
+            floors: &floors,
+            null: first0.null,
+            neff: first0.neff,
+            first: None,
         };
-        noise_floor.insert(ch.name().to_string(), sig / r);
-        // Weighted residuals of pure noise have unit variance.
-        if *w > 0.0 {
-            noise_ss += (sig * w).powi(2) * m.len() as f64;
+        let swapped = pairs::compare(
+            &r,
+            &first0.singles,
+            rss_after,
+            (&mut model, &mut free),
+            &mut added,
+            &mut last,
+            &mut |s| progress(s, total, total),
+        );
+        if swapped {
+            sims_after = simulate(&model, &p).unwrap_or_default();
+            rss_after = rss_of(&p, &sims_after, opts.holdout);
         }
+        clock.lap("pair compare");
     }
+    progress("report", total, total);
+    let nrmse_after = nrmse_of(&p, &sims_after);
     let traces = traces(rec, &p, &sims_before, &sims_after);
     let report = Report {
         rig: declared.roles.name.clone(),
@@ -731,7 +740,7 @@ pub fn diagnose_rig_traced(
         data_problems,
         smoother: info.clone(),
         smoother_windows: vec![info.half_window],
-        initial_state: "velocity and chamber pressures at the first sample from the smoother's local cubic fit (not the raw noisy sample), initial position and velocity fitted first on the declared model and again with every refit (the rig integrates flow into position; the smoother's one-sided derivative at the first sample is noisy); spool at the first command; the rig's steady pressures where p1/p2 are not measured".into(),
+        initial_state: format!("velocity and chamber pressures at the first sample from the smoother's local cubic fit (not the raw noisy sample), initial position and velocity fitted first on the declared model (kept only if no compared channel gets worse than from the smoother's, by the acceptance rule's tolerance) and again with every refit (the rig integrates flow into position; the smoother's one-sided derivative at the first sample is noisy); spool at the first command; the rig's steady pressures where p1/p2 are not measured. \"before\" starts from initial position and velocity {initial_used}"),
         nrmse_declared,
         nrmse_before,
         nrmse_after,
@@ -759,7 +768,7 @@ pub fn diagnose_rig_traced(
         warnings,
         noise_share: (noise_ss / rss_after.max(1e-300)).min(1.0),
         selection: format!(
-            "output-error tracing: add the effect removing the largest share of the noise-weighted output-error SS if share >= {:.0} %, held-out share >= {:.1} % and BIC falls; refit all added parameters on the output error; keep it only if its size's 95 % interval excludes zero and stays in the parameter's valid range, no parameter sits at a bound, no compared channel's NRMSE rises by more than {:.0} % of its noise floor and the held-out part improves; after the last joint refit, drop the least resolved added effect whose interval no longer passes and refit the rest, until all pass",
+            "output-error tracing: add the effect removing the largest share of the noise-weighted output-error SS if share >= {:.0} %, held-out share >= {:.1} % and BIC falls; refit all added parameters on the output error; keep it only if its size's 95 % interval excludes zero and stays in the parameter's valid range, no parameter sits at a bound, no compared channel's NRMSE rises by more than {:.0} % of its noise floor and the held-out part improves; after the last joint refit, drop the least resolved added effect whose interval no longer passes and refit the rest, until all pass; where a round adds no single effect, pairs of its best candidates are traced and refitted together, and a pair is added when both effects pass the same rule; after the forward step, where what is left is more than twice the noise, the best pair from the declared model replaces the added set when it passes the rule, leaves less and its ΔBIC against the set is negative",
             100.0 * opts.min_share,
             50.0 * opts.min_share,
             100.0 * crate::accept::WORSEN_TOL

@@ -608,6 +608,7 @@ pub fn diagnose_bench(
                 explained_share: share,
                 heldout_share: held,
                 delta_bic: dbic,
+                note: None,
             };
             let why = match &fit {
                 Err(e) => Some(format!("fit failed: {e}")),

@@ -162,6 +162,52 @@ pub(super) fn verdict(
     round: &Model,
     base: &Baseline<'_>,
 ) -> Result<(), String> {
+    verdict_with(id, free, res, refit, round, base, || {
+        let (nrmse, held) = nrmse_and_held(refit, base.p, base.holdout);
+        Scores { nrmse, held }
+    })
+}
+
+/// `Ok` if both effects of a pair (`ids`), refitted together as `refit`
+/// (`res` over `free`, both effects' parameters among them; `round` the
+/// model before them), earn their place: the rule made on each as if it
+/// were the candidate (the other one's parameters then count as already
+/// there), rules 3 and 4 on the one refitted model (simulated once). Else
+/// the reason, naming the effect that fails rule 1 or 2.
+pub(super) fn verdict_pair(
+    ids: [EffectId; 2],
+    free: &ParamList,
+    res: &LmResult,
+    refit: &Model,
+    round: &Model,
+    base: &Baseline<'_>,
+) -> Result<(), String> {
+    let scores = std::cell::OnceCell::new();
+    let after = || {
+        scores
+            .get_or_init(|| {
+                let (nrmse, held) = nrmse_and_held(refit, base.p, base.holdout);
+                Scores { nrmse, held }
+            })
+            .clone()
+    };
+    for id in ids {
+        verdict_with(id, free, res, refit, round, base, after)
+            .map_err(|why| format!("{}: {why}", id.id()))?;
+    }
+    Ok(())
+}
+
+/// [`verdict`] with the refitted model's scores from `after`.
+fn verdict_with(
+    id: EffectId,
+    free: &ParamList,
+    res: &LmResult,
+    refit: &Model,
+    round: &Model,
+    base: &Baseline<'_>,
+    after: impl FnOnce() -> Scores,
+) -> Result<(), String> {
     let params = fitted_params(free, res, refit, Some((id, round)), base.declared);
     let size = size_of(id, refit, base.declared);
     let negligible = negligible(id, refit, base.declared)
@@ -178,9 +224,6 @@ pub(super) fn verdict(
             },
             floors: &base.floors,
         },
-        || {
-            let (nrmse, held) = nrmse_and_held(refit, base.p, base.holdout);
-            Scores { nrmse, held }
-        },
+        after,
     )
 }

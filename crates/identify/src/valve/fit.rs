@@ -339,7 +339,7 @@ fn columns(params: &ParamList) -> Vec<Column> {
 /// `rig` with column `c` stepped by its finite-difference step, and the step:
 /// 10 % of a parameter's typical size, 10 µm of initial position (away from
 /// a stop the piston may start on), 0.1 mm/s of initial velocity.
-fn perturbed(rig: &Model, c: Column) -> (Model, f64) {
+pub(super) fn perturbed(rig: &Model, c: Column) -> (Model, f64) {
     let mut t = rig.clone();
     let h = match c {
         Column::Param(id, n) => {
@@ -378,7 +378,7 @@ pub(super) struct FirstStep {
     /// Its residual on the traced part.
     pub(super) r0: Vec<f64>,
     /// The columns computed, with their values.
-    cols: Vec<(Column, Vec<f64>)>,
+    pub(super) cols: Vec<(Column, Vec<f64>)>,
 }
 
 impl FirstStep {

@@ -552,6 +552,79 @@ pub(super) fn nrmse_of(p: &Prepared, sims: &[Vec<f64>]) -> BTreeMap<String, f64>
         .collect()
 }
 
+/// The noise floor of every channel of `p` as an NRMSE (the noise's σ over
+/// the channel's range; NaN where none is measured: a velocity derived
+/// from position), and the weighted sum of squares pure noise would leave
+/// (weighted residuals of pure noise have unit variance).
+pub(super) fn noise_floors(p: &Prepared) -> (BTreeMap<String, f64>, f64) {
+    let mut floors = BTreeMap::new();
+    let mut ss = 0.0;
+    for (((ch, m), r), w) in p.meas.iter().zip(&p.ranges).zip(&p.weights) {
+        let sig = if *w == 0.0 {
+            f64::NAN
+        } else {
+            crate::smooth::noise_sigma(&p.t, m)
+        };
+        floors.insert(ch.name().to_string(), sig / r);
+        if *w > 0.0 {
+            ss += (sig * w).powi(2) * m.len() as f64;
+        }
+    }
+    (floors, ss)
+}
+
+/// Noise floor of each compared channel of `p` as an NRMSE (the weights'
+/// floor of 1e-4 of the range for noise-free records).
+pub(super) fn compared_floors(p: &Prepared) -> BTreeMap<String, f64> {
+    p.meas
+        .iter()
+        .zip(p.ranges.iter().zip(&p.weights))
+        .filter(|(_, (_, w))| **w > 0.0)
+        .map(|((ch, _), (r, w))| (ch.name().to_string(), 1.0 / (w * r)))
+        .collect()
+}
+
+/// The initial state "before" starts from: `rig0` (the declared model from
+/// the smoother's initial state, whose runs are `declared`) takes the
+/// initial-state fit's position and velocity (`fitted`) only where no
+/// compared channel's NRMSE rises by more than the acceptance rule lets an
+/// effect raise it (rule 3, [`crate::accept::worsened`], against the
+/// smoother's). The fit lowers the noise-weighted sum of squares, which the
+/// position dominates, and on a record the declared model cannot follow (a
+/// leak the position drifts with) it bought position with both pressures:
+/// "before" read worse than "declared", and every effect was scored
+/// against that worse start. Returns the runs "before" and, in words,
+/// which initial state they start from; a failed fit is a warning.
+pub(super) fn initial_state(
+    rig0: &mut Model,
+    fitted: Result<Model, lm::LmError>,
+    declared: Vec<Vec<f64>>,
+    p: &Prepared,
+    floors: &BTreeMap<String, f64>,
+    warnings: &mut Vec<String>,
+) -> (Vec<Vec<f64>>, String) {
+    let r = match fitted {
+        Ok(r) => r,
+        Err(e) => {
+            warnings.push(format!(
+                "initial-state fit: {e}; the smoother's initial position and velocity are kept"
+            ));
+            return (declared, "the smoother's (the fit failed)".into());
+        }
+    };
+    let sims = simulate(&r, p).unwrap_or_default();
+    match crate::accept::worsened(&nrmse_of(p, &declared), &nrmse_of(p, &sims), floors) {
+        None => {
+            *rig0 = r;
+            (sims, "fitted on the declared model".into())
+        }
+        Some(why) => (
+            declared,
+            format!("the smoother's, kept: with the fitted ones {why}"),
+        ),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

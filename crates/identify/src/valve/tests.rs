@@ -200,6 +200,7 @@ fn an_added_effect_whose_interval_widened_to_include_zero_is_dropped() {
         explained_share: 0.9,
         heldout_share: 0.9,
         delta_bic: -100.0,
+        note: None,
     };
     let mut added = vec![
         report(EffectId::InternalLeakage, "Cl", 7.23e-14, 2.64e-13),
@@ -235,4 +236,101 @@ fn an_added_effect_whose_interval_widened_to_include_zero_is_dropped() {
         ci < 0.5 * f0.abs() && (f0 - 400.0).abs() <= 2.0 * ci.max(1.0),
         "F0 = {f0} ± {ci}"
     );
+}
+
+/// The compare after the forward step (`pairs::compare`): a forward step
+/// that added the nearest single effect (`flow_gain_error`, as the old loop
+/// did on t34's rec_leakbias) on a record of a leak and a null bias of
+/// opposite drift is replaced by the pair traced and refitted from the
+/// declared model, which passes the acceptance rule and leaves less; the
+/// replaced effect is rejected saying so, and the pair's notes name it.
+#[test]
+fn the_compare_replaces_a_greedy_set_that_a_pair_explains_better() {
+    use super::fit::refit_polished;
+    use super::pairs::{compare, Round};
+    use super::sim::{compared_floors, prepare, rss_all_held, rss_of, simulate, with_initial};
+    use crate::diagnose::{DiagnoseOptions, EffectReport};
+    use std::collections::BTreeMap;
+    let net = hydrocyl_system::rig::preset("leaney-moog").unwrap();
+    let declared = Model::new(&net).unwrap();
+    let mut truth = declared.clone();
+    set(&mut truth, EffectId::InternalLeakage, "Cl", 5e-12);
+    set(&mut truth, EffectId::ValveNullBias, "xb", -8e-6);
+    let rec =
+        crate::synth::netlist_record(&truth.net, 1250, 2e-3, 63, &crate::synth::valve_command)
+            .unwrap();
+    let opts = DiagnoseOptions::default();
+    let (p, _) = prepare(&rec, None, &[], declared.stroke()).unwrap();
+    let pt = super::sim::Prepared {
+        rtol: 1e-6,
+        ..p.clone()
+    };
+    let rig0 = with_initial(&declared, &p);
+    // the forward step's set: flow_gain_error alone, refitted
+    let mut model = rig0.clone();
+    set(&mut model, EffectId::FlowGainError, "kw", 0.95);
+    let mut free = vec![(EffectId::FlowGainError, "kw")];
+    let res = refit_polished(&mut model, &free, &p, opts.holdout).unwrap();
+    let rss = rss_of(&p, &simulate(&model, &p).unwrap(), opts.holdout);
+    let mut added = vec![EffectReport {
+        id: "flow_gain_error".into(),
+        params: BTreeMap::from([("kw".to_string(), res.x[0])]),
+        ci95: BTreeMap::from([("kw".to_string(), Some(res.ci95[0]))]),
+        explained_share: 0.9,
+        heldout_share: 0.8,
+        delta_bic: -10.0,
+        note: None,
+    }];
+    let mut last = BTreeMap::new();
+    let floors = compared_floors(&p);
+    let r = Round {
+        model: &rig0,
+        free: &Vec::new(),
+        pt: &pt,
+        p: &p,
+        opts: &opts,
+        declared: &declared,
+        floors: &floors,
+        null: rss_all_held(&rig0, &pt, opts.holdout),
+        neff: 500.0,
+        first: None,
+    };
+    // the first round's singles: the leak and the bias each explain little
+    // alone; the linearised ranking brings the pair in
+    let singles = [
+        (EffectId::FlowGainError, 0.9),
+        (EffectId::SupplyDroop, 0.8),
+        (EffectId::InternalLeakage, -1.0),
+        (EffectId::ValveNullBias, 0.0),
+    ];
+    let swapped = compare(
+        &r,
+        &singles,
+        rss,
+        (&mut model, &mut free),
+        &mut added,
+        &mut last,
+        &mut |_| {},
+    );
+    assert!(swapped, "{added:?}");
+    let mut ids: Vec<&str> = added.iter().map(|a| a.id.as_str()).collect();
+    ids.sort();
+    assert_eq!(ids, ["internal_leakage", "valve_null_bias"]);
+    for a in &added {
+        let note = a.note.as_deref().unwrap_or_default();
+        assert!(
+            note.contains("in place of the forward step's flow_gain_error"),
+            "{note}"
+        );
+    }
+    let cl = added.iter().find(|a| a.id == "internal_leakage").unwrap();
+    let (v, ci) = (cl.params["Cl"], cl.ci95["Cl"].unwrap());
+    assert!((v - 5e-12).abs() <= ci, "Cl = {v} ± {ci}");
+    let why = &last[&EffectId::FlowGainError].reason;
+    assert!(
+        why.starts_with("added by the forward step, then replaced"),
+        "{why}"
+    );
+    assert_eq!(get(&model, EffectId::FlowGainError, "kw"), Some(1.0));
+    assert_eq!(free.len(), 2);
 }

@@ -6,6 +6,7 @@ mod checks;
 mod closed_loop;
 mod hybrid;
 mod model;
+mod pairs;
 mod planted;
 mod probes;
 mod valve;

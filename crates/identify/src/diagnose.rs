@@ -613,7 +613,14 @@ impl Report {
                 100.0 * p.explained_share
             );
         }
-        for w in &self.warnings {
+        // the warnings a data problem gave are listed above, under "data
+        // problems" (the JSON keeps both lists whole)
+        let restates = |w: &str| {
+            self.data_problems
+                .iter()
+                .any(|p| w.starts_with(p.channel.as_str()) && w.ends_with(p.message.as_str()))
+        };
+        for w in self.warnings.iter().filter(|w| !restates(w)) {
             let _ = writeln!(s, "warning: {w}");
         }
         let stages: Vec<String> = self

@@ -310,6 +310,19 @@ fn bar_under_a_psi_header_is_named_by_the_force_balance() {
     );
     assert!(r.data_problems.iter().all(|p| p.left_out));
     assert!(r.effects_added.is_empty(), "{}", r.human());
+    // the human report lists each problem once, under "data problems" (the
+    // JSON's warnings keep them too, for a reader of that list alone)
+    let text = r.human();
+    assert_eq!(
+        text.matches("do not balance the piston").count(),
+        2,
+        "{text}"
+    );
+    assert!(!text.contains("warning: p1 left out of the fit"), "{text}");
+    assert!(r
+        .warnings
+        .iter()
+        .any(|w| w.starts_with("p1 left out of the fit")));
     // the position fit is what it is without the pressures
     assert!(
         r.nrmse_after["position"] < 1.1 * r.noise_floor["position"],

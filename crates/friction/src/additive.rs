@@ -150,6 +150,9 @@ impl<M: FrictionModel> FrictionModel for WithSealTerms<M> {
     fn mode(&self) -> FrictionMode {
         self.inner.mode()
     }
+    fn can_stick(&self) -> bool {
+        self.inner.can_stick()
+    }
 }
 
 #[cfg(test)]

@@ -175,4 +175,8 @@ impl FrictionModel for Karnopp {
     fn mode(&self) -> FrictionMode {
         self.mode
     }
+
+    fn can_stick(&self) -> bool {
+        true
+    }
 }

@@ -127,4 +127,7 @@ impl FrictionModel for FrictionLaw {
     fn mode(&self) -> FrictionMode {
         each!(self, m => m.mode())
     }
+    fn can_stick(&self) -> bool {
+        each!(self, m => m.can_stick())
+    }
 }

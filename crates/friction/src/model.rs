@@ -197,6 +197,12 @@ pub trait FrictionModel {
     fn mode(&self) -> FrictionMode {
         FrictionMode::Slip
     }
+
+    /// Whether the model can enter [`FrictionMode::Stick`] (a stick–slip
+    /// model with a held mode, e.g. Karnopp's); `false` by default.
+    fn can_stick(&self) -> bool {
+        false
+    }
 }
 
 /// Central finite-difference [`FrictionJacobian`] of any model with at most

@@ -172,10 +172,10 @@ impl Component for Friction {
     fn derivatives(&self, _t: f64, x: &[f64], w: &Wires, dx: &mut [f64]) {
         self.model.state_derivative(&self.input(w), x, dx);
     }
-    /// A law with modes (Karnopp's stick) reports, while stuck, the force
+    /// A law that can stick (Karnopp's) reports, while stuck, the force
     /// that holds the rod: everything else acting on it.
     fn settles(&self) -> bool {
-        self.model.n_events() > 0
+        self.model.can_stick()
     }
     fn settle(&self, _t: f64, _x: &[f64], w: &mut Wires) {
         if self.mode == FrictionMode::Stick {

@@ -139,6 +139,28 @@ pub struct EffectReport {
     pub note: Option<String>,
 }
 
+impl EffectReport {
+    /// A candidate's report once traced: its traced parameter values and its
+    /// scores (share, held-out share, ΔBIC), no intervals yet, no note.
+    pub fn traced(
+        id: &str,
+        params: BTreeMap<String, f64>,
+        explained_share: f64,
+        heldout_share: f64,
+        delta_bic: f64,
+    ) -> Self {
+        Self {
+            id: id.into(),
+            params,
+            ci95: BTreeMap::new(),
+            explained_share,
+            heldout_share,
+            delta_bic,
+            note: None,
+        }
+    }
+}
+
 /// An effect tried and rejected: its scores and, always, why (the type has
 /// no rejected effect without a reason).
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -436,18 +436,11 @@ pub fn diagnose_rig_traced(
                         + params.len() as f64 * neff.ln(),
                 )
             };
-            let rep = EffectReport {
-                id: id.id().into(),
-                params: params
-                    .iter()
-                    .filter_map(|(eid, n)| get(&trial, *eid, n).map(|v| (n.to_string(), v)))
-                    .collect(),
-                ci95: BTreeMap::new(),
-                explained_share: share,
-                heldout_share: held,
-                delta_bic: dbic,
-                note: None,
-            };
+            let traced = params
+                .iter()
+                .filter_map(|(eid, n)| get(&trial, *eid, n).map(|v| (n.to_string(), v)))
+                .collect();
+            let rep = EffectReport::traced(id.id(), traced, share, held, dbic);
             let why = if let Err(e) = &res {
                 Some(format!("fit failed: {e}"))
             } else if let Some(lin) = screened {

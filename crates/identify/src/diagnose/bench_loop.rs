@@ -598,18 +598,11 @@ pub fn diagnose_bench(
             let held = 1.0 - rss1_held / rss0_held.max(1e-300);
             let k = params.len() as f64;
             let dbic = neff * (rss1 / rss0.max(1e-300)).ln() + k * neff.ln();
-            let rep = EffectReport {
-                id: id.id().into(),
-                params: params
-                    .iter()
-                    .map(|p| (param_name(p).to_string(), trial.get(p)))
-                    .collect(),
-                ci95: BTreeMap::new(),
-                explained_share: share,
-                heldout_share: held,
-                delta_bic: dbic,
-                note: None,
-            };
+            let traced = params
+                .iter()
+                .map(|p| (param_name(p).to_string(), trial.get(p)))
+                .collect();
+            let rep = EffectReport::traced(id.id(), traced, share, held, dbic);
             let why = match &fit {
                 Err(e) => Some(format!("fit failed: {e}")),
                 Ok(_) => opts.screen(share, held, dbic),

@@ -146,18 +146,13 @@ fn trace_pair(r: &Round<'_>, ids: [EffectId; 2]) -> TracedPair {
             r.neff * (rss1 / null.max(1e-300)).max(1e-300).ln() + own.len() as f64 * r.neff.ln(),
         )
     };
-    let rep = |id: EffectId| EffectReport {
-        id: id.id().into(),
-        params: id
+    let rep = |id: EffectId| {
+        let params = id
             .params()
             .iter()
             .filter_map(|q| get(&trial, id, q.name).map(|v| (q.name.to_string(), v)))
-            .collect(),
-        ci95: BTreeMap::new(),
-        explained_share: share,
-        heldout_share: held,
-        delta_bic: dbic,
-        note: None,
+            .collect();
+        EffectReport::traced(id.id(), params, share, held, dbic)
     };
     let why = match &traced {
         Err(e) => Some(format!("trace failed: {e}")),

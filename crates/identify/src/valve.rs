@@ -669,18 +669,14 @@ pub fn diagnose_rig_traced(
     // what it carried); the least resolved that fails is dropped and the
     // rest refitted, until all pass.
     let dropped = accept::backward(
-        &mut model,
-        &mut free,
+        (&mut model, &mut free),
         joint_res,
         &mut added,
         declared,
         &p,
         opts.holdout,
-    )
-    .map_err(|e| DiagnoseError::Fit {
-        what: "refit after the backward step".into(),
-        reason: e.to_string(),
-    })?;
+        &mut warnings,
+    );
     for d in dropped {
         if let Some(id) = EffectId::from_id(&d.effect.id) {
             last.insert(id, d);

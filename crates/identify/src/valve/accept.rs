@@ -13,7 +13,7 @@ use super::{
 use crate::accept::{self, FittedParam, Refitted, Scores};
 use crate::catalog::EffectId;
 use crate::diagnose::{EffectReport, RejectedEffect};
-use crate::lm::{self, LmResult};
+use crate::lm::LmResult;
 
 /// The neutral ("off") value of parameter `name` of effect `id`.
 pub(super) fn neutral(id: EffectId, name: &str, declared: &Model) -> f64 {
@@ -70,16 +70,18 @@ fn size_of(id: EffectId, rig: &Model, declared: &Model) -> accept::Size {
 /// the least resolved (the smallest size in half-widths) is dropped: set
 /// to its neutral value and taken out of `free` and `added`, and the rest
 /// refitted; then checked again, until every one passes. Returns the
-/// dropped effects with the reason.
+/// dropped effects with the reason. A refit that fails ends the step: the
+/// effects left keep their values from the refit before it, and `warnings`
+/// says so (the diagnosis goes on with what it has).
 pub(super) fn backward(
-    model: &mut Model,
-    free: &mut ParamList,
+    (model, free): (&mut Model, &mut ParamList),
     mut res: Option<LmResult>,
     added: &mut Vec<EffectReport>,
     declared: &Model,
     p: &Prepared,
     holdout: f64,
-) -> Result<Vec<RejectedEffect>, lm::LmError> {
+    warnings: &mut Vec<String>,
+) -> Vec<RejectedEffect> {
     let mut dropped = Vec::new();
     while let Some(r) = res.take() {
         let params = fitted_params(free, &r, model, None, declared);
@@ -120,7 +122,15 @@ pub(super) fn backward(
             break;
         }
         let mut refit = model.clone();
-        let r = refit_polished(&mut refit, free, p, holdout)?;
+        let r = match refit_polished(&mut refit, free, p, holdout) {
+            Ok(r) => r,
+            Err(e) => {
+                warnings.push(format!(
+                    "the refit after dropping {id} failed ({e}); the effects left keep their values from the refit before it"
+                ));
+                break;
+            }
+        };
         *model = refit;
         for ((eid, n), (x, ci)) in free.iter().zip(r.x.iter().zip(&r.ci95)) {
             if let Some(a) = added.iter_mut().find(|a| a.id == eid.id()) {
@@ -130,7 +140,7 @@ pub(super) fn backward(
         }
         res = Some(r);
     }
-    Ok(dropped)
+    dropped
 }
 
 /// What the rule compares a candidate with: the model before it, its

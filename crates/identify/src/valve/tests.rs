@@ -206,16 +206,17 @@ fn an_added_effect_whose_interval_widened_to_include_zero_is_dropped() {
         report(EffectId::InternalLeakage, "Cl", 7.23e-14, 2.64e-13),
         report(EffectId::ExternalForce, "F0", 400.0, 5.0),
     ];
+    let mut warnings = Vec::new();
     let dropped = super::accept::backward(
-        &mut model,
-        &mut free,
+        (&mut model, &mut free),
         Some(res),
         &mut added,
         &declared,
         &p,
         0.3,
-    )
-    .unwrap();
+        &mut warnings,
+    );
+    assert!(warnings.is_empty(), "{warnings:?}");
     let ids: Vec<&str> = dropped.iter().map(|d| d.effect.id.as_str()).collect();
     assert_eq!(ids, ["internal_leakage"]);
     let why = &dropped[0].reason;

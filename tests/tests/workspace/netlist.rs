@@ -659,7 +659,7 @@ fn netlist_errors_name_the_json_path_and_line() {
             &[
                 (
                     "\"reference\": {\n      \"type\": \"command_input\"\n    },",
-                    "\"ctl2\": {\"type\": \"position_controller\", \"gain\": 10.0},",
+                    "\"ctl2\": {\"type\": \"position_controller\", \"gain\": 10.0}, \"reference\": {\"type\": \"command_input\"},",
                 ),
                 (
                     "\"reference.out\",\n      \"controller.reference\"",
@@ -667,7 +667,8 @@ fn netlist_errors_name_the_json_path_and_line() {
                 ),
                 (
                     "\"controller.command\",\n      \"spool.command\"",
-                    "\"controller.command\",\n      \"ctl2.reference\",\n      \"spool.command\"",
+                    // the loop in one unit (a set-point [m]); the input drives the spool
+                    "\"controller.command\",\n      \"ctl2.reference\"\n    ],\n    [\n      \"reference.out\",\n      \"spool.command\"",
                 ),
                 (
                     "\"controller.rod\"\n",

@@ -613,7 +613,14 @@ impl Circuit {
                             Some(s + self.comps[i].inflow_slope(t, xs(i), w, g.node.pressure)?)
                         })
                     };
-                    g.solve(t, &mut w, &mut self.scratch.borrow_mut(), eval, slope);
+                    let laws = |w: &Wires| match g.members[..] {
+                        [a, b] => Some([
+                            self.comps[a].orifice_inflow(t, xs(a), w, g.node.pressure)?,
+                            self.comps[b].orifice_inflow(t, xs(b), w, g.node.pressure)?,
+                        ]),
+                        _ => None,
+                    };
+                    g.solve(t, &mut w, &mut self.scratch.borrow_mut(), eval, slope, laws);
                 }
             }
         }

@@ -3,6 +3,7 @@
 //! [`PowerTerms`] it reports to the energy ledger.
 
 use super::{AnyWire, BuildError, Netlist, Tangents, Wire, Wires};
+use crate::series::OrificeInflow;
 use hydrocyl_integrators::{Crossing, EventAction};
 use hydrocyl_ports::Quantity;
 
@@ -134,6 +135,22 @@ pub trait Component {
         _w: &Wires,
         _node: Wire<hydrocyl_ports::Pressure>,
     ) -> Option<f64> {
+        None
+    }
+
+    /// The flow this component adds into hydraulic node `node` as an orifice
+    /// law of that node's pressure ([`OrificeInflow`]: `k·√(other − p)`,
+    /// regularised near zero), where it is one; `None` (the default) when it
+    /// is not or cannot say. An algebraic node with two such members is
+    /// solved in closed form ([`crate::series`]); the law must be the one
+    /// [`evaluate`](Component::evaluate) computes, bit for bit in `k`.
+    fn orifice_inflow(
+        &self,
+        _t: f64,
+        _x: &[f64],
+        _w: &Wires,
+        _node: Wire<hydrocyl_ports::Pressure>,
+    ) -> Option<OrificeInflow> {
         None
     }
 

@@ -3,6 +3,7 @@
 use crate::circuit::{
     BuildError, Component, HydraulicNode, Netlist, PowerTerms, Tangents, Wire, Wires,
 };
+use crate::series::OrificeInflow;
 use hydrocyl_ports::{Pressure, VolumeFlow};
 use hydrocyl_valves::orifice::Orifice;
 
@@ -72,6 +73,17 @@ impl Component for FixedOrifice {
         } else {
             0.0
         })
+    }
+    fn orifice_inflow(
+        &self,
+        _t: f64,
+        _x: &[f64],
+        w: &Wires,
+        node: Wire<Pressure>,
+    ) -> Option<OrificeInflow> {
+        let k = self.orifice.coefficient() * self.area.si();
+        let transition = self.orifice.dp_transition.si();
+        OrificeInflow::between(k, transition, (self.a, self.b), w, node)
     }
     fn power(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         p.dissipated = ((w.get(self.a.pressure) - w.get(self.b.pressure)) * self.flow(w)).si();

@@ -18,6 +18,7 @@
 use crate::circuit::{
     BuildError, Causality, Component, Netlist, PowerTerms, Probe, Tangents, Wire,
 };
+use crate::series::OrificeInflow;
 use crate::wires::HydraulicNode;
 use crate::Wires;
 use hydrocyl_integrators::{Crossing, EventAction};
@@ -161,6 +162,15 @@ impl Component for ServoNeedle {
         w.add(self.i.inflow, -q);
         w.add(self.o.inflow, q);
         w.set(self.opening, v.area.si());
+    }
+    fn orifice_inflow(
+        &self,
+        _t: f64,
+        _x: &[f64],
+        w: &Wires,
+        node: Wire<Pressure>,
+    ) -> Option<OrificeInflow> {
+        OrificeInflow::needle(&self.valve(w), (self.i, self.o), w, node)
     }
     fn inflow_slope(&self, _t: f64, _x: &[f64], w: &Wires, node: Wire<Pressure>) -> Option<f64> {
         let g = self

@@ -10,6 +10,7 @@ use crate::circuit::{
     BuildError, Causality, Component, HydraulicNode, Netlist, PowerTerms, Probe, Tangents, Wire,
     Wires,
 };
+use crate::series::OrificeInflow;
 use hydrocyl_integrators::{Crossing, EventAction};
 use hydrocyl_ports::{Position, Pressure, Voltage, VolumeFlow};
 use hydrocyl_pump_motor::IdentifiedPump;
@@ -602,6 +603,22 @@ impl Component for PilotValve {
         w.set(self.flow_a, if y > 0.0 { none } else { q });
         w.set(self.flow_b, if y > 0.0 { q } else { none });
     }
+    fn orifice_inflow(
+        &self,
+        _t: f64,
+        _x: &[f64],
+        w: &Wires,
+        node: Wire<Pressure>,
+    ) -> Option<OrificeInflow> {
+        if node == self.pp1.pressure || node == self.pp2.pressure {
+            return None; // the opening moves with the pilot pressures
+        }
+        // Q = k √(p_x − p_T) leaves the open chamber and enters T
+        let y = self.opening(w);
+        let open = if y > 0.0 { self.b } else { self.a };
+        let k = self.four_way.return_coefficient(y);
+        OrificeInflow::between(k, self.four_way.dp_transition.si(), (open, self.t), w, node)
+    }
     fn inflow_slope(&self, _t: f64, _x: &[f64], w: &Wires, node: Wire<Pressure>) -> Option<f64> {
         let y = self.opening(w);
         let open = if y > 0.0 { self.b } else { self.a };
@@ -739,6 +756,15 @@ impl Component for NeedleComponent {
             .flow(w.get(self.i.pressure), w.get(self.o.pressure));
         w.add(self.i.inflow, -q);
         w.add(self.o.inflow, q);
+    }
+    fn orifice_inflow(
+        &self,
+        _t: f64,
+        _x: &[f64],
+        w: &Wires,
+        node: Wire<Pressure>,
+    ) -> Option<OrificeInflow> {
+        OrificeInflow::needle(&self.needle, (self.i, self.o), w, node)
     }
     fn inflow_slope(&self, _t: f64, _x: &[f64], w: &Wires, node: Wire<Pressure>) -> Option<f64> {
         // Q leaves the inlet and enters the outlet; ∂Q/∂p_in = −∂Q/∂p_out = g

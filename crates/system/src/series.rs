@@ -208,13 +208,14 @@ fn orifice_pair_root(
     // else a guess near it (the last solve's) saves iterations
     let still = a.k == 0.0 || b.k == 0.0 || a.other == b.other;
     let in_transition = |m: OrificeInflow| (m.other - plain).abs() < m.transition;
-    let mut p = if !still && (in_transition(a) || in_transition(b)) && guess > x0 && guess < x1 {
+    let exact = still || !(in_transition(a) || in_transition(b));
+    let mut p = if !exact && guess > x0 && guess < x1 {
         guess
     } else {
         plain
     };
-    let mut root = None;
-    for _ in 0..NEWTON_ITERATIONS {
+    let mut root = exact.then_some(plain);
+    for _ in 0..if exact { 0 } else { NEWTON_ITERATIONS } {
         let r = inflow(p);
         if r == 0.0 {
             root = Some(p);

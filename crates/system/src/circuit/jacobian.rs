@@ -44,6 +44,9 @@ pub struct Tangents {
     /// The current component's first state and first quadrature.
     offset: usize,
     q_offset: usize,
+    /// Scratch: an algebraic node's `∂p/∂x` row (kept, so that a Jacobian
+    /// allocates nothing once the first has sized it).
+    node_row: Vec<f64>,
 }
 
 impl Tangents {
@@ -213,7 +216,9 @@ impl Circuit {
                     if !(drdp < 0.0 && drdp.is_finite()) {
                         return false;
                     }
-                    let dpdx: Vec<f64> = tg.row(r)[..n].iter().map(|d| -d / drdp).collect();
+                    let mut dpdx = std::mem::take(&mut tg.node_row);
+                    dpdx.clear();
+                    dpdx.extend(tg.row(r)[..n].iter().map(|d| -d / drdp));
                     for &wi in grp.writes() {
                         let row = &mut tg.rows[wi * m..(wi + 1) * m];
                         let c = row[col];
@@ -222,6 +227,7 @@ impl Circuit {
                             row[col] = 0.0;
                         }
                     }
+                    tg.node_row = dpdx;
                 }
             }
         }

@@ -820,9 +820,10 @@ mod tests {
         let sol = solve(Method::DormandPrince45, &mut c, 0.0, &x0, 1.0, &opts).unwrap();
         let p = sol.last().unwrap()[0];
         assert!((p - 7.0e6).abs() < 1e3, "{p}");
-        // warm-started Newton: a few member evaluations per solve
-        let per = diag(&c, "m.solve_evaluations") / diag(&c, "m.solves");
-        assert!(diag(&c, "m.solves") > 0.0 && per < 4.0, "{per}");
+        // two fixed orifices declare their laws: each solve evaluates the
+        // members once, at the root found on the laws
+        assert!(diag(&c, "m.solves") > 100.0);
+        assert_eq!(diag(&c, "m.solve_evaluations"), diag(&c, "m.solves"));
         assert_eq!(diag(&c, "m.solve_fallbacks"), 0.0);
     }
 
@@ -1007,26 +1008,6 @@ mod tests {
         let mut cracked = law(1e-7, 2e5);
         cracked.valid = (3e6, f64::INFINITY);
         assert!(orifice_pair_root(law(1e-7, 5e6), cracked, (2e5, 5e6), tol, 3e6).is_none());
-    }
-
-    #[test]
-    fn two_orifice_laws_solve_with_one_member_evaluation() {
-        // the algebraic node between two fixed orifices, inside an ODE: each
-        // solve evaluates the members once (at the root found on their laws)
-        let mut c = Circuit::build(two_in_series(Box::new(Volume::new(
-            "vol", "L", 1e-5, 7e8, 0.0, None,
-        ))))
-        .unwrap();
-        let x0 = c.initial_state();
-        c.reset(0.0, &x0);
-        let opts = Options {
-            atol: c.atol(1e-8),
-            rtol: 1e-8,
-            ..Options::default()
-        };
-        solve(Method::DormandPrince45, &mut c, 0.0, &x0, 1.0, &opts).unwrap();
-        assert!(diag(&c, "m.solves") > 100.0);
-        assert_eq!(diag(&c, "m.solve_evaluations"), diag(&c, "m.solves"));
     }
 
     #[test]

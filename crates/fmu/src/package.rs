@@ -76,14 +76,20 @@ pub fn find_library(explicit: Option<&Path>) -> Result<PathBuf, FmuError> {
 /// the rig (preset name or file stem). The caller writes it where it goes
 /// (`hydrocyl fmu` through its outputs: a temporary file put in place).
 pub fn fmu_archive(rig: &Value, model_name: &str, library: &Path) -> Result<Vec<u8>, FmuError> {
-    let vars = Variables::of(rig)?;
+    let mut vars = Variables::of(rig)?;
     let lib = std::fs::read(library)
         .map_err(|e| FmuError::Library(format!("{}: {e}", library.display())))?;
-    if !lib.starts_with(b"\x7fELF") || !contains(&lib, b"fmi2DoStep") {
-        return Err(FmuError::Library(format!(
-            "{} is not the hydrocyl FMU library (no ELF object exporting fmi2DoStep)",
+    // every refusal of the library names it and how to build the right one
+    let refused = |why: &str| {
+        FmuError::Library(format!(
+            "the FMU library {} {why}: build both with `cargo build -p hydrocyl-fmu -p hydrocyl-cli` (same profile), or name the library of this build with --library / ${LIBRARY_ENV}",
             library.display()
-        )));
+        ))
+    };
+    if !lib.starts_with(b"\x7fELF") || !contains(&lib, b"fmi2DoStep") {
+        return Err(refused(
+            "is not the hydrocyl FMU library (no ELF object exporting fmi2DoStep)",
+        ));
     }
     let rig_text = serde_json::to_string_pretty(rig).map_err(|e| RigError::Invalid {
         path: "rig".into(),
@@ -94,7 +100,26 @@ pub fn fmu_archive(rig: &Value, model_name: &str, library: &Path) -> Result<Vec<
         .and_then(Value::as_str)
         .map(str::to_string)
         .unwrap_or_else(|| format!("hydrocyl rig {model_name}"));
-    let xml = model_description(&vars, model_name, &description, &guid(&rig_text));
+    // the library must make the same variables of this rig, value
+    // reference for value reference: it computes the same GUID only then
+    let ours = guid(&rig_text, &vars);
+    let other_build = |why: &str| {
+        refused(&format!(
+            "is not from the same build as this hydrocyl ({why})"
+        ))
+    };
+    match crate::ffi::library_guid(library, &rig_text) {
+        Ok(theirs) if theirs == ours => {}
+        Ok(theirs) => {
+            return Err(other_build(&format!(
+                "for this rig it computes the GUID {theirs}, this hydrocyl {ours}: its variables differ, so value references would set the wrong parameters"
+            )))
+        }
+        Err(why) => return Err(other_build(&why)),
+    }
+    // the dependencies declared hold for every value of the parameters
+    vars.widen_feedthrough(rig);
+    let xml = model_description(&vars, model_name, &description, &rig_text);
     let id = model_identifier(model_name);
     let files: [(String, &[u8]); 3] = [
         ("modelDescription.xml".into(), xml.as_bytes()),

@@ -219,6 +219,28 @@ fn a_freed_instance_or_state_is_refused_not_used() {
     unsafe { fmi2FreeInstance(c) };
 }
 
+/// The packager's check against the library of this build (cargo builds
+/// the cdylib beside this test binary): it computes the packager's GUID
+/// for every preset, and the archive is made.
+#[test]
+fn the_library_of_this_build_is_accepted() {
+    let deps = std::env::current_exe().unwrap();
+    let lib = deps
+        .parent()
+        .unwrap()
+        .join(hydrocyl_fmu::package::LIBRARY_FILE);
+    assert!(lib.is_file(), "{}", lib.display());
+    for p in rig::PRESETS {
+        let value = (p.json)();
+        let text = serde_json::to_string_pretty(&value).unwrap();
+        let ours = guid(&text, &Variables::of(&value).unwrap());
+        assert_eq!(library_guid(&lib, &text), Ok(ours), "{}", p.name);
+    }
+    let value = rig::preset("leaney-moog").unwrap();
+    let zip = hydrocyl_fmu::package::fmu_archive(&value, "leaney-moog", &lib).unwrap();
+    assert!(zip.starts_with(b"PK"));
+}
+
 #[test]
 fn resource_locations_are_file_uris_or_paths() {
     assert_eq!(

@@ -12,7 +12,7 @@
 //! friction stick/slip, stops, valve states) lives on between steps.
 
 use crate::variables::{
-    circuit_with_input, output_channels, Role, SolverParam, Variables, METHODS,
+    circuit_with_input, nullable, output_channels, Role, SolverParam, Variables, METHODS,
 };
 use hydrocyl_system::external::ExternalInput;
 use hydrocyl_system::netlist::{self, registry};
@@ -604,23 +604,6 @@ fn failure_time(message: &str) -> Option<f64> {
         let number = rest.split(" s").next()?;
         number.parse::<f64>().ok().filter(|t| t.is_finite())
     })
-}
-
-/// Whether parameter `path` of `rig` may be left to the rig (`null` in a
-/// rig file: its default is "computed" or "none", [`registry::Default::Absent`]):
-/// then `NaN` sets it back to that.
-fn nullable(rig: &Value, path: &str) -> bool {
-    let Some((component, name)) = path.split_once('.') else {
-        return false;
-    };
-    let Some(ty) = rig::component_type(rig, component) else {
-        return false;
-    };
-    let default = match name.strip_prefix("initial.") {
-        Some(state) => ty.state(state).map(|s| s.default),
-        None => ty.param(name).map(|p| p.default),
-    };
-    matches!(default, Some(registry::Default::Absent))
 }
 
 /// Whether a solver parameter's `value` meets `setting`'s rule, and the rule.

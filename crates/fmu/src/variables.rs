@@ -130,6 +130,26 @@ pub fn circuit_with_input(rig: &Value) -> Result<(Circuit, ExternalInput), RigEr
     Ok((c, input))
 }
 
+/// Whether parameter `path` of `rig` may be left to the rig (`null` in a
+/// rig file: its default is "computed" or "none", [`Default::Absent`](hydrocyl_system::netlist::registry::Default::Absent)):
+/// then `NaN` sets it back to that.
+pub fn nullable(rig: &Value, path: &str) -> bool {
+    let Some((component, name)) = path.split_once('.') else {
+        return false;
+    };
+    let Some(ty) = rig::component_type(rig, component) else {
+        return false;
+    };
+    let default = match name.strip_prefix("initial.") {
+        Some(state) => ty.state(state).map(|s| s.default),
+        None => ty.param(name).map(|p| p.default),
+    };
+    matches!(
+        default,
+        Some(hydrocyl_system::netlist::registry::Default::Absent)
+    )
+}
+
 /// Direct feedthrough of each probe: whether it changes with the input
 /// alone, at the circuit's initial state.
 fn feeds_through(circuit: &Circuit, input: &ExternalInput, probes: &[Probe]) -> Vec<bool> {
@@ -218,6 +238,10 @@ impl Variables {
         for p in rig::parameters(rig) {
             list.push(Variable {
                 description: match p.value {
+                    Some(_) if nullable(rig, &p.path) => format!(
+                        "rig parameter `{}`; NaN leaves it to the rig (computed, or none: null in the rig file)",
+                        p.path
+                    ),
                     Some(_) => format!("rig parameter `{}`", p.path),
                     None => format!(
                         "rig parameter `{}`; NaN (the start) leaves it to the rig (null in the rig file)",

@@ -9,7 +9,11 @@
 //! `resources/rig.json`, and the slave library `libhydrocyl_fmu.so` (crate
 //! `hydrocyl-fmu`) as `binaries/linux64/<modelIdentifier>.so`. The library
 //! is found by `--library`, else `$HYDROCYL_FMU_LIBRARY`, else next to the
-//! `hydrocyl` executable (where `cargo build -p hydrocyl-fmu` puts it);
+//! `hydrocyl` executable (where `cargo build -p hydrocyl-fmu` puts it).
+//! It must be the library of this build: the packager loads it and
+//! refuses it (exit 2, nothing written) unless it computes the packager's
+//! GUID for the rig, i.e. makes the same variables of it (a library built
+//! from other sources would map value references to other parameters);
 //! see `docs/fmu.md`.
 
 use crate::error::CliError;
@@ -31,8 +35,8 @@ pub struct Args {
     /// it becomes the parameter's start value.
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
-    /// The slave library (`libhydrocyl_fmu.so`); default: $HYDROCYL_FMU_LIBRARY,
-    /// else next to this executable.
+    /// The slave library (`libhydrocyl_fmu.so`) of this build; default:
+    /// $HYDROCYL_FMU_LIBRARY, else next to this executable.
     #[arg(long)]
     library: Option<PathBuf>,
     /// Print the preset names (one per line) and exit.

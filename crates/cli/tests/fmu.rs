@@ -1,5 +1,5 @@
-//! `hydrocyl fmu` end to end without the slave library: one-line errors,
-//! exit code 2, no file written. (Exports with the library, checked by
+//! `hydrocyl fmu` end to end without the slave library of this build:
+//! one-line errors, exit code 2, no file written. (Exports with the library, checked by
 //! FMPy, are in `crates/fmu/tests/python`, run by `crates/fmu/tests/run_fmpy_tests.sh`.)
 
 use std::path::Path;
@@ -63,6 +63,48 @@ fn a_file_that_is_not_the_library_and_a_bad_set_are_refused() {
     assert!(refused(&out, &[], Some(&fake), None).contains("fmi2DoStep"));
     let err = refused(&out, &["--set", "load.mass=-1"], Some(&fake), None);
     assert!(err.contains("load.mass"), "{err}");
+}
+
+/// A library that is not the one of this build is refused before anything
+/// is written: a shared library that is not the FMU's (a proc-macro library
+/// of this build's dependencies, beside the test binary) and an ELF file
+/// that names `fmi2DoStep` but does not load. The message names the library
+/// and the remedy. (A library lacking `hydrocyl_fmu_guid`, or computing
+/// another GUID, is refused by the same check: `hydrocyl_fmu::ffi` tests.)
+#[test]
+fn a_library_of_another_build_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("drive.fmu");
+    let deps = std::env::current_exe()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .to_path_buf();
+    let older = std::fs::read_dir(&deps)
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .find(|p| {
+            let n = p.file_name().unwrap().to_string_lossy();
+            n.starts_with("libthiserror_impl-") && n.ends_with(".so")
+        })
+        .expect("thiserror's proc-macro library beside the test binary");
+    let err = refused(&out, &[], Some(&older), None);
+    assert!(
+        err.contains(&older.display().to_string())
+            && err.contains("is not the hydrocyl FMU library")
+            && err.contains("cargo build -p hydrocyl-fmu -p hydrocyl-cli"),
+        "{err}"
+    );
+    let broken = dir.path().join("broken.so");
+    std::fs::write(&broken, b"\x7fELF\x02\x01\x01 truncated, names fmi2DoStep").unwrap();
+    let err = refused(&out, &[], None, Some(&broken));
+    assert!(
+        err.contains("broken.so")
+            && err.contains("is not from the same build as this hydrocyl")
+            && err.contains("does not load as a library")
+            && err.contains("cargo build -p hydrocyl-fmu -p hydrocyl-cli"),
+        "{err}"
+    );
 }
 
 #[test]

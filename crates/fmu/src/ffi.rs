@@ -13,11 +13,14 @@
 //! `fmi2String` `const char*`.
 #![allow(unsafe_code, non_snake_case, clippy::missing_safety_doc)]
 
-use crate::model_description::guid;
+use crate::model_description::{guid, rig_digest, variables_digest, DIGESTS};
 use crate::slave::{Slave, Snapshot};
+use crate::variables::Variables;
+use std::collections::BTreeSet;
 use std::ffi::{c_char, c_int, c_uint, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
 
 /// `fmi2Status`.
 pub type Status = c_int;
@@ -94,6 +97,57 @@ impl Instance {
     }
 }
 
+/// The addresses of the live instances (from `fmi2Instantiate` to
+/// `fmi2FreeInstance`) and of the live FMU states (from `fmi2GetFMUstate` or
+/// `fmi2DeSerializeFMUstate` to `fmi2FreeFMUstate`). An entry point given
+/// a pointer that is not in its set (freed already, never made here) refuses
+/// it (`fmi2Error`, nothing logged: there is no instance to log through)
+/// instead of using or freeing it again.
+static LIVE_INSTANCES: Mutex<BTreeSet<usize>> = Mutex::new(BTreeSet::new());
+static LIVE_STATES: Mutex<BTreeSet<usize>> = Mutex::new(BTreeSet::new());
+
+fn registry(set: &'static Mutex<BTreeSet<usize>>) -> MutexGuard<'static, BTreeSet<usize>> {
+    // a panic never happens while the lock is held; a poisoned set is whole
+    set.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Whether `c` is a live instance.
+fn is_live(c: *mut c_void) -> bool {
+    registry(&LIVE_INSTANCES).contains(&(c as usize))
+}
+
+/// Whether `s` is a live FMU state.
+fn is_state(s: *mut c_void) -> bool {
+    registry(&LIVE_STATES).contains(&(s as usize))
+}
+
+/// A new live FMU state.
+fn new_state(snap: Snapshot) -> *mut c_void {
+    let p: *mut c_void = Box::into_raw(Box::new(snap)).cast();
+    registry(&LIVE_STATES).insert(p as usize);
+    p
+}
+
+/// Frees a live FMU state; `false` (nothing done) for any other pointer.
+unsafe fn free_state(s: *mut c_void) -> bool {
+    let was = registry(&LIVE_STATES).remove(&(s as usize));
+    if was {
+        drop(unsafe { Box::from_raw(s.cast::<Snapshot>()) });
+    }
+    was
+}
+
+/// The live FMU state behind `s`, or why it is not one.
+unsafe fn state<'a>(s: *mut c_void) -> Result<&'a mut Snapshot, String> {
+    if s.is_null() {
+        Err("null FMU state".into())
+    } else if !is_state(s) {
+        Err("not an FMU state of this FMU (freed already?)".into())
+    } else {
+        Ok(unsafe { &mut *s.cast::<Snapshot>() })
+    }
+}
+
 /// Runs `f` on the instance behind `c`, turning an `Err` into a logged
 /// `fmi2Error` and a panic into a logged `fmi2Error` that fails the instance.
 unsafe fn with(
@@ -101,7 +155,8 @@ unsafe fn with(
     what: &str,
     f: impl FnOnce(&mut Instance) -> Result<Status, String>,
 ) -> Status {
-    if c.is_null() {
+    // not an instance (null, freed, never made here): nothing to log through
+    if c.is_null() || !is_live(c) {
         return ERROR;
     }
     let inst = unsafe { &mut *(c as *mut Instance) };
@@ -179,33 +234,59 @@ pub fn resource_dir(location: &str) -> Result<PathBuf, String> {
     Ok(PathBuf::from(std::ffi::OsString::from_vec(bytes)))
 }
 
+/// The value of attribute `name` of the first element of `xml` that has
+/// it after `from` (the model description is ours: attributes in double
+/// quotes, nothing escaped in those read here).
+fn attribute<'a>(xml: &'a str, from: &str, name: &str) -> Option<&'a str> {
+    let at = xml.find(from)?;
+    let key = format!(" {name}=\"");
+    let start = at + xml[at..].find(&key)? + key.len();
+    let end = xml[start..].find('"')?;
+    Some(&xml[start..start + end])
+}
+
 /// Why the GUID the host gives (the one in `modelDescription.xml`) is not
-/// that of this library's version and `rig`'s text: the GUID covers both,
-/// and the `generationTool` of the FMU's `modelDescription.xml` (beside its
-/// `resources` folder) names the version that packaged it. The same version
-/// as this library: the rig file differs from the one packaged (edited
-/// after the export); another: the version; no model description to read:
-/// either.
-fn why_guid_differs(rig: &Path) -> String {
+/// the one this library computes for `text` (the FMU's `resources/rig.json`
+/// at `rig`) and the variables it makes of it (`made`: the variables, or
+/// why it cannot make them). The GUID covers this crate's version, the
+/// variable list and the rig's text; the model description beside the
+/// `resources` folder names the version that packaged the FMU
+/// (`generationTool`) and holds the digests of the rig's text and of the
+/// variable list as packaged, which tell which of them differs.
+fn why_guid_differs(rig: &Path, text: &str, made: Result<&Variables, &str>) -> String {
     let ours = env!("CARGO_PKG_VERSION");
-    let packaged = rig
+    let rebuild = "rebuild with `cargo build -p hydrocyl-fmu -p hydrocyl-cli` and export the rig again (`hydrocyl fmu`)";
+    let xml = rig
         .parent()
         .and_then(Path::parent)
-        .and_then(|root| std::fs::read_to_string(root.join("modelDescription.xml")).ok())
-        .and_then(|xml| {
-            let at = xml.find("generationTool=\"hydrocyl ")? + "generationTool=\"hydrocyl ".len();
-            let end = xml[at..].find('"')?;
-            Some(xml[at..at + end].to_string())
-        });
-    match packaged {
-        Some(v) if v == ours => format!(
-            "resources/rig.json is not the rig this FMU was packaged with (the GUID covers the rig's text; the FMU and this library are both hydrocyl {ours}): a rig file edited after the export is refused; export the edited rig again (`hydrocyl fmu`), or set its parameters through the FMU's variables"
+        .and_then(|root| std::fs::read_to_string(root.join("modelDescription.xml")).ok());
+    let xml = xml.as_deref().unwrap_or("");
+    let version = attribute(xml, "<fmiModelDescription", "generationTool")
+        .and_then(|t| t.strip_prefix("hydrocyl "));
+    let digests = (
+        attribute(xml, &format!("<{DIGESTS} "), "rig"),
+        attribute(xml, &format!("<{DIGESTS} "), "variables"),
+    );
+    match (version, digests) {
+        (Some(v), _) if v != ours => format!(
+            "the FMU was packaged by hydrocyl {v} (modelDescription.xml), this library is hydrocyl {ours}: {rebuild}"
         ),
-        Some(v) => format!(
-            "the FMU was packaged by hydrocyl {v} (modelDescription.xml), this library is hydrocyl {ours}; export the rig again with one version"
+        (_, (Some(r), _)) if r != rig_digest(text) => format!(
+            "the rig differs: resources/rig.json is not the rig this FMU was packaged with (edited after the export; the library is the same build as far as the rig can tell): export the edited rig again (`hydrocyl fmu`), or set its parameters through the FMU's variables{}",
+            made.err().map(|e| format!("; the edited rig: {e}")).unwrap_or_default()
         ),
-        None => format!(
-            "resources/rig.json differs from the rig the FMU was packaged with (edited after the export?), or the FMU was packaged by a hydrocyl version other than this library's ({ours}): the GUID covers both"
+        (_, (Some(_), Some(vd))) => match made {
+            Err(e) => format!(
+                "the build differs: resources/rig.json is the rig packaged, but this library (another build than the one that packaged the FMU) cannot read it: {e}; {rebuild}"
+            ),
+            Ok(vars) if variables_digest(vars) != vd => format!(
+                "the build differs: resources/rig.json is the rig packaged, but this library is another build than the one that packaged the FMU: it makes other variables of the rig (value references would reach the wrong parameters); {rebuild}"
+            ),
+            Ok(_) => "the rig and the variables are those packaged: the GUID given is not the one in modelDescription.xml".into(),
+        },
+        _ => format!(
+            "resources/rig.json differs from the rig the FMU was packaged with (edited after the export?), or this library is another build than the one that packaged the FMU (hydrocyl {ours}; the model description holds no digests to tell which): the GUID covers both{}",
+            made.err().map(|e| format!("; the rig: {e}")).unwrap_or_default()
         ),
     }
 }
@@ -214,16 +295,101 @@ fn instantiate(guid_given: &str, location: Option<&str>) -> Result<Slave, String
     let location = location.ok_or("no fmuResourceLocation: the rig is in resources/rig.json")?;
     let path = resource_dir(location)?.join("rig.json");
     let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let expected = guid(&text);
-    if guid_given != expected {
-        return Err(format!(
-            "fmuGUID {guid_given} does not match this library and {} ({expected}): {}",
-            path.display(),
-            why_guid_differs(&path)
-        ));
+    let slave = serde_json::from_str(&text)
+        .map_err(|e| format!("not valid JSON: {e}"))
+        .and_then(Slave::new);
+    let expected = slave
+        .as_ref()
+        .map(|s| guid(&text, s.variables()))
+        .map_err(String::as_str);
+    if expected.as_deref() != Ok(guid_given) {
+        let why = why_guid_differs(
+            &path,
+            &text,
+            slave.as_ref().map(Slave::variables).map_err(String::as_str),
+        );
+        return Err(match expected {
+            Ok(expected) => format!(
+                "fmuGUID {guid_given} does not match this library and {} ({expected}): {why}",
+                path.display()
+            ),
+            Err(_) => format!(
+                "fmuGUID {guid_given}: this library cannot compute the GUID of {}: {why}",
+                path.display()
+            ),
+        });
     }
-    let rig = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-    Slave::new(rig)
+    slave
+}
+
+/// The size of the buffer [`library_guid`] hands to [`hydrocyl_fmu_guid`].
+const GUID_BUFFER: usize = 4096;
+
+/// hydrocyl's own entry point (not FMI), for the packager: writes into
+/// `out` (`size` bytes, NUL-terminated, truncated to fit) the GUID this
+/// library computes for an FMU whose `resources/rig.json` holds the
+/// NUL-terminated `rig_text`, and returns 0; when it cannot read the rig,
+/// writes why and returns 1; -1 on a null pointer. `hydrocyl fmu` packages
+/// a library only if its GUID is the packager's ([`library_guid`]).
+#[no_mangle]
+pub unsafe extern "C" fn hydrocyl_fmu_guid(
+    rig_text: *const c_char,
+    out: *mut c_char,
+    size: usize,
+) -> c_int {
+    if rig_text.is_null() || out.is_null() || size == 0 {
+        return -1;
+    }
+    let text = unsafe { CStr::from_ptr(rig_text) }
+        .to_string_lossy()
+        .into_owned();
+    let result = catch_unwind(|| {
+        let rig = serde_json::from_str(&text).map_err(|e| format!("not valid JSON: {e}"))?;
+        Slave::new(rig).map(|s| guid(&text, s.variables()))
+    })
+    .unwrap_or_else(|_| Err("internal error (panic)".into()));
+    let (code, msg) = match result {
+        Ok(g) => (0, g),
+        Err(e) => (1, e),
+    };
+    let bytes = msg.replace('\0', " ").into_bytes();
+    let n = bytes.len().min(size - 1);
+    unsafe {
+        std::ptr::copy_nonoverlapping(bytes.as_ptr(), out.cast::<u8>(), n);
+        *out.add(n) = 0;
+    }
+    code
+}
+
+/// The GUID the slave library at `library` computes for the rig `rig_text`
+/// (through its [`hydrocyl_fmu_guid`]), or why there is none: the file
+/// does not load as a library, has no `hydrocyl_fmu_guid` (a build older
+/// than it), or cannot read the rig. The library stays loaded (unloading a
+/// Rust library can leave its thread-local destructors dangling).
+pub fn library_guid(library: &Path, rig_text: &str) -> Result<String, String> {
+    use std::os::unix::ffi::OsStrExt;
+    let one_line = |s: String| s.split_whitespace().collect::<Vec<_>>().join(" ");
+    let path = CString::new(library.as_os_str().as_bytes())
+        .map_err(|_| "its path holds a NUL byte".to_string())?;
+    let text = CString::new(rig_text).map_err(|_| "the rig's text holds a NUL byte".to_string())?;
+    let handle = unsafe { libc::dlopen(path.as_ptr(), libc::RTLD_NOW | libc::RTLD_LOCAL) };
+    if handle.is_null() {
+        let why = unsafe { string(libc::dlerror()) }.unwrap_or_default();
+        return Err(one_line(format!("it does not load as a library: {why}")));
+    }
+    let sym = unsafe { libc::dlsym(handle, c"hydrocyl_fmu_guid".as_ptr()) };
+    if sym.is_null() {
+        return Err("it has no hydrocyl_fmu_guid: a build older than this hydrocyl's".to_string());
+    }
+    type GuidFn = unsafe extern "C" fn(*const c_char, *mut c_char, usize) -> c_int;
+    let f: GuidFn = unsafe { std::mem::transmute::<*mut c_void, GuidFn>(sym) };
+    let mut buf = vec![0 as c_char; GUID_BUFFER];
+    let code = unsafe { f(text.as_ptr(), buf.as_mut_ptr(), buf.len()) };
+    let msg = unsafe { string(buf.as_ptr()) }.unwrap_or_default();
+    match code {
+        0 => Ok(msg),
+        _ => Err(one_line(format!("it cannot read this rig: {msg}"))),
+    }
 }
 
 /// `fmi2GetTypesPlatform`.
@@ -275,22 +441,27 @@ pub unsafe extern "C" fn fmi2Instantiate(
         let g = unsafe { string(fmu_guid) }.unwrap_or_default();
         let loc = unsafe { string(resource_location) };
         match instantiate(&g, loc.as_deref()) {
-            Ok(slave) => Box::into_raw(Box::new(Instance {
-                name,
-                callbacks,
-                logging: logging_on != 0,
-                slave,
-            })) as *mut c_void,
+            Ok(slave) => {
+                let c = Box::into_raw(Box::new(Instance {
+                    name,
+                    callbacks,
+                    logging: logging_on != 0,
+                    slave,
+                })) as *mut c_void;
+                registry(&LIVE_INSTANCES).insert(c as usize);
+                c
+            }
             Err(msg) => fail(msg),
         }
     });
     result.unwrap_or(std::ptr::null_mut())
 }
 
-/// `fmi2FreeInstance`.
+/// `fmi2FreeInstance`: frees a live instance; any other pointer (freed
+/// already, null, never made here) is ignored.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: *mut c_void) {
-    if !c.is_null() {
+    if registry(&LIVE_INSTANCES).remove(&(c as usize)) {
         let _ = catch_unwind(|| drop(unsafe { Box::from_raw(c as *mut Instance) }));
     }
 }
@@ -583,9 +754,9 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: *mut c_void, s: *mut *mut c_void) ->
             }
             let snap = i.slave.get_state()?;
             if (*s).is_null() {
-                *s = Box::into_raw(Box::new(snap)).cast();
+                *s = new_state(snap);
             } else {
-                *(*s).cast::<Snapshot>() = snap;
+                *state(*s)? = snap;
             }
             Ok(OK)
         })
@@ -597,10 +768,7 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: *mut c_void, s: *mut *mut c_void) ->
 pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, s: *mut c_void) -> Status {
     unsafe {
         with(c, "fmi2SetFMUstate", |i| {
-            if s.is_null() {
-                return Err("fmi2SetFMUstate: null state".into());
-            }
-            i.slave.set_state(&*s.cast::<Snapshot>()).map(|_| OK)
+            i.slave.set_state(state(s)?).map(|_| OK)
         })
     }
 }
@@ -610,10 +778,13 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, s: *mut c_void) -> Stat
 pub unsafe extern "C" fn fmi2FreeFMUstate(c: *mut c_void, s: *mut *mut c_void) -> Status {
     unsafe {
         with(c, "fmi2FreeFMUstate", |_| {
-            if !s.is_null() && !(*s).is_null() {
-                drop(Box::from_raw((*s).cast::<Snapshot>()));
-                *s = std::ptr::null_mut();
+            if s.is_null() || (*s).is_null() {
+                return Ok(OK);
             }
+            if !free_state(*s) {
+                return Err("not an FMU state of this FMU (freed already?)".into());
+            }
+            *s = std::ptr::null_mut();
             Ok(OK)
         })
     }
@@ -628,10 +799,10 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
 ) -> Status {
     unsafe {
         with(c, "fmi2SerializedFMUstateSize", |_| {
-            if s.is_null() || size.is_null() {
-                return Err("null state or size pointer".into());
+            if size.is_null() {
+                return Err("null size pointer".into());
             }
-            *size = (*s.cast::<Snapshot>()).serialize().len();
+            *size = state(s)?.serialize().len();
             Ok(OK)
         })
     }
@@ -647,10 +818,10 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
 ) -> Status {
     unsafe {
         with(c, "fmi2SerializeFMUstate", |_| {
-            if s.is_null() || bytes.is_null() {
-                return Err("null state or buffer".into());
+            if bytes.is_null() {
+                return Err("null buffer".into());
             }
-            let data = (*s.cast::<Snapshot>()).serialize();
+            let data = state(s)?.serialize();
             if data.len() > size {
                 return Err(format!(
                     "buffer of {size} bytes, the state needs {}",
@@ -678,10 +849,9 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
             }
             let data = std::slice::from_raw_parts(bytes.cast::<u8>(), size);
             let snap = Snapshot::deserialize(data)?;
-            if !(*s).is_null() {
-                drop(Box::from_raw((*s).cast::<Snapshot>()));
-            }
-            *s = Box::into_raw(Box::new(snap)).cast();
+            // a live state given is replaced; any other pointer is output only
+            free_state(*s);
+            *s = new_state(snap);
             Ok(OK)
         })
     }
@@ -766,25 +936,32 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model_description::model_description;
 
     /// An unpacked FMU of leaney-moog: its `resources/rig.json` as packaged
     /// and, unless `tool` is None, a `modelDescription.xml` naming that
-    /// generation tool; returns the folder, the resource URI and the GUID.
-    fn unpacked(tool: Option<&str>) -> (tempfile::TempDir, String, String) {
+    /// generation tool (with the digests when `digests`); returns the
+    /// folder, the resource URI and the GUID.
+    fn unpacked(tool: Option<&str>, digests: bool) -> (tempfile::TempDir, String, String) {
         let dir = tempfile::tempdir().unwrap();
         let res = dir.path().join("resources");
         std::fs::create_dir(&res).unwrap();
-        let text =
-            serde_json::to_string_pretty(&hydrocyl_system::rig::preset("leaney-moog").unwrap())
-                .unwrap();
+        let rig = hydrocyl_system::rig::preset("leaney-moog").unwrap();
+        let text = serde_json::to_string_pretty(&rig).unwrap();
         std::fs::write(res.join("rig.json"), &text).unwrap();
-        let g = guid(&text);
+        let vars = Variables::of(&rig).unwrap();
+        let g = guid(&text, &vars);
         if let Some(tool) = tool {
-            std::fs::write(
-                dir.path().join("modelDescription.xml"),
-                format!(r#"<fmiModelDescription fmiVersion="2.0" modelName="leaney-moog" guid="{g}" generationTool="{tool}">"#),
-            )
-            .unwrap();
+            let mut xml = model_description(&vars, "leaney-moog", "a rig", &text)
+                .replace(&format!("hydrocyl {}", env!("CARGO_PKG_VERSION")), tool);
+            if !digests {
+                let (a, b) = (
+                    xml.find("  <VendorAnnotations>").unwrap(),
+                    xml.find("  <ModelVariables>").unwrap(),
+                );
+                xml.replace_range(a..b, "");
+            }
+            std::fs::write(dir.path().join("modelDescription.xml"), xml).unwrap();
         }
         let uri = format!("file://{}", res.display());
         (dir, uri, g)
@@ -799,20 +976,55 @@ mod tests {
     #[test]
     fn an_edited_rig_file_is_refused_as_such() {
         let ours = format!("hydrocyl {}", env!("CARGO_PKG_VERSION"));
-        let (dir, uri, g) = unpacked(Some(&ours));
+        let (dir, uri, g) = unpacked(Some(&ours), true);
         assert!(instantiate(&g, Some(&uri)).is_ok());
         edit_rig(&dir);
         let e = instantiate(&g, Some(&uri)).err().unwrap();
         assert!(
-            e.contains("resources/rig.json is not the rig this FMU was packaged with"),
+            e.contains(
+                "the rig differs: resources/rig.json is not the rig this FMU was packaged with"
+            ),
             "{e}"
         );
-        assert!(!e.contains("another hydrocyl version"), "{e}");
+        assert!(
+            !e.contains("version") && !e.contains("build differs"),
+            "{e}"
+        );
+    }
+
+    /// The same rig, a library that makes other variables of it (another
+    /// build): the message says the build differs, not the rig.
+    #[test]
+    fn another_build_is_named() {
+        let ours = format!("hydrocyl {}", env!("CARGO_PKG_VERSION"));
+        let (dir, uri, g) = unpacked(Some(&ours), true);
+        // the packager's variables had one more parameter than this library's
+        let md = dir.path().join("modelDescription.xml");
+        let xml = std::fs::read_to_string(&md).unwrap();
+        let vd = attribute(&xml, "<Digests ", "variables")
+            .unwrap()
+            .to_string();
+        std::fs::write(
+            &md,
+            xml.replace(&vd, "{00000000-0000-0000-0000-000000000002}"),
+        )
+        .unwrap();
+        let e = instantiate("{00000000-0000-0000-0000-000000000003}", Some(&uri))
+            .err()
+            .unwrap();
+        assert!(
+            e.contains("the build differs")
+                && e.contains("cargo build -p hydrocyl-fmu -p hydrocyl-cli"),
+            "{e}"
+        );
+        assert!(!e.contains("rig differs"), "{e}");
+        // the GUID itself still opens the FMU
+        assert!(instantiate(&g, Some(&uri)).is_ok());
     }
 
     #[test]
     fn another_version_is_named() {
-        let (_dir, uri, _) = unpacked(Some("hydrocyl 0.0.0-old"));
+        let (_dir, uri, _) = unpacked(Some("hydrocyl 0.0.0-old"), true);
         // the GUID in such an FMU is that version's
         let e = instantiate("{00000000-0000-0000-0000-000000000001}", Some(&uri))
             .err()
@@ -828,13 +1040,66 @@ mod tests {
     }
 
     #[test]
-    fn without_a_model_description_both_causes_are_named() {
-        let (dir, uri, g) = unpacked(None);
-        edit_rig(&dir);
-        let e = instantiate(&g, Some(&uri)).err().unwrap();
+    fn without_digests_both_causes_are_named() {
+        let ours = format!("hydrocyl {}", env!("CARGO_PKG_VERSION"));
+        for tool in [None, Some(ours.as_str())] {
+            let (dir, uri, g) = unpacked(tool, false);
+            edit_rig(&dir);
+            let e = instantiate(&g, Some(&uri)).err().unwrap();
+            assert!(
+                e.contains("differs from the rig the FMU was packaged with")
+                    && e.contains("another build"),
+                "{e}"
+            );
+        }
+    }
+
+    /// The packager's check of a library: a file that does not load, and a
+    /// library without `hydrocyl_fmu_guid` (a proc-macro library of this
+    /// build's dependencies, beside the test binary), are named as such.
+    #[test]
+    fn a_library_without_the_guid_function_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let fake = dir.path().join("fake.so");
+        std::fs::write(&fake, b"\x7fELF not a library fmi2DoStep").unwrap();
+        let e = library_guid(&fake, "{}").unwrap_err();
         assert!(
-            e.contains("differs from the rig the FMU was packaged with") && e.contains("version"),
+            e.starts_with("it does not load as a library") && !e.contains('\n'),
             "{e}"
         );
+        let deps = std::env::current_exe()
+            .unwrap()
+            .parent()
+            .unwrap()
+            .to_path_buf();
+        let other = std::fs::read_dir(&deps)
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .find(|p| {
+                let n = p.file_name().unwrap().to_string_lossy();
+                n.starts_with("libthiserror_impl-") && n.ends_with(".so")
+            })
+            .expect("thiserror's proc-macro library beside the test binary");
+        let e = library_guid(&other, "{}").unwrap_err();
+        assert!(e.contains("no hydrocyl_fmu_guid"), "{e}");
+    }
+
+    /// The library's own entry point: the GUID of a rig, or why there is none.
+    #[test]
+    fn the_guid_entry_point_gives_the_guid_or_why_not() {
+        let rig = hydrocyl_system::rig::preset("leaney-moog").unwrap();
+        let text = serde_json::to_string_pretty(&rig).unwrap();
+        let call = |t: &str, size: usize| {
+            let t = CString::new(t).unwrap();
+            let mut buf = vec![0 as c_char; size];
+            let code = unsafe { hydrocyl_fmu_guid(t.as_ptr(), buf.as_mut_ptr(), size) };
+            (code, unsafe { string(buf.as_ptr()) }.unwrap())
+        };
+        let (code, g) = call(&text, GUID_BUFFER);
+        assert_eq!((code, g), (0, guid(&text, &Variables::of(&rig).unwrap())));
+        let (code, e) = call("{\"kind\": 3}", GUID_BUFFER);
+        assert!(code == 1 && e.contains("kind"), "{e}");
+        let (code, e) = call("not json", 8);
+        assert!(code == 1 && e.len() == 7, "{e}");
     }
 }

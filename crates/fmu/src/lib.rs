@@ -34,8 +34,11 @@
 //! assert!(vars.outputs.iter().any(|(name, unit)| name == "p1" && *unit == "Pa"));
 //! let n_par = vars.list.iter().filter(|v| matches!(v.role, Role::Parameter(_))).count();
 //! assert_eq!(n_par, rig::parameters(&r).len()); // every rig parameter
-//! let xml = model_description(&vars, "leaney-moog", "a valve rig", &guid(&r.to_string()));
+//! let text = r.to_string();
+//! let xml = model_description(&vars, "leaney-moog", "a valve rig", &text);
 //! assert!(xml.contains(r#"<ScalarVariable name="load.mass""#));
+//! // the GUID covers the rig's text and the variable list
+//! assert!(xml.contains(&format!(r#"guid="{}""#, guid(&text, &vars))));
 //! ```
 //!
 //! The crate implements no thesis equation: the physics is the rig's

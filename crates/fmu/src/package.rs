@@ -76,14 +76,14 @@ pub fn find_library(explicit: Option<&Path>) -> Result<PathBuf, FmuError> {
 /// the rig (preset name or file stem). The caller writes it where it goes
 /// (`hydrocyl fmu` through its outputs: a temporary file put in place).
 pub fn fmu_archive(rig: &Value, model_name: &str, library: &Path) -> Result<Vec<u8>, FmuError> {
-    let vars = Variables::of(rig)?;
+    let mut vars = Variables::of(rig)?;
     let lib = std::fs::read(library)
         .map_err(|e| FmuError::Library(format!("{}: {e}", library.display())))?;
+    let refused = |why: &str| refusal(library, why);
     if !lib.starts_with(b"\x7fELF") || !contains(&lib, b"fmi2DoStep") {
-        return Err(FmuError::Library(format!(
-            "{} is not the hydrocyl FMU library (no ELF object exporting fmi2DoStep)",
-            library.display()
-        )));
+        return Err(refused(
+            "is not the hydrocyl FMU library (no ELF object exporting fmi2DoStep)",
+        ));
     }
     let rig_text = serde_json::to_string_pretty(rig).map_err(|e| RigError::Invalid {
         path: "rig".into(),
@@ -94,7 +94,16 @@ pub fn fmu_archive(rig: &Value, model_name: &str, library: &Path) -> Result<Vec<
         .and_then(Value::as_str)
         .map(str::to_string)
         .unwrap_or_else(|| format!("hydrocyl rig {model_name}"));
-    let xml = model_description(&vars, model_name, &description, &guid(&rig_text));
+    // the library must make the same variables of this rig, value
+    // reference for value reference: it computes the same GUID only then
+    same_build(
+        library,
+        &guid(&rig_text, &vars),
+        crate::ffi::library_guid(library, &rig_text),
+    )?;
+    // the dependencies declared hold for every value of the parameters
+    vars.widen_feedthrough(rig);
+    let xml = model_description(&vars, model_name, &description, &rig_text);
     let id = model_identifier(model_name);
     let files: [(String, &[u8]); 3] = [
         ("modelDescription.xml".into(), xml.as_bytes()),
@@ -115,6 +124,64 @@ pub fn fmu_archive(rig: &Value, model_name: &str, library: &Path) -> Result<Vec<
     zipped.map_err(|e| FmuError::Archive(e.to_string()))
 }
 
+/// A refused library: the message names it, says why and how to build the
+/// right one.
+fn refusal(library: &Path, why: &str) -> FmuError {
+    FmuError::Library(format!(
+        "the FMU library {} {why}: build both with `cargo build -p hydrocyl-fmu -p hydrocyl-cli` (same profile), or name the library of this build with --library / ${LIBRARY_ENV}",
+        library.display()
+    ))
+}
+
+/// Whether `library` is of this build for the rig: `theirs` is the GUID it
+/// computes for the rig's text (or why it has none), `ours` the packager's.
+fn same_build(library: &Path, ours: &str, theirs: Result<String, String>) -> Result<(), FmuError> {
+    let why = match theirs {
+        Ok(theirs) if theirs == ours => return Ok(()),
+        Ok(theirs) => format!(
+            "for this rig it computes the GUID {theirs}, this hydrocyl {ours}: it makes other variables of the rig, so value references would set the wrong parameters"
+        ),
+        Err(why) => why,
+    };
+    Err(refusal(
+        library,
+        &format!("is not from the same build as this hydrocyl ({why})"),
+    ))
+}
+
 fn contains(hay: &[u8], needle: &[u8]) -> bool {
     hay.windows(needle.len()).any(|w| w == needle)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A library that computes another GUID for the rig (another build),
+    /// or none, is refused with one line naming it, why and the remedy.
+    #[test]
+    fn a_library_computing_another_guid_is_refused() {
+        let lib = Path::new("/x/libhydrocyl_fmu.so");
+        let ours = "{00000000-0000-0000-0000-00000000000a}";
+        assert!(same_build(lib, ours, Ok(ours.into())).is_ok());
+        for (theirs, why) in [
+            (
+                Ok("{00000000-0000-0000-0000-00000000000b}".to_string()),
+                "it makes other variables of the rig",
+            ),
+            (
+                Err("it has no hydrocyl_fmu_guid: a build older than this hydrocyl's".into()),
+                "no hydrocyl_fmu_guid",
+            ),
+        ] {
+            let e = same_build(lib, ours, theirs).unwrap_err().to_string();
+            assert!(
+                e.starts_with("the FMU library /x/libhydrocyl_fmu.so is not from the same build")
+                    && e.contains(why)
+                    && e.contains("cargo build -p hydrocyl-fmu -p hydrocyl-cli")
+                    && !e.contains('\n'),
+                "{e}"
+            );
+        }
+    }
 }

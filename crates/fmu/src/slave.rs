@@ -12,7 +12,7 @@
 //! friction stick/slip, stops, valve states) lives on between steps.
 
 use crate::variables::{
-    circuit_with_input, output_channels, Role, SolverParam, Variables, METHODS,
+    circuit_with_input, nullable, output_channels, Role, SolverParam, Variables, METHODS,
 };
 use hydrocyl_system::external::ExternalInput;
 use hydrocyl_system::netlist::{self, registry};
@@ -140,7 +140,8 @@ pub type SlaveError = String;
 impl Slave {
     /// A new instance of the FMU of `rig` (the rig is checked).
     pub fn new(rig: Value) -> Result<Self, SlaveError> {
-        let vars = Variables::of(&rig).map_err(|e| format!("rig.json: {e}"))?;
+        let vars =
+            Variables::of(&rig).map_err(|e| format!("rig.json: {}", rig::set_form(e, &rig)))?;
         let values = vars.list.iter().map(|v| v.start).collect();
         Ok(Self {
             base: rig.clone(),
@@ -313,12 +314,14 @@ impl Slave {
         if self.sim.is_some() {
             return Ok(());
         }
+        // the error's paths as `--set` and the variables name them
         let (circuit, input) = rig::check(&self.rig)
             .and_then(|_| circuit_with_input(&self.rig))
             .map_err(|e| {
                 format!(
-                    "the parameters set ({}) do not make a valid rig: {e}",
-                    self.parameters_set()
+                    "the parameters set ({}) do not make a valid rig: {}",
+                    self.parameters_set(),
+                    rig::set_form(e, &self.rig)
                 )
             })?;
         let probes = output_channels(&circuit, &crate::variables::input_name(&self.rig));
@@ -453,7 +456,9 @@ impl Slave {
                     &[Phase::Instantiated, Phase::Initializing],
                     &format!("setting fixed parameter `{name}`"),
                 )?;
-                let text = if value.is_nan() && v.start.is_nan() {
+                // NaN: back to "computed by the rig" / "none", for every
+                // parameter the rig may leave null
+                let text = if value.is_nan() && (v.start.is_nan() || nullable(&self.rig, path)) {
                     "null".to_string()
                 } else if value.is_finite() {
                     format!("{value:?}")
@@ -566,8 +571,13 @@ impl Slave {
             .map(|(n, v)| format!("{n} = {v:e}"))
             .collect();
         self.phase = Phase::Failed;
+        // the solver's message says when it failed; the state is the one it
+        // started the step from
+        let when = failure_time(&failure)
+            .map(|tf| format!(" at t = {tf} s"))
+            .unwrap_or_default();
         Err(format!(
-            "step from t = {t} s to {t_end} s failed: {failure}; state at t = {t} s: {}",
+            "step from t = {t} s to {t_end} s failed{when}: {failure}; state at the step's start (t = {t} s): {}",
             state.join(", ")
         ))
     }
@@ -584,6 +594,16 @@ impl Slave {
     pub fn fail(&mut self) {
         self.phase = Phase::Failed;
     }
+}
+
+/// The time a solver failure happened at, from its message: the last
+/// `t = <number> s` in it (`... at t = 0.00164 s`, `... up to t = ...`).
+fn failure_time(message: &str) -> Option<f64> {
+    message.rmatch_indices("t = ").find_map(|(i, m)| {
+        let rest = &message[i + m.len()..];
+        let number = rest.split(" s").next()?;
+        number.parse::<f64>().ok().filter(|t| t.is_finite())
+    })
 }
 
 /// Whether a solver parameter's `value` meets `setting`'s rule, and the rule.
@@ -637,7 +657,16 @@ mod tests {
         s.exit_initialization().unwrap();
         s.set_real(vr(&s, "command"), 0.5).unwrap();
         let e = s.do_step(0.0, 1.0).unwrap_err();
-        assert!(e.contains("solver dp45") && e.contains("t = 0 s"), "{e}");
+        assert!(
+            e.contains("solver dp45") && e.contains("state at the step's start (t = 0 s)"),
+            "{e}"
+        );
+        // the time of the failure is the solver's, inside the step
+        let tf = failure_time(&e).unwrap();
+        assert!(
+            e.contains(&format!("failed at t = {tf} s")) && (0.0..1.0).contains(&tf),
+            "{e}"
+        );
         assert!(e.contains("load.") && e.contains("cylinder."), "{e}");
         assert_eq!(s.phase(), Phase::Failed);
         assert!(s.do_step(0.0, 1e-3).is_err());
@@ -760,6 +789,63 @@ mod tests {
         }
         s.do_step(0.0, 1e-3).unwrap();
         assert_eq!(s.time(), 1e-3);
+    }
+
+    #[test]
+    fn the_failure_time_is_read_from_the_solver_message() {
+        assert_eq!(
+            failure_time(
+                "solver dp45: step size 1e-20 s fell below the minimum at t = 0.00164 s: x"
+            ),
+            Some(0.00164)
+        );
+        assert_eq!(
+            failure_time("up to t = 2.5 s (event function 3 the last)"),
+            Some(2.5)
+        );
+        assert_eq!(failure_time("no time here"), None);
+    }
+
+    /// Every parameter the rig may leave null (an initial pressure computed
+    /// from the steady state, an absent end stop) takes NaN as "back to
+    /// computed/none", whatever its start value; the others refuse NaN.
+    #[test]
+    fn nan_is_computed_for_every_nullable_parameter() {
+        let mut n_null = 0;
+        for preset in ["leaney-moog", "wang-hybrid", "tudelft-seal-25"] {
+            let r = rig::preset(preset).unwrap();
+            let mut s = Slave::new(r.clone()).unwrap();
+            for (i, v) in s.variables().list.clone().iter().enumerate() {
+                let Role::Parameter(path) = &v.role else {
+                    continue;
+                };
+                let result = s.set_real(i as u32, f64::NAN);
+                if nullable(&r, path) {
+                    n_null += 1;
+                    assert!(result.is_ok(), "{preset} {path}: {result:?}");
+                    assert!(s.get_real(i as u32).unwrap().is_nan());
+                } else {
+                    let e = result.unwrap_err();
+                    assert!(e.contains(path) && e.contains("must be finite"), "{e}");
+                }
+            }
+            // all back to the rig's own choice: a rig that cannot compute
+            // one of them (no steady state to start from) says which
+            s.enter_initialization().unwrap();
+            if let Err(e) = s.exit_initialization() {
+                assert!(e.contains("= NaN") && e.contains("give it"), "{e}");
+            }
+        }
+        assert!(n_null > 4, "{n_null}");
+        // an initial pressure set, then set back: the computed one again
+        let mut s = Slave::new(rig::preset("leaney-moog").unwrap()).unwrap();
+        let p1 = vr(&s, "cylinder.initial.p1");
+        s.enter_initialization().unwrap();
+        let computed = s.get_real(vr(&s, "p1")).unwrap();
+        s.set_real(p1, computed + 1e6).unwrap();
+        assert_eq!(s.get_real(vr(&s, "p1")).unwrap(), computed + 1e6);
+        s.set_real(p1, f64::NAN).unwrap();
+        assert_eq!(s.get_real(vr(&s, "p1")).unwrap(), computed);
     }
 
     #[test]

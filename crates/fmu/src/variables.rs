@@ -130,6 +130,41 @@ pub fn circuit_with_input(rig: &Value) -> Result<(Circuit, ExternalInput), RigEr
     Ok((c, input))
 }
 
+/// Whether parameter `path` of `rig` may be left to the rig (`null` in a
+/// rig file: its default is "computed" or "none", [`Default::Absent`](hydrocyl_system::netlist::registry::Default::Absent)):
+/// then `NaN` sets it back to that.
+pub fn nullable(rig: &Value, path: &str) -> bool {
+    let Some((component, name)) = path.split_once('.') else {
+        return false;
+    };
+    let Some(ty) = rig::component_type(rig, component) else {
+        return false;
+    };
+    let default = match name.strip_prefix("initial.") {
+        Some(state) => ty.state(state).map(|s| s.default),
+        None => ty.param(name).map(|p| p.default),
+    };
+    matches!(
+        default,
+        Some(hydrocyl_system::netlist::registry::Default::Absent)
+    )
+}
+
+/// Direct feedthrough of each probe: whether it changes with the input
+/// alone, at the circuit's initial state.
+fn feeds_through(circuit: &Circuit, input: &ExternalInput, probes: &[Probe]) -> Vec<bool> {
+    let x0 = circuit.initial_state();
+    let wires: Vec<_> = probes.iter().map(|p| p.wire).collect();
+    let read = |u: f64| {
+        input.set(0.0, u, 0.0);
+        let mut row = vec![0.0; wires.len()];
+        circuit.read_wires(0.0, &x0, &wires, &mut row);
+        row
+    };
+    let (lo, hi) = (read(-0.5), read(0.5));
+    lo.iter().zip(&hi).map(|(a, b)| a != b).collect()
+}
+
 impl Variables {
     /// The variables of the FMU of `rig` (checked here).
     pub fn of(rig: &Value) -> Result<Self, RigError> {
@@ -137,16 +172,7 @@ impl Variables {
         let (circuit, input) = circuit_with_input(rig)?;
         let input_name = input_name(rig);
         let probes = output_channels(&circuit, &input_name);
-        // direct feedthrough: does the output change with the input at a fixed state?
-        let x0 = circuit.initial_state();
-        let wires: Vec<_> = probes.iter().map(|p| p.wire).collect();
-        let read = |u: f64| {
-            input.set(0.0, u, 0.0);
-            let mut row = vec![0.0; wires.len()];
-            circuit.read_wires(0.0, &x0, &wires, &mut row);
-            row
-        };
-        let (lo, hi) = (read(-0.5), read(0.5));
+        let feeds = feeds_through(&circuit, &input, &probes);
         let mut list = vec![Variable {
             name: input_name.clone(),
             role: Role::Input,
@@ -168,7 +194,7 @@ impl Variables {
                 start: f64::NAN,
                 unit: unit_name(p.unit),
                 description: format!("output channel `{}`", p.name),
-                feedthrough: lo[i] != hi[i],
+                feedthrough: feeds[i],
             });
         }
         let d = RunOptions::default();
@@ -212,6 +238,10 @@ impl Variables {
         for p in rig::parameters(rig) {
             list.push(Variable {
                 description: match p.value {
+                    Some(_) if nullable(rig, &p.path) => format!(
+                        "rig parameter `{}`; NaN leaves it to the rig (computed, or none: null in the rig file)",
+                        p.path
+                    ),
                     Some(_) => format!("rig parameter `{}`", p.path),
                     None => format!(
                         "rig parameter `{}`; NaN (the start) leaves it to the rig (null in the rig file)",
@@ -238,6 +268,56 @@ impl Variables {
             list,
             outputs: probes.iter().map(|p| (p.name.clone(), p.unit)).collect(),
         })
+    }
+
+    /// Widens the outputs' direct feedthrough (found by [`Variables::of`] at
+    /// the rig's own parameter values) to every value of the parameters a
+    /// host may set: an output also feeds through when it does with any one
+    /// parameter moved across its range (0 to a positive value and back,
+    /// halved, doubled, shifted by one; a value the rig refuses is skipped).
+    /// A damping that is 0 in the exported rig, and with it the output's
+    /// dependence on the input, is then declared (`friction.sigma1` of a
+    /// friction bench). A dependency declared that some values do not
+    /// have is allowed by FMI; one missing is not.
+    pub fn widen_feedthrough(&mut self, rig: &Value) {
+        let names: Vec<String> = self.outputs.iter().map(|(n, _)| n.clone()).collect();
+        let mut any: Vec<bool> = self
+            .list
+            .iter()
+            .filter(|v| matches!(v.role, Role::Output(_)))
+            .map(|v| v.feedthrough)
+            .collect();
+        for p in rig::parameters(rig) {
+            let candidates = match p.value {
+                Some(v) if v != 0.0 => vec![2.0 * v, 0.5 * v, v + 1.0, 0.0],
+                _ => vec![1.0, 1e-2, 1e2, 1e4],
+            };
+            for c in candidates {
+                let mut r = rig.clone();
+                if rig::apply_set(&mut r, &format!("{}={c:?}", p.path)).is_err()
+                    || rig::check(&r).is_err()
+                {
+                    continue;
+                }
+                let Ok((circuit, input)) = circuit_with_input(&r) else {
+                    continue;
+                };
+                let probes = output_channels(&circuit, &input_name(&r));
+                let feeds = feeds_through(&circuit, &input, &probes);
+                for (i, name) in names.iter().enumerate() {
+                    if let Some(k) = probes.iter().position(|p| &p.name == name) {
+                        any[i] |= feeds[k];
+                    }
+                }
+            }
+        }
+        let mut k = 0;
+        for v in self.list.iter_mut() {
+            if matches!(v.role, Role::Output(_)) {
+                v.feedthrough = any[k];
+                k += 1;
+            }
+        }
     }
 
     /// The variable with value reference `vr`.
@@ -296,6 +376,40 @@ mod tests {
         }
         // the spool lags the command: nothing feeds through
         let v = Variables::of(&rig::preset("leaney-moog").unwrap()).unwrap();
+        assert!(v.list.iter().all(|x| !x.feedthrough));
+    }
+
+    fn feedthrough(v: &Variables, name: &str) -> bool {
+        v.list.iter().find(|x| x.name == name).unwrap().feedthrough
+    }
+
+    /// The friction bench's forces do not feed through at its exported
+    /// σ1 = σ2 = 0; with σ1 > 0 they do, and the widened analysis declares
+    /// it for the exported rig. What feeds through at the rig's own values
+    /// stays declared.
+    #[test]
+    fn feedthrough_that_a_parameter_creates_is_declared() {
+        let r = rig::preset("tudelft-seal-25").unwrap();
+        let exported = Variables::of(&r).unwrap();
+        let mut with_sigma1 = r.clone();
+        rig::apply_set(&mut with_sigma1, "friction.sigma1=100").unwrap();
+        let damped = Variables::of(&with_sigma1).unwrap();
+        let mut widened = exported.clone();
+        widened.widen_feedthrough(&r);
+        let mut created = 0;
+        for (name, _) in &exported.outputs {
+            let (at, then) = (feedthrough(&exported, name), feedthrough(&damped, name));
+            created += usize::from(then && !at);
+            assert!(
+                feedthrough(&widened, name) || !(at || then),
+                "{name}: exported {at}, with sigma1 {then}"
+            );
+        }
+        assert!(created > 0, "sigma1 creates a feedthrough");
+        // a rig whose every output lags the input keeps none
+        let lm = rig::preset("leaney-moog").unwrap();
+        let mut v = Variables::of(&lm).unwrap();
+        v.widen_feedthrough(&lm);
         assert!(v.list.iter().all(|x| !x.feedthrough));
     }
 }

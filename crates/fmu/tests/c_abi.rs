@@ -24,10 +24,11 @@ fn fmu(rig_name: &str) -> Fmu {
     let value = rig::preset(rig_name).unwrap();
     let text = serde_json::to_string_pretty(&value).unwrap();
     std::fs::write(res.join("rig.json"), &text).unwrap();
+    let vars = Variables::of(&value).unwrap();
     Fmu {
         uri: CString::new(format!("file://{}", res.display())).unwrap(),
-        guid: CString::new(guid(&text)).unwrap(),
-        vars: Variables::of(&value).unwrap(),
+        guid: CString::new(guid(&text, &vars)).unwrap(),
+        vars,
         _dir: dir,
     }
 }
@@ -178,6 +179,66 @@ fn errors_are_statuses_not_crashes() {
         assert_eq!(fmi2DoStep(c, 2e-3 + 1e-6, 1.0, 1), OK);
         fmi2FreeInstance(c);
     }
+}
+
+/// Freeing an instance twice, or using it after it was freed, is illegal
+/// per FMI; the library refuses the pointer (no double free, no use after
+/// free) and the host goes on. Likewise an FMU state freed twice.
+#[test]
+fn a_freed_instance_or_state_is_refused_not_used() {
+    let f = fmu("leaney-moog");
+    let c = f.instantiate(&f.guid);
+    assert!(!c.is_null());
+    start(c);
+    unsafe {
+        let mut s = null_mut();
+        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
+        let copy = s;
+        assert_eq!(fmi2FreeFMUstate(c, &mut s), OK);
+        let mut again = copy;
+        assert_eq!(fmi2FreeFMUstate(c, &mut again), ERROR);
+        assert_eq!(fmi2SetFMUstate(c, copy), ERROR);
+        let mut size = 0;
+        assert_eq!(fmi2SerializedFMUstateSize(c, copy, &mut size), ERROR);
+        fmi2FreeInstance(c);
+        fmi2FreeInstance(c);
+        assert_eq!(fmi2DoStep(c, 0.0, 1e-3, 1), ERROR);
+        assert_eq!(fmi2Terminate(c), ERROR);
+        let vr = f.vr("load.mass");
+        let mut v = 0.0;
+        assert_eq!(fmi2GetReal(c, &vr, 1, &mut v), ERROR);
+        // a pointer never made here
+        let mut other = 0u64;
+        fmi2FreeInstance((&mut other as *mut u64).cast());
+        assert_eq!(fmi2Reset((&mut other as *mut u64).cast()), ERROR);
+    }
+    // the library goes on: a new instance works
+    let c = f.instantiate(&f.guid);
+    start(c);
+    assert!(run(c, &f, 0.1, 10, 1e-3).is_finite());
+    unsafe { fmi2FreeInstance(c) };
+}
+
+/// The packager's check against the library of this build (cargo builds
+/// the cdylib beside this test binary): it computes the packager's GUID
+/// for every preset, and the archive is made.
+#[test]
+fn the_library_of_this_build_is_accepted() {
+    let deps = std::env::current_exe().unwrap();
+    let lib = deps
+        .parent()
+        .unwrap()
+        .join(hydrocyl_fmu::package::LIBRARY_FILE);
+    assert!(lib.is_file(), "{}", lib.display());
+    for p in rig::PRESETS {
+        let value = (p.json)();
+        let text = serde_json::to_string_pretty(&value).unwrap();
+        let ours = guid(&text, &Variables::of(&value).unwrap());
+        assert_eq!(library_guid(&lib, &text), Ok(ours), "{}", p.name);
+    }
+    let value = rig::preset("leaney-moog").unwrap();
+    let zip = hydrocyl_fmu::package::fmu_archive(&value, "leaney-moog", &lib).unwrap();
+    assert!(zip.starts_with(b"PK"));
 }
 
 #[test]

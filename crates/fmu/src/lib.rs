@@ -18,7 +18,9 @@
 //! * [`model_description`]: the XML and the GUID;
 //! * [`slave`]: one instance, in safe Rust (the state machine, parameter
 //!   checks through `rig::check`, the step);
-//! * [`ffi`]: the C API, written by hand (the only module with `unsafe`);
+//! * [`ffi`]: the C API, written by hand (with `instantiate`, where an
+//!   instance's rig is read and its GUID checked, and the packager's check of
+//!   a slave library's build: the only modules with `unsafe`);
 //! * [`package`]: the `.fmu` archive and where the library is found.
 //!
 //! The variables and the model description of a preset's FMU:
@@ -48,6 +50,7 @@
 //! export only (`fmi-export`) or bind the API for importers (`fmi-sys`).
 
 pub mod ffi;
+mod instantiate;
 pub mod model_description;
 pub mod package;
 pub mod slave;

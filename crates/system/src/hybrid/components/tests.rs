@@ -3,7 +3,7 @@ use super::*;
 use crate::components::PressureSource;
 use crate::series::AlgebraicNode;
 use crate::Circuit;
-use hydrocyl_valves::pilot_valve::series_coefficient;
+use hydrocyl_valves::pilot_valve::{series_coefficient, PilotFourWay};
 
 /// chamber ══[ pilot valve ]══ T (solved) ══[ needle ]══ tank, pilot fully shifted
 fn series(p_chamber: f64) -> Circuit {

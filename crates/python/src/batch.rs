@@ -3,7 +3,7 @@
 //! `(N, len(t))` arrays in parameter-set order, so they do not depend on
 //! the number of threads (each run is sequential and deterministic).
 
-use crate::convert::{array, count_arg, frozen, names_arg, no_channel, vector, vector_arg, Named};
+use crate::convert::{array, count_arg, frozen, names_arg, no_channel, vector_arg, Named};
 use crate::errors::{interruptible, stopped, Failure, Outcome, Stop};
 use crate::rig::Rig;
 use crate::run::state_array;
@@ -235,9 +235,7 @@ pub fn simulate_batch(
     };
     for (k, v) in params.iter() {
         let path: String = k.extract()?;
-        let col = vector(v.extract().map_err(|_| {
-            PyValueError::new_err(format!("params[{path:?}]: not a 1-D array of numbers"))
-        })?);
+        let col = vector_arg(&format!("params[{path:?}]"), &v)?;
         if sets.paths.is_empty() {
             sets.n = col.len();
         } else if col.len() != sets.n {

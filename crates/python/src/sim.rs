@@ -87,7 +87,10 @@ pub fn simulate(
         .map_err(|e| match e {
             _ if stopped(stop) => Failure::Interrupted,
             RigError::Sim(_) => locate_failure(value, command, t, opts, stop, e.to_string()),
-            other => Failure::Input(other.to_string()),
+            // the rig's parameters named as `--set`, `Rig.set` and the
+            // batch's `params` name them (`load.mass`, not the JSON path
+            // `components.load.mass`): a batch set's value is checked here
+            other => Failure::Input(rig::set_form(other, value).to_string()),
         })?;
     let cavitation = match run.physical() {
         Err(u) => return Err(unphysical(value, command, opts, &run, u)),

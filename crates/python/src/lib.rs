@@ -59,6 +59,7 @@ fn hydrocyl(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "CavitationWarning",
         m.py().get_type::<errors::CavitationWarning>(),
     )?;
+    m.add("RatingWarning", m.py().get_type::<errors::RatingWarning>())?;
     m.add_class::<rig::Rig>()?;
     m.add_class::<run::PyRun>()?;
     m.add_class::<batch::PyBatch>()?;

@@ -3,7 +3,7 @@
 //! piecewise-linear table over the output times, the energy ledger when
 //! asked for, and a solver failure located (time and state).
 
-use crate::errors::{stopped, Failure, Outcome, Stop};
+use crate::errors::{stopped, Failure, Outcome, RunWarning, Stop};
 use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
 use hydrocyl_integrators::SolveError;
 use hydrocyl_system::rig::{self, RigError};
@@ -65,9 +65,11 @@ pub struct Simulated {
     pub run: Run,
     /// The ledger (`None` unless `RunOptions::ledger`).
     pub ledger: Option<Result<Ledger, String>>,
-    /// The warning of a chamber far below vacuum
-    /// ([`Run::deep_cavitation`]), for a `CavitationWarning`.
-    pub cavitation: Option<String>,
+    /// The warnings of the run, in the CLI's order: the command beyond
+    /// the rating of the pump the input drives ([`rig::input_rating`], as
+    /// `hydrocyl simulate` warns of it), a chamber far below vacuum
+    /// ([`Run::deep_cavitation`]).
+    pub warnings: Vec<RunWarning>,
 }
 
 /// Simulates the rig value (checked or not) on `command` sampled at `t`
@@ -97,10 +99,19 @@ pub fn simulate(
         Ok(deep) => deep.map(|d| cavitation_warning(value, opts, &d)),
     };
     let ledger = opts.ledger.then(|| whole_run_ledger(value, command, &run));
+    let rating = match command {
+        Signal::Table { time_s, value: u } => rig::input_rating(value)
+            .and_then(|r| r.check(time_s, u))
+            .map(|w| RunWarning::Rating(format!("command (t, u): {w}"))),
+        _ => None,
+    };
     Ok(Simulated {
         run,
         ledger,
-        cavitation,
+        warnings: rating
+            .into_iter()
+            .chain(cavitation.map(RunWarning::Cavitation))
+            .collect(),
     })
 }
 

@@ -382,6 +382,21 @@ pub fn circuit(v: &Value, command: Signal) -> Result<crate::Circuit, RigError> {
     (kind_of(&v)?.circuit)(&v, command)
 }
 
+/// The rating a rig value's command is checked against (a pump driven by
+/// the run's input in volts, with a maximum speed:
+/// [`Schematic::input_rating`](crate::netlist::Schematic::input_rating)),
+/// as `hydrocyl simulate` checks it; `None` for a rig without one, or one
+/// that does not read.
+pub fn input_rating(v: &Value) -> Option<crate::netlist::InputRating> {
+    let v = migrated(v).ok()?;
+    if v.get("kind").and_then(Value::as_str) != Some(crate::netlist::KIND) {
+        return None;
+    }
+    // the components as read: the rating needs no steady initial state
+    let s = crate::netlist::read(&v).ok()?;
+    s.input_rating().filter(|_| s.input_unit() == Some("V"))
+}
+
 /// The registry type of component `name` in a rig value of any kind (an
 /// older kind read as its netlist), `None` when it has no such component:
 /// what a message may propose to set on the component is looked up in it

@@ -52,13 +52,14 @@ class CavitationWarning(UserWarning):
     parameter set, ``simulate_batch``."""
 
 class RatingWarning(UserWarning):
-    """The command goes beyond the rating of what the run's input drives: a
-    pump driven in volts turned past its maximum speed (its
-    ``displacement`` and ``max_speed``). The pump is not limited to its
-    rating (its flow follows the command) and the run is returned. The
-    message is the CLI's warning after ``command (t, u): ``: the count of
-    samples beyond, the rated speed and the command reaching it, the largest
-    sample and its speed. Warned once per run by ``Rig.simulate`` and, per
+    """The command goes beyond the limit of what the run's input drives: a
+    normalised spool demand outside +-1 (the spool's stroke: the valve
+    clamps it there), or a pump driven in volts turned past its maximum
+    speed (its ``displacement`` and ``max_speed``; the pump is not limited
+    to it, its flow follows the command). The run is returned. The message
+    is the CLI's warning after ``command (t, u): ``: the count of samples
+    beyond, the largest and when (for a pump, the rated speed and the
+    command reaching it, and the largest's speed). Warned once per run by ``Rig.simulate`` and, per
     parameter set and naming it, by ``simulate_batch``."""
 
 class Rig:

@@ -41,21 +41,22 @@ pyo3::create_exception!(
     hydrocyl,
     RatingWarning,
     PyUserWarning,
-    "The command goes beyond the rating of what the run's input drives: \
-     samples past the maximum speed of a pump driven in volts (its \
-     `displacement` and `max_speed`). The pump is not limited to its rating: \
-     its flow follows the command and the run is returned. The message is \
-     the CLI's warning (`hydrocyl simulate`): the count of samples beyond, \
-     the rated speed and the command reaching it, the largest sample and \
-     its speed; a batch names the run."
+    "The command goes beyond the limit of what the run's input drives: \
+     samples of a normalised spool demand outside +-1 (the spool's stroke, \
+     where the valve clamps them), or past the maximum speed of a pump \
+     driven in volts (its `displacement` and `max_speed`; the pump is not \
+     limited to it, its flow follows the command). The run is returned. The \
+     message is the CLI's warning (`hydrocyl simulate`): the count of \
+     samples beyond, the largest and when (for a pump, the rated speed and \
+     the command reaching it); a batch names the run."
 );
 
 /// A warning a run that is returned leaves, raised with Python's
 /// `warnings.warn` once the run is (once per run; in a batch, naming it).
 #[derive(Debug, Clone, PartialEq)]
 pub enum RunWarning {
-    /// The command beyond the rating of the pump the input drives
-    /// (`InputRating::check`): a [`RatingWarning`].
+    /// The command beyond the spool's stroke or the rating of the pump
+    /// the input drives (`CommandLimit::check`): a [`RatingWarning`].
     Rating(String),
     /// A chamber far below vacuum in a run that did not blow up: a
     /// [`CavitationWarning`].

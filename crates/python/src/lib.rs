@@ -21,7 +21,10 @@
 //! `hydrocyl.SimulationError` for a solver failure (time and state in the
 //! message), RuntimeError for a caught panic (a bug); a run kept although a
 //! chamber's constant-B oil left its range warns with
-//! `hydrocyl.CavitationWarning`. The GIL is released
+//! `hydrocyl.CavitationWarning`, one whose command is beyond the spool's
+//! stroke or the pump's rating with `hydrocyl.RatingWarning`; array
+//! arguments are real numbers in any layout (`convert::real_array`). The
+//! GIL is released
 //! while Rust runs; `simulate_batch` runs its parameter sets on rayon's
 //! threads. The type stubs are `hydrocyl.pyi` beside this crate's manifest;
 //! the pytest suite is `tests/` (`cargo xtask test` builds the wheel and

@@ -66,8 +66,9 @@ pub struct Simulated {
     /// The ledger (`None` unless `RunOptions::ledger`).
     pub ledger: Option<Result<Ledger, String>>,
     /// The warnings of the run, in the CLI's order: the command beyond
-    /// the rating of the pump the input drives ([`rig::input_rating`], as
-    /// `hydrocyl simulate` warns of it), a chamber far below vacuum
+    /// the spool's stroke or the rating of the pump the input drives
+    /// ([`rig::command_limit`], as `hydrocyl simulate` warns of it), a
+    /// chamber far below vacuum
     /// ([`Run::deep_cavitation`]).
     pub warnings: Vec<RunWarning>,
 }
@@ -100,8 +101,8 @@ pub fn simulate(
     };
     let ledger = opts.ledger.then(|| whole_run_ledger(value, command, &run));
     let rating = match command {
-        Signal::Table { time_s, value: u } => rig::input_rating(value)
-            .and_then(|r| r.check(time_s, u))
+        Signal::Table { time_s, value: u } => rig::command_limit(value)
+            .and_then(|l| l.check(time_s, u))
             .map(|w| RunWarning::Rating(format!("command (t, u): {w}"))),
         _ => None,
     };

@@ -1,6 +1,7 @@
-"""Run warnings: a command beyond the maximum speed of the pump it drives is
-warned of as the CLI warns of it (one text, from the library), once per
-run, and in a batch naming the run."""
+"""Run warnings: a command beyond the maximum speed of the pump it drives,
+or a spool demand beyond the spool's stroke, is warned of as the CLI warns
+of it (one text, from the library), once per run, and in a batch naming the
+run."""
 
 import subprocess
 import warnings
@@ -25,15 +26,16 @@ def recorded(call):
     return [x for x in w if issubclass(x.category, hydrocyl.RatingWarning)], out
 
 
-def cli_warning(cli, tmp_path, t, u):
-    """The CLI's rating warning on the command (t, u), after its file name."""
+def cli_warning(cli, tmp_path, t, u, rig="wang-hybrid", words="maximum speed"):
+    """The CLI's warning holding `words` on the command (t, u), after its
+    file name."""
     cmd = tmp_path / "cmd.csv"
     write_command(cmd, t, u)
-    p = subprocess.run([cli, "simulate", "--rig", "wang-hybrid", "--command", cmd, "--out", tmp_path / "out.csv"],
+    p = subprocess.run([cli, "simulate", "--rig", rig, "--command", cmd, "--out", tmp_path / "out.csv"],
                        capture_output=True, text=True)
     assert p.returncode == 0, p.stderr
     prefix = f"hydrocyl: warning: {cmd}: "
-    lines = [line for line in p.stderr.splitlines() if "maximum speed" in line]
+    lines = [line for line in p.stderr.splitlines() if words in line]
     assert len(lines) == 1 and lines[0].startswith(prefix), p.stderr
     return lines[0][len(prefix):]
 
@@ -75,3 +77,15 @@ def test_the_rating_warning_can_be_made_an_error():
             assert "maximum speed" in str(e)
         else:
             raise AssertionError("no RatingWarning raised")
+
+
+def test_a_spool_demand_beyond_the_stroke_warns_with_the_clis_text(cli, tmp_path):
+    t = np.linspace(0.0, 0.1, 201)
+    u = np.where(t < 0.01, 0.0, 1.5)
+    expected = cli_warning(cli, tmp_path, t, u, rig="leaney-moog", words="outside ±1")
+    assert expected.startswith(f"{np.count_nonzero(u)} command samples outside ±1")
+    w, _ = recorded(lambda: hydrocyl.Rig.load("leaney-moog").simulate(t, u))
+    assert [str(x.message) for x in w] == [f"command (t, u): {expected}"]
+    within, _ = recorded(lambda: hydrocyl.Rig.load("leaney-moog").simulate(t, u / 2))
+    assert within == []
+

@@ -382,19 +382,50 @@ pub fn circuit(v: &Value, command: Signal) -> Result<crate::Circuit, RigError> {
     (kind_of(&v)?.circuit)(&v, command)
 }
 
-/// The rating a rig value's command is checked against (a pump driven by
-/// the run's input in volts, with a maximum speed:
-/// [`Schematic::input_rating`](crate::netlist::Schematic::input_rating)),
-/// as `hydrocyl simulate` checks it; `None` for a rig without one, or one
-/// that does not read.
-pub fn input_rating(v: &Value) -> Option<crate::netlist::InputRating> {
+/// What a rig's command is checked against before a run, as `hydrocyl
+/// simulate` checks it ([`command_limit`]); a command beyond it is warned
+/// of, not refused.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CommandLimit {
+    /// A normalised spool demand: ±1, the spool's stroke, where the valve
+    /// clamps it ([`crate::netlist::stroke_warning`]).
+    Stroke,
+    /// A pump driven in volts, with a maximum speed
+    /// ([`Schematic::input_rating`](crate::netlist::Schematic::input_rating)).
+    Rating(crate::netlist::InputRating),
+}
+
+impl CommandLimit {
+    /// The warning of the command samples `u` at times `t` beyond the
+    /// limit (the count and the largest); `None` when none is.
+    pub fn check(&self, t: &[f64], u: &[f64]) -> Option<String> {
+        match self {
+            CommandLimit::Stroke => {
+                let (outside, peak) = crate::netlist::samples_beyond(t, u, 1.0);
+                crate::netlist::stroke_warning(outside, peak)
+            }
+            CommandLimit::Rating(r) => r.check(t, u),
+        }
+    }
+}
+
+/// The limit a rig value's command is checked against, from the unit its
+/// input is read in (as the CLI reads a command file): a position [m], a
+/// velocity [m/s] or a set-point has none, a pump's voltage [V] its
+/// rating when the pump has one, anything else is a normalised spool
+/// demand (±1). `None` also for a rig that does not read as a netlist.
+pub fn command_limit(v: &Value) -> Option<CommandLimit> {
     let v = migrated(v).ok()?;
     if v.get("kind").and_then(Value::as_str) != Some(crate::netlist::KIND) {
         return None;
     }
-    // the components as read: the rating needs no steady initial state
+    // the components as read: the limit needs no steady initial state
     let s = crate::netlist::read(&v).ok()?;
-    s.input_rating().filter(|_| s.input_unit() == Some("V"))
+    match s.input_unit() {
+        Some("m" | "m/s") => None,
+        Some("V") => s.input_rating().map(CommandLimit::Rating),
+        _ => Some(CommandLimit::Stroke),
+    }
 }
 
 /// The registry type of component `name` in a rig value of any kind (an

@@ -48,6 +48,19 @@ pub fn samples_beyond(t: &[f64], u: &[f64], limit: f64) -> (usize, (f64, f64)) {
     (outside, peak)
 }
 
+/// The warning of `outside` samples of a normalised spool demand beyond
+/// ±1 (the spool's stroke, where the valve clamps it), the largest in
+/// magnitude `peak` = (value, time); `None` when none is. One text for
+/// every front end, which says where the command came from before it.
+pub fn stroke_warning(outside: usize, peak: (f64, f64)) -> Option<String> {
+    (outside > 0).then(|| {
+        format!(
+            "{outside} command samples outside ±1 (largest {} at t = {} s); the valve clamps them to ±1 (the spool's stroke)",
+            peak.0, peak.1
+        )
+    })
+}
+
 impl InputRating {
     /// The steady speed at command `u` \[rad·s⁻¹\].
     pub fn speed(&self, u: f64) -> f64 {

@@ -598,6 +598,36 @@ fn describe(v: &Value) -> &'static str {
 mod tests {
     use super::*;
 
+    /// The limit follows the unit the input is read in: a spool demand its
+    /// stroke, a pump in volts its rating, a set-point none; and the check
+    /// counts the samples beyond it.
+    #[test]
+    fn a_commands_limit_is_the_stroke_the_pumps_rating_or_none() {
+        let limit = |name: &str| command_limit(&preset(name).unwrap());
+        assert_eq!(limit("leaney-moog"), Some(CommandLimit::Stroke));
+        assert_eq!(limit("leaney-moog-closed-loop"), None);
+        let Some(CommandLimit::Rating(r)) = limit("wang-hybrid") else {
+            panic!("wang-hybrid: {:?}", limit("wang-hybrid"))
+        };
+        assert_eq!(r.component, "pump");
+        let t = [0.0, 0.1, 0.2, 0.3];
+        let stroke = CommandLimit::Stroke
+            .check(&t, &[0.0, 1.5, -2.0, 1.0])
+            .unwrap();
+        assert!(
+            stroke.starts_with("2 command samples outside ±1 (largest -2 at t = 0.2 s)"),
+            "{stroke}"
+        );
+        assert_eq!(CommandLimit::Stroke.check(&t, &[0.0, 1.0, -1.0, 0.5]), None);
+        let over = [0.0, 0.5, 2.0, 1.0].map(|k| k * r.limit);
+        let rating = CommandLimit::Rating(r.clone()).check(&t, &over).unwrap();
+        assert!(
+            rating.starts_with("1 command samples beyond the maximum speed of `pump`"),
+            "{rating}"
+        );
+        assert_eq!(CommandLimit::Rating(r).check(&t, &over[..2]), None);
+    }
+
     #[test]
     fn rig_text_reads_as_a_file_does_and_a_byte_order_mark_is_skipped() {
         let text = serde_json::to_string_pretty(&preset("leaney-moog").unwrap()).unwrap();

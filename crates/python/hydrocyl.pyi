@@ -5,7 +5,11 @@ CLI's ``--set``, runs as named numpy arrays in SI units (pressures in Pa
 gauge), batch runs on all cores, Leaney's X factor and the measured-data
 diagnosis. Bad input raises ValueError with the CLI's one-line message; a
 solver failure raises SimulationError; a run whose constant-B oil cavitates
-far below vacuum is returned with a CavitationWarning.
+far below vacuum is returned with a CavitationWarning, one whose command
+turns a pump past its maximum speed with a RatingWarning. Array arguments
+are real numbers (ints or floats, any layout: unaligned, big-endian or
+strided arrays are read as their values); complex numbers, booleans and
+elements that are not numbers are a TypeError naming the argument.
 """
 
 import os
@@ -46,6 +50,17 @@ class CavitationWarning(UserWarning):
     and when, and the remedy (entrained air, ``<cylinder>.air_fraction``,
     where the cylinder's type has it). Warned by ``Rig.simulate`` and, per
     parameter set, ``simulate_batch``."""
+
+class RatingWarning(UserWarning):
+    """The command goes beyond the limit of what the run's input drives: a
+    normalised spool demand outside +-1 (the spool's stroke: the valve
+    clamps it there), or a pump driven in volts turned past its maximum
+    speed (its ``displacement`` and ``max_speed``; the pump is not limited
+    to it, its flow follows the command). The run is returned. The message
+    is the CLI's warning after ``command (t, u): ``: the count of samples
+    beyond, the largest and when (for a pump, the rated speed and the
+    command reaching it, and the largest's speed). Warned once per run by ``Rig.simulate`` and, per
+    parameter set and naming it, by ``simulate_batch``."""
 
 class Rig:
     """A rig: kind and parameters as in its JSON file (SI units, pressures
@@ -112,7 +127,8 @@ class Rig:
         SimulationError when the solver fails or the run blows up (a
         non-finite value, a chamber pressure below -1000 bar); a chamber
         far below vacuum short of that warns (CavitationWarning) and the
-        run is returned. Ctrl-C (SIGINT) stops the run within a few tens
+        run is returned; so does a command beyond the maximum speed of the
+        pump it drives (RatingWarning). Ctrl-C (SIGINT) stops the run within a few tens
         of milliseconds with KeyboardInterrupt."""
 
 class Run:

@@ -227,18 +227,7 @@ pub fn read_table(path: &Path, bytes: &[u8], unit: CommandUnit) -> Result<Table,
 /// The samples `u` (at times `t`) beyond `limit` in magnitude, and the
 /// largest in magnitude with its time.
 pub fn beyond(t: &[f64], u: &[f64], limit: f64) -> (usize, (f64, f64)) {
-    let outside = u.iter().filter(|x| x.abs() > limit).count();
-    let peak = t
-        .iter()
-        .zip(u)
-        .fold((0.0, f64::NAN), |(p, tp), (&tk, &uk)| {
-            if uk.abs() > f64::abs(p) {
-                (uk, tk)
-            } else {
-                (p, tp)
-            }
-        });
-    (outside, peak)
+    hydrocyl_system::netlist::samples_beyond(t, u, limit)
 }
 
 /// The [`Table`] of file `file`'s samples `(t, u)`.

@@ -11,9 +11,6 @@ use hydrocyl_system::netlist::InputRating;
 use hydrocyl_system::signal::Signal;
 use std::path::Path;
 
-/// Revolutions per minute in one radian per second.
-const RPM_PER_RAD_S: f64 = 60.0 / (2.0 * std::f64::consts::PI);
-
 /// The samples of a command table beyond `limit` in magnitude, and the
 /// largest in magnitude with its time (`(0, NaN)` for no samples).
 pub fn beyond(signal: &Signal, limit: f64) -> (usize, (f64, f64)) {
@@ -25,19 +22,11 @@ pub fn beyond(signal: &Signal, limit: f64) -> (usize, (f64, f64)) {
 
 /// The warning of `outside` command samples of `file` beyond the rating,
 /// the largest in magnitude `peak` = (value, time); `None` when none is.
+/// The text is the library's ([`InputRating::warning`], which Python warns
+/// with too), after the file's name.
 pub fn warning(file: &Path, r: &InputRating, outside: usize, peak: (f64, f64)) -> Option<String> {
-    (outside > 0).then(|| {
-        format!(
-            "hydrocyl: warning: {}: {outside} command samples beyond the maximum speed of `{}` ({:.0} rpm, reached at ±{:.3} V; largest {} V at t = {} s: {:.0} rpm); the pump is not limited to it: its flow follows the command",
-            file.display(),
-            r.component,
-            r.max_speed * RPM_PER_RAD_S,
-            r.limit,
-            peak.0,
-            peak.1,
-            r.speed(peak.0) * RPM_PER_RAD_S
-        )
-    })
+    r.warning(outside, peak)
+        .map(|w| format!("hydrocyl: warning: {}: {w}", file.display()))
 }
 
 /// Prints [`warning`], if any, on standard error.
@@ -50,6 +39,9 @@ pub fn warn(file: &Path, r: &InputRating, outside: usize, peak: (f64, f64)) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Revolutions per minute in one radian per second.
+    const RPM_PER_RAD_S: f64 = 60.0 / (2.0 * std::f64::consts::PI);
 
     /// Table 4-2's pump: 2.05 cc/rev, 8000 rpm, at 1.07e-5 m^3/(s V): 25.5 V.
     fn wang() -> InputRating {

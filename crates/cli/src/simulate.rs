@@ -332,13 +332,8 @@ fn whole_pascals(p: f64) -> String {
 /// largest in magnitude `peak` = (value, time)): the spool stops at its
 /// stroke, so the valve acts on ±1.
 fn warn_clamped(file: &Path, outside: usize, peak: (f64, f64)) {
-    if outside > 0 {
-        crate::console::note(format_args!(
-            "hydrocyl: warning: {}: {outside} command samples outside ±1 (largest {} at t = {} s); the valve clamps them to ±1 (the spool's stroke)",
-            file.display(),
-            peak.0,
-            peak.1
-        ));
+    if let Some(w) = hydrocyl_system::netlist::stroke_warning(outside, peak) {
+        crate::console::note(format_args!("hydrocyl: warning: {}: {w}", file.display()));
     }
 }
 

@@ -3,8 +3,8 @@
 //! `(N, len(t))` arrays in parameter-set order, so they do not depend on
 //! the number of threads (each run is sequential and deterministic).
 
-use crate::convert::{array, count_arg, frozen, names_arg, no_channel, vector, vector_arg, Named};
-use crate::errors::{interruptible, stopped, Failure, Outcome, Stop};
+use crate::convert::{array, count_arg, frozen, names_arg, no_channel, vector_arg, Named};
+use crate::errors::{interruptible, stopped, Failure, Outcome, RunWarning, Stop};
 use crate::rig::Rig;
 use crate::run::state_array;
 use crate::sim;
@@ -111,12 +111,12 @@ impl Sets {
 }
 
 /// What one run leaves: its channels (the selected ones), statistics and
-/// the warning of a chamber far below vacuum.
+/// its warnings (naming the run).
 struct Row {
     names: Vec<String>,
     values: Vec<Vec<f64>>,
     stats: [f64; 4],
-    cavitation: Option<String>,
+    warnings: Vec<RunWarning>,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -149,7 +149,7 @@ fn one(
                 wall,
                 ..
             },
-        cavitation,
+        warnings,
         ..
     } = sim::simulate(&v, cmd, t, opts, stop).map_err(|e| match e {
         Failure::Interrupted => e,
@@ -172,8 +172,10 @@ fn one(
             stats.rhs_evals as f64,
             wall.as_secs_f64(),
         ],
-        cavitation: cavitation
-            .map(|w| format!("run {i} ({}): {w}", sets.assignments(i).join(", "))),
+        warnings: warnings
+            .into_iter()
+            .map(|w| w.context(&format!("run {i} ({})", sets.assignments(i).join(", "))))
+            .collect(),
     })
 }
 
@@ -198,7 +200,9 @@ fn one(
 /// both naming the set); `on_error="nan"` fills its rows with NaN and
 /// reports it in `batch.ok` / `batch.errors`. A set whose chamber fell far
 /// below vacuum without blowing up is kept, with a
-/// `hydrocyl.CavitationWarning` naming it.
+/// `hydrocyl.CavitationWarning` naming it; a set whose command is beyond
+/// the maximum speed of the pump it drives warns with a
+/// `hydrocyl.RatingWarning` naming it.
 #[pyfunction]
 #[pyo3(signature = (rig, t, u, params, *, solver = "auto", rtol = 1e-6, rk4_step = 2e-5, h_max = None, channels = None, threads = None, on_error = "raise"))]
 #[allow(clippy::too_many_arguments)]
@@ -235,9 +239,7 @@ pub fn simulate_batch(
     };
     for (k, v) in params.iter() {
         let path: String = k.extract()?;
-        let col = vector(v.extract().map_err(|_| {
-            PyValueError::new_err(format!("params[{path:?}]: not a 1-D array of numbers"))
-        })?);
+        let col = vector_arg(&format!("params[{path:?}]"), &v)?;
         if sets.paths.is_empty() {
             sets.n = col.len();
         } else if col.len() != sets.n {
@@ -350,7 +352,7 @@ fn stack(
     for (i, r) in rows.into_iter().enumerate() {
         match r {
             Ok(row) if row.names == names => {
-                warnings.extend(row.cavitation);
+                warnings.extend(row.warnings);
                 for (d, v) in data.iter_mut().zip(&row.values) {
                     d[i * m..(i + 1) * m].copy_from_slice(v);
                 }
@@ -395,7 +397,7 @@ fn stack(
         .collect::<PyResult<Vec<_>>>()?;
     // the sets kept, in order, once the batch is sure to be returned
     for w in &warnings {
-        crate::errors::warn_cavitation(py, w)?;
+        w.warn(py)?;
     }
     Ok(PyBatch {
         time: array(py, t)?,

@@ -1,10 +1,14 @@
 //! Values between Python and the rig JSON / numpy: JSON values as Python
 //! objects, Python values as the text `--set path=value` takes, arrays.
 
-use numpy::{AllowTypeChange, PyArray1, PyArrayLike1, PyArrayLikeDyn, PyUntypedArrayMethods};
+use numpy::ndarray::{ArrayD, Dimension, IxDyn};
+use numpy::{
+    Element, PyArray, PyArray1, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray,
+    PyUntypedArrayMethods,
+};
 use pyo3::exceptions::{PyKeyError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
+use pyo3::types::{PyBool, PyComplex, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use serde_json::Value;
 
 /// A JSON value as a Python object (`null` → `None`, objects → `dict`,
@@ -62,23 +66,152 @@ pub fn set_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
     )))
 }
 
-/// A 1-D float array from any array-like (list, numpy array of any real
-/// dtype), copied.
-pub fn vector(x: PyArrayLike1<'_, f64, AllowTypeChange>) -> Vec<f64> {
-    x.as_array().to_vec()
+/// The one reader of numpy arrays: `x` as an array of element type `T`
+/// (its own dtype converted to `T`'s where it differs, e.g. an int array to
+/// float), in native byte order, aligned and C-contiguous. An array that is
+/// not so — unaligned (read from a buffer at an odd offset, or unpickled:
+/// Dask's arrays arrive so), big-endian (`>f8`), strided (a slice) — is
+/// copied by numpy (`numpy.require(x, dtype, ["C", "A"])`); one that is, is
+/// taken as it is. Reading the result never meets a pointer the Rust side
+/// cannot read (an unaligned one is a panic, not an error). Every array
+/// the package reads comes through here: [`real_array`] for arguments,
+/// [`state_array`](crate::run::state_array) for pickled results.
+pub fn readable<'py, T: Element, D: Dimension>(
+    x: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray<T, D>>> {
+    let py = x.py();
+    let a =
+        py.import("numpy")?
+            .getattr("require")?
+            .call1((x, numpy::dtype::<T>(py), ["C", "A"]))?;
+    Ok(a.cast_into::<PyArray<T, D>>()?)
+}
+
+/// Where element `flat` (in C order) of an array of `shape` is, as Python
+/// indexes it: `[3]`, `[1, 2]`, `[]` for a 0-D array.
+fn index_of(flat: usize, shape: &[usize]) -> String {
+    let mut rest = flat;
+    let mut at = vec![0; shape.len()];
+    for (i, &n) in shape.iter().enumerate().rev() {
+        if n > 0 {
+            at[i] = rest % n;
+            rest /= n;
+        }
+    }
+    format!(
+        "[{}]",
+        at.iter()
+            .map(usize::to_string)
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
+}
+
+/// The real numbers given as argument `name`, of any shape, copied (through
+/// [`readable`]: an unaligned, big-endian or strided array is read as its
+/// values). `expected` says what the argument is, for the messages (`a 1-D
+/// array of numbers`). Ints and floats are numbers; anything else is
+/// refused rather than cast, with the argument named:
+///
+/// * complex numbers (a complex array, or a complex element of a list):
+///   TypeError `u: complex numbers are not accepted ...` — numpy would
+///   drop the imaginary part with only a ComplexWarning;
+/// * booleans (a bool array, an element of an object array, or of a list
+///   or tuple, which numpy would read as 0 or 1): TypeError — a command or
+///   a parameter is a number, and `True` is not read as `1.0`;
+/// * an element that is not a number (an object array or a list holding
+///   `None`, a string, ...): TypeError naming the element
+///   (`u[3]: None is not a number`), not read as NaN;
+/// * an array of strings, dates or records, or a ragged list: ValueError
+///   `u: expected ..., got a list that is not numbers`.
+pub fn real_array(name: &str, expected: &str, x: &Bound<'_, PyAny>) -> PyResult<ArrayD<f64>> {
+    let py = x.py();
+    let not_numbers =
+        |what: String| PyValueError::new_err(format!("{name}: expected {expected}, got {what}"));
+    let type_name = |x: &Bound<'_, PyAny>| {
+        x.get_type()
+            .name()
+            .map_or_else(|_| "?".to_string(), |n| n.to_string())
+    };
+    let np = py.import("numpy")?;
+    // numpy reads a bool in a list of numbers as 0 or 1: refused first
+    if x.is_instance_of::<PyList>() || x.is_instance_of::<PyTuple>() {
+        let np_bool = np.getattr("bool_")?;
+        for (k, e) in x.try_iter()?.enumerate() {
+            let e = e?;
+            if e.is_instance_of::<PyBool>() || e.is_instance(&np_bool)? {
+                return Err(PyTypeError::new_err(format!(
+                    "{name}[{k}]: {} is a bool, not a number",
+                    e.repr()?
+                )));
+            }
+        }
+    }
+    let a = np
+        .getattr("asanyarray")?
+        .call1((x,))
+        .map_err(|_| not_numbers(format!("a {} that is not numbers", type_name(x))))?;
+    let a = a.cast_into::<PyUntypedArray>()?;
+    let dtype = a.dtype();
+    match dtype.kind() {
+        b'i' | b'u' | b'f' => {}
+        b'c' => {
+            return Err(PyTypeError::new_err(format!(
+                "{name}: complex numbers are not accepted (got an array of {dtype}); give the real numbers meant (e.g. {name}.real)"
+            )))
+        }
+        b'b' => {
+            return Err(PyTypeError::new_err(format!(
+                "{name}: booleans are not accepted as numbers (got an array of bool); give numbers (e.g. {name}.astype(float))"
+            )))
+        }
+        b'O' => {
+            let shape = a.shape().to_vec();
+            let (np_bool, np_complex) = (np.getattr("bool_")?, np.getattr("complexfloating")?);
+            for (k, e) in a.call_method0("ravel")?.try_iter()?.enumerate() {
+                let e = e?;
+                let why = if e.is_instance_of::<PyBool>() || e.is_instance(&np_bool)? {
+                    Some(format!("{} is a bool, not a number", e.repr()?))
+                } else if e.is_instance_of::<PyComplex>() || e.is_instance(&np_complex)? {
+                    Some(format!(
+                        "{} is complex; complex numbers are not accepted",
+                        e.repr()?
+                    ))
+                } else if e.extract::<f64>().is_err() {
+                    Some(format!("{} is not a number (a {})", e.repr()?, type_name(&e)))
+                } else {
+                    None
+                };
+                if let Some(why) = why {
+                    return Err(PyTypeError::new_err(format!(
+                        "{name}{}: {why}",
+                        index_of(k, &shape)
+                    )));
+                }
+            }
+        }
+        _ => {
+            return Err(not_numbers(format!(
+                "a {} of {dtype} (not numbers)",
+                type_name(x)
+            )))
+        }
+    }
+    Ok(readable::<f64, IxDyn>(a.as_any())?.to_owned_array())
 }
 
 /// The 1-D float array given as argument `name` (any array-like of real
-/// numbers), copied; anything else is a one-line ValueError naming the
-/// argument, the shape expected and what was given (`t: expected a 1-D
-/// array of numbers, got a 2-D array of shape (2, 401)`).
+/// numbers, [`real_array`]), copied; anything else is a one-line error
+/// naming the argument, the shape expected and what was given (`t: expected
+/// a 1-D array of numbers, got a 2-D array of shape (2, 401)`).
 pub fn vector_arg(name: &str, x: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    const EXPECTED: &str = "a 1-D array of numbers";
     let got = if x.is_none() {
         "None".to_string()
-    } else if let Ok(a) = x.extract::<PyArrayLike1<'_, f64, AllowTypeChange>>() {
-        return Ok(vector(a));
-    } else if let Ok(a) = x.extract::<PyArrayLikeDyn<'_, f64, AllowTypeChange>>() {
+    } else {
+        let a = real_array(name, EXPECTED, x)?;
         match a.shape() {
+            [_] => return Ok(a.iter().copied().collect()),
             [] => "a scalar (a 0-D array)".to_string(),
             dims => format!(
                 "a {}-D array of shape ({})",
@@ -89,11 +222,9 @@ pub fn vector_arg(name: &str, x: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
                     .join(", ")
             ),
         }
-    } else {
-        format!("a {} that is not numbers", x.get_type().name()?)
     };
     Err(PyValueError::new_err(format!(
-        "{name}: expected a 1-D array of numbers, got {got}"
+        "{name}: expected {EXPECTED}, got {got}"
     )))
 }
 

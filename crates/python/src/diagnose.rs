@@ -2,7 +2,7 @@
 //! record (crate `hydrocyl-identify`): residuals, the missing effects,
 //! refits, before/after; the report as a dict (the CLI's `--report` JSON).
 
-use crate::convert::{json_to_py, vector};
+use crate::convert::{json_to_py, vector_arg};
 use crate::errors::{detached, Failure};
 use crate::rig::Rig;
 use hydrocyl_identify::catalog::EffectId;
@@ -29,11 +29,7 @@ fn read_record(obj: &Bound<'_, PyAny>) -> PyResult<Record> {
         let mut header = Vec::new();
         for (k, v) in d.iter() {
             header.push(k.extract::<String>()?);
-            cols.push(vector(v.extract().map_err(|_| {
-                PyValueError::new_err(format!(
-                    "{DICT_RECORD}: column {k}: not a 1-D array of numbers"
-                ))
-            })?));
+            cols.push(vector_arg(&format!("{DICT_RECORD}: column {k}"), &v)?);
         }
         let csv_err = |e: csv::Error| PyValueError::new_err(format!("{DICT_RECORD}: {e}"));
         w.write_record(&header).map_err(csv_err)?;

@@ -3,7 +3,8 @@
 //! time and the state where it stopped, and a Rust panic (a bug) a
 //! `RuntimeError` — never an unwinding panic through the interpreter. A run
 //! that is kept but left its model's range warns with a
-//! [`CavitationWarning`] ([`warn_cavitation`]).
+//! [`CavitationWarning`], one whose command is beyond the pump's rating
+//! with a [`RatingWarning`] ([`RunWarning`]).
 
 use pyo3::exceptions::{
     PyException, PyKeyboardInterrupt, PyRuntimeError, PyUserWarning, PyValueError,
@@ -36,12 +37,51 @@ pyo3::create_exception!(
      (entrained air, where the cylinder's type has it)."
 );
 
-/// Warns with `message` as a [`CavitationWarning`] (an error when the
-/// warning filters make it one).
-pub fn warn_cavitation(py: Python<'_>, message: &str) -> PyResult<()> {
-    let message = std::ffi::CString::new(message.replace('\0', " "))
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    PyErr::warn(py, py.get_type::<CavitationWarning>().as_any(), &message, 1)
+pyo3::create_exception!(
+    hydrocyl,
+    RatingWarning,
+    PyUserWarning,
+    "The command goes beyond the limit of what the run's input drives: \
+     samples of a normalised spool demand outside +-1 (the spool's stroke, \
+     where the valve clamps them), or past the maximum speed of a pump \
+     driven in volts (its `displacement` and `max_speed`; the pump is not \
+     limited to it, its flow follows the command). The run is returned. The \
+     message is the CLI's warning (`hydrocyl simulate`): the count of \
+     samples beyond, the largest and when (for a pump, the rated speed and \
+     the command reaching it); a batch names the run."
+);
+
+/// A warning a run that is returned leaves, raised with Python's
+/// `warnings.warn` once the run is (once per run; in a batch, naming it).
+#[derive(Debug, Clone, PartialEq)]
+pub enum RunWarning {
+    /// The command beyond the spool's stroke or the rating of the pump
+    /// the input drives (`CommandLimit::check`): a [`RatingWarning`].
+    Rating(String),
+    /// A chamber far below vacuum in a run that did not blow up: a
+    /// [`CavitationWarning`].
+    Cavitation(String),
+}
+
+impl RunWarning {
+    /// Prefixes the message (e.g. with the batch row it is of).
+    pub fn context(self, what: &str) -> Self {
+        match self {
+            RunWarning::Rating(m) => RunWarning::Rating(format!("{what}: {m}")),
+            RunWarning::Cavitation(m) => RunWarning::Cavitation(format!("{what}: {m}")),
+        }
+    }
+
+    /// Warns with it (an error when the warning filters make it one).
+    pub fn warn(&self, py: Python<'_>) -> PyResult<()> {
+        let (category, message) = match self {
+            RunWarning::Rating(m) => (py.get_type::<RatingWarning>(), m),
+            RunWarning::Cavitation(m) => (py.get_type::<CavitationWarning>(), m),
+        };
+        let message = std::ffi::CString::new(message.replace('\0', " "))
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        PyErr::warn(py, category.as_any(), &message, 1)
+    }
 }
 
 /// A failure on the Rust side, before it becomes a Python exception (kept

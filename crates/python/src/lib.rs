@@ -21,7 +21,10 @@
 //! `hydrocyl.SimulationError` for a solver failure (time and state in the
 //! message), RuntimeError for a caught panic (a bug); a run kept although a
 //! chamber's constant-B oil left its range warns with
-//! `hydrocyl.CavitationWarning`. The GIL is released
+//! `hydrocyl.CavitationWarning`, one whose command is beyond the spool's
+//! stroke or the pump's rating with `hydrocyl.RatingWarning`; array
+//! arguments are real numbers in any layout (`convert::real_array`). The
+//! GIL is released
 //! while Rust runs; `simulate_batch` runs its parameter sets on rayon's
 //! threads. The type stubs are `hydrocyl.pyi` beside this crate's manifest;
 //! the pytest suite is `tests/` (`cargo xtask test` builds the wheel and
@@ -59,6 +62,7 @@ fn hydrocyl(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "CavitationWarning",
         m.py().get_type::<errors::CavitationWarning>(),
     )?;
+    m.add("RatingWarning", m.py().get_type::<errors::RatingWarning>())?;
     m.add_class::<rig::Rig>()?;
     m.add_class::<run::PyRun>()?;
     m.add_class::<batch::PyBatch>()?;

@@ -369,7 +369,9 @@ impl Rig {
     /// the solver fails or the run blows up (time and state in the
     /// message). A chamber pressure far below vacuum in a run that did not
     /// blow up (the constant-B oil cavitating) warns with
-    /// `hydrocyl.CavitationWarning` and the run is returned.
+    /// `hydrocyl.CavitationWarning`, a command beyond the maximum speed of
+    /// the pump it drives with `hydrocyl.RatingWarning` (the CLI's
+    /// warning), and the run is returned.
     #[pyo3(signature = (t, u, *, solver = "auto", rtol = 1e-6, rk4_step = 2e-5, h_max = None, ledger = false))]
     #[allow(clippy::too_many_arguments)]
     fn simulate(
@@ -390,8 +392,8 @@ impl Rig {
             let cmd = sim::command(&t, &u)?;
             sim::simulate(&value, &cmd, &t, &opts, stop)
         })?;
-        if let Some(w) = &out.cavitation {
-            crate::errors::warn_cavitation(py, w)?;
+        for w in &out.warnings {
+            w.warn(py)?;
         }
         PyRun::new(py, out)
     }

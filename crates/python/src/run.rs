@@ -2,10 +2,13 @@
 //! simulate` writes), solver statistics, component counters and the energy
 //! ledger.
 
-use crate::convert::{array, frozen, json_to_py, py_to_json, Named};
+use crate::convert::{array, frozen, json_to_py, py_to_json, readable, Named};
 use crate::sim::Simulated;
 use hydrocyl_energy::ledger::Ledger;
-use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{
+    IntoPyArray, PyArray1, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray,
+    PyUntypedArrayMethods,
+};
 use pyo3::exceptions::{PyImportError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyIterator, PyList, PyTuple};
@@ -35,19 +38,31 @@ fn bad_state(what: &str) -> PyErr {
     PyValueError::new_err(format!("not the pickled state of a hydrocyl.Run: {what}"))
 }
 
-/// The array `x` of a pickled state (dimension `D`), copied into an array
-/// of the result's own, read-only as a fresh result's ([`frozen`]; an
-/// unpickled array may be a view of a writable buffer).
+/// The array `x` of a pickled state (element type `T`, dimension `D`),
+/// copied into an array of the result's own, read-only as a fresh result's
+/// ([`frozen`]; an unpickled array may be a view of a writable buffer). It
+/// is read through [`readable`]: an unpickled array is often unaligned (and
+/// may be big-endian, from another machine), which is read as its values.
+/// An array of another kind of element (not float for `f64`, not bool for
+/// `bool`) or of another dimension is not a pickled result's.
 pub fn state_array<T: numpy::Element, D: numpy::ndarray::Dimension>(
     x: &Bound<'_, PyAny>,
     what: &str,
     bad: fn(&str) -> PyErr,
 ) -> PyResult<Py<numpy::PyArray<T, D>>> {
-    let a = x.cast::<numpy::PyArray<T, D>>().map_err(|_| {
+    let wrong = || {
         bad(&format!(
             "`{what}` is not an array of the right type and shape"
         ))
-    })?;
+    };
+    let kind = numpy::dtype::<T>(x.py()).kind();
+    let same_kind = x
+        .cast::<PyUntypedArray>()
+        .is_ok_and(|a| a.dtype().kind() == kind);
+    if !same_kind {
+        return Err(wrong());
+    }
+    let a = readable::<T, D>(x).map_err(|_| wrong())?;
     frozen(a.to_owned_array().into_pyarray(x.py()))
 }
 

@@ -3,7 +3,7 @@
 //! piecewise-linear table over the output times, the energy ledger when
 //! asked for, and a solver failure located (time and state).
 
-use crate::errors::{stopped, Failure, Outcome, Stop};
+use crate::errors::{stopped, Failure, Outcome, RunWarning, Stop};
 use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
 use hydrocyl_integrators::SolveError;
 use hydrocyl_system::rig::{self, RigError};
@@ -65,9 +65,12 @@ pub struct Simulated {
     pub run: Run,
     /// The ledger (`None` unless `RunOptions::ledger`).
     pub ledger: Option<Result<Ledger, String>>,
-    /// The warning of a chamber far below vacuum
-    /// ([`Run::deep_cavitation`]), for a `CavitationWarning`.
-    pub cavitation: Option<String>,
+    /// The warnings of the run, in the CLI's order: the command beyond
+    /// the spool's stroke or the rating of the pump the input drives
+    /// ([`rig::command_limit`], as `hydrocyl simulate` warns of it), a
+    /// chamber far below vacuum
+    /// ([`Run::deep_cavitation`]).
+    pub warnings: Vec<RunWarning>,
 }
 
 /// Simulates the rig value (checked or not) on `command` sampled at `t`
@@ -87,17 +90,29 @@ pub fn simulate(
         .map_err(|e| match e {
             _ if stopped(stop) => Failure::Interrupted,
             RigError::Sim(_) => locate_failure(value, command, t, opts, stop, e.to_string()),
-            other => Failure::Input(other.to_string()),
+            // the rig's parameters named as `--set`, `Rig.set` and the
+            // batch's `params` name them (`load.mass`, not the JSON path
+            // `components.load.mass`): a batch set's value is checked here
+            other => Failure::Input(rig::set_form(other, value).to_string()),
         })?;
     let cavitation = match run.physical() {
         Err(u) => return Err(unphysical(value, command, opts, &run, u)),
         Ok(deep) => deep.map(|d| cavitation_warning(value, opts, &d)),
     };
     let ledger = opts.ledger.then(|| whole_run_ledger(value, command, &run));
+    let rating = match command {
+        Signal::Table { time_s, value: u } => rig::command_limit(value)
+            .and_then(|l| l.check(time_s, u))
+            .map(|w| RunWarning::Rating(format!("command (t, u): {w}"))),
+        _ => None,
+    };
     Ok(Simulated {
         run,
         ledger,
-        cavitation,
+        warnings: rating
+            .into_iter()
+            .chain(cavitation.map(RunWarning::Cavitation))
+            .collect(),
     })
 }
 

@@ -1,9 +1,10 @@
 //! `hydrocyl.xfactor`: Leaney's X factor (thesis eqs 3.4–3.30, crate
 //! `hydrocyl-xfactor`) over an array of spool travels.
 
+use crate::convert::real_array;
 use crate::errors::{detached, Failure};
 use hydrocyl_xfactor::XFactorError;
-use numpy::{AllowTypeChange, IntoPyArray, PyArrayDyn, PyArrayLikeDyn};
+use numpy::{IntoPyArray, PyArrayDyn};
 use pyo3::prelude::*;
 
 /// Leaney's X factor for the cylinder area ratio `gamma` = A1/A2 (>= 1) at
@@ -15,9 +16,9 @@ use pyo3::prelude::*;
 pub fn xfactor<'py>(
     py: Python<'py>,
     gamma: f64,
-    travel: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    travel: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    let travel = travel.as_array().to_owned();
+    let travel = real_array("travel", "an array of numbers", travel)?;
     let x = detached(py, || {
         let mut out = travel.clone();
         for (i, (o, t)) in out.iter_mut().zip(travel.iter()).enumerate() {

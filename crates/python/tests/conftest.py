@@ -75,3 +75,13 @@ def path_of(rig, word):
     hits = [p for p in rig.parameters() if p.rsplit(".", 1)[-1].startswith(word)]
     assert len(hits) == 1, (word, hits)
     return hits[0]
+
+
+def unaligned(a):
+    """A float64 copy of `a` in a buffer at an odd address, as an unpickled
+    array may be: not aligned (reading it as it is would be a panic)."""
+    a = np.asarray(a, dtype=np.float64)
+    out = np.frombuffer(bytearray(a.nbytes + 1), dtype=np.float64, count=a.size, offset=1).reshape(a.shape)
+    out[...] = a
+    assert not out.flags.aligned
+    return out

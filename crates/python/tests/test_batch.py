@@ -158,3 +158,20 @@ def test_two_python_threads_run_batches_at_the_same_time(sets):
     shorter = min(a1 - a0, b1 - b0)
     assert overlap > 0.5 * shorter, (out[0].interval_s, out[1].interval_s)
     np.testing.assert_array_equal(out[0]["position"], out[1]["position"])
+
+
+def test_a_batch_names_a_parameter_out_of_range_as_rig_set_does():
+    """The batch's sets are checked as `rig.set` checks its value, and the
+    parameter is named as `--set` takes it (not by its JSON path)."""
+    rig = hydrocyl.Rig.load("leaney-moog")
+    path = next(p for p in rig.parameters() if p.endswith(".mass"))
+    with pytest.raises(ValueError) as single:
+        rig.set(path, -1.0)
+    assert f"'{path}'" in str(single.value) or f"`{path}`" in str(single.value), single.value
+    t = np.linspace(0.0, 0.05, 51)
+    u = np.where(t < 0.01, 0.0, 0.4)
+    with pytest.raises(ValueError) as batch:
+        hydrocyl.simulate_batch(rig, t, u, {path: [rig.get(path), -1.0]})
+    assert str(batch.value) == f"run 1 ({path}=-1.0): {single.value}"
+    kept = hydrocyl.simulate_batch(rig, t, u, {path: [rig.get(path), -1.0]}, on_error="nan")
+    assert kept.errors[1] == f"run 1 ({path}=-1.0): {single.value}"

@@ -2,12 +2,13 @@
 or a dict of arrays."""
 
 import json
+import re
 
 import numpy as np
 import pytest
 
 import hydrocyl
-from conftest import run_cli
+from conftest import run_cli, unaligned
 
 RECORD = "fixtures/measured/valve-internal_leakage.csv"
 
@@ -48,6 +49,25 @@ def test_a_dict_record_gives_the_same_report(repo, report):
     record = {h: data[:, i] for i, h in enumerate(header)}
     got = hydrocyl.diagnose(hydrocyl.Rig.load("leaney-moog"), record, effects=["internal_leakage"])
     assert comparable(got) == comparable(report)
+
+
+def test_a_dict_record_of_unaligned_arrays_gives_the_same_report(repo, report):
+    path = repo / RECORD
+    header = path.read_text().splitlines()[0].split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=1)
+    record = {h: unaligned(data[:, i]) for i, h in enumerate(header)}
+    got = hydrocyl.diagnose(hydrocyl.Rig.load("leaney-moog"), record, effects=["internal_leakage"])
+    assert comparable(got) == comparable(report)
+
+
+def test_a_dict_record_column_of_complex_numbers_is_a_type_error_naming_it(repo):
+    path = repo / RECORD
+    header = path.read_text().splitlines()[0].split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=1)
+    record = {h: data[:, i] for i, h in enumerate(header)}
+    record[header[1]] = record[header[1]].astype(np.complex128)
+    with pytest.raises(TypeError, match=rf"column {re.escape(header[1])}: complex numbers are not accepted"):
+        hydrocyl.diagnose(hydrocyl.Rig.load("leaney-moog"), record, effects=["internal_leakage"])
 
 
 def test_diagnose_errors(repo):

@@ -382,6 +382,52 @@ pub fn circuit(v: &Value, command: Signal) -> Result<crate::Circuit, RigError> {
     (kind_of(&v)?.circuit)(&v, command)
 }
 
+/// What a rig's command is checked against before a run, as `hydrocyl
+/// simulate` checks it ([`command_limit`]); a command beyond it is warned
+/// of, not refused.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CommandLimit {
+    /// A normalised spool demand: ±1, the spool's stroke, where the valve
+    /// clamps it ([`crate::netlist::stroke_warning`]).
+    Stroke,
+    /// A pump driven in volts, with a maximum speed
+    /// ([`Schematic::input_rating`](crate::netlist::Schematic::input_rating)).
+    Rating(crate::netlist::InputRating),
+}
+
+impl CommandLimit {
+    /// The warning of the command samples `u` at times `t` beyond the
+    /// limit (the count and the largest); `None` when none is.
+    pub fn check(&self, t: &[f64], u: &[f64]) -> Option<String> {
+        match self {
+            CommandLimit::Stroke => {
+                let (outside, peak) = crate::netlist::samples_beyond(t, u, 1.0);
+                crate::netlist::stroke_warning(outside, peak)
+            }
+            CommandLimit::Rating(r) => r.check(t, u),
+        }
+    }
+}
+
+/// The limit a rig value's command is checked against, from the unit its
+/// input is read in (as the CLI reads a command file): a position [m], a
+/// velocity [m/s] or a set-point has none, a pump's voltage [V] its
+/// rating when the pump has one, anything else is a normalised spool
+/// demand (±1). `None` also for a rig that does not read as a netlist.
+pub fn command_limit(v: &Value) -> Option<CommandLimit> {
+    let v = migrated(v).ok()?;
+    if v.get("kind").and_then(Value::as_str) != Some(crate::netlist::KIND) {
+        return None;
+    }
+    // the components as read: the limit needs no steady initial state
+    let s = crate::netlist::read(&v).ok()?;
+    match s.input_unit() {
+        Some("m" | "m/s") => None,
+        Some("V") => s.input_rating().map(CommandLimit::Rating),
+        _ => Some(CommandLimit::Stroke),
+    }
+}
+
 /// The registry type of component `name` in a rig value of any kind (an
 /// older kind read as its netlist), `None` when it has no such component:
 /// what a message may propose to set on the component is looked up in it
@@ -551,6 +597,36 @@ fn describe(v: &Value) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The limit follows the unit the input is read in: a spool demand its
+    /// stroke, a pump in volts its rating, a set-point none; and the check
+    /// counts the samples beyond it.
+    #[test]
+    fn a_commands_limit_is_the_stroke_the_pumps_rating_or_none() {
+        let limit = |name: &str| command_limit(&preset(name).unwrap());
+        assert_eq!(limit("leaney-moog"), Some(CommandLimit::Stroke));
+        assert_eq!(limit("leaney-moog-closed-loop"), None);
+        let Some(CommandLimit::Rating(r)) = limit("wang-hybrid") else {
+            panic!("wang-hybrid: {:?}", limit("wang-hybrid"))
+        };
+        assert_eq!(r.component, "pump");
+        let t = [0.0, 0.1, 0.2, 0.3];
+        let stroke = CommandLimit::Stroke
+            .check(&t, &[0.0, 1.5, -2.0, 1.0])
+            .unwrap();
+        assert!(
+            stroke.starts_with("2 command samples outside ±1 (largest -2 at t = 0.2 s)"),
+            "{stroke}"
+        );
+        assert_eq!(CommandLimit::Stroke.check(&t, &[0.0, 1.0, -1.0, 0.5]), None);
+        let over = [0.0, 0.5, 2.0, 1.0].map(|k| k * r.limit);
+        let rating = CommandLimit::Rating(r.clone()).check(&t, &over).unwrap();
+        assert!(
+            rating.starts_with("1 command samples beyond the maximum speed of `pump`"),
+            "{rating}"
+        );
+        assert_eq!(CommandLimit::Rating(r).check(&t, &over[..2]), None);
+    }
 
     #[test]
     fn rig_text_reads_as_a_file_does_and_a_byte_order_mark_is_skipped() {

@@ -26,10 +26,72 @@ pub struct InputRating {
     pub limit: f64,
 }
 
+/// Revolutions per minute in one radian per second.
+const RPM_PER_RAD_S: f64 = 60.0 / (2.0 * std::f64::consts::PI);
+
+/// The samples of a command `u` over times `t` beyond `limit` in
+/// magnitude, and the largest in magnitude with its time (`(0, NaN)` for
+/// no samples): what a command past a valve's stroke or a pump's rating is
+/// warned of with.
+pub fn samples_beyond(t: &[f64], u: &[f64], limit: f64) -> (usize, (f64, f64)) {
+    let outside = u.iter().filter(|x| x.abs() > limit).count();
+    let peak = t
+        .iter()
+        .zip(u)
+        .fold((0.0, f64::NAN), |(p, tp), (&tk, &uk)| {
+            if uk.abs() > f64::abs(p) {
+                (uk, tk)
+            } else {
+                (p, tp)
+            }
+        });
+    (outside, peak)
+}
+
+/// The warning of `outside` samples of a normalised spool demand beyond
+/// ±1 (the spool's stroke, where the valve clamps it), the largest in
+/// magnitude `peak` = (value, time); `None` when none is. One text for
+/// every front end, which says where the command came from before it.
+pub fn stroke_warning(outside: usize, peak: (f64, f64)) -> Option<String> {
+    (outside > 0).then(|| {
+        format!(
+            "{outside} command samples outside ±1 (largest {} at t = {} s); the valve clamps them to ±1 (the spool's stroke)",
+            peak.0, peak.1
+        )
+    })
+}
+
 impl InputRating {
     /// The steady speed at command `u` \[rad·s⁻¹\].
     pub fn speed(&self, u: f64) -> f64 {
         u.abs() * self.speed_per_command
+    }
+
+    /// The warning of `outside` command samples beyond the rating, the
+    /// largest in magnitude `peak` = (value, time); `None` when none is.
+    /// The pump is not limited to its rating (a motor's maximum speed is a
+    /// rating, not a stop): its flow follows the command, and the run goes
+    /// on. One text for every front end, which says where the command came
+    /// from before it (the CLI its file, Python `command (t, u)`).
+    pub fn warning(&self, outside: usize, peak: (f64, f64)) -> Option<String> {
+        (outside > 0).then(|| {
+            format!(
+                "{outside} command samples beyond the maximum speed of `{}` ({:.0} rpm, reached at ±{:.3} V; largest {} V at t = {} s: {:.0} rpm); the pump is not limited to it: its flow follows the command",
+                self.component,
+                self.max_speed * RPM_PER_RAD_S,
+                self.limit,
+                peak.0,
+                peak.1,
+                self.speed(peak.0) * RPM_PER_RAD_S
+            )
+        })
+    }
+
+    /// [`InputRating::warning`] for the command samples `u` at times `t`
+    /// ([`samples_beyond`] the rating's limit).
+    pub fn check(&self, t: &[f64], u: &[f64]) -> Option<String> {
+        let (outside, peak) = samples_beyond(t, u, self.limit);
+        self.warning(outside, peak)
     }
 }
 

@@ -55,7 +55,7 @@ use crate::run::{Run, RunOptions};
 use crate::signal::Signal;
 pub(crate) use catalog::friction_terms_of as catalog_friction_terms;
 pub(crate) use catalog::typed_view_friction_law;
-pub use inputs::{InputRating, INPUT_TYPES};
+pub use inputs::{samples_beyond, stroke_warning, InputRating, INPUT_TYPES};
 pub use reader::{read, NetlistError, Schematic};
 use serde_json::{Map, Value};
 

@@ -1,0 +1,200 @@
+"""How arrays are read: every entry point takes an unaligned, big-endian or
+strided numpy array as its values (an unpickled array is often unaligned:
+Dask's arrive so), and refuses complex numbers, booleans and elements that
+are not numbers with an error naming the argument."""
+
+import pickle
+import re
+
+import numpy as np
+import pytest
+
+import hydrocyl
+from conftest import unaligned
+
+
+def big_endian(a):
+    out = np.asarray(a, dtype=">f8")
+    assert out.dtype.byteorder == ">"
+    return out
+
+
+def strided(a):
+    """`a` as every other element of an array twice its length."""
+    a = np.asarray(a, dtype=np.float64)
+    wide = np.zeros(2 * a.size)
+    wide[::2] = a
+    out = wide[::2]
+    assert not out.flags.c_contiguous
+    return out
+
+
+LAYOUTS = [unaligned, big_endian, strided]
+
+
+@pytest.fixture(scope="module")
+def rig():
+    return hydrocyl.Rig.load("leaney-moog")
+
+
+@pytest.fixture(scope="module")
+def command():
+    t = np.linspace(0.0, 0.1, 201)
+    return t, np.where(t < 0.01, 0.0, 0.5)
+
+
+@pytest.fixture(scope="module")
+def reference(rig, command):
+    return rig.simulate(*command)
+
+
+def same_run(a, b):
+    assert a.names == b.names
+    np.testing.assert_array_equal(a.time, b.time)
+    for name in a.names:
+        np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+@pytest.mark.parametrize("which", ["t", "u", "both"])
+def test_simulate_reads_any_layout_as_its_values(rig, command, reference, layout, which):
+    t, u = command
+    args = {"t": t, "u": u}
+    for k in (["t", "u"] if which == "both" else [which]):
+        args[k] = layout(args[k])
+    same_run(rig.simulate(args["t"], args["u"]), reference)
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_simulate_batch_reads_any_layout_as_its_values(rig, command, layout):
+    t, u = command
+    masses = np.array([80.0, 120.0])
+    path = next(p for p in rig.parameters() if p.endswith(".mass"))
+    want = hydrocyl.simulate_batch(rig, t, u, {path: masses}, threads=1)
+    got = hydrocyl.simulate_batch(rig, layout(t), layout(u), {path: layout(masses)}, threads=1)
+    for name in want:
+        np.testing.assert_array_equal(got[name], want[name], err_msg=name)
+    np.testing.assert_array_equal(got.params[path], masses)
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_xfactor_reads_any_layout_as_its_values(layout):
+    travel = np.linspace(-1.5, 1.5, 31)
+    want = hydrocyl.xfactor(1.9707, travel)
+    np.testing.assert_array_equal(hydrocyl.xfactor(1.9707, layout(travel)), want)
+    # any shape: a 2-D unaligned array keeps its shape
+    got = hydrocyl.xfactor(1.9707, unaligned(travel[:30].reshape(5, 6)))
+    np.testing.assert_array_equal(got, want[:30].reshape(5, 6))
+
+
+def unaligned_state(obj):
+    """The pickled state of a Run or BatchRun with every float array in it
+    replaced by an unaligned copy."""
+    ctor, (state,) = obj.__reduce__()
+    state = dict(state)
+    state["time"] = unaligned(state["time"])
+    state["values"] = [unaligned(v) for v in state["values"]]
+    return ctor, state
+
+
+def test_a_run_from_unaligned_arrays_is_the_run_and_pickles(reference):
+    ctor, state = unaligned_state(reference)
+    run = ctor(state)
+    same_run(run, reference)
+    assert run.time.flags.aligned and not run.time.flags.writeable
+    same_run(pickle.loads(pickle.dumps(run)), reference)
+
+
+def test_a_batch_from_unaligned_arrays_is_the_batch_and_pickles(rig, command):
+    t, u = command
+    path = next(p for p in rig.parameters() if p.endswith(".mass"))
+    batch = hydrocyl.simulate_batch(rig, t, u, {path: [80.0, 120.0]}, threads=1)
+    ctor, state = unaligned_state(batch)
+    back = ctor(state)
+    for b in (back, pickle.loads(pickle.dumps(back))):
+        np.testing.assert_array_equal(b.time, batch.time)
+        for name in batch:
+            np.testing.assert_array_equal(b[name], batch[name], err_msg=name)
+
+
+def test_a_pickled_state_of_another_element_type_is_refused(reference):
+    ctor, (state,) = reference.__reduce__()
+    state = dict(state, time=state["time"].astype(np.complex128))
+    with pytest.raises(ValueError, match="not the pickled state of a hydrocyl.Run: `time`"):
+        ctor(state)
+
+
+def entry_points(rig, command):
+    """Each way an array argument `name` reaches the package: (name, call
+    taking the array)."""
+    t, u = command
+    path = next(p for p in rig.parameters() if p.endswith(".mass"))
+    return [
+        ("t", lambda x: rig.simulate(x, u)),
+        ("u", lambda x: rig.simulate(t, x)),
+        ("t", lambda x: hydrocyl.simulate_batch(rig, x, u, {path: [100.0]})),
+        ("u", lambda x: hydrocyl.simulate_batch(rig, t, x, {path: [100.0]})),
+        (f'params["{path}"]', lambda x: hydrocyl.simulate_batch(rig, t, u, {path: x[:1]})),
+        ("travel", lambda x: hydrocyl.xfactor(1.5, x)),
+    ]
+
+
+def test_complex_numbers_are_a_type_error_naming_the_argument(rig, command):
+    for name, call in entry_points(rig, command):
+        x = command[1].astype(np.complex128)
+        with pytest.raises(TypeError, match=rf"^{re.escape(name)}: complex numbers are not accepted"):
+            call(x)
+        # a list holding a complex element too
+        lst = list(command[1])
+        lst[0] = 1 + 2j
+        with pytest.raises(TypeError, match=rf"^{re.escape(name)}: complex numbers are not accepted"):
+            call(lst)
+
+
+def test_booleans_are_a_type_error_naming_the_argument(rig, command):
+    for name, call in entry_points(rig, command):
+        with pytest.raises(TypeError, match=rf"^{re.escape(name)}: booleans are not accepted as numbers"):
+            call(command[1] > 0.1)
+
+
+def test_an_element_that_is_not_a_number_is_named_with_its_index(rig, command):
+    for name, call in entry_points(rig, command):
+        x = command[1].astype(object)
+        x[0] = None
+        with pytest.raises(TypeError, match=rf"^{re.escape(name)}\[0\]: None is not a number"):
+            call(x)
+    # the index is where the element is; an object array of None and a list
+    # holding a string or a bool are refused the same way
+    t, u = command
+    x = u.astype(object)
+    x[7] = None
+    with pytest.raises(TypeError, match=r"^u\[7\]: None is not a number \(a NoneType\)$"):
+        rig.simulate(t, x)
+    with pytest.raises(TypeError, match=r"^u\[0\]: None is not a number"):
+        rig.simulate(t, np.full(t.size, None))
+    x = u.astype(object)
+    x[1] = "a"
+    with pytest.raises(TypeError, match=r"^u\[1\]: 'a' is not a number \(a str\)$"):
+        rig.simulate(t, x)
+    # a list mixing numbers and strings is numpy's array of strings
+    with pytest.raises(ValueError, match=r"^u: expected a 1-D array of numbers, got a list of <U\d+ \(not numbers\)$"):
+        rig.simulate(t, [0.0, "a"] + [0.0] * (t.size - 2))
+    with pytest.raises(TypeError, match=r"^u\[2\]: True is a bool, not a number$"):
+        rig.simulate(t, [0.0, 0.5, True] + [0.5] * (t.size - 3))
+    x = np.linspace(0, 1, 6).astype(object).reshape(2, 3)
+    x[1, 2] = None
+    with pytest.raises(TypeError, match=r"^travel\[1, 2\]: None is not a number"):
+        hydrocyl.xfactor(1.5, x)
+
+
+def test_ints_and_an_object_array_of_numbers_are_read_as_floats(rig, command, reference):
+    t, u = command
+    same_run(rig.simulate(t, u.astype(object)), reference)
+    travel = np.arange(-2, 3)
+    np.testing.assert_array_equal(hydrocyl.xfactor(1.5, travel), hydrocyl.xfactor(1.5, travel.astype(float)))
+
+
+def test_strings_are_a_value_error_naming_the_argument(rig, command):
+    t, _ = command
+    with pytest.raises(ValueError, match=r"^u: expected a 1-D array of numbers, got a ndarray of <U3 \(not numbers\)$"):
+        rig.simulate(t, np.full(t.size, "0.5"))

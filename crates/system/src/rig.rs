@@ -410,8 +410,8 @@ impl CommandLimit {
 }
 
 /// The limit a rig value's command is checked against, from the unit its
-/// input is read in (as the CLI reads a command file): a position [m], a
-/// velocity [m/s] or a set-point has none, a pump's voltage [V] its
+/// input is read in (as the CLI reads a command file): a position \[m\], a
+/// velocity \[m/s\] or a set-point has none, a pump's voltage \[V\] its
 /// rating when the pump has one, anything else is a normalised spool
 /// demand (±1). `None` also for a rig that does not read as a netlist.
 pub fn command_limit(v: &Value) -> Option<CommandLimit> {

@@ -32,7 +32,9 @@ def os_threads():
 
 def settle(baseline, within=2.0):
     """Waits until the process is back to `baseline` threads (a thread pool
-    dropped ends its threads asynchronously); returns the count."""
+    dropped ends its threads asynchronously); returns the count. A thread of
+    an earlier test may end meanwhile too, so a count below `baseline` is no
+    leak: callers assert `<= baseline`."""
     end = time.monotonic() + within
     while os_threads() > baseline and time.monotonic() < end:
         time.sleep(0.02)
@@ -97,7 +99,7 @@ def test_ctrl_c_stops_a_simulate(how):
     baseline = os_threads()
     took = interrupted_after(lambda: rig.simulate(t, u, **LONG), how)
     assert took < 2.0, took
-    assert settle(baseline) == baseline
+    assert settle(baseline) <= baseline, "a thread outlived the interrupted run"
     # the next run is not stopped: the interrupt belonged to the one before
     short = rig.simulate(t[:11], u[:11])
     assert short["position"].shape == (11,)
@@ -115,7 +117,7 @@ def test_ctrl_c_stops_every_run_of_a_batch(threads):
         lambda: hydrocyl.simulate_batch(rig, t, u, params, threads=threads, **LONG), kill
     )
     assert took < 2.0, took
-    assert settle(baseline) == baseline
+    assert settle(baseline) <= baseline, "a thread outlived the interrupted run"
     # the pool is idle again: a short batch runs at once
     start = time.monotonic()
     batch = hydrocyl.simulate_batch(rig, t[:11], u[:11], params, threads=threads)

@@ -152,8 +152,13 @@ impl OrificeInflow {
         w: &Wires,
         node: Wire<Pressure>,
     ) -> Option<Self> {
-        let k = v.orifice.coefficient() * (v.area * v.effective_factor).si();
-        let mut law = Self::between(k, v.orifice.dp_transition.si(), (i, o), w, node)?;
+        let mut law = Self::between(
+            v.coefficient(),
+            v.orifice.dp_transition.si(),
+            (i, o),
+            w,
+            node,
+        )?;
         let crack = v.reverse_check.cracking.si();
         law.valid = if node == i.pressure {
             (law.other - crack, f64::INFINITY)

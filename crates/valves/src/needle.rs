@@ -118,10 +118,12 @@ impl NeedleValve {
         })
     }
 
-    /// Metering coefficient `Cd (0.8 Avn) √(2/ρ)` \[m³·s⁻¹·Pa^-½\].
+    /// Metering coefficient `Cd (0.8 Avn) √(2/ρ)` \[m³·s⁻¹·Pa^-½\]: the
+    /// one [`NeedleValve::metered_flow`] multiplies the signed square root
+    /// by, bit for bit.
     #[inline]
     pub fn coefficient(&self) -> f64 {
-        self.orifice.coefficient() * self.effective_factor * self.area.si()
+        self.orifice.coefficient() * (self.area * self.effective_factor).si()
     }
 
     /// Metered flow `p_in → p_out` (either sign) \[m³·s⁻¹\].
@@ -248,6 +250,18 @@ mod tests {
             let qb = n.flow(Pressure::new(b), Pressure::ZERO).si();
             if a < b { prop_assert!(qa <= qb); }
             prop_assert!(n.power_dissipated(Pressure::new(a), Pressure::ZERO).si() >= 0.0);
+        }
+
+        #[test]
+        fn the_coefficient_is_the_metered_flows_bit_for_bit(
+            turns in 0.0f64..5.0, factor in 0.1f64..1.0, dp in -3.0e6f64..3.0e6,
+        ) {
+            // an algebraic node solved on the needle's law (hydrocyl-system's
+            // series solve) needs the very k that metered_flow multiplies by
+            let n = NeedleValve { effective_factor: factor, ..NeedleValve::nccc_at_turns(turns).unwrap() };
+            let law = n.coefficient()
+                * crate::orifice::signed_sqrt_regularised(dp, n.orifice.dp_transition.si());
+            prop_assert_eq!(n.metered_flow(Pressure::new(dp), Pressure::ZERO).si(), law);
         }
     }
 }

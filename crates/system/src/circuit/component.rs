@@ -127,15 +127,22 @@ pub trait Component {
     /// `∂Q/∂p` of the flow this component adds into hydraulic node `node`
     /// with respect to that node's pressure \[m³·s⁻¹·Pa⁻¹\] (negative for a
     /// resistive component), or `None` if it cannot say. The assembler's
-    /// Newton solve of an algebraic node ([`crate::series`]) uses it.
+    /// Newton solve of an algebraic node ([`crate::series`]) uses it. The
+    /// default is the slope of the component's
+    /// [`orifice_inflow`](Component::orifice_inflow) law where the node's
+    /// pressure lies in it ([`OrificeInflow::slope`]), else `None`: a
+    /// component whose law has another branch (a needle's check cracked)
+    /// gives its slope itself.
     fn inflow_slope(
         &self,
-        _t: f64,
-        _x: &[f64],
-        _w: &Wires,
-        _node: Wire<hydrocyl_ports::Pressure>,
+        t: f64,
+        x: &[f64],
+        w: &Wires,
+        node: Wire<hydrocyl_ports::Pressure>,
     ) -> Option<f64> {
-        None
+        let p = w.get(node).si();
+        let law = self.orifice_inflow(t, x, w, node)?;
+        law.holds(p).then(|| law.slope(p))
     }
 
     /// The flow this component adds into hydraulic node `node` as an orifice

@@ -63,17 +63,6 @@ impl Component for FixedOrifice {
         w.add(self.a.inflow, -q);
         w.add(self.b.inflow, q);
     }
-    fn inflow_slope(&self, _t: f64, _x: &[f64], w: &Wires, node: Wire<Pressure>) -> Option<f64> {
-        // Q leaves a and enters b; ∂Q/∂p_a = −∂Q/∂p_b = g
-        let g = self
-            .orifice
-            .conductance(self.area, w.get(self.a.pressure), w.get(self.b.pressure));
-        Some(if node == self.a.pressure || node == self.b.pressure {
-            -g
-        } else {
-            0.0
-        })
-    }
     fn orifice_inflow(
         &self,
         _t: f64,

@@ -52,6 +52,17 @@ impl OrificeInflow {
         })
     }
 
+    /// `∂Q_in/∂p` of the law at node pressure `p` \[m³·s⁻¹·Pa⁻¹\]:
+    /// `−k·s′(other − p)`.
+    pub fn slope(&self, p: f64) -> f64 {
+        -(self.k * signed_sqrt_regularised_derivative(self.other - p, self.transition))
+    }
+
+    /// Whether the law holds at node pressure `p` (`p` in `valid`).
+    pub fn holds(&self, p: f64) -> bool {
+        p >= self.valid.0 && p <= self.valid.1
+    }
+
     /// The inflow into `node` of needle valve `v` from `i` to `o`: its
     /// metered orifice, where its reverse check (`o → i`) stays shut (the
     /// drop `p_o − p_i` at most the check's cracking pressure).
@@ -103,10 +114,7 @@ pub(super) fn orifice_pair_root(
         a.k * signed_sqrt_regularised(a.other - p, a.transition)
             + b.k * signed_sqrt_regularised(b.other - p, b.transition)
     };
-    let slope = |p: f64| {
-        -(a.k * signed_sqrt_regularised_derivative(a.other - p, a.transition)
-            + b.k * signed_sqrt_regularised_derivative(b.other - p, b.transition))
-    };
+    let slope = |p: f64| a.slope(p) + b.slope(p);
     // the inflow falls with p from positive below both sides to negative
     // above them: the root lies between them
     let (mut x0, mut x1) = (a.other.min(b.other), a.other.max(b.other));
@@ -153,9 +161,8 @@ pub(super) fn orifice_pair_root(
         };
     }
     let p = root?;
-    let holds = |m: OrificeInflow| p >= m.valid.0 && p <= m.valid.1;
     let s = slope(p);
-    (p >= lo && p <= hi && holds(a) && holds(b) && s < 0.0 && s.is_finite()).then_some((p, s))
+    (p >= lo && p <= hi && a.holds(p) && b.holds(p) && s < 0.0 && s.is_finite()).then_some((p, s))
 }
 
 #[cfg(test)]
@@ -219,6 +226,28 @@ mod tests {
             // a few tol (the slope changes little over it)
             proptest::prop_assert!((p - exact).abs() <= 4.0 * tol + 4.0 * f64::EPSILON * exact.abs(), "{} {} {}", p, exact, tol);
             proptest::prop_assert!(s < 0.0);
+        }
+    }
+
+    proptest::proptest! {
+        /// The law's slope (the default `Component::inflow_slope` of a
+        /// member that declares a law) is the derivative of its inflow: a
+        /// central difference agrees, inside the transition and outside.
+        #[test]
+        fn the_slope_is_the_inflows_derivative(
+            k in 1e-10f64..1e-6,
+            drop in proptest::prop_oneof![-2e3f64..2e3, -3e7f64..3e7],
+        ) {
+            let m = law(k, 1e6);
+            let p = 1e6 - drop;
+            // h small against the drop and the transition: a difference
+            // across the transition's edge (a jump in the second
+            // derivative) errs by ~h/transition
+            let h = 1e-6 * drop.abs().max(1.0).min(m.transition);
+            let q = |p: f64| m.k * signed_sqrt_regularised(m.other - p, m.transition);
+            let fd = (q(p + h) - q(p - h)) / (2.0 * h);
+            proptest::prop_assert!(m.slope(p) < 0.0);
+            proptest::prop_assert!((m.slope(p) - fd).abs() <= 1e-5 * fd.abs(), "{} {}", m.slope(p), fd);
         }
     }
 

@@ -219,21 +219,6 @@ impl Component for PilotValve {
         let k = self.four_way.return_coefficient(y);
         OrificeInflow::between(k, self.four_way.dp_transition.si(), (open, self.t), w, node)
     }
-    fn inflow_slope(&self, _t: f64, _x: &[f64], w: &Wires, node: Wire<Pressure>) -> Option<f64> {
-        let y = self.opening(w);
-        let open = if y > 0.0 { self.b } else { self.a };
-        if node == self.pp1.pressure || node == self.pp2.pressure {
-            return None; // the opening moves with the pilot pressures
-        }
-        if node != self.t.pressure && node != open.pressure {
-            return Some(0.0);
-        }
-        // Q = k √(p_x − p_T) leaves the open chamber and enters T
-        let k = self.four_way.return_coefficient(y);
-        let dp = (w.get(open.pressure) - w.get(self.t.pressure)).si();
-        let xt = self.four_way.dp_transition.si();
-        Some(-k * signed_sqrt_regularised_derivative(dp, xt))
-    }
     fn n_events(&self) -> usize {
         3
     }

@@ -227,27 +227,8 @@ impl SeriesGroup {
             self.slope.set(s);
             p
         } else {
-            let (start, warm) = closed.unwrap_or((guess, self.slope.get()));
-            match newton(&mut f, &slope, w, start, (lo, hi), tol, warm) {
-                Some((p, s)) => {
-                    self.slope.set(s);
-                    p
-                }
-                None => {
-                    self.fallbacks.set(self.fallbacks.get() + 1);
-                    self.slope.set(f64::NAN);
-                    let (flo, fhi) = (f(lo, w), f(hi, w));
-                    if flo <= 0.0 {
-                        lo
-                    } else if fhi >= 0.0 {
-                        hi
-                    } else {
-                        // f(lo) > 0 > f(hi): a bracket, so Brent converges
-                        hydrocyl_xfactor::brent(|p| f(p, w), lo, hi, tol)
-                            .map_or(0.5 * (lo + hi), |s| s.x)
-                    }
-                }
-            }
+            let start = closed.unwrap_or((guess, self.slope.get()));
+            self.member_solve(&mut f, &slope, w, start, (lo, hi), tol)
         };
         let [_, _, t1, p1] = self.history.get();
         self.history.set([t1, p1, t, p]);
@@ -282,6 +263,45 @@ impl SeriesGroup {
         }
         self.solves.set(self.solves.get() + 1);
         self.evaluations.set(self.evaluations.get() + n.get());
+    }
+}
+
+impl SeriesGroup {
+    /// The root by the members' own Newton solve from `(start, warm)`
+    /// ([`newton`]), Brent's method where that fails: the path of a node
+    /// whose members declare no orifice laws, or whose laws' root did not
+    /// pass. Out of line, so that the law path's code in the circuit's
+    /// evaluation stays small (on the hybrid rig this path is rare).
+    #[inline(never)]
+    fn member_solve(
+        &self,
+        f: &mut impl FnMut(f64, &mut Wires) -> f64,
+        slope: &impl Fn(&Wires) -> Option<f64>,
+        w: &mut Wires,
+        (start, warm): (f64, f64),
+        (lo, hi): (f64, f64),
+        tol: f64,
+    ) -> f64 {
+        match newton(f, slope, w, start, (lo, hi), tol, warm) {
+            Some((p, s)) => {
+                self.slope.set(s);
+                p
+            }
+            None => {
+                self.fallbacks.set(self.fallbacks.get() + 1);
+                self.slope.set(f64::NAN);
+                let (flo, fhi) = (f(lo, w), f(hi, w));
+                if flo <= 0.0 {
+                    lo
+                } else if fhi >= 0.0 {
+                    hi
+                } else {
+                    // f(lo) > 0 > f(hi): a bracket, so Brent converges
+                    hydrocyl_xfactor::brent(|p| f(p, w), lo, hi, tol)
+                        .map_or(0.5 * (lo + hi), |s| s.x)
+                }
+            }
+        }
     }
 }
 

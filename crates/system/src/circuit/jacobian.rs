@@ -3,13 +3,13 @@
 //! One pass propagates the gradients of every wire with respect to all `n`
 //! states at once, in the order of an evaluation:
 //!
-//! 1. [`Component::publish_tangents`]: the rows of the efforts a component
+//! 1. [`Component::publish_tangents`](crate::Component::publish_tangents): the rows of the efforts a component
 //!    sets from its own states (`∂p/∂x_k = 1` for a volume's pressure);
 //! 2. [`Component::evaluate_tangents`](crate::Component::evaluate_tangents) in dependency order: the component's
 //!    local partials (an orifice's `∂Q/∂p_a`, a friction law's `∂F/∂v`)
 //!    chained onto the rows of the wires it reads, added into the rows of the
 //!    wires it writes;
-//! 3. [`Component::derivative_tangents`]: the rows of `∂ẋ/∂x` (and
+//! 3. [`Component::derivative_tangents`](crate::Component::derivative_tangents): the rows of `∂ẋ/∂x` (and
 //!    [`Component::quadrature_tangents`](crate::Component::quadrature_tangents) for the quadratures).
 //!
 //! An algebraic node's pressure ([`crate::series`]) is implicit: its members

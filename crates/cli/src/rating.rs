@@ -5,9 +5,11 @@
 //! the count and the largest, as a valve command beyond its stroke is. It is
 //! not limited: a motor's maximum speed is a rating, not a stop (the spool's
 //! stroke is one, and the valve clamps there); the identified model's flow
-//! follows the command past it.
+//! follows the command past it. Either is the rig's [`CommandLimit`]
+//! (from its one reading, [`crate::rigfile::Checked::command_limit`]),
+//! warned of here after the command file's name.
 
-use hydrocyl_system::netlist::InputRating;
+use hydrocyl_system::rig::CommandLimit;
 use hydrocyl_system::signal::Signal;
 use std::path::Path;
 
@@ -20,18 +22,26 @@ pub fn beyond(signal: &Signal, limit: f64) -> (usize, (f64, f64)) {
     crate::command::beyond(time_s, value, limit)
 }
 
-/// The warning of `outside` command samples of `file` beyond the rating,
-/// the largest in magnitude `peak` = (value, time); `None` when none is.
-/// The text is the library's ([`InputRating::warning`], which Python warns
-/// with too), after the file's name.
-pub fn warning(file: &Path, r: &InputRating, outside: usize, peak: (f64, f64)) -> Option<String> {
-    r.warning(outside, peak)
+/// The warning of `outside` command samples of `file` beyond the rig's
+/// command limit (a pump's rating, or the spool's stroke, where the valve
+/// clamps the command to ±1), the largest in magnitude `peak` = (value,
+/// time); `None` when none is. The text is the library's
+/// ([`CommandLimit::warning`], which Python warns with too), after the
+/// file's name.
+pub fn warning(
+    file: &Path,
+    limit: &CommandLimit,
+    outside: usize,
+    peak: (f64, f64),
+) -> Option<String> {
+    limit
+        .warning(outside, peak)
         .map(|w| format!("hydrocyl: warning: {}: {w}", file.display()))
 }
 
 /// Prints [`warning`], if any, on standard error.
-pub fn warn(file: &Path, r: &InputRating, outside: usize, peak: (f64, f64)) {
-    if let Some(w) = warning(file, r, outside, peak) {
+pub fn warn(file: &Path, limit: &CommandLimit, outside: usize, peak: (f64, f64)) {
+    if let Some(w) = warning(file, limit, outside, peak) {
         crate::console::note(format_args!("{w}"));
     }
 }
@@ -39,6 +49,7 @@ pub fn warn(file: &Path, r: &InputRating, outside: usize, peak: (f64, f64)) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hydrocyl_system::netlist::InputRating;
 
     /// Revolutions per minute in one radian per second.
     const RPM_PER_RAD_S: f64 = 60.0 / (2.0 * std::f64::consts::PI);
@@ -62,7 +73,8 @@ mod tests {
         let s = Signal::table(vec![0.0, 0.5, 1.0], vec![0.0, 50.0, -30.0]).unwrap();
         let (n, peak) = beyond(&s, r.limit);
         assert_eq!((n, peak), (2, (50.0, 0.5)));
-        let w = warning(Path::new("bigv.csv"), &r, n, peak).unwrap();
+        let limit = CommandLimit::Rating(r);
+        let w = warning(Path::new("bigv.csv"), &limit, n, peak).unwrap();
         for part in [
             "bigv.csv: 2 command samples",
             "8000 rpm",
@@ -73,6 +85,14 @@ mod tests {
         ] {
             assert!(w.contains(part), "{part}: {w}");
         }
-        assert_eq!(warning(Path::new("c.csv"), &r, 0, (10.0, 0.1)), None);
+        assert_eq!(warning(Path::new("c.csv"), &limit, 0, (10.0, 0.1)), None);
+        // a spool demand: the stroke's text, after the file's name too
+        let w = warning(Path::new("u.csv"), &CommandLimit::Stroke, 1, (1.5, 0.2)).unwrap();
+        assert!(
+            w.starts_with(
+                "hydrocyl: warning: u.csv: 1 command samples outside ±1 (largest 1.5 at t = 0.2 s)"
+            ),
+            "{w}"
+        );
     }
 }

@@ -58,10 +58,13 @@ impl Checked {
         self.schematic.input_is_set_point()
     }
 
-    /// The rating the run's input is checked against (a pump's maximum
-    /// speed, [`Schematic::input_rating`]).
-    pub fn input_rating(&self) -> Option<netlist::InputRating> {
-        self.schematic.input_rating()
+    /// What the run's command is checked against (the spool's stroke, a
+    /// pump's rating, or nothing: [`rig::CommandLimit::of`], from this one
+    /// reading of the netlist, as
+    /// [`Simulation::command_limit`](hydrocyl_system::simulation::Simulation::command_limit)
+    /// has it for the Python package).
+    pub fn command_limit(&self) -> Option<rig::CommandLimit> {
+        rig::CommandLimit::of(&self.schematic)
     }
 
     /// The registry type of each component, by instance name

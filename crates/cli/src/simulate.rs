@@ -328,15 +328,6 @@ fn whole_pascals(p: f64) -> String {
     format!("{:.0}", if r == 0.0 { 0.0 } else { r })
 }
 
-/// Warns when a normalised valve command leaves ±1 (`outside` samples, the
-/// largest in magnitude `peak` = (value, time)): the spool stops at its
-/// stroke, so the valve acts on ±1.
-fn warn_clamped(file: &Path, outside: usize, peak: (f64, f64)) {
-    if let Some(w) = hydrocyl_system::netlist::stroke_warning(outside, peak) {
-        crate::console::note(format_args!("hydrocyl: warning: {}: {w}", file.display()));
-    }
-}
-
 /// The command of a run: a table read whole (and its times, the output
 /// times), or a long file streamed into a window.
 enum Input {
@@ -472,23 +463,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Some(a) => a.table(unit)?,
         None => None,
     };
-    // a pump's rating is checked as a valve's stroke is (warned of, not limited)
-    let rating = checked.input_rating().filter(|_| unit == CommandUnit::Volt);
-    let limit = match &rating {
-        Some(r) => r.limit,
-        None => 1.0,
-    };
+    // the command's limit, from the rig's one reading (the library's, as
+    // Python's): a spool demand beyond the spool's stroke (the valve clamps
+    // it), a pump's voltage beyond its rating (not limited), warned of
+    let limit = checked.command_limit();
+    let bound = limit.as_ref().map_or(1.0, rig::CommandLimit::bound);
     let long = match table {
         Some(_) => None,
-        None => command_stream::scan(&cmd_path, unit, limit)?,
+        None => command_stream::scan(&cmd_path, unit, bound)?,
     };
     let (rows, t0, t1, signal, mut input) = match (long, table) {
         (Some((scan, chunks)), _) => {
-            if unit == CommandUnit::Normalised && !args.quiet {
-                warn_clamped(&cmd_path, scan.outside, scan.peak);
-            }
-            if let Some(r) = rating.as_ref().filter(|_| !args.quiet) {
-                crate::rating::warn(&cmd_path, r, scan.outside, scan.peak);
+            if let Some(l) = limit.as_ref().filter(|_| !args.quiet) {
+                crate::rating::warn(&cmd_path, l, scan.outside, scan.peak);
             }
             let table = StreamedTable::new(WINDOW);
             table.set_range(scan.min, scan.max);
@@ -507,12 +494,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 // not plain enough to stream: read whole
                 None => read_table(&cmd_path, &read_bytes(&cmd_path)?, unit)?,
             };
-            if unit == CommandUnit::Normalised && !args.quiet {
-                warn_clamped(&cmd_path, table.outside, table.peak);
-            }
-            if let Some(r) = rating.as_ref().filter(|_| !args.quiet) {
-                let (outside, peak) = crate::rating::beyond(&table.signal, r.limit);
-                crate::rating::warn(&cmd_path, r, outside, peak);
+            if let Some(l) = limit.as_ref().filter(|_| !args.quiet) {
+                // a spool demand's samples beyond ±1 are counted as it is read
+                let (outside, peak) = match l {
+                    rig::CommandLimit::Stroke => (table.outside, table.peak),
+                    rig::CommandLimit::Rating(r) => crate::rating::beyond(&table.signal, r.limit),
+                };
+                crate::rating::warn(&cmd_path, l, outside, peak);
             }
             let t = &table.times;
             let (rows, t0, t1) = (t.len(), t[0], t[t.len() - 1]);

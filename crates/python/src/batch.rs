@@ -129,7 +129,6 @@ fn one(
     opts: &hydrocyl_system::run::RunOptions,
     keep: Option<&[String]>,
     stop: &Stop,
-    limit: &sim::Limit,
 ) -> Outcome<Row> {
     // a batch being interrupted starts no more runs
     if stopped(stop) {
@@ -152,7 +151,7 @@ fn one(
             },
         warnings,
         ..
-    } = sim::simulate(&v, cmd, t, opts, stop, limit).map_err(|e| match e {
+    } = sim::simulate(&v, cmd, t, opts, stop).map_err(|e| match e {
         Failure::Interrupted => e,
         e => ctx(e),
     })?;
@@ -283,13 +282,10 @@ pub fn simulate_batch(
             ..sim::options(solver, rtol, rk4_step, h_max, false)?
         };
         let cmd = sim::command(&t, &u)?;
-        let limit = sim::Limit::of_batch(base);
         let work = || {
             (0..sets.n)
                 .into_par_iter()
-                .map(|i| {
-                    crate::errors::guard(|| one(base, sets, i, &cmd, &t, &opts, keep, stop, &limit))
-                })
+                .map(|i| crate::errors::guard(|| one(base, sets, i, &cmd, &t, &opts, keep, stop)))
                 .collect::<Vec<_>>()
         };
         let rows = match threads {

@@ -390,7 +390,7 @@ impl Rig {
         let out = interruptible(py, |stop| {
             let opts = sim::options(solver, rtol, rk4_step, h_max, ledger)?;
             let cmd = sim::command(&t, &u)?;
-            sim::simulate(&value, &cmd, &t, &opts, stop, &sim::Limit::Read)
+            sim::simulate(&value, &cmd, &t, &opts, stop)
         })?;
         for w in &out.warnings {
             w.warn(py)?;

@@ -67,52 +67,33 @@ pub struct Simulated {
     pub ledger: Option<Result<Ledger, String>>,
     /// The warnings of the run, in the CLI's order: the command beyond
     /// the spool's stroke or the rating of the pump the input drives
-    /// ([`rig::command_limit`], as `hydrocyl simulate` warns of it), a
+    /// ([`Simulation::command_limit`], as `hydrocyl simulate` warns of it), a
     /// chamber far below vacuum
     /// ([`Run::deep_cavitation`]).
     pub warnings: Vec<RunWarning>,
 }
 
-/// Where a run's command limit ([`rig::CommandLimit`]) comes from.
-#[derive(Clone, Debug)]
-pub enum Limit {
-    /// Read from the run's rig value ([`rig::command_limit`]: its netlist
-    /// read once more, ~0.1 ms, half a short run of the valve rig).
-    Read,
-    /// Known before the run: a batch's runs share the base rig's unless
-    /// their parameters can change it ([`Limit::of_batch`]).
-    Known(Option<rig::CommandLimit>),
-}
-
-impl Limit {
-    /// The limit of a batch's runs on `base`: the input's unit is the same
-    /// for every run (a set changes numbers only), so no limit and the
-    /// spool's stroke hold for all of them; a pump's rating is read per run
-    /// (a set may change its maximum speed).
-    pub fn of_batch(base: &Value) -> Self {
-        match rig::command_limit(base) {
-            Some(rig::CommandLimit::Rating(_)) => Limit::Read,
-            known => Limit::Known(known),
-        }
-    }
-}
-
 /// Simulates the rig value (checked or not) on `command` sampled at `t`
 /// ([`rig::simulate`]), stopped by `stop` ([`Failure::Interrupted`]); the
-/// command is checked against `limit`.
+/// command is checked against the limit of the rig's command
+/// ([`Simulation::command_limit`]: read with the rig's netlist, the run's
+/// own, a batch set's parameters and all).
 pub fn simulate(
     value: &Value,
     command: &Signal,
     t: &[f64],
     opts: &RunOptions,
     stop: &Stop,
-    limit: &Limit,
 ) -> Outcome<Simulated> {
     if stopped(stop) {
         return Err(Failure::Interrupted);
     }
+    let mut limit = None;
     let run = Simulation::new(value, command.clone())
-        .and_then(|s| s.options(opts.clone()).stop_on(Arc::clone(stop)).run(t))
+        .and_then(|s| {
+            limit = s.command_limit().cloned();
+            s.options(opts.clone()).stop_on(Arc::clone(stop)).run(t)
+        })
         .map_err(|e| match e {
             _ if stopped(stop) => Failure::Interrupted,
             RigError::Sim(_) => locate_failure(value, command, t, opts, stop, e.to_string()),
@@ -127,12 +108,9 @@ pub fn simulate(
     };
     let ledger = opts.ledger.then(|| whole_run_ledger(value, command, &run));
     let rating = match command {
-        Signal::Table { time_s, value: u } => match limit {
-            Limit::Read => rig::command_limit(value),
-            Limit::Known(l) => l.clone(),
-        }
-        .and_then(|l| l.check(time_s, u))
-        .map(|w| RunWarning::Rating(format!("command (t, u): {w}"))),
+        Signal::Table { time_s, value: u } => limit
+            .and_then(|l| l.check(time_s, u))
+            .map(|w| RunWarning::Rating(format!("command (t, u): {w}"))),
         _ => None,
     };
     Ok(Simulated {

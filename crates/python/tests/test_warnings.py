@@ -67,6 +67,24 @@ def test_a_batch_warns_once_for_each_run_beyond_the_rating_naming_it():
     assert [str(x.message) for x in w] == [f"run {i} ({path}={rated!r}): {single[0].message}" for i in (1, 2)]
 
 
+def test_a_batch_checks_each_run_against_its_own_rigs_rating():
+    """The limit is the run's rig's, not the base rig's: a set that rates
+    an unrated pump makes its run warn; one that rates it ten times faster
+    does not."""
+    rig = hydrocyl.Rig.load("wang-hybrid")
+    t, u = pump_step(30.0)
+    path = path_of(rig, "max_speed")
+    rated = rig.get(path)
+    single, _ = recorded(lambda: rig.simulate(t, u))
+    unrated = rig.copy()
+    unrated.set(path, None)
+    quiet, _ = recorded(lambda: unrated.simulate(t, u))
+    assert quiet == [] and len(single) == 1
+    w, batch = recorded(lambda: hydrocyl.simulate_batch(unrated, t, u, {path: [10 * rated, rated]}))
+    assert batch.ok.all()
+    assert [str(x.message) for x in w] == [f"run 1 ({path}={rated!r}): {single[0].message}"]
+
+
 def test_the_rating_warning_can_be_made_an_error():
     t, u = pump_step(30.0)
     with warnings.catch_warnings():

@@ -382,9 +382,32 @@ pub fn circuit(v: &Value, command: Signal) -> Result<crate::Circuit, RigError> {
     (kind_of(&v)?.circuit)(&v, command)
 }
 
+/// Assembles the circuit of a rig value of any kind, driven by `command`,
+/// with the limit its command is checked against ([`CommandLimit::of`]),
+/// both from the one reading of its netlist: what
+/// [`Simulation::new`](crate::simulation::Simulation::new) keeps
+/// ([`Simulation::command_limit`](crate::simulation::Simulation::command_limit)).
+/// A rig kind that is not a netlist has no limit.
+pub(crate) fn assembled(
+    v: &Value,
+    command: Signal,
+) -> Result<(crate::Circuit, Option<CommandLimit>), RigError> {
+    let v = migrated(v)?;
+    let kind = kind_of(&v)?;
+    if kind.kind != crate::netlist::KIND {
+        return Ok(((kind.circuit)(&v, command)?, None));
+    }
+    // `netlist::circuit`, with the schematic kept for the limit
+    let s = crate::netlist::schematic(&v)?;
+    let limit = CommandLimit::of(&s);
+    Ok((crate::netlist::assemble(&s, command)?, limit))
+}
+
 /// What a rig's command is checked against before a run, as `hydrocyl
-/// simulate` checks it ([`command_limit`]); a command beyond it is warned
-/// of, not refused.
+/// simulate` and the Python package check it; a command beyond it is
+/// warned of, not refused. A rig's is read with its netlist, once
+/// ([`CommandLimit::of`]: a [`Simulation`](crate::simulation::Simulation)
+/// keeps it, [`Simulation::command_limit`](crate::simulation::Simulation::command_limit)).
 #[derive(Clone, Debug, PartialEq)]
 pub enum CommandLimit {
     /// A normalised spool demand: ±1, the spool's stroke, where the valve
@@ -396,35 +419,46 @@ pub enum CommandLimit {
 }
 
 impl CommandLimit {
+    /// The limit of a netlist's command, from the unit its input is read
+    /// in (as the CLI reads a command file): a position \[m\], a velocity
+    /// \[m/s\] or a set-point has none, a pump's voltage \[V\] its rating
+    /// when the pump has one, anything else is a normalised spool demand
+    /// (±1). A parameter changed by a `--set` (a pump's `max_speed`) is the
+    /// schematic's own: the limit is the run's rig's.
+    pub fn of(s: &crate::netlist::Schematic) -> Option<Self> {
+        match s.input_unit() {
+            Some("m" | "m/s") => None,
+            Some("V") => s.input_rating().map(CommandLimit::Rating),
+            _ => Some(CommandLimit::Stroke),
+        }
+    }
+
+    /// The command magnitude beyond which a sample is warned of: 1 for the
+    /// stroke, the rating's [`limit`](crate::netlist::InputRating::limit)
+    /// \[V\].
+    pub fn bound(&self) -> f64 {
+        match self {
+            CommandLimit::Stroke => 1.0,
+            CommandLimit::Rating(r) => r.limit,
+        }
+    }
+
+    /// The warning of `outside` command samples beyond the limit, the
+    /// largest in magnitude `peak` = (value, time); `None` when none is.
+    /// One text for every front end, which says where the command came
+    /// from before it (the CLI its file, Python `command (t, u)`).
+    pub fn warning(&self, outside: usize, peak: (f64, f64)) -> Option<String> {
+        match self {
+            CommandLimit::Stroke => crate::netlist::stroke_warning(outside, peak),
+            CommandLimit::Rating(r) => r.warning(outside, peak),
+        }
+    }
+
     /// The warning of the command samples `u` at times `t` beyond the
     /// limit (the count and the largest); `None` when none is.
     pub fn check(&self, t: &[f64], u: &[f64]) -> Option<String> {
-        match self {
-            CommandLimit::Stroke => {
-                let (outside, peak) = crate::netlist::samples_beyond(t, u, 1.0);
-                crate::netlist::stroke_warning(outside, peak)
-            }
-            CommandLimit::Rating(r) => r.check(t, u),
-        }
-    }
-}
-
-/// The limit a rig value's command is checked against, from the unit its
-/// input is read in (as the CLI reads a command file): a position \[m\], a
-/// velocity \[m/s\] or a set-point has none, a pump's voltage \[V\] its
-/// rating when the pump has one, anything else is a normalised spool
-/// demand (±1). `None` also for a rig that does not read as a netlist.
-pub fn command_limit(v: &Value) -> Option<CommandLimit> {
-    let v = migrated(v).ok()?;
-    if v.get("kind").and_then(Value::as_str) != Some(crate::netlist::KIND) {
-        return None;
-    }
-    // the components as read: the limit needs no steady initial state
-    let s = crate::netlist::read(&v).ok()?;
-    match s.input_unit() {
-        Some("m" | "m/s") => None,
-        Some("V") => s.input_rating().map(CommandLimit::Rating),
-        _ => Some(CommandLimit::Stroke),
+        let (outside, peak) = crate::netlist::samples_beyond(t, u, self.bound());
+        self.warning(outside, peak)
     }
 }
 
@@ -600,10 +634,16 @@ mod tests {
 
     /// The limit follows the unit the input is read in: a spool demand its
     /// stroke, a pump in volts its rating, a set-point none; and the check
-    /// counts the samples beyond it.
+    /// counts the samples beyond it. A simulation keeps its rig's.
     #[test]
     fn a_commands_limit_is_the_stroke_the_pumps_rating_or_none() {
-        let limit = |name: &str| command_limit(&preset(name).unwrap());
+        let limit_of = |v: &Value| {
+            crate::simulation::Simulation::new(v, Signal::Constant { value: 0.0 })
+                .unwrap()
+                .command_limit()
+                .cloned()
+        };
+        let limit = |name: &str| limit_of(&preset(name).unwrap());
         assert_eq!(limit("leaney-moog"), Some(CommandLimit::Stroke));
         assert_eq!(limit("leaney-moog-closed-loop"), None);
         let Some(CommandLimit::Rating(r)) = limit("wang-hybrid") else {
@@ -625,7 +665,37 @@ mod tests {
             rating.starts_with("1 command samples beyond the maximum speed of `pump`"),
             "{rating}"
         );
-        assert_eq!(CommandLimit::Rating(r).check(&t, &over[..2]), None);
+        assert_eq!(CommandLimit::Rating(r.clone()).check(&t, &over[..2]), None);
+        // the rating is the rig's as set, not the preset's: a pump ten
+        // times faster, ten times the command; none without a maximum speed
+        let mut faster = preset("wang-hybrid").unwrap();
+        apply_set(
+            &mut faster,
+            &format!("pump.max_speed={}", 10.0 * r.max_speed),
+        )
+        .unwrap();
+        let Some(CommandLimit::Rating(f)) = limit_of(&faster) else {
+            panic!("faster: {:?}", limit_of(&faster))
+        };
+        assert!(
+            (f.limit / r.limit - 10.0).abs() < 1e-12,
+            "{} {}",
+            f.limit,
+            r.limit
+        );
+        let mut unrated = preset("wang-hybrid").unwrap();
+        apply_set(&mut unrated, "pump.max_speed=null").unwrap();
+        assert_eq!(limit_of(&unrated), None);
+        // a circuit assembled by hand has no rig read: no limit
+        let c = circuit(
+            &preset("leaney-moog").unwrap(),
+            Signal::Constant { value: 0.0 },
+        )
+        .unwrap();
+        assert_eq!(
+            crate::simulation::Simulation::of_circuit(c).command_limit(),
+            None
+        );
     }
 
     #[test]

@@ -45,7 +45,7 @@
 //! ```
 
 use crate::circuit::Circuit;
-use crate::rig::{self, RigError};
+use crate::rig::{self, CommandLimit, RigError};
 use crate::run::{self as runner, CommandSource, Run, RunOptions, SimError, StateSink};
 use crate::signal::{Signal, StreamedTable};
 use crate::wires::AnyWire;
@@ -68,14 +68,22 @@ pub struct Simulation {
     /// Set from outside to stop [`Simulation::run`] and
     /// [`Simulation::try_run`] ([`Simulation::stop_on`]).
     stop: Option<Arc<AtomicBool>>,
+    /// The limit of the rig's command, from the netlist read in
+    /// [`Simulation::new`] ([`Simulation::command_limit`]).
+    command_limit: Option<CommandLimit>,
 }
 
 impl Simulation {
     /// Reads, checks and assembles `rig` (a preset's or file's JSON value of
     /// any rig kind, after any `--set`) driven by `command`. Errors name the
-    /// JSON path.
+    /// JSON path. The rig's netlist is read once: the circuit and the
+    /// limit its command is checked against ([`Simulation::command_limit`])
+    /// both come from that reading.
     pub fn new(rig: &Value, command: Signal) -> Result<Self, RigError> {
-        Ok(Self::of_circuit(rig::circuit(rig, command)?))
+        let (circuit, limit) = rig::assembled(rig, command)?;
+        let mut s = Self::of_circuit(circuit);
+        s.command_limit = limit;
+        Ok(s)
     }
 
     /// A simulation of an assembled circuit, from the circuit's own initial
@@ -88,6 +96,7 @@ impl Simulation {
             options: RunOptions::default(),
             now: None,
             stop: None,
+            command_limit: None,
         }
     }
 
@@ -114,6 +123,18 @@ impl Simulation {
     pub fn initial_state(mut self, x0: Vec<f64>) -> Self {
         self.initial = x0;
         self
+    }
+
+    /// What the command is checked against before a run, as `hydrocyl
+    /// simulate` and the Python package check it (warned of, not refused):
+    /// the spool's stroke (±1) of a normalised spool demand, the rating of
+    /// a pump driven in volts, `None` for a position, a velocity or a
+    /// set-point, or a pump with no rating ([`CommandLimit::of`]). It is
+    /// the rig's as given to [`Simulation::new`], `--set`s and all, read
+    /// with its netlist (not once more); a simulation of a circuit
+    /// assembled by hand ([`Simulation::of_circuit`]) has none.
+    pub fn command_limit(&self) -> Option<&CommandLimit> {
+        self.command_limit.as_ref()
     }
 
     /// The assembled circuit (its components, probes, state names; the energy

@@ -251,8 +251,15 @@ pub struct NotApplicable {
 /// One fitted declared parameter.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ParamReport {
-    /// `Fc`, `m` or `effect.param`.
+    /// Its `--set` path on the rig diagnosed (`friction.coulomb`,
+    /// `drive.mass`, `friction.extending.curve.coulomb`), so the fitted
+    /// value goes back with `--set <name>=<fitted>`.
     pub name: String,
+    /// The rig's other `--set` paths that hold the same parameter and take
+    /// the same value (a law with one set per direction, `friction_lugre`:
+    /// the retracting curve's); absent from the JSON when there are none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub also_set: Vec<String>,
     /// Declared value.
     pub declared: f64,
     /// Value after the final refit.
@@ -554,15 +561,25 @@ impl Report {
         }
         if !self.declared_refit.is_empty() {
             let _ = writeln!(s, "\ndeclared parameters refitted:");
+            let w = self
+                .declared_refit
+                .iter()
+                .map(|p| p.name.chars().count())
+                .max()
+                .unwrap_or(0)
+                .max(24);
             for p in &self.declared_refit {
                 let _ = writeln!(
                     s,
-                    "  {:<24} {:>12.5e} -> {:>12.5e} ± {}",
+                    "  {:<w$} {:>12.5e} -> {:>12.5e} ± {}",
                     p.name,
                     p.declared,
                     p.fitted,
                     fmt_ci(p.ci95)
                 );
+                if !p.also_set.is_empty() {
+                    let _ = writeln!(s, "    (the same value at {})", p.also_set.join(", "));
+                }
             }
         }
         let _ = writeln!(s, "\neffects added (in order):");

@@ -1,7 +1,6 @@
-//! How a friction bench is read: the built-in presets (the identification
-//! view of the bench netlists of `fixtures/rigs/`,
-//! [`FrictionBench::from_netlist`], plus what identification needs beyond
-//! the circuit: column map, refit) and rig files — a netlist whose
+//! How a friction bench is read: the built-in presets (the bench netlists of
+//! `fixtures/rigs/` with their identification sections, read as any rig
+//! file is) and rig files — a netlist whose
 //! identification section names the `friction-bench` model
 //! ([`FrictionBench::from_rig`]), or an older `friction-bench` file read
 //! as that netlist (`hydrocyl_system::rig::load` migrates it).
@@ -17,51 +16,10 @@ use hydrocyl_system::netlist::migrate::bench as net;
 /// `fixtures/rigs/` listed in `hydrocyl_system::rig::PRESETS`.
 pub const PRESETS: [&str; 3] = ["tudelft-seal-25", "tudelft-seal-257", "emps"];
 
-/// What identification needs of a bench preset beyond its circuit: where
-/// the signals are in the measured files, which parameters to refit, and the
-/// smoothing velocity of the static law where the netlist's law has none.
-struct Identification {
-    name: &'static str,
-    columns: &'static [(Signal, &'static str)],
-    refit: &'static [&'static str],
-    smoothing_velocity: f64,
-}
-
-const TUDELFT_COLUMNS: &[(Signal, &str)] = &[
-    (Signal::Time, "time_ms [ms]"),
-    (Signal::Position, "position_mm [mm]"),
-    (Signal::P2, "pressure_bar_gauge [bar]"),
-    (Signal::Force, "force_N [N]"),
-];
-const TUDELFT_REFIT: &[&str] = &["friction.coulomb", "friction.sigma0", "friction.viscous"];
-
-const IDENTIFICATION: [Identification; 3] = [
-    Identification {
-        name: "tudelft-seal-25",
-        columns: TUDELFT_COLUMNS,
-        refit: TUDELFT_REFIT,
-        smoothing_velocity: 1e-4,
-    },
-    Identification {
-        name: "tudelft-seal-257",
-        columns: TUDELFT_COLUMNS,
-        refit: TUDELFT_REFIT,
-        smoothing_velocity: 1e-4,
-    },
-    Identification {
-        name: "emps",
-        columns: &[
-            (Signal::Time, "t_s"),
-            (Signal::Position, "qm_motor_position_m"),
-            (Signal::Force, "force_N(=gtau*vir)"),
-        ],
-        refit: &["friction.coulomb", "drive.mass", "friction.viscous"],
-        smoothing_velocity: 1e-3,
-    },
-];
-
-/// A built-in friction-bench preset, or `None`: the identification view
-/// ([`FrictionBench::from_netlist`]) of the netlist preset of that name.
+/// A built-in friction-bench preset, or `None`: the netlist preset of that
+/// name read as its file is ([`FrictionBench::from_rig`]: the circuit's view
+/// and the file's own `identify` section), so the name, the file and its
+/// `--print-rig` are one bench.
 ///
 /// * `tudelft-seal-25` / `tudelft-seal-257`: the TU Delft pneumatic seal
 ///   rig (Zillen 2021), bore 25 mm / 25.7 mm, one chamber at constant gauge
@@ -74,19 +32,17 @@ const IDENTIFICATION: [Identification; 3] = [
 ///   force `gtau · vir` pushes +x, no pressures; declared Coulomb + viscous
 ///   with Fc, b and the moving mass m refitted.
 pub fn preset(name: &str) -> Option<FrictionBench> {
-    let id = IDENTIFICATION.iter().find(|i| i.name == name)?;
-    let v = hydrocyl_system::rig::preset(name)?;
-    let mut rig = FrictionBench::from_netlist(&v, id.smoothing_velocity).ok()?;
-    rig.name = name.into();
-    for (sig, col) in id.columns {
-        rig.columns.0.insert(*sig, (*col).into());
+    if !PRESETS.contains(&name) {
+        return None;
     }
-    rig.refit = id.refit.iter().map(|r| r.to_string()).collect();
-    Some(rig)
+    // the preset file's own identification section (columns, refits, the
+    // LuGre law's smoothing velocity): what its file and `--print-rig` read as
+    FrictionBench::from_rig(&hydrocyl_system::rig::preset(name)?).ok()
 }
 
 /// The law's tanh smoothing velocity \[m/s\] of a rig file's bench whose
-/// netlist law has none (LuGre, `friction_lugre`).
+/// netlist law has none (LuGre, `friction_lugre`) and whose identification
+/// section gives none (`identify.smoothing_velocity`).
 pub const SMOOTHING_VELOCITY: f64 = 1e-3;
 
 /// `true` when a rig value is a friction bench for identification: a
@@ -125,7 +81,8 @@ impl FrictionBench {
                 IdentifyModel::FrictionBench.name()
             ));
         };
-        let mut b = FrictionBench::from_netlist(net, SMOOTHING_VELOCITY)?;
+        let vt = id.smoothing_velocity.unwrap_or(SMOOTHING_VELOCITY);
+        let mut b = FrictionBench::from_netlist(net, vt)?;
         for (role, header) in &id.columns {
             let sig = Signal::from_name(role)
                 .ok_or_else(|| format!("`identify.columns.{role}`: not a measured-data signal"))?;
@@ -566,7 +523,19 @@ mod tests {
             );
             assert_eq!(
                 r.refit,
-                ["friction.coulomb", "friction.sigma0", "friction.viscous"]
+                [
+                    "friction.extending.curve.coulomb",
+                    "friction.sigma0",
+                    "friction.extending.sigma2"
+                ]
+            );
+            assert_eq!(
+                r.refit_params(),
+                [
+                    ParamRef::Coulomb,
+                    ParamRef::Effect(EffectId::LugreDynamics, "sigma0".into()),
+                    ParamRef::Effect(EffectId::Viscous, "b".into())
+                ]
             );
             assert_eq!(r.columns.0[&Signal::Time], "time_ms [ms]");
         }

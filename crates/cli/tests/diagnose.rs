@@ -463,6 +463,14 @@ fn the_lists_partition_the_catalog_on_a_bench_rig() {
             .contains("already on in the declared rig"),
         "{visc}"
     );
+    // the tried effects' parameters by their `--set` paths on this rig
+    let pv = json["effects_applicable"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["id"] == "pressure_viscous")
+        .expect("pressure_viscous listed");
+    assert_eq!(pv["paths"], serde_json::json!(["friction.seal.k_pressure"]));
 }
 
 /// `--effects` naming an effect the loop cannot try says why.

@@ -229,6 +229,31 @@ impl RejectedEffect {
     }
 }
 
+/// The friction bench's effects the loop tried (added or rejected), in
+/// catalog order, each with the `--set` paths of its parameters on the rig
+/// diagnosed ([`FrictionBench::set_paths`]; none where the rig's friction
+/// law has no such parameter, e.g. `stribeck` on a Coulomb + viscous law).
+pub(crate) fn bench_applicable(
+    rig: &FrictionBench,
+    added: &[EffectReport],
+    rejected: &[RejectedEffect],
+) -> Vec<Applicable> {
+    BENCH_EFFECTS
+        .iter()
+        .filter(|e| {
+            added.iter().any(|a| a.id == e.id()) || rejected.iter().any(|r| r.effect.id == e.id())
+        })
+        .map(|e| Applicable {
+            id: e.id().into(),
+            paths: e
+                .params()
+                .iter()
+                .flat_map(|p| rig.set_paths(&ParamRef::Effect(*e, p.name.to_string())))
+                .collect(),
+        })
+        .collect()
+}
+
 /// An effect that applies to the rig, and where it acts.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Applicable {
@@ -308,7 +333,9 @@ pub struct Report {
     /// Catalog effects not tried on this rig, each with the reason.
     pub effects_not_applicable: Vec<NotApplicable>,
     /// The effects that apply to the rig, with the `<component>.<parameter>`
-    /// paths each one writes (netlist rigs; empty for the friction bench).
+    /// paths each one writes (on the friction bench: the effects tried, with
+    /// the `--set` paths of their parameters on the rig, none where its law
+    /// has no such parameter).
     pub effects_applicable: Vec<Applicable>,
     /// Residual sum of squares after, as a share of before.
     pub unexplained_share: f64,

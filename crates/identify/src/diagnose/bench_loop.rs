@@ -807,6 +807,7 @@ pub fn diagnose_bench(
         })
         .collect();
     let rejected: Vec<RejectedEffect> = rejected.into_values().collect();
+    let applicable = bench_applicable(rig, &added, &rejected);
     let report = Report {
         rig: rig.name.clone(),
         rig_kind: "friction-bench".into(),
@@ -827,7 +828,7 @@ pub fn diagnose_bench(
         declared_refit,
         effects_added: added,
         effects_rejected: rejected,
-        effects_applicable: Vec::new(),
+        effects_applicable: applicable,
         simulations: 0,
         effects_not_applicable: not_applicable,
         unexplained_share: rss_after / rss_before.max(1e-300),

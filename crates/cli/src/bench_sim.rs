@@ -57,6 +57,29 @@ pub fn load(
     Ok(Some((bench, net)))
 }
 
+/// `true` when `simulate` runs the rig `spec` on a record's motion
+/// ([`load`], [`simulate`]): a friction-bench rig file whose netlist takes
+/// the record's acceleration or pressures as inputs of their own
+/// (`command_input` components: an older `friction-bench` file, the
+/// netlists of `fixtures/measured/`). A bench preset's netlist (`emps`,
+/// `tudelft-seal-25`), whose one input is the drive's velocity, is
+/// simulated on a command as the preset is, by name, as a file or printed
+/// by `--print-rig`; `diagnose` reads each of them as the same bench.
+pub fn runs_on_motion(spec: &str) -> bool {
+    use hydrocyl_system::rig;
+    rig::preset(spec).is_none()
+        && rig::load(spec).is_ok_and(|v| {
+            bench::is_bench_rig(&v)
+                && v.get("components")
+                    .and_then(|c| c.as_object())
+                    .is_some_and(|c| {
+                        c.values().any(|i| {
+                            i.get("type").and_then(|t| t.as_str()) == Some("command_input")
+                        })
+                    })
+        })
+}
+
 /// Simulates `bench` on the motion in `input`; returns the output CSV text.
 pub fn simulate(bench: &FrictionBench, input: &Path) -> Result<String, CliError> {
     let mut rec =

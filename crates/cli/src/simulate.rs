@@ -386,8 +386,10 @@ fn budget_message(rk4_step: f64, span: f64, max: usize) -> String {
 /// Runs `hydrocyl simulate`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let rig_err = |e: rig::RigError| CliError::Input(e.to_string());
-    if let Some((bench, net)) = crate::bench_sim::load(&args.rig, &args.set)? {
-        return run_bench(&args, &bench, &net);
+    if crate::bench_sim::runs_on_motion(&args.rig) {
+        if let Some((bench, net)) = crate::bench_sim::load(&args.rig, &args.set)? {
+            return run_bench(&args, &bench, &net);
+        }
     }
     // the command file is read (and parsed once the rig's unit is known) on
     // a thread of its own while the rig is read and checked

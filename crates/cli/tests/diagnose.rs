@@ -463,6 +463,14 @@ fn the_lists_partition_the_catalog_on_a_bench_rig() {
             .contains("already on in the declared rig"),
         "{visc}"
     );
+    // the tried effects' parameters by their `--set` paths on this rig
+    let pv = json["effects_applicable"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["id"] == "pressure_viscous")
+        .expect("pressure_viscous listed");
+    assert_eq!(pv["paths"], serde_json::json!(["friction.seal.k_pressure"]));
 }
 
 /// `--effects` naming an effect the loop cannot try says why.
@@ -588,4 +596,90 @@ fn a_record_without_p2_says_p2_is_not_compared() {
     assert_eq!(p["channel"], "p2");
     assert_eq!(p["kind"], "missing");
     assert!(json["nrmse_after"].get("p2").is_none());
+}
+
+/// A bench preset's file (`fixtures/rigs/<name>.json`) and its printout
+/// (`simulate --rig <name> --print-rig`) diagnose as its name does: the
+/// identification section is in the file, so the three give one report
+/// (JSON equal apart from the times taken), on a short record in the
+/// preset's own column names. Each declared refit is named by a `--set`
+/// path of the preset, which `simulate --set` takes.
+#[test]
+fn a_bench_presets_file_and_printout_diagnose_as_its_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let rigs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/rigs");
+    let (n, dt) = (400, 5e-3);
+    let w = 2.0 * std::f64::consts::PI * 0.8;
+    let motion = |i: usize| {
+        let t = i as f64 * dt;
+        let v = 0.08 * (w * t).sin();
+        let x = -0.08 / w * (w * t).cos();
+        let a = 0.08 * w * (w * t).cos();
+        let wiggle = 0.3 * (37.0 * t).sin();
+        (t, x, v, a, wiggle)
+    };
+    let emps = dir.path().join("emps.csv");
+    let mut text = String::from("t_s,qm_motor_position_m,force_N(=gtau*vir)\n");
+    for i in 0..n {
+        let (t, x, v, a, e) = motion(i);
+        let f = 60.0 * a + 12.0 * (v / 1e-3).tanh() + 130.0 * v + e;
+        text.push_str(&format!("{t},{x},{f}\n"));
+    }
+    std::fs::write(&emps, text).unwrap();
+    let seal = dir.path().join("seal.csv");
+    let mut text =
+        String::from("time_ms [ms],position_mm [mm],pressure_bar_gauge [bar],force_N [N]\n");
+    let area = std::f64::consts::PI * 0.0125f64.powi(2);
+    for i in 0..n {
+        let (t, x, v, _, e) = motion(i);
+        let f = 3e5 * area + 4.5 * (v / 1e-4).tanh() + 40.0 * v + 0.1 * e;
+        text.push_str(&format!("{},{},3,{f}\n", 1e3 * t, 1e3 * x));
+    }
+    std::fs::write(&seal, text).unwrap();
+    for (name, data) in [("emps", &emps), ("tudelft-seal-25", &seal)] {
+        let printed = dir.path().join(format!("{name}.printed.json"));
+        let out = bin()
+            .args(["simulate", "--rig", name, "--print-rig"])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        std::fs::write(&printed, &out.stdout).unwrap();
+        let file = rigs.join(format!("{name}.json"));
+        let report = |rig: &std::ffi::OsStr| {
+            let mut r = diagnose_json(&[
+                "--rig".as_ref(),
+                rig,
+                "--data".as_ref(),
+                data.as_os_str(),
+                "--effects".as_ref(),
+                "external_force".as_ref(),
+            ]);
+            let m = r.as_object_mut().unwrap();
+            m.remove("wall_times_s");
+            m.remove("elapsed_s");
+            r
+        };
+        let by_name = report(name.as_ref());
+        assert_eq!(report(file.as_os_str()), by_name, "{name}: file");
+        assert_eq!(report(printed.as_os_str()), by_name, "{name}: --print-rig");
+        let refits = by_name["declared_refit"].as_array().unwrap();
+        assert_eq!(refits.len(), 3, "{name}: {refits:?}");
+        for r in refits {
+            let path = r["name"].as_str().unwrap();
+            let set = format!("{path}={}", r["fitted"]);
+            let out = bin()
+                .args(["simulate", "--rig", name, "--print-rig", "--set", &set])
+                .output()
+                .unwrap();
+            assert!(
+                out.status.success(),
+                "{name}: --set {set}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+    }
 }

@@ -294,7 +294,14 @@ fn channel_problem(
         .find(|(c, _)| *c == s)
         .and_then(|(_, r)| *r);
     let many_levels = coarse.is_some_and(|(_, levels)| levels as f64 >= COARSE_LEVELS);
-    for (count, v, which) in [(at_hi, hi, "maximum"), (at_lo, lo, "minimum")] {
+    // a run at the extreme from the record's first sample is the piston (or
+    // a pressure) at rest before anything moves, not a saturated sensor:
+    // only the samples at the extreme after the channel first leaves it count
+    let lead = |v: f64| y.iter().take_while(|x| (**x - v).abs() <= tol).count() as f64;
+    for (count, v, which) in [
+        (at_hi - lead(hi), hi, "maximum"),
+        (at_lo - lead(lo), lo, "minimum"),
+    ] {
         if many_levels
             && count >= (CLIP_SHARE * n).max(5.0)
             && !physical(v)
@@ -692,6 +699,36 @@ mod tests {
             (Signal::P2, coarse),
         ]);
         assert_eq!(k, [("p2".to_string(), ProblemKind::Quantised)]);
+    }
+
+    /// A noise-free record whose piston rests at its lowest position for
+    /// the first 5 % of the samples before it moves is not clipped; the same
+    /// record clipped after it has moved (at the top, or at the bottom on
+    /// each cycle) still is.
+    #[test]
+    fn a_rest_at_the_records_start_is_not_clipping() {
+        let n = 2000;
+        let w = 2.0 * std::f64::consts::PI * 0.7;
+        let x: Vec<f64> = (0..n)
+            .map(|i| {
+                let t = (i as f64 * 1e-3 - 0.1).max(0.0);
+                0.05 * (1.0 - (w * t).cos()) + 0.01 * t
+            })
+            .collect();
+        let kinds = |x: Vec<f64>| -> Vec<(String, ProblemKind)> {
+            check_record(&rec(&[(Signal::Position, x)]), None)
+                .into_iter()
+                .map(|p| (p.channel, p.kind))
+                .collect()
+        };
+        assert_eq!(kinds(x.clone()), vec![]);
+        let top: Vec<f64> = x.iter().map(|v| v.min(0.08)).collect();
+        assert_eq!(kinds(top), [("position".to_string(), ProblemKind::Clipped)]);
+        let bottom: Vec<f64> = x.iter().map(|v| (v - 0.03).max(0.0)).collect();
+        assert_eq!(
+            kinds(bottom),
+            [("position".to_string(), ProblemKind::Clipped)]
+        );
     }
 
     #[test]

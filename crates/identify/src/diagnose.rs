@@ -229,6 +229,31 @@ impl RejectedEffect {
     }
 }
 
+/// The friction bench's effects the loop tried (added or rejected), in
+/// catalog order, each with the `--set` paths of its parameters on the rig
+/// diagnosed ([`FrictionBench::set_paths`]; none where the rig's friction
+/// law has no such parameter, e.g. `stribeck` on a Coulomb + viscous law).
+pub(crate) fn bench_applicable(
+    rig: &FrictionBench,
+    added: &[EffectReport],
+    rejected: &[RejectedEffect],
+) -> Vec<Applicable> {
+    BENCH_EFFECTS
+        .iter()
+        .filter(|e| {
+            added.iter().any(|a| a.id == e.id()) || rejected.iter().any(|r| r.effect.id == e.id())
+        })
+        .map(|e| Applicable {
+            id: e.id().into(),
+            paths: e
+                .params()
+                .iter()
+                .flat_map(|p| rig.set_paths(&ParamRef::Effect(*e, p.name.to_string())))
+                .collect(),
+        })
+        .collect()
+}
+
 /// An effect that applies to the rig, and where it acts.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Applicable {
@@ -251,8 +276,15 @@ pub struct NotApplicable {
 /// One fitted declared parameter.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ParamReport {
-    /// `Fc`, `m` or `effect.param`.
+    /// Its `--set` path on the rig diagnosed (`friction.coulomb`,
+    /// `drive.mass`, `friction.extending.curve.coulomb`), so the fitted
+    /// value goes back with `--set <name>=<fitted>`.
     pub name: String,
+    /// The rig's other `--set` paths that hold the same parameter and take
+    /// the same value (a law with one set per direction, `friction_lugre`:
+    /// the retracting curve's); absent from the JSON when there are none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub also_set: Vec<String>,
     /// Declared value.
     pub declared: f64,
     /// Value after the final refit.
@@ -301,7 +333,9 @@ pub struct Report {
     /// Catalog effects not tried on this rig, each with the reason.
     pub effects_not_applicable: Vec<NotApplicable>,
     /// The effects that apply to the rig, with the `<component>.<parameter>`
-    /// paths each one writes (netlist rigs; empty for the friction bench).
+    /// paths each one writes (on the friction bench: the effects tried, with
+    /// the `--set` paths of their parameters on the rig, none where its law
+    /// has no such parameter).
     pub effects_applicable: Vec<Applicable>,
     /// Residual sum of squares after, as a share of before.
     pub unexplained_share: f64,
@@ -554,15 +588,25 @@ impl Report {
         }
         if !self.declared_refit.is_empty() {
             let _ = writeln!(s, "\ndeclared parameters refitted:");
+            let w = self
+                .declared_refit
+                .iter()
+                .map(|p| p.name.chars().count())
+                .max()
+                .unwrap_or(0)
+                .max(24);
             for p in &self.declared_refit {
                 let _ = writeln!(
                     s,
-                    "  {:<24} {:>12.5e} -> {:>12.5e} ± {}",
+                    "  {:<w$} {:>12.5e} -> {:>12.5e} ± {}",
                     p.name,
                     p.declared,
                     p.fitted,
                     fmt_ci(p.ci95)
                 );
+                if !p.also_set.is_empty() {
+                    let _ = writeln!(s, "    (the same value at {})", p.also_set.join(", "));
+                }
             }
         }
         let _ = writeln!(s, "\neffects added (in order):");

@@ -70,6 +70,7 @@ pub fn base_rig() -> FrictionBench {
         },
         refit: vec![],
         columns: ColumnMap::default(),
+        paths: Default::default(),
         steady_state: false,
     }
 }

@@ -245,7 +245,7 @@ fn unaccepted(o: &Outcome) -> String {
     let fc = r
         .declared_refit
         .iter()
-        .find(|p| p.name == "Fc")
+        .find(|p| o.rig.param(&p.name) == Some(hydrocyl_identify::bench::ParamRef::Coulomb))
         .map_or(o.rig.friction.coulomb, |p| p.fitted);
     let bad: Vec<String> = r
         .effects_added
@@ -289,21 +289,21 @@ fn real_data(s: &mut Section) {
                 let rel = |a: f64, b: f64| (a / b - 1.0).abs();
                 s.check(
                     "EMPS mass m [kg]",
-                    format!("{:.2}", get("m")),
+                    format!("{:.2}", get("drive.mass")),
                     "95.11 (IDIM-LS), within 3 %".into(),
-                    rel(get("m"), 95.1089) < 0.03,
+                    rel(get("drive.mass"), 95.1089) < 0.03,
                 );
                 s.check(
                     "EMPS viscous b [N s/m]",
-                    format!("{:.1}", get("viscous.b")),
+                    format!("{:.1}", get("friction.viscous")),
                     "203.5 (IDIM-LS), within 5 %".into(),
-                    rel(get("viscous.b"), 203.5034) < 0.05,
+                    rel(get("friction.viscous"), 203.5034) < 0.05,
                 );
                 s.check(
                     "EMPS Coulomb Fc [N]",
-                    format!("{:.2}", get("Fc")),
+                    format!("{:.2}", get("friction.coulomb")),
                     "20.39 (IDIM-LS), within 5 %".into(),
-                    rel(get("Fc"), 20.3935) < 0.05,
+                    rel(get("friction.coulomb"), 20.3935) < 0.05,
                 );
                 let off = r
                     .effects_added

@@ -126,6 +126,13 @@ pub struct FrictionBench {
     /// Where the signals are in files whose headers are not the format's.
     #[serde(default)]
     pub columns: ColumnMap,
+    /// The `--set` paths of the parameters in the rig's own netlist where
+    /// they are not [`ParamRef::path`] (a law other than `friction_bench`,
+    /// components named otherwise): each parameter's paths, two for a law
+    /// with one set per direction (`friction_lugre`); none for an effect
+    /// the rig's law does not have. Filled by [`FrictionBench::from_netlist`].
+    #[serde(skip)]
+    pub paths: BTreeMap<ParamRef, Vec<String>>,
 }
 
 fn bench_kind() -> String {
@@ -297,7 +304,7 @@ impl FrictionBench {
             }
         }
         for r in &self.refit {
-            let p = ParamRef::parse(r).ok_or_else(|| RigError::Parameter {
+            let p = self.param(r).ok_or_else(|| RigError::Parameter {
                 place: "refit".into(),
                 reason: format!(
                     "'{r}' is not a bench parameter (`friction.coulomb`, `drive.mass`, `friction.<parameter>`, or Fc, m, effect.param)"
@@ -320,6 +327,45 @@ impl FrictionBench {
         let rig: FrictionBench = serde_json::from_str(text).map_err(|e| e.to_string())?;
         rig.validate().map_err(|e| e.to_string())?;
         Ok(rig)
+    }
+
+    /// The parameter a refit entry names: a `--set` path of the rig's
+    /// netlist ([`FrictionBench::set_paths`]), else [`ParamRef::parse`].
+    pub fn param(&self, s: &str) -> Option<ParamRef> {
+        self.paths
+            .iter()
+            .find(|(_, ps)| ps.iter().any(|q| q == s))
+            .map(|(p, _)| p.clone())
+            .or_else(|| ParamRef::parse(s))
+    }
+
+    /// The `--set` paths of parameter `p` in the rig's netlist (so a fitted
+    /// value can be fed back with `--set <path>=<value>`): [`ParamRef::path`]
+    /// unless the rig's netlist holds it elsewhere (two paths for a law with
+    /// one set per direction, none for an effect its law does not have).
+    pub fn set_paths(&self, p: &ParamRef) -> Vec<String> {
+        self.paths.get(p).cloned().unwrap_or_else(|| vec![p.path()])
+    }
+
+    /// Its name in reports: its first `--set` path on this rig, or its
+    /// catalog name ([`ParamRef::label`]) where the rig's netlist has none.
+    pub fn name_of(&self, p: &ParamRef) -> String {
+        self.set_paths(p)
+            .into_iter()
+            .next()
+            .unwrap_or_else(|| p.label())
+    }
+
+    /// The parameters the rig's `refit` names ([`FrictionBench::param`]),
+    /// each once, in the order first named.
+    pub fn refit_params(&self) -> Vec<ParamRef> {
+        let mut out: Vec<ParamRef> = Vec::new();
+        for p in self.refit.iter().filter_map(|s| self.param(s)) {
+            if !out.contains(&p) {
+                out.push(p);
+            }
+        }
+        out
     }
 
     /// `true` when effect `id` is on.

@@ -4,7 +4,7 @@
 //! acceleration and pressures, run through the one run path
 //! ([`Simulation`]); the predicted load-cell force at every sample.
 
-use super::{BenchSignals, FrictionBench};
+use super::{BenchSignals, FrictionBench, ParamRef};
 use crate::catalog::EffectId;
 use hydrocyl_system::netlist::{self, migrate::bench as net};
 use hydrocyl_system::run::{RunOptions, Solver};
@@ -66,7 +66,11 @@ impl FrictionBench {
     /// ([`net::to_netlist`] of its declaration): what a bench rig file holds
     /// (`make_fixtures` writes it, [`FrictionBench::from_rig`] reads it back).
     pub fn netlist(&self) -> Result<serde_json::Value, String> {
-        let v = serde_json::to_value(self).map_err(|e| e.to_string())?;
+        // the refits as the bench circuit's paths (a preset names them by
+        // its own netlist's, `friction.extending.curve.coulomb`)
+        let mut b = self.clone();
+        b.refit = self.refit_params().iter().map(ParamRef::path).collect();
+        let v = serde_json::to_value(&b).map_err(|e| e.to_string())?;
         net::to_netlist(&v).map_err(|e| e.to_string())
     }
 
@@ -371,6 +375,7 @@ mod tests {
             },
             refit: vec![],
             columns: ColumnMap::default(),
+            paths: Default::default(),
             steady_state: false,
         }
     }

@@ -1,14 +1,13 @@
-//! How a friction bench is read: the built-in presets (the identification
-//! view of the bench netlists of `fixtures/rigs/`,
-//! [`FrictionBench::from_netlist`], plus what identification needs beyond
-//! the circuit: column map, refit) and rig files — a netlist whose
+//! How a friction bench is read: the built-in presets (the bench netlists of
+//! `fixtures/rigs/` with their identification sections, read as any rig
+//! file is) and rig files — a netlist whose
 //! identification section names the `friction-bench` model
 //! ([`FrictionBench::from_rig`]), or an older `friction-bench` file read
 //! as that netlist (`hydrocyl_system::rig::load` migrates it).
 
 use std::collections::BTreeMap;
 
-use super::{BenchFriction, FrictionBench, KIND};
+use super::{BenchFriction, FrictionBench, ParamRef, KIND};
 use crate::catalog::EffectId;
 use crate::data::{ColumnMap, Signal};
 use hydrocyl_system::netlist::migrate::bench as net;
@@ -17,51 +16,10 @@ use hydrocyl_system::netlist::migrate::bench as net;
 /// `fixtures/rigs/` listed in `hydrocyl_system::rig::PRESETS`.
 pub const PRESETS: [&str; 3] = ["tudelft-seal-25", "tudelft-seal-257", "emps"];
 
-/// What identification needs of a bench preset beyond its circuit: where
-/// the signals are in the measured files, which parameters to refit, and the
-/// smoothing velocity of the static law where the netlist's law has none.
-struct Identification {
-    name: &'static str,
-    columns: &'static [(Signal, &'static str)],
-    refit: &'static [&'static str],
-    smoothing_velocity: f64,
-}
-
-const TUDELFT_COLUMNS: &[(Signal, &str)] = &[
-    (Signal::Time, "time_ms [ms]"),
-    (Signal::Position, "position_mm [mm]"),
-    (Signal::P2, "pressure_bar_gauge [bar]"),
-    (Signal::Force, "force_N [N]"),
-];
-const TUDELFT_REFIT: &[&str] = &["friction.coulomb", "friction.sigma0", "friction.viscous"];
-
-const IDENTIFICATION: [Identification; 3] = [
-    Identification {
-        name: "tudelft-seal-25",
-        columns: TUDELFT_COLUMNS,
-        refit: TUDELFT_REFIT,
-        smoothing_velocity: 1e-4,
-    },
-    Identification {
-        name: "tudelft-seal-257",
-        columns: TUDELFT_COLUMNS,
-        refit: TUDELFT_REFIT,
-        smoothing_velocity: 1e-4,
-    },
-    Identification {
-        name: "emps",
-        columns: &[
-            (Signal::Time, "t_s"),
-            (Signal::Position, "qm_motor_position_m"),
-            (Signal::Force, "force_N(=gtau*vir)"),
-        ],
-        refit: &["friction.coulomb", "drive.mass", "friction.viscous"],
-        smoothing_velocity: 1e-3,
-    },
-];
-
-/// A built-in friction-bench preset, or `None`: the identification view
-/// ([`FrictionBench::from_netlist`]) of the netlist preset of that name.
+/// A built-in friction-bench preset, or `None`: the netlist preset of that
+/// name read as its file is ([`FrictionBench::from_rig`]: the circuit's view
+/// and the file's own `identify` section), so the name, the file and its
+/// `--print-rig` are one bench.
 ///
 /// * `tudelft-seal-25` / `tudelft-seal-257`: the TU Delft pneumatic seal
 ///   rig (Zillen 2021), bore 25 mm / 25.7 mm, one chamber at constant gauge
@@ -74,19 +32,17 @@ const IDENTIFICATION: [Identification; 3] = [
 ///   force `gtau · vir` pushes +x, no pressures; declared Coulomb + viscous
 ///   with Fc, b and the moving mass m refitted.
 pub fn preset(name: &str) -> Option<FrictionBench> {
-    let id = IDENTIFICATION.iter().find(|i| i.name == name)?;
-    let v = hydrocyl_system::rig::preset(name)?;
-    let mut rig = FrictionBench::from_netlist(&v, id.smoothing_velocity).ok()?;
-    rig.name = name.into();
-    for (sig, col) in id.columns {
-        rig.columns.0.insert(*sig, (*col).into());
+    if !PRESETS.contains(&name) {
+        return None;
     }
-    rig.refit = id.refit.iter().map(|r| r.to_string()).collect();
-    Some(rig)
+    // the preset file's own identification section (columns, refits, the
+    // LuGre law's smoothing velocity): what its file and `--print-rig` read as
+    FrictionBench::from_rig(&hydrocyl_system::rig::preset(name)?).ok()
 }
 
 /// The law's tanh smoothing velocity \[m/s\] of a rig file's bench whose
-/// netlist law has none (LuGre, `friction_lugre`).
+/// netlist law has none (LuGre, `friction_lugre`) and whose identification
+/// section gives none (`identify.smoothing_velocity`).
 pub const SMOOTHING_VELOCITY: f64 = 1e-3;
 
 /// `true` when a rig value is a friction bench for identification: a
@@ -125,7 +81,8 @@ impl FrictionBench {
                 IdentifyModel::FrictionBench.name()
             ));
         };
-        let mut b = FrictionBench::from_netlist(net, SMOOTHING_VELOCITY)?;
+        let vt = id.smoothing_velocity.unwrap_or(SMOOTHING_VELOCITY);
+        let mut b = FrictionBench::from_netlist(net, vt)?;
         for (role, header) in &id.columns {
             let sig = Signal::from_name(role)
                 .ok_or_else(|| format!("`identify.columns.{role}`: not a measured-data signal"))?;
@@ -276,7 +233,7 @@ impl FrictionBench {
         if h != 0.0 {
             on(EffectId::AccelerationFriction, &[("H", h)]);
         }
-        let rig = FrictionBench {
+        let mut rig = FrictionBench {
             kind: KIND.into(),
             name: s.name.clone(),
             area1,
@@ -291,7 +248,66 @@ impl FrictionBench {
             steady_state: false,
             refit: Vec::new(),
             columns: ColumnMap::default(),
+            paths: BTreeMap::new(),
         };
+        // where each parameter is in this netlist (its `--set` paths),
+        // kept where that is not the bench circuit's path
+        let stribeck = rig.has(EffectId::Stribeck);
+        let at = |q: &str| format!("{}.{q}", law.name);
+        let both = |q: &str| {
+            vec![
+                at(&format!("extending.{q}")),
+                at(&format!("retracting.{q}")),
+            ]
+        };
+        let law_paths = |p: &ParamRef| -> Vec<String> {
+            let seal = |q: &str| law.ty.param(q).map_or_else(Vec::new, |_| vec![at(q)]);
+            match (law.ty.name, p) {
+                (_, ParamRef::Mass) => vec![format!("{}.mass", drive.name)],
+                ("friction_bench", p) => {
+                    let path = p.path();
+                    vec![at(path.split_once('.').map_or("", |(_, q)| q))]
+                }
+                ("friction_coulomb_viscous", ParamRef::Coulomb) => vec![at("coulomb")],
+                ("friction_coulomb_viscous", ParamRef::Effect(EffectId::Viscous, _)) => {
+                    vec![at("viscous")]
+                }
+                // no Stribeck hump: the stiction level is the Coulomb level
+                ("friction_lugre", ParamRef::Coulomb) if !stribeck => {
+                    [both("curve.coulomb"), both("curve.stiction")].concat()
+                }
+                ("friction_lugre", ParamRef::Coulomb) => both("curve.coulomb"),
+                ("friction_lugre", ParamRef::Effect(id, q)) => match (id, q.as_str()) {
+                    (EffectId::Stribeck, "Fs") => both("curve.stiction"),
+                    (EffectId::Stribeck, "vs") => both("curve.stribeck_velocity"),
+                    (EffectId::Stribeck, "alpha") => both("curve.stribeck_exponent"),
+                    (EffectId::LugreDynamics, q) => vec![at(q)],
+                    (EffectId::Viscous, _) => both("sigma2"),
+                    (EffectId::PressureViscous, _) => seal("seal.k_pressure"),
+                    (EffectId::AccelerationFriction, _) => seal("seal.h_acceleration"),
+                    _ => Vec::new(),
+                },
+                (_, ParamRef::Effect(EffectId::PressureViscous, _)) => seal("seal.k_pressure"),
+                (_, ParamRef::Effect(EffectId::AccelerationFriction, _)) => {
+                    seal("seal.h_acceleration")
+                }
+                _ => Vec::new(),
+            }
+        };
+        let mut all = vec![ParamRef::Coulomb, ParamRef::Mass];
+        for id in super::BENCH_EFFECTS {
+            all.extend(
+                id.params()
+                    .iter()
+                    .map(|q| ParamRef::Effect(id, q.name.to_string())),
+            );
+        }
+        for p in all {
+            let ps = law_paths(&p);
+            if ps != [p.path()] {
+                rig.paths.insert(p, ps);
+            }
+        }
         rig.validate().map_err(|e| e.to_string())?;
         Ok(rig)
     }
@@ -371,6 +387,99 @@ mod tests {
         }
     }
 
+    /// Every declared refit the report names is a `--set` path of the rig
+    /// it was run on (with the rig's other paths of the same parameter), so
+    /// the fitted value goes back with `--set <name>=<fitted>`: on the
+    /// `emps` preset (Coulomb + viscous law), `tudelft-seal-25` (LuGre, one
+    /// set per direction) and a `friction_bench` rig file. Each path is one
+    /// `rig::parameters` lists, setting it gives the bench the fitted value
+    /// and changes the run.
+    #[test]
+    fn declared_refits_are_named_by_their_set_paths() {
+        use crate::diagnose::{diagnose_bench, DiagnoseOptions};
+        let table = json(&fixtures().join("measured/wang-table-5-3.steady.rig.json"));
+        let rigs = [
+            ("emps", hydrocyl_system::rig::preset("emps").unwrap()),
+            (
+                "tudelft-seal-25",
+                hydrocyl_system::rig::preset("tudelft-seal-25").unwrap(),
+            ),
+            ("wang-table-5-3", table),
+        ];
+        for (name, net) in rigs {
+            let rig = match preset(name) {
+                Some(r) => r,
+                None => FrictionBench::from_rig(&net).unwrap(),
+            };
+            // a record of the rig with its refitted parameters moved
+            let mut truth = rig.clone();
+            for p in rig.refit_params() {
+                truth.set(&p, 1.3 * rig.get(&p) + 1.0);
+            }
+            truth.steady_state = false;
+            let mut declared = rig.clone();
+            declared.steady_state = false;
+            let rec = crate::synth::record(
+                &truth,
+                400,
+                5e-3,
+                crate::synth::Noise::default(),
+                crate::synth::Foreign::None,
+                7,
+            );
+            let opts = DiagnoseOptions {
+                candidates: Some(vec![]),
+                ..DiagnoseOptions::default()
+            };
+            let out = diagnose_bench(
+                &declared,
+                std::slice::from_ref(&rec),
+                &opts,
+                &mut |_, _, _| {},
+            )
+            .unwrap();
+            let refits = &out.report.declared_refit;
+            assert_eq!(refits.len(), rig.refit_params().len(), "{name}");
+            let listed: Vec<String> = hydrocyl_system::rig::parameters(&net)
+                .into_iter()
+                .map(|p| p.path)
+                .collect();
+            let (sigs, _) = crate::bench::bench_signals(&rec, None, false).unwrap();
+            let inputs = crate::bench::BenchInputs::of(&sigs).unwrap();
+            let before = declared.simulate(&sigs, &inputs).unwrap();
+            for r in refits {
+                let p = rig
+                    .param(&r.name)
+                    .unwrap_or_else(|| panic!("{name}: {}", r.name));
+                let mut set = net.clone();
+                for path in std::iter::once(&r.name).chain(&r.also_set) {
+                    assert!(listed.contains(path), "{name}: {path} not in {listed:?}");
+                    hydrocyl_system::rig::apply_set(&mut set, &format!("{path}={}", r.fitted))
+                        .unwrap_or_else(|e| panic!("{name}: --set {path}: {e}"));
+                }
+                let mut b =
+                    FrictionBench::from_netlist(&set, rig.friction.smoothing_velocity).unwrap();
+                // to the last digit serde_json's reading of the number keeps
+                let x = b.get(&p);
+                assert!(
+                    (x - r.fitted).abs() <= 1e-12 * r.fitted.abs(),
+                    "{name}: {}: {x} != {}",
+                    r.name,
+                    r.fitted
+                );
+                assert_eq!(
+                    b.friction.effects.keys().collect::<Vec<_>>(),
+                    rig.friction.effects.keys().collect::<Vec<_>>(),
+                    "{name}: {}",
+                    r.name
+                );
+                b.steady_state = false;
+                let after = b.simulate(&sigs, &inputs).unwrap();
+                assert_ne!(after, before, "{name}: --set {} changes nothing", r.name);
+            }
+        }
+    }
+
     /// A netlist that is not a friction bench is refused by path.
     #[test]
     fn a_cylinder_netlist_is_not_a_bench() {
@@ -414,7 +523,19 @@ mod tests {
             );
             assert_eq!(
                 r.refit,
-                ["friction.coulomb", "friction.sigma0", "friction.viscous"]
+                [
+                    "friction.extending.curve.coulomb",
+                    "friction.sigma0",
+                    "friction.extending.sigma2"
+                ]
+            );
+            assert_eq!(
+                r.refit_params(),
+                [
+                    ParamRef::Coulomb,
+                    ParamRef::Effect(EffectId::LugreDynamics, "sigma0".into()),
+                    ParamRef::Effect(EffectId::Viscous, "b".into())
+                ]
             );
             assert_eq!(r.columns.0[&Signal::Time], "time_ms [ms]");
         }

@@ -13,14 +13,12 @@ fn declared_on_why(rig: &FrictionBench, e: EffectId) -> String {
         .iter()
         .map(|p| {
             let r = ParamRef::Effect(e, p.name.to_string());
-            format!("{} = {:.4e}", r.path(), rig.get(&r))
+            format!("{} = {:.4e}", rig.name_of(&r), rig.get(&r))
         })
         .collect();
     let refitted = e.params().iter().any(|p| {
         let r = ParamRef::Effect(e, p.name.to_string());
-        rig.refit
-            .iter()
-            .any(|s| ParamRef::parse(s).as_ref() == Some(&r))
+        rig.refit_params().contains(&r)
     });
     format!(
         "already on in the declared rig ({}): the loop adds only effects that are off ({})",
@@ -53,7 +51,7 @@ fn fitted_params(
                 effect,
                 name: match p {
                     ParamRef::Effect(_, n) => n.clone(),
-                    _ => p.label(),
+                    _ => model.name_of(p),
                 },
                 value: res.x[k],
                 ci95: res.ci95.get(k).copied().unwrap_or(f64::NAN),
@@ -472,11 +470,7 @@ pub fn diagnose_bench(
     let nrmse_declared = channel(rig);
     // Declared refit.
     let mut model = rig.clone();
-    let refit: Vec<ParamRef> = rig
-        .refit
-        .iter()
-        .filter_map(|s| ParamRef::parse(s))
-        .collect();
+    let refit: Vec<ParamRef> = rig.refit_params();
     let total_steps = 2 + opts.max_effects;
     progress("declared refit", 0, total_steps);
     if !refit.is_empty() {
@@ -761,7 +755,8 @@ pub fn diagnose_bench(
                     }
                 }
                 _ => declared_refit.push(ParamReport {
-                    name: p.label(),
+                    name: rig.name_of(p),
+                    also_set: rig.set_paths(p).into_iter().skip(1).collect(),
                     declared: rig.get(p),
                     fitted: *x,
                     ci95: ci.is_finite().then_some(*ci),
@@ -812,6 +807,7 @@ pub fn diagnose_bench(
         })
         .collect();
     let rejected: Vec<RejectedEffect> = rejected.into_values().collect();
+    let applicable = bench_applicable(rig, &added, &rejected);
     let report = Report {
         rig: rig.name.clone(),
         rig_kind: "friction-bench".into(),
@@ -832,7 +828,7 @@ pub fn diagnose_bench(
         declared_refit,
         effects_added: added,
         effects_rejected: rejected,
-        effects_applicable: Vec::new(),
+        effects_applicable: applicable,
         simulations: 0,
         effects_not_applicable: not_applicable,
         unexplained_share: rss_after / rss_before.max(1e-300),

@@ -28,6 +28,9 @@
 //! * `steady_state` (friction-bench only, default false): each sample is a
 //!   steady state (a table of velocity against force): the measured velocity
 //!   is used as it is and the acceleration is zero.
+//! * `smoothing_velocity` (friction-bench only, m/s, > 0): the velocity of
+//!   the static law's tanh where the circuit's friction law has none
+//!   (`friction_lugre`; default 1e-3).
 //!
 //! The reader checks every key, role, path and type; each error names its
 //! JSON path (`identify.refit[1]`).
@@ -53,7 +56,13 @@ pub const COLUMN_ROLES: [&str; 10] = [
 ];
 
 /// The keys of the identification section.
-const KEYS: [&str; 4] = ["model", "columns", "refit", "steady_state"];
+const KEYS: [&str; 5] = [
+    "model",
+    "columns",
+    "refit",
+    "steady_state",
+    "smoothing_velocity",
+];
 
 /// The model `diagnose` builds from a netlist.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -87,6 +96,9 @@ pub struct Identify {
     pub refit: Vec<String>,
     /// Each sample is a steady state.
     pub steady_state: bool,
+    /// The static law's tanh smoothing velocity \[m/s\] where the bench's
+    /// friction law has none (`friction_lugre`); `None`: the default.
+    pub smoothing_velocity: Option<f64>,
 }
 
 fn err<T>(path: impl Into<String>, why: impl Into<String>) -> Result<T, NetlistError> {
@@ -169,6 +181,18 @@ pub fn read(v: &Value, instances: &[Instance]) -> Result<Identify, NetlistError>
             )
         }
     };
+    let smoothing_velocity = match m.get("smoothing_velocity") {
+        None => None,
+        Some(Value::Number(n)) if n.as_f64().is_some_and(|x| x.is_finite() && x > 0.0) => {
+            n.as_f64()
+        }
+        Some(other) => {
+            return err(
+                "identify.smoothing_velocity",
+                format!("must be a number > 0 [m/s], got {other}"),
+            )
+        }
+    };
     if model == IdentifyModel::Cylinder {
         let only = |key: &str| {
             err(
@@ -182,12 +206,16 @@ pub fn read(v: &Value, instances: &[Instance]) -> Result<Identify, NetlistError>
         if steady_state {
             return only("steady_state");
         }
+        if smoothing_velocity.is_some() {
+            return only("smoothing_velocity");
+        }
     }
     Ok(Identify {
         model,
         columns,
         refit,
         steady_state,
+        smoothing_velocity,
     })
 }
 

@@ -52,7 +52,9 @@ pub struct Args {
     /// Print nothing but errors.
     #[arg(long)]
     pub quiet: bool,
-    /// Show a progress bar even when stderr is not a terminal.
+    /// Show progress when stderr is not a terminal too (a CI log, a file):
+    /// there as plain lines, one every 5 s at most after the first second,
+    /// not a redrawn bar (on a terminal a bar shows without this flag).
     #[arg(long)]
     pub progress: bool,
 }

@@ -144,7 +144,9 @@ pub struct Args {
     /// Flush the output to the disk (fsync) before it is renamed into place.
     #[arg(long)]
     fsync: bool,
-    /// Show a progress bar even when stderr is not a terminal.
+    /// Show progress when stderr is not a terminal too (a CI log, a file):
+    /// there as plain lines, one every 5 s at most after the first second,
+    /// not a redrawn bar (on a terminal a bar shows without this flag).
     #[arg(long)]
     progress: bool,
     /// Print nothing but errors (no progress, no warnings, no summary).

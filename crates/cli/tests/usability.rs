@@ -69,3 +69,67 @@ fn progress_shows_as_plain_lines_when_stderr_is_not_a_terminal() {
         "{without:?}"
     );
 }
+
+/// `hydrocyl simulate` with `args`, expected to fail: its one stderr line
+/// (exit code 2), the output `out` not written.
+fn simulate_fails(args: &[&str], out: &Path) -> String {
+    let o = hydrocyl().arg("simulate").args(args).output().unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(!out.exists(), "{} written", out.display());
+    let e = stderr(&o);
+    assert_eq!(e.lines().count(), 1, "not one line: {e:?}");
+    assert!(e.starts_with("hydrocyl: error: "), "{e:?}");
+    e
+}
+
+#[test]
+fn a_fixed_step_run_that_blows_up_names_the_remedy() {
+    let d = scratch("rk4-blows-up");
+    let out = d.join("o.csv");
+    let e = simulate_fails(
+        &[
+            "--rig",
+            "wang-hybrid",
+            "--command",
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../../fixtures/commands/ch7-square.csv"
+            ),
+            "--out",
+            out.to_str().unwrap(),
+            "--solver",
+            "rk4",
+            "--rk4-step",
+            "0.0005",
+        ],
+        &out,
+    );
+    assert!(e.contains("is not finite"), "{e}");
+    assert!(
+        e.contains("--rk4-step 0.0005 is likely too large") && e.contains("--solver auto"),
+        "{e}"
+    );
+}
+
+#[test]
+fn an_rtol_below_what_double_precision_meets_is_refused_up_front() {
+    let d = scratch("tiny-rtol");
+    let cmd = command_file(&d, 101, 1e-3);
+    let out = d.join("o.csv");
+    let e = simulate_fails(
+        &[
+            "--rig",
+            "leaney-moog",
+            "--command",
+            cmd.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--rtol",
+            "1e-300",
+        ],
+        &out,
+    );
+    assert!(e.contains("--rtol 1e-300: below 1e-14"), "{e}");
+    assert!(e.contains("use a value in [1e-14, 1)"), "{e}");
+    assert!(!e.contains("physical range"), "{e}");
+}

@@ -133,3 +133,84 @@ fn an_rtol_below_what_double_precision_meets_is_refused_up_front() {
     assert!(e.contains("use a value in [1e-14, 1)"), "{e}");
     assert!(!e.contains("physical range"), "{e}");
 }
+
+#[test]
+fn argument_errors_are_one_line_naming_the_option_and_the_help() {
+    let d = scratch("clap");
+    let out = d.join("o.csv");
+    let o = out.to_str().unwrap();
+    let cases: &[(&[&str], &[&str])] = &[
+        (
+            &[
+                "simulate",
+                "--rig",
+                "leaney-moog",
+                "--command",
+                "c.csv",
+                "--out",
+                o,
+                "--rtol",
+                "abc",
+            ],
+            &[
+                "--rtol: invalid value 'abc': ",
+                "(see hydrocyl simulate --help)",
+            ],
+        ),
+        (
+            &[
+                "diagnose",
+                "--rig",
+                "leaney-moog",
+                "--data",
+                "d.csv",
+                "--holdout",
+                "abc",
+            ],
+            &[
+                "--holdout: invalid value 'abc'",
+                "(see hydrocyl diagnose --help)",
+            ],
+        ),
+        (
+            &["simulate", "--rig", "leaney-moog", "--command", "c.csv"],
+            &["missing required --out", "(see hydrocyl simulate --help)"],
+        ),
+        (
+            &[
+                "simulate",
+                "--rig",
+                "leaney-moog",
+                "--command",
+                "c.csv",
+                "--ou",
+                o,
+            ],
+            &["unexpected argument '--ou'; did you mean '--out'?"],
+        ),
+        (
+            &["simulat"],
+            &[
+                "unknown subcommand 'simulat'; did you mean 'simulate'?",
+                "(see hydrocyl --help)",
+            ],
+        ),
+    ];
+    for (args, wanted) in cases {
+        let r = hydrocyl().args(*args).current_dir(&d).output().unwrap();
+        let e = stderr(&r);
+        assert_eq!(r.status.code(), Some(2), "{args:?}: {e}");
+        assert_eq!(e.lines().count(), 1, "{args:?}: not one line: {e:?}");
+        assert!(e.starts_with("hydrocyl: error: "), "{args:?}: {e:?}");
+        for w in *wanted {
+            assert!(e.contains(w), "{args:?}: {w:?} not in {e:?}");
+        }
+        assert!(r.stdout.is_empty() && !out.exists(), "{args:?}");
+    }
+    // help and version still print as usual, on stdout, exit code 0
+    for args in [&["simulate", "--help"][..], &["--version"], &["--help"]] {
+        let r = hydrocyl().args(args).output().unwrap();
+        assert_eq!(r.status.code(), Some(0), "{args:?}");
+        assert!(!r.stdout.is_empty() && r.stderr.is_empty(), "{args:?}");
+    }
+}

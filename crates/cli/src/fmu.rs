@@ -63,7 +63,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         rig::apply_set(&mut value, s).map_err(|e| input(&e))?;
     }
     // errors name the file and line of their JSON path
-    rig::check(&value).map_err(|e| input(&rig::at_line(e, &rig_arg)))?;
+    rig::check(&value)
+        .map_err(|e| input(&crate::rigfile::at_line_or_set(e, &rig_arg, &args.set)))?;
     let library = find_library(args.library.as_deref()).map_err(|e| input(&e))?;
     // the FMU must not be written over an input: the rig file or the library
     let rig_file = (rig::preset(&rig_arg).is_none()).then(|| PathBuf::from(&rig_arg));

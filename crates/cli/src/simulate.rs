@@ -433,7 +433,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let kind = value.get("kind").and_then(|k| k.as_str());
     crate::progress::mark("rig loaded");
-    let checked = crate::rigfile::check(&value, &args.rig)?;
+    let checked = crate::rigfile::check(&value, &args.rig, &args.set)?;
     check_initial_pressures(&checked)?;
     crate::progress::mark("rig checked");
     if args.print_rig {

@@ -214,3 +214,40 @@ fn argument_errors_are_one_line_naming_the_option_and_the_help() {
         assert!(!r.stdout.is_empty() && r.stderr.is_empty(), "{args:?}");
     }
 }
+
+#[test]
+fn a_bad_value_from_set_names_the_set_not_a_line_of_the_rig_file() {
+    let d = scratch("set-blame");
+    let cmd = command_file(&d, 11, 1e-3);
+    let rig = d.join("lm.json");
+    let p = hydrocyl()
+        .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
+        .output()
+        .unwrap();
+    assert!(p.status.success());
+    std::fs::write(&rig, &p.stdout).unwrap();
+    let out = d.join("o.csv");
+    let base = [
+        "--rig",
+        rig.to_str().unwrap(),
+        "--command",
+        cmd.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let e = simulate_fails(&[&base[..], &["--set", "load.mass=-1"]].concat(), &out);
+    assert!(
+        e.contains("load.mass") && e.contains("(set by --set load.mass=-1 on "),
+        "{e}"
+    );
+    assert!(!e.contains("line "), "{e}");
+    // the same value in the file itself: its line
+    let text =
+        String::from_utf8(p.stdout)
+            .unwrap()
+            .replacen("\"mass\": 100.0", "\"mass\": -1.0", 1);
+    assert!(text.contains("\"mass\": -1.0"));
+    std::fs::write(&rig, text).unwrap();
+    let e = simulate_fails(&base, &out);
+    assert!(e.contains("(line ") && !e.contains("--set"), "{e}");
+}

@@ -26,10 +26,10 @@ use std::path::{Path, PathBuf};
 #[derive(clap::Args)]
 pub struct Args {
     /// A preset name (leaney-moog, ...) or a rig JSON file.
-    #[arg(long, required_unless_present = "list_presets")]
+    #[arg(long, required = true, conflicts_with = "list_presets")]
     rig: Option<String>,
     /// The FMU file to write.
-    #[arg(long, required_unless_present = "list_presets")]
+    #[arg(long, required = true, conflicts_with = "list_presets")]
     out: Option<PathBuf>,
     /// Override a rig parameter by its JSON path before export (repeatable);
     /// it becomes the parameter's start value.
@@ -40,7 +40,7 @@ pub struct Args {
     #[arg(long)]
     library: Option<PathBuf>,
     /// Print the preset names (one per line) and exit.
-    #[arg(long)]
+    #[arg(long, exclusive = true)]
     list_presets: bool,
 }
 

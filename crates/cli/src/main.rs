@@ -67,7 +67,8 @@ fn run(cli: Cli) -> Result<(), CliError> {
     }
 }
 
-/// The command line's definition, `--rig`'s help listing every preset.
+/// The command line's definition, `--rig`'s help listing every preset
+/// (`diagnose`: those it takes, [`diagnose::presets`]).
 fn definition() -> clap::Command {
     let names = presets::names();
     let rig_help = |sub: clap::Command| {
@@ -76,7 +77,23 @@ fn definition() -> clap::Command {
         );
         sub.mut_arg("rig", move |a| a.help(help))
     };
-    Cli::command().mut_subcommand("simulate", rig_help)
+    // the presets diagnose takes are found by reading each (a few
+    // milliseconds): only when help may be shown
+    let help = std::env::args_os().any(|a| a == "--help" || a == "-h" || a == "help");
+    let diagnosable = if help {
+        diagnose::presets().join(", ")
+    } else {
+        "see hydrocyl presets".to_string()
+    };
+    Cli::command()
+        .mut_subcommand("simulate", rig_help)
+        .mut_subcommand("diagnose", move |sub| {
+            sub.mut_arg("rig", move |a| {
+                a.help(format!(
+                    "A preset name ({diagnosable}: a friction bench or a netlist with a cylinder on a mass) or a rig JSON file (a netlist, its `identify` section naming the model, columns and refits; or an older valve-cylinder or friction-bench file)"
+                ))
+            })
+        })
 }
 
 /// Ends the process on an error of the command line's parser: help and
@@ -175,10 +192,15 @@ fn argument_message(e: &clap::Error) -> String {
                 .collect();
             format!("missing required {}", missing.join(", "))
         }
-        (ErrorKind::ArgumentConflict, Some(a), _) => match first(ContextKind::PriorArg) {
-            Some(p) if flag(&p) != a => format!("{a} cannot be used with {}", flag(&p)),
-            _ => format!("{a} cannot be given more than once"),
-        },
+        (ErrorKind::ArgumentConflict, Some(a), _)
+            if first(ContextKind::PriorArg).is_some_and(|p| flag(&p) != a) =>
+        {
+            let p = first(ContextKind::PriorArg).unwrap_or_default();
+            format!("{a} cannot be used with {}", flag(&p))
+        }
+        (ErrorKind::ArgumentConflict, Some(a), _) if first(ContextKind::PriorArg).is_some() => {
+            format!("{a} cannot be given more than once")
+        }
         (ErrorKind::MissingSubcommand, _, _) => "a subcommand is required".to_string(),
         // anything else: clap's own message, its first line
         _ => {

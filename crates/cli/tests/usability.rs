@@ -251,3 +251,36 @@ fn a_bad_value_from_set_names_the_set_not_a_line_of_the_rig_file() {
     let e = simulate_fails(&base, &out);
     assert!(e.contains("(line ") && !e.contains("--set"), "{e}");
 }
+
+/// The help of `hydrocyl <sub> --help`.
+fn help(sub: &str) -> String {
+    let o = hydrocyl().args([sub, "--help"]).output().unwrap();
+    assert!(o.status.success(), "{sub} --help");
+    String::from_utf8(o.stdout).unwrap()
+}
+
+#[test]
+fn help_shows_what_is_required_and_which_rigs_work() {
+    // fmu's usage line names its two required options
+    let fmu = help("fmu");
+    let usage = fmu.lines().find(|l| l.starts_with("Usage:")).unwrap();
+    assert!(
+        usage.contains("--rig <RIG>") && usage.contains("--out <OUT>"),
+        "{usage}"
+    );
+    // ... which --list-presets does without
+    let o = hydrocyl().args(["fmu", "--list-presets"]).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    // diagnose's --rig lists the presets it takes, the closed loop and the
+    // hybrid rig among them
+    let diagnose = help("diagnose");
+    for p in [
+        "leaney-moog-closed-loop",
+        "wang-hybrid",
+        "leaney-moog",
+        "tudelft-seal-25",
+        "emps",
+    ] {
+        assert!(diagnose.contains(p), "{p} not in diagnose --help");
+    }
+}

@@ -139,8 +139,10 @@ pub struct Args {
         allow_negative_numbers = true
     )]
     ledger_from: Option<f64>,
-    /// Print the rig (after --set) as JSON and exit.
-    #[arg(long)]
+    /// Print the rig (after --set) as JSON and exit: nothing is run or
+    /// written, so --out and --ledger are refused with it; --command and the
+    /// run's options (--solver, --rtol, ...) are not read.
+    #[arg(long, conflicts_with_all = ["out", "ledger"])]
     print_rig: bool,
     /// Flush the output to the disk (fsync) before it is renamed into place.
     #[arg(long)]

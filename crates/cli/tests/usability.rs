@@ -284,3 +284,42 @@ fn help_shows_what_is_required_and_which_rigs_work() {
         assert!(diagnose.contains(p), "{p} not in diagnose --help");
     }
 }
+
+#[test]
+fn print_rig_refuses_the_output_options_it_would_not_write() {
+    let d = scratch("print-rig");
+    let out = d.join("o.csv");
+    let ledger = d.join("l.json");
+    for extra in [
+        &["--out", out.to_str().unwrap()][..],
+        &["--ledger", ledger.to_str().unwrap()],
+    ] {
+        let o = hydrocyl()
+            .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
+            .args(extra)
+            .output()
+            .unwrap();
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {e}");
+        assert_eq!(e.lines().count(), 1, "{e:?}");
+        assert!(
+            e.starts_with("hydrocyl: error: --print-rig cannot be used with ")
+                || e.contains("cannot be used with --print-rig"),
+            "{e}"
+        );
+        assert!(o.stdout.is_empty() && !out.exists() && !ledger.exists());
+    }
+    // with --set only, it prints the rig
+    let o = hydrocyl()
+        .args([
+            "simulate",
+            "--rig",
+            "leaney-moog",
+            "--print-rig",
+            "--set",
+            "load.mass=50",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success() && String::from_utf8_lossy(&o.stdout).contains("50"));
+}

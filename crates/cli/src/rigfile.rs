@@ -22,8 +22,9 @@ pub fn locate(e: RigError, source: &str, sets: &[String]) -> CliError {
 /// [`rig::at_line`], except for an error about a value a `--set` of `sets`
 /// gave: the file's line holds the value the `--set` replaced, so the
 /// message names the `--set` instead, `(set by --set load.mass=-1 on
-/// lm.json)` (on a preset without the file). A path is matched with or
-/// without its `components.` prefix.
+/// lm.json)` (a preset has no lines: [`rig::at_line`] names its paths as
+/// `--set` takes them). A path is matched with or without its
+/// `components.` prefix.
 pub fn at_line_or_set(e: RigError, source: &str, sets: &[String]) -> RigError {
     let path = match &e {
         RigError::Invalid { path, .. } | RigError::OutOfRange { path, .. } => path.clone(),
@@ -34,15 +35,12 @@ pub fn at_line_or_set(e: RigError, source: &str, sets: &[String]) -> RigError {
         s.split_once('=')
             .is_some_and(|(p, _)| !p.trim().is_empty() && bare(p) == bare(&path))
     });
-    let Some(set) = set else {
+    // a preset has no lines: its message names the path as `--set` takes
+    // it, as Python's `Rig.set` words it
+    let (Some(set), None) = (set, rig::preset(source)) else {
         return rig::at_line(e, source);
     };
-    // the paths as `--set` takes them on a preset; a file is named (the
-    // rig the `--set` applies to), without a line
-    let (e, by) = match rig::preset(source) {
-        Some(v) => (rig::set_form(e, &v), format!("(set by --set {set})")),
-        None => (e, format!("(set by --set {set} on {source})")),
-    };
+    let by = format!("(set by --set {set} on {source})");
     match e {
         RigError::Invalid { path, why } => RigError::Invalid {
             why: format!("{why} {by}"),

@@ -252,6 +252,44 @@ fn a_bad_value_from_set_names_the_set_not_a_line_of_the_rig_file() {
     assert!(e.contains("(line ") && !e.contains("--set"), "{e}");
 }
 
+#[test]
+fn a_friction_bench_writes_its_command_column_like_every_rig() {
+    let d = scratch("bench-command");
+    let mut s = String::from("time,command\n");
+    for k in 0..201 {
+        let t = k as f64 * 1e-3;
+        s.push_str(&format!("{t},{}\n", if t < 0.1 { 0.01 } else { -0.02 }));
+    }
+    let cmd = d.join("velocity.csv");
+    std::fs::write(&cmd, s).unwrap();
+    for (rig, set) in [
+        ("tudelft-seal-25", &["--set", "chamber.pressure=5e5"][..]),
+        ("emps", &[][..]),
+    ] {
+        let out = d.join(format!("{rig}.csv"));
+        let o = hydrocyl()
+            .args(["simulate", "--rig", rig, "--command"])
+            .arg(&cmd)
+            .arg("--out")
+            .arg(&out)
+            .args(set)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{rig}: {}", stderr(&o));
+        let text = std::fs::read_to_string(&out).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        assert_eq!(&header[..2], ["time [s]", "command [m/s]"], "{rig}");
+        assert!(header.contains(&"force [N]"), "{rig}: {header:?}");
+        // the command as read, at the command's times
+        for (k, l) in lines.enumerate() {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            let want = if (k as f64) * 1e-3 < 0.1 { 0.01 } else { -0.02 };
+            assert_eq!(v[1], want, "{rig} row {k}");
+        }
+    }
+}
+
 /// The help of `hydrocyl <sub> --help`.
 fn help(sub: &str) -> String {
     let o = hydrocyl().args([sub, "--help"]).output().unwrap();

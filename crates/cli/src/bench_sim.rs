@@ -52,7 +52,7 @@ pub fn load(
             )));
         }
     }
-    rig::check(&net).map_err(|e| err(rig::at_line(e, spec)))?;
+    rig::check(&net).map_err(|e| err(crate::rigfile::at_line_or_set(e, spec, sets)))?;
     let bench = read(&net)?;
     Ok(Some((bench, net)))
 }

@@ -19,10 +19,10 @@ use crate::progress::Progress;
 /// Arguments of this subcommand.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Rig: a preset name (valve rig: leaney-moog; friction benches:
-    /// tudelft-seal-25, tudelft-seal-257, emps) or a rig JSON file (a
-    /// netlist, its `identify` section naming the model, columns and refits;
-    /// or an older valve-cylinder or friction-bench file, read as its netlist).
+    /// Rig: a preset name (those diagnose takes: [`presets`]) or a rig JSON
+    /// file (a netlist, its `identify` section naming the model, columns and
+    /// refits; or an older valve-cylinder or friction-bench file, read as
+    /// its netlist).
     #[arg(long)]
     pub rig: String,
     /// Measured record(s) (CSV); repeat for several records of one rig
@@ -52,7 +52,9 @@ pub struct Args {
     /// Print nothing but errors.
     #[arg(long)]
     pub quiet: bool,
-    /// Show a progress bar even when stderr is not a terminal.
+    /// Show progress when stderr is not a terminal too (a CI log, a file):
+    /// there as plain lines, one every 5 s at most after the first second,
+    /// not a redrawn bar (on a terminal a bar shows without this flag).
     #[arg(long)]
     pub progress: bool,
 }
@@ -132,6 +134,17 @@ fn load_rig(spec: &str) -> Result<Rig, CliError> {
             hydrocyl_system::valve_rig::KIND
         ))),
     }
+}
+
+/// The presets `diagnose` takes (a friction bench, or a netlist with a
+/// cylinder on a mass): those [`load_rig`] reads, so `--help` lists what
+/// works, in `hydrocyl presets`' order.
+pub fn presets() -> Vec<&'static str> {
+    hydrocyl_system::rig::PRESETS
+        .iter()
+        .map(|p| p.name)
+        .filter(|n| load_rig(n).is_ok())
+        .collect()
 }
 
 /// Fewer samples than this per record: the ± intervals of the report assume

@@ -26,10 +26,10 @@ use std::path::{Path, PathBuf};
 #[derive(clap::Args)]
 pub struct Args {
     /// A preset name (leaney-moog, ...) or a rig JSON file.
-    #[arg(long, required_unless_present = "list_presets")]
+    #[arg(long, required = true, conflicts_with = "list_presets")]
     rig: Option<String>,
     /// The FMU file to write.
-    #[arg(long, required_unless_present = "list_presets")]
+    #[arg(long, required = true, conflicts_with = "list_presets")]
     out: Option<PathBuf>,
     /// Override a rig parameter by its JSON path before export (repeatable);
     /// it becomes the parameter's start value.
@@ -40,7 +40,7 @@ pub struct Args {
     #[arg(long)]
     library: Option<PathBuf>,
     /// Print the preset names (one per line) and exit.
-    #[arg(long)]
+    #[arg(long, exclusive = true)]
     list_presets: bool,
 }
 
@@ -63,7 +63,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         rig::apply_set(&mut value, s).map_err(|e| input(&e))?;
     }
     // errors name the file and line of their JSON path
-    rig::check(&value).map_err(|e| input(&rig::at_line(e, &rig_arg)))?;
+    rig::check(&value)
+        .map_err(|e| input(&crate::rigfile::at_line_or_set(e, &rig_arg, &args.set)))?;
     let library = find_library(args.library.as_deref()).map_err(|e| input(&e))?;
     // the FMU must not be written over an input: the rig file or the library
     let rig_file = (rig::preset(&rig_arg).is_none()).then(|| PathBuf::from(&rig_arg));

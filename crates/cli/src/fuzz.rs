@@ -96,7 +96,7 @@ fn rig_target(bytes: &[u8]) -> Result<(), TestCaseError> {
     // precondition; on other text it may allocate without bound)
     if let Ok(v) = serde_json::from_str::<serde_json::Value>(text) {
         let _ = hydrocyl_system::netlist::locate::scan(text);
-        let _ = crate::rigfile::check(&v, "fuzz.json");
+        let _ = crate::rigfile::check(&v, "fuzz.json", &[]);
         let _ = hydrocyl_system::rig::parameters(&v);
     }
     Ok(())

@@ -67,7 +67,8 @@ fn run(cli: Cli) -> Result<(), CliError> {
     }
 }
 
-/// The command line's definition, `--rig`'s help listing every preset.
+/// The command line's definition, `--rig`'s help listing every preset
+/// (`diagnose`: those it takes, [`diagnose::presets`]).
 fn definition() -> clap::Command {
     let names = presets::names();
     let rig_help = |sub: clap::Command| {
@@ -76,15 +77,149 @@ fn definition() -> clap::Command {
         );
         sub.mut_arg("rig", move |a| a.help(help))
     };
-    Cli::command().mut_subcommand("simulate", rig_help)
+    // the presets diagnose takes are found by reading each (a few
+    // milliseconds): only when help may be shown
+    let help = std::env::args_os().any(|a| a == "--help" || a == "-h" || a == "help");
+    let diagnosable = if help {
+        diagnose::presets().join(", ")
+    } else {
+        "see hydrocyl presets".to_string()
+    };
+    Cli::command()
+        .mut_subcommand("simulate", rig_help)
+        .mut_subcommand("diagnose", move |sub| {
+            sub.mut_arg("rig", move |a| {
+                a.help(format!(
+                    "A preset name ({diagnosable}: a friction bench or a netlist with a cylinder on a mass) or a rig JSON file (a netlist, its `identify` section naming the model, columns and refits; or an older valve-cylinder or friction-bench file)"
+                ))
+            })
+        })
+}
+
+/// Ends the process on an error of the command line's parser: help and
+/// the version as clap prints them (exit code 0; a bare `hydrocyl`, the
+/// help with exit code 2), anything else as one line like every other
+/// error, exit code 2: `hydrocyl: error: --rtol: invalid value 'abc':
+/// invalid float literal (see hydrocyl simulate --help)`.
+fn argument_error(e: &clap::Error) -> ! {
+    use clap::error::ErrorKind;
+    if matches!(
+        e.kind(),
+        ErrorKind::DisplayHelp
+            | ErrorKind::DisplayVersion
+            | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    ) {
+        e.exit()
+    }
+    // the subcommand, the first word that is not an option
+    let sub = std::env::args_os()
+        .skip(1)
+        .find(|a| !a.to_string_lossy().starts_with('-'))
+        .and_then(|a| {
+            let a = a.to_string_lossy().into_owned();
+            definition()
+                .get_subcommands()
+                .any(|s| s.get_name() == a)
+                .then_some(a)
+        });
+    let help = match &sub {
+        Some(s) => format!("hydrocyl {s} --help"),
+        None => "hydrocyl --help".to_string(),
+    };
+    console::note(format_args!(
+        "hydrocyl: error: {} (see {help})",
+        argument_message(e)
+    ));
+    std::process::exit(2)
+}
+
+/// What is wrong with the command line, in one line, from the parser's
+/// error context: the option (as `--rtol`, without its value's name), the
+/// value and why.
+fn argument_message(e: &clap::Error) -> String {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    let strings = |k: ContextKind| -> Vec<String> {
+        match e.get(k) {
+            Some(ContextValue::String(s)) => vec![s.clone()],
+            Some(ContextValue::Strings(v)) => v.clone(),
+            Some(ContextValue::StyledStr(s)) => vec![s.to_string()],
+            Some(ContextValue::StyledStrs(v)) => v.iter().map(ToString::to_string).collect(),
+            _ => Vec::new(),
+        }
+    };
+    // `--rtol <RTOL>` -> `--rtol`
+    let flag = |s: &str| s.split_whitespace().next().unwrap_or(s).to_string();
+    let first = |k: ContextKind| strings(k).into_iter().next();
+    let arg = first(ContextKind::InvalidArg).map(|a| flag(&a));
+    let value = first(ContextKind::InvalidValue);
+    let did_you_mean = |k: ContextKind| {
+        let s = strings(k);
+        if s.is_empty() {
+            String::new()
+        } else {
+            format!("; did you mean '{}'?", s.join("' or '"))
+        }
+    };
+    let why = std::error::Error::source(e).map(ToString::to_string);
+    match (e.kind(), arg, value) {
+        (ErrorKind::InvalidValue, Some(a), Some(v)) if v.is_empty() => {
+            format!("{a}: a value is required but none was given")
+        }
+        (ErrorKind::InvalidValue | ErrorKind::ValueValidation, Some(a), Some(v)) => {
+            let valid = strings(ContextKind::ValidValue);
+            let why = match (why, valid.is_empty()) {
+                (Some(w), _) => format!(": {w}"),
+                (None, false) => format!(": use one of {}", valid.join(", ")),
+                (None, true) => String::new(),
+            };
+            format!("{a}: invalid value '{v}'{why}")
+        }
+        (ErrorKind::UnknownArgument, Some(a), _) => format!(
+            "unexpected argument '{a}'{}",
+            did_you_mean(ContextKind::SuggestedArg)
+        ),
+        (ErrorKind::InvalidSubcommand, ..) if first(ContextKind::InvalidSubcommand).is_some() => {
+            format!(
+                "unknown subcommand '{}'{}",
+                first(ContextKind::InvalidSubcommand).unwrap_or_default(),
+                did_you_mean(ContextKind::SuggestedSubcommand)
+            )
+        }
+        (ErrorKind::MissingRequiredArgument, _, _) => {
+            let missing: Vec<String> = strings(ContextKind::InvalidArg)
+                .iter()
+                .map(|a| flag(a))
+                .collect();
+            format!("missing required {}", missing.join(", "))
+        }
+        (ErrorKind::ArgumentConflict, Some(a), _)
+            if first(ContextKind::PriorArg).is_some_and(|p| flag(&p) != a) =>
+        {
+            let p = first(ContextKind::PriorArg).unwrap_or_default();
+            format!("{a} cannot be used with {}", flag(&p))
+        }
+        (ErrorKind::ArgumentConflict, Some(a), _) if first(ContextKind::PriorArg).is_some() => {
+            format!("{a} cannot be given more than once")
+        }
+        (ErrorKind::MissingSubcommand, _, _) => "a subcommand is required".to_string(),
+        // anything else: clap's own message, its first line
+        _ => {
+            let text = e.to_string();
+            let line = text.lines().next().unwrap_or("invalid arguments");
+            line.strip_prefix("error: ").unwrap_or(line).to_string()
+        }
+    }
 }
 
 fn main() {
     progress::start();
     progress::mark("main");
-    let cli = match Cli::from_arg_matches(&definition().get_matches()) {
+    let cli = match definition()
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m))
+    {
         Ok(c) => c,
-        Err(e) => e.exit(),
+        Err(e) => argument_error(&e),
     };
     progress::mark("arguments parsed");
     let r = run(cli);

@@ -1,8 +1,9 @@
 //! Rig files as `hydrocyl simulate` reads them: a preset or a file
 //! (duplicate keys refused, an older rig kind read as its netlist:
 //! [`rig::load`]), checked once ([`check`]): every error names the JSON path
-//! and, for a file, its line — those found when the circuit is assembled
-//! (an algebraic loop) too ([`Checked::circuit`]).
+//! and, for a file, its line — or the `--set` that gave the value — those
+//! found when the circuit is assembled (an algebraic loop) too
+//! ([`Checked::circuit`]).
 
 use crate::error::CliError;
 use hydrocyl_system::netlist::{self, Schematic};
@@ -12,9 +13,46 @@ use hydrocyl_system::Circuit;
 use serde_json::Value;
 
 /// A rig error with the line of its JSON path in `source` added (when
-/// `source` is a file).
-pub fn locate(e: RigError, source: &str) -> CliError {
-    CliError::Input(rig::at_line(e, source).to_string())
+/// `source` is a file), or, when a `--set` of `sets` gave the value at that
+/// path, that `--set` ([`at_line_or_set`]).
+pub fn locate(e: RigError, source: &str, sets: &[String]) -> CliError {
+    CliError::Input(at_line_or_set(e, source, sets).to_string())
+}
+
+/// [`rig::at_line`], except for an error about a value a `--set` of `sets`
+/// gave: the file's line holds the value the `--set` replaced, so the
+/// message names the `--set` instead, `(set by --set load.mass=-1 on
+/// lm.json)` (a preset has no lines: [`rig::at_line`] names its paths as
+/// `--set` takes them). A path is matched with or without its
+/// `components.` prefix.
+pub fn at_line_or_set(e: RigError, source: &str, sets: &[String]) -> RigError {
+    let path = match &e {
+        RigError::Invalid { path, .. } | RigError::OutOfRange { path, .. } => path.clone(),
+        _ => return rig::at_line(e, source),
+    };
+    let bare = |p: &str| p.trim().trim_start_matches("components.").to_string();
+    let set = sets.iter().find(|s| {
+        s.split_once('=')
+            .is_some_and(|(p, _)| !p.trim().is_empty() && bare(p) == bare(&path))
+    });
+    // a preset has no lines: its message names the path as `--set` takes
+    // it, as Python's `Rig.set` words it
+    let (Some(set), None) = (set, rig::preset(source)) else {
+        return rig::at_line(e, source);
+    };
+    let by = format!("(set by --set {set} on {source})");
+    match e {
+        RigError::Invalid { path, why } => RigError::Invalid {
+            why: format!("{why} {by}"),
+            path,
+        },
+        RigError::OutOfRange { path, value, why } => RigError::OutOfRange {
+            why: format!("{why} {by}"),
+            path,
+            value,
+        },
+        other => other,
+    }
 }
 
 /// A rig read and checked once, ready to be assembled.
@@ -24,14 +62,19 @@ pub struct Checked {
     /// Where it was read from (`--rig`: a preset name or a file), for the
     /// lines of the errors found when it is assembled.
     source: String,
+    /// The `--set`s applied to it, which those errors name rather than a
+    /// line of the file ([`at_line_or_set`]).
+    sets: Vec<String>,
 }
 
-/// Reads and checks a rig value of a kind `simulate` runs (see [`locate`]).
-pub fn check(value: &Value, source: &str) -> Result<Checked, CliError> {
+/// Reads and checks a rig value of a kind `simulate` runs, after the
+/// `--set`s `sets` (see [`locate`]).
+pub fn check(value: &Value, source: &str, sets: &[String]) -> Result<Checked, CliError> {
     let checked = match value.get("kind").and_then(Value::as_str) {
         Some(netlist::KIND) => netlist::schematic(value).map(|s| Checked {
             schematic: s.into(),
             source: source.to_string(),
+            sets: sets.to_vec(),
         }),
         // a missing or unknown kind: the error names the kinds there are
         _ => Err(match rig::kind_of(value) {
@@ -42,7 +85,7 @@ pub fn check(value: &Value, source: &str) -> Result<Checked, CliError> {
             },
         }),
     };
-    checked.map_err(|e| locate(e, source))
+    checked.map_err(|e| locate(e, source, sets))
 }
 
 impl Checked {
@@ -87,8 +130,10 @@ impl Checked {
 
     /// Assembles the rig's circuit driven by `command`; an error found
     /// only now (an algebraic loop, a component refusing its parameters)
-    /// names its JSON path and, for a file, its line ([`rig::at_line`]).
+    /// names its JSON path and, for a file, its line ([`rig::at_line`]), or
+    /// the `--set` that gave the value ([`at_line_or_set`]).
     pub fn circuit(&self, command: Signal) -> Result<Circuit, RigError> {
-        netlist::assemble(&self.schematic, command).map_err(|e| rig::at_line(e, &self.source))
+        netlist::assemble(&self.schematic, command)
+            .map_err(|e| at_line_or_set(e, &self.source, &self.sets))
     }
 }

@@ -104,7 +104,8 @@ pub struct Args {
     /// friction bench's LuGre bristle).
     #[arg(long, default_value = "auto")]
     solver: String,
-    /// Relative tolerance of the adaptive methods.
+    /// Relative tolerance of the adaptive methods, in [1e-14, 1) (a smaller
+    /// one asks for more digits than double precision carries).
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     rtol: f64,
     /// Fixed step of rk4, and the longest step of exponential \[s\].
@@ -138,13 +139,17 @@ pub struct Args {
         allow_negative_numbers = true
     )]
     ledger_from: Option<f64>,
-    /// Print the rig (after --set) as JSON and exit.
-    #[arg(long)]
+    /// Print the rig (after --set) as JSON and exit: nothing is run or
+    /// written, so --out and --ledger are refused with it; --command and the
+    /// run's options (--solver, --rtol, ...) are not read.
+    #[arg(long, conflicts_with_all = ["out", "ledger"])]
     print_rig: bool,
     /// Flush the output to the disk (fsync) before it is renamed into place.
     #[arg(long)]
     fsync: bool,
-    /// Show a progress bar even when stderr is not a terminal.
+    /// Show progress when stderr is not a terminal too (a CI log, a file):
+    /// there as plain lines, one every 5 s at most after the first second,
+    /// not a redrawn bar (on a terminal a bar shows without this flag).
     #[arg(long)]
     progress: bool,
     /// Print nothing but errors (no progress, no warnings, no summary).
@@ -161,6 +166,11 @@ pub struct Args {
     #[arg(long, hide = true, default_value_t = crate::writer::QUEUE)]
     probes_behind: usize,
 }
+
+/// The smallest `--rtol` taken: below it (about 50 machine epsilons) the
+/// error estimates are rounding noise and the step falls to nothing, which
+/// the solver would report as a rate out of its physical range.
+const RTOL_FLOOR: f64 = 1e-14;
 
 /// Output times per block of a streamed run: the memory a run needs grows
 /// with this, not with the record. Blocks this small let the writer thread
@@ -342,8 +352,21 @@ enum Input {
 /// long or too stiff for the budget.
 fn solver_hint(e: rig::RigError, solver: Solver, rk4_step: f64, span: f64) -> CliError {
     let m = e.to_string();
-    // SolveError::EventStorm's and ::Chattering's messages: a fixed step is
-    // the likely cause
+    // SolveError::EventStorm's and ::Chattering's messages, and a state
+    // that blew up (SolveError::NonFinite's, not at the start, where the
+    // message names the parameter's range): a fixed step is the likely cause
+    let blew_up = m.contains("is not finite at") && !m.contains("physical range");
+    if blew_up && solver.fixed_step() {
+        return CliError::Input(format!(
+            "{m}; --rk4-step {rk4_step} is likely too large for this rig: use a smaller step, or --solver auto (or rosenbrock for a stiff rig)"
+        ));
+    }
+    if blew_up {
+        return CliError::Input(format!(
+            "{m}; the {} solution is unstable: try --solver rosenbrock or a smaller --rtol",
+            solver.name()
+        ));
+    }
     if (m.contains("events in a row") || m.contains("the solution chatters")) && solver.fixed_step()
     {
         return CliError::Input(format!(
@@ -405,7 +428,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let kind = value.get("kind").and_then(|k| k.as_str());
     crate::progress::mark("rig loaded");
-    let checked = crate::rigfile::check(&value, &args.rig)?;
+    let checked = crate::rigfile::check(&value, &args.rig, &args.set)?;
     check_initial_pressures(&checked)?;
     crate::progress::mark("rig checked");
     if args.print_rig {
@@ -432,6 +455,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ("--rk4-step", Setting::Rk4Step, args.rk4_step),
     ] {
         setting.check_named(flag, value).map_err(CliError::Input)?;
+    }
+    if args.rtol < RTOL_FLOOR {
+        return Err(CliError::Input(format!(
+            "--rtol {:e}: below {RTOL_FLOOR:e} (about 50 machine epsilons), a tolerance double precision cannot meet; use a value in [{RTOL_FLOOR:e}, 1), e.g. 1e-6",
+            args.rtol
+        )));
     }
     let (Some(cmd_path), Some(out)) = (args.command, args.out) else {
         return Err(CliError::Input("--command and --out are required".into()));

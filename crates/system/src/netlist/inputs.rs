@@ -261,11 +261,15 @@ mod tests {
         let s = crate::netlist::schematic(&v).unwrap();
         assert_eq!(s.input_unit(), Some("m"));
         assert!(!s.input_is_set_point());
-        // the friction benches' drive takes the rod's velocity; it shows no command
+        // the friction benches' drive takes the rod's velocity, shown as
+        // the `command` column every rig writes (the drive's `command` probe)
         for bench in ["emps", "tudelft-seal-25"] {
             let s = schematic(bench);
             assert_eq!(s.inputs().count(), 1);
-            assert_eq!((s.input_channel(), s.input_unit()), (None, Some("m/s")));
+            assert_eq!(
+                (s.input_channel().as_deref(), s.input_unit()),
+                (Some("command"), Some("m/s"))
+            );
         }
     }
 

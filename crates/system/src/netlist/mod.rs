@@ -188,7 +188,7 @@ fn assemble_driven(s: &Schematic, drive: &[(String, Signal)]) -> Result<Circuit,
         other => RigError::Build(other),
     })?;
     // the run's input is shown in the unit in which its readers take it
-    // (a bench drive shows no command: its velocity probe has its unit)
+    // (a bench drive's `command` is the velocity it imposes, in m/s)
     if let (Some(unit), Some(input)) = (s.input_unit(), s.inputs().next()) {
         if input.ty.probes.iter().any(|(p, _)| *p == "command") {
             c.set_probe_unit(&input.name, "command", unit);

@@ -150,6 +150,9 @@ impl Component for ImposedMotion {
             Probe::of("position", self.rod.position),
             Probe::of("velocity", self.rod.velocity),
             Probe::of(format!("{}_force", self.name), self.force),
+            // the run's command as the drive imposes it (the `command`
+            // column every rig writes)
+            Probe::of("command", self.rod.velocity),
         ]
     }
 }
@@ -305,7 +308,7 @@ pub const TYPES: &[ComponentType] = &[
             })
         },
         hints: None,
-        probes: &[("position", "m"), ("velocity", "m/s"), ("force", "N")],
+        probes: &[("position", "m"), ("velocity", "m/s"), ("force", "N"), ("command", "m/s")],
     },
     ComponentType {
         name: "piston",

@@ -1,0 +1,363 @@
+//! What the README and `--help` promise about the command line itself:
+//! progress where stderr is not a terminal, remedies, one-line argument
+//! errors, `--set`'s blame, the benches' columns, help text and
+//! `--print-rig`'s combinations.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn hydrocyl() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_hydrocyl"))
+}
+
+/// A fresh scratch folder for one test.
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hydrocyl-usability-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A command file of `n` samples `dt` apart (a gentle square wave).
+fn command_file(dir: &Path, n: usize, dt: f64) -> PathBuf {
+    let mut s = String::from("time,command\n");
+    for k in 0..n {
+        let t = k as f64 * dt;
+        let u = if (t % 1.0) < 0.5 { 0.1 } else { -0.1 };
+        s.push_str(&format!("{t},{u}\n"));
+    }
+    let p = dir.join("cmd.csv");
+    std::fs::write(&p, s).unwrap();
+    p
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn progress_shows_as_plain_lines_when_stderr_is_not_a_terminal() {
+    let d = scratch("progress");
+    let cmd = command_file(&d, 2001, 1e-3);
+    let out = d.join("o.csv");
+    let run = |progress: bool| {
+        let mut c = hydrocyl();
+        c.args(["simulate", "--rig", "leaney-moog", "--command"])
+            .arg(&cmd)
+            .arg("--out")
+            .arg(&out)
+            .env("HYDROCYL_PROGRESS_SECONDS", "0");
+        if progress {
+            c.arg("--progress");
+        }
+        let o = c.output().unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    let with = run(true);
+    let lines: Vec<&str> = with
+        .lines()
+        .filter(|l| l.starts_with("hydrocyl: simulate: rows "))
+        .collect();
+    assert!(!lines.is_empty(), "no progress line in {with:?}");
+    assert!(lines.iter().any(|l| l.contains("/2001")), "{with:?}");
+    assert!(!with.contains('\r'), "a redrawn bar in a log: {with:?}");
+    // without --progress a log gets only the summary
+    let without = run(false);
+    assert!(
+        !without.contains("hydrocyl: simulate: rows "),
+        "{without:?}"
+    );
+}
+
+/// `hydrocyl simulate` with `args`, expected to fail: its one stderr line
+/// (exit code 2), the output `out` not written.
+fn simulate_fails(args: &[&str], out: &Path) -> String {
+    let o = hydrocyl().arg("simulate").args(args).output().unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(!out.exists(), "{} written", out.display());
+    let e = stderr(&o);
+    assert_eq!(e.lines().count(), 1, "not one line: {e:?}");
+    assert!(e.starts_with("hydrocyl: error: "), "{e:?}");
+    e
+}
+
+#[test]
+fn a_fixed_step_run_that_blows_up_names_the_remedy() {
+    let d = scratch("rk4-blows-up");
+    let out = d.join("o.csv");
+    let e = simulate_fails(
+        &[
+            "--rig",
+            "wang-hybrid",
+            "--command",
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../../fixtures/commands/ch7-square.csv"
+            ),
+            "--out",
+            out.to_str().unwrap(),
+            "--solver",
+            "rk4",
+            "--rk4-step",
+            "0.0005",
+        ],
+        &out,
+    );
+    assert!(e.contains("is not finite"), "{e}");
+    assert!(
+        e.contains("--rk4-step 0.0005 is likely too large") && e.contains("--solver auto"),
+        "{e}"
+    );
+}
+
+#[test]
+fn an_rtol_below_what_double_precision_meets_is_refused_up_front() {
+    let d = scratch("tiny-rtol");
+    let cmd = command_file(&d, 101, 1e-3);
+    let out = d.join("o.csv");
+    let e = simulate_fails(
+        &[
+            "--rig",
+            "leaney-moog",
+            "--command",
+            cmd.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--rtol",
+            "1e-300",
+        ],
+        &out,
+    );
+    assert!(e.contains("--rtol 1e-300: below 1e-14"), "{e}");
+    assert!(e.contains("use a value in [1e-14, 1)"), "{e}");
+    assert!(!e.contains("physical range"), "{e}");
+}
+
+#[test]
+fn argument_errors_are_one_line_naming_the_option_and_the_help() {
+    let d = scratch("clap");
+    let out = d.join("o.csv");
+    let o = out.to_str().unwrap();
+    let cases: &[(&[&str], &[&str])] = &[
+        (
+            &[
+                "simulate",
+                "--rig",
+                "leaney-moog",
+                "--command",
+                "c.csv",
+                "--out",
+                o,
+                "--rtol",
+                "abc",
+            ],
+            &[
+                "--rtol: invalid value 'abc': ",
+                "(see hydrocyl simulate --help)",
+            ],
+        ),
+        (
+            &[
+                "diagnose",
+                "--rig",
+                "leaney-moog",
+                "--data",
+                "d.csv",
+                "--holdout",
+                "abc",
+            ],
+            &[
+                "--holdout: invalid value 'abc'",
+                "(see hydrocyl diagnose --help)",
+            ],
+        ),
+        (
+            &["simulate", "--rig", "leaney-moog", "--command", "c.csv"],
+            &["missing required --out", "(see hydrocyl simulate --help)"],
+        ),
+        (
+            &[
+                "simulate",
+                "--rig",
+                "leaney-moog",
+                "--command",
+                "c.csv",
+                "--ou",
+                o,
+            ],
+            &["unexpected argument '--ou'; did you mean '--out'?"],
+        ),
+        (
+            &["simulat"],
+            &[
+                "unknown subcommand 'simulat'; did you mean 'simulate'?",
+                "(see hydrocyl --help)",
+            ],
+        ),
+    ];
+    for (args, wanted) in cases {
+        let r = hydrocyl().args(*args).current_dir(&d).output().unwrap();
+        let e = stderr(&r);
+        assert_eq!(r.status.code(), Some(2), "{args:?}: {e}");
+        assert_eq!(e.lines().count(), 1, "{args:?}: not one line: {e:?}");
+        assert!(e.starts_with("hydrocyl: error: "), "{args:?}: {e:?}");
+        for w in *wanted {
+            assert!(e.contains(w), "{args:?}: {w:?} not in {e:?}");
+        }
+        assert!(r.stdout.is_empty() && !out.exists(), "{args:?}");
+    }
+    // help and version still print as usual, on stdout, exit code 0
+    for args in [&["simulate", "--help"][..], &["--version"], &["--help"]] {
+        let r = hydrocyl().args(args).output().unwrap();
+        assert_eq!(r.status.code(), Some(0), "{args:?}");
+        assert!(!r.stdout.is_empty() && r.stderr.is_empty(), "{args:?}");
+    }
+}
+
+#[test]
+fn a_bad_value_from_set_names_the_set_not_a_line_of_the_rig_file() {
+    let d = scratch("set-blame");
+    let cmd = command_file(&d, 11, 1e-3);
+    let rig = d.join("lm.json");
+    let p = hydrocyl()
+        .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
+        .output()
+        .unwrap();
+    assert!(p.status.success());
+    std::fs::write(&rig, &p.stdout).unwrap();
+    let out = d.join("o.csv");
+    let base = [
+        "--rig",
+        rig.to_str().unwrap(),
+        "--command",
+        cmd.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let e = simulate_fails(&[&base[..], &["--set", "load.mass=-1"]].concat(), &out);
+    assert!(
+        e.contains("load.mass") && e.contains("(set by --set load.mass=-1 on "),
+        "{e}"
+    );
+    assert!(!e.contains("line "), "{e}");
+    // the same value in the file itself: its line
+    let text =
+        String::from_utf8(p.stdout)
+            .unwrap()
+            .replacen("\"mass\": 100.0", "\"mass\": -1.0", 1);
+    assert!(text.contains("\"mass\": -1.0"));
+    std::fs::write(&rig, text).unwrap();
+    let e = simulate_fails(&base, &out);
+    assert!(e.contains("(line ") && !e.contains("--set"), "{e}");
+}
+
+#[test]
+fn a_friction_bench_writes_its_command_column_like_every_rig() {
+    let d = scratch("bench-command");
+    let mut s = String::from("time,command\n");
+    for k in 0..201 {
+        let t = k as f64 * 1e-3;
+        s.push_str(&format!("{t},{}\n", if t < 0.1 { 0.01 } else { -0.02 }));
+    }
+    let cmd = d.join("velocity.csv");
+    std::fs::write(&cmd, s).unwrap();
+    for (rig, set) in [
+        ("tudelft-seal-25", &["--set", "chamber.pressure=5e5"][..]),
+        ("emps", &[][..]),
+    ] {
+        let out = d.join(format!("{rig}.csv"));
+        let o = hydrocyl()
+            .args(["simulate", "--rig", rig, "--command"])
+            .arg(&cmd)
+            .arg("--out")
+            .arg(&out)
+            .args(set)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{rig}: {}", stderr(&o));
+        let text = std::fs::read_to_string(&out).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        assert_eq!(&header[..2], ["time [s]", "command [m/s]"], "{rig}");
+        assert!(header.contains(&"force [N]"), "{rig}: {header:?}");
+        // the command as read, at the command's times
+        for (k, l) in lines.enumerate() {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            let want = if (k as f64) * 1e-3 < 0.1 { 0.01 } else { -0.02 };
+            assert_eq!(v[1], want, "{rig} row {k}");
+        }
+    }
+}
+
+/// The help of `hydrocyl <sub> --help`.
+fn help(sub: &str) -> String {
+    let o = hydrocyl().args([sub, "--help"]).output().unwrap();
+    assert!(o.status.success(), "{sub} --help");
+    String::from_utf8(o.stdout).unwrap()
+}
+
+#[test]
+fn help_shows_what_is_required_and_which_rigs_work() {
+    // fmu's usage line names its two required options
+    let fmu = help("fmu");
+    let usage = fmu.lines().find(|l| l.starts_with("Usage:")).unwrap();
+    assert!(
+        usage.contains("--rig <RIG>") && usage.contains("--out <OUT>"),
+        "{usage}"
+    );
+    // ... which --list-presets does without
+    let o = hydrocyl().args(["fmu", "--list-presets"]).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    // diagnose's --rig lists the presets it takes, the closed loop and the
+    // hybrid rig among them
+    let diagnose = help("diagnose");
+    for p in [
+        "leaney-moog-closed-loop",
+        "wang-hybrid",
+        "leaney-moog",
+        "tudelft-seal-25",
+        "emps",
+    ] {
+        assert!(diagnose.contains(p), "{p} not in diagnose --help");
+    }
+}
+
+#[test]
+fn print_rig_refuses_the_output_options_it_would_not_write() {
+    let d = scratch("print-rig");
+    let out = d.join("o.csv");
+    let ledger = d.join("l.json");
+    for extra in [
+        &["--out", out.to_str().unwrap()][..],
+        &["--ledger", ledger.to_str().unwrap()],
+    ] {
+        let o = hydrocyl()
+            .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
+            .args(extra)
+            .output()
+            .unwrap();
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {e}");
+        assert_eq!(e.lines().count(), 1, "{e:?}");
+        assert!(
+            e.starts_with("hydrocyl: error: --print-rig cannot be used with ")
+                || e.contains("cannot be used with --print-rig"),
+            "{e}"
+        );
+        assert!(o.stdout.is_empty() && !out.exists() && !ledger.exists());
+    }
+    // with --set only, it prints the rig
+    let o = hydrocyl()
+        .args([
+            "simulate",
+            "--rig",
+            "leaney-moog",
+            "--print-rig",
+            "--set",
+            "load.mass=50",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success() && String::from_utf8_lossy(&o.stdout).contains("50"));
+}

@@ -75,19 +75,7 @@ fn a_file_that_is_not_the_library_and_a_bad_set_are_refused() {
 fn a_library_of_another_build_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("drive.fmu");
-    let deps = std::env::current_exe()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .to_path_buf();
-    let older = std::fs::read_dir(&deps)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .find(|p| {
-            let n = p.file_name().unwrap().to_string_lossy();
-            n.starts_with("libthiserror_impl-") && n.ends_with(".so")
-        })
-        .expect("thiserror's proc-macro library beside the test binary");
+    let older = hydrocyl_fmu::test_support::foreign_library();
     let err = refused(&out, &[], Some(&older), None);
     assert!(
         err.contains(&older.display().to_string())

@@ -336,19 +336,7 @@ mod tests {
             e.starts_with("it does not load as a library") && !e.contains('\n'),
             "{e}"
         );
-        let deps = std::env::current_exe()
-            .unwrap()
-            .parent()
-            .unwrap()
-            .to_path_buf();
-        let other = std::fs::read_dir(&deps)
-            .unwrap()
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .find(|p| {
-                let n = p.file_name().unwrap().to_string_lossy();
-                n.starts_with("libthiserror_impl-") && n.ends_with(".so")
-            })
-            .expect("thiserror's proc-macro library beside the test binary");
+        let other = crate::test_support::foreign_library();
         let e = library_guid(&other, "{}").unwrap_err();
         assert!(e.contains("no hydrocyl_fmu_guid"), "{e}");
     }

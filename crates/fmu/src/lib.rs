@@ -54,5 +54,7 @@ mod instantiate;
 pub mod model_description;
 pub mod package;
 pub mod slave;
+#[doc(hidden)]
+pub mod test_support;
 pub mod units;
 pub mod variables;

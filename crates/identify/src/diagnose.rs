@@ -33,7 +33,9 @@ use crate::data_checks::DataProblem;
 use crate::lm::{self, LmOptions};
 use crate::smooth::{noise_sigma, SmootherInfo};
 
+mod bench_checks;
 mod bench_loop;
+mod bench_model;
 pub use bench_loop::diagnose_bench;
 
 /// Options of the loop.

@@ -330,3 +330,20 @@ pub enum SolveError {
         why: String,
     },
 }
+
+impl SolveError {
+    /// The time the solve failed at (the time each variant holds); `None`
+    /// for [`SolveError::InvalidInput`], which fails before any step.
+    pub fn time(&self) -> Option<f64> {
+        match self {
+            SolveError::StepTooSmall { t, .. }
+            | SolveError::TooManySteps { t, .. }
+            | SolveError::NonFinite { t, .. }
+            | SolveError::Singular { t }
+            | SolveError::EventStorm { t, .. }
+            | SolveError::Chattering { t, .. }
+            | SolveError::Interrupted { t, .. } => Some(*t),
+            SolveError::InvalidInput(_) => None,
+        }
+    }
+}

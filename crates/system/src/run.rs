@@ -55,9 +55,27 @@ pub enum SimError {
     /// Bad run settings.
     #[error("run settings: {0}")]
     Settings(String),
+    /// The circuit ended a step early
+    /// ([`crate::simulation::Simulation::step_to`]): an event stopped it.
+    #[error("the rig stopped the run at t = {t} s")]
+    Stopped {
+        /// The time the run stopped at \[s\].
+        t: f64,
+    },
 }
 
 impl SimError {
+    /// The time the run failed at: the solver's ([`SolveError::time`]) or
+    /// the one the circuit stopped it at; `None` for a failure before any
+    /// step (assembly, settings, an invalid solver input).
+    pub fn failed_at(&self) -> Option<f64> {
+        match self {
+            SimError::Solve { source, .. } => source.time(),
+            SimError::Stopped { t } => Some(*t),
+            SimError::Build(_) | SimError::Settings(_) => None,
+        }
+    }
+
     /// A solver failure of `circuit` started at `(t0, x0)`, with the state
     /// it is about named: a non-finite state by its name, a failure at the
     /// start (a step that fell to nothing, a non-finite value at `t0`) by

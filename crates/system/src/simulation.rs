@@ -407,36 +407,33 @@ impl Simulation {
     /// The circuit is not reset, so its components' modes (stick/slip,
     /// stops, valve states) carry over; the integrator restarts, so no step
     /// straddles the time reached. On failure the time and state stay where
-    /// they were: [`RigError::Sim`] says why (the solver's error, or the
-    /// circuit stopping the run early).
-    pub fn step_to(&mut self, t_end: f64) -> Result<(), RigError> {
+    /// they were: the [`SimError`] says why (the solver's error,
+    /// [`SimError::Solve`], or the circuit stopping the run early,
+    /// [`SimError::Stopped`]) and when ([`SimError::failed_at`]); stepping
+    /// before the start or not forward is [`SimError::Settings`].
+    pub fn step_to(&mut self, t_end: f64) -> Result<(), SimError> {
         let (t, x) = self
             .now
             .as_ref()
-            .ok_or_else(|| RigError::Sim("not started (Simulation::start)".into()))?;
+            .ok_or_else(|| SimError::Settings("not started (Simulation::start)".into()))?;
         let t = *t;
         if !(t_end > t && t_end.is_finite()) {
-            return Err(RigError::Sim(
-                SimError::Settings(format!("step to t = {t_end} s from t = {t} s")).to_string(),
-            ));
+            return Err(SimError::Settings(format!(
+                "step to t = {t_end} s from t = {t} s"
+            )));
         }
         let opts = self.options.solver_options(&self.circuit, vec![t, t_end]);
         let method = self.options.solver;
-        let sol =
-            solve(method.method(), &mut self.circuit, t, x, t_end, &opts).map_err(|source| {
-                RigError::Sim(
-                    SimError::solve(method.name(), source, &self.circuit, t, x).to_string(),
-                )
-            })?;
+        let sol = solve(method.method(), &mut self.circuit, t, x, t_end, &opts)
+            .map_err(|source| SimError::solve(method.name(), source, &self.circuit, t, x))?;
         match (sol.t.last(), sol.last()) {
             (Some(&te), Some(last)) if te == t_end => {
                 self.now = Some((t_end, last.to_vec()));
                 Ok(())
             }
-            (reached, _) => Err(RigError::Sim(format!(
-                "the rig stopped the run at t = {} s",
-                reached.copied().unwrap_or(t)
-            ))),
+            (reached, _) => Err(SimError::Stopped {
+                t: reached.copied().unwrap_or(t),
+            }),
         }
     }
 

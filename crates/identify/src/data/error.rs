@@ -1,0 +1,148 @@
+//! Why a record could not be read: [`DataError`], naming the file and,
+//! for one cell, its row and column.
+
+use thiserror::Error;
+
+/// What went wrong reading a record. Every variant names the file; those
+/// about one cell name its row (1-based line of the file, header = row 1)
+/// and column.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum DataError {
+    /// The file could not be opened or read.
+    #[error("{file}: cannot read: {reason}")]
+    Io {
+        /// The file.
+        file: String,
+        /// The operating system's reason.
+        reason: String,
+    },
+    /// The CSV structure is broken (ragged row, bad quoting, empty file).
+    #[error("{file}: row {row}: {reason}")]
+    Malformed {
+        /// The file.
+        file: String,
+        /// The row (1-based line).
+        row: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A required column is missing.
+    #[error("{file}: row 1: missing column '{column}'")]
+    MissingColumn {
+        /// The file.
+        file: String,
+        /// The missing column's name.
+        column: String,
+    },
+    /// A column the rig's column map names is not in the file.
+    #[error("{file}: row 1: missing column '{column}' (the rig's column map, `identify.columns.{signal}`; the file's headers: {headers})")]
+    MissingMappedColumn {
+        /// The file.
+        file: String,
+        /// The header the map names (as written in the map).
+        column: String,
+        /// The signal it was to hold.
+        signal: String,
+        /// The file's headers, comma separated.
+        headers: String,
+    },
+    /// A column's unit is not accepted for its signal.
+    #[error("{file}: row 1, column '{column}': unknown unit '{unit}' (accepted: {accepted})")]
+    UnknownUnit {
+        /// The file.
+        file: String,
+        /// The column header.
+        column: String,
+        /// The unit found.
+        unit: String,
+        /// The units accepted.
+        accepted: String,
+    },
+    /// The same signal appears twice.
+    #[error("{file}: row 1, column '{column}': signal '{signal}' appears twice")]
+    DuplicateSignal {
+        /// The file.
+        file: String,
+        /// The second column header.
+        column: String,
+        /// The signal.
+        signal: String,
+    },
+    /// The smoother half-width asked for is wider than the record allows.
+    #[error("{file}: a smoother half-width (window) of {half_window} samples does not fit its {samples} samples: at most {max}", max = samples.saturating_sub(1) / 2)]
+    WindowTooWide {
+        /// The record.
+        file: String,
+        /// The half-width asked for.
+        half_window: usize,
+        /// The record's samples.
+        samples: usize,
+    },
+    /// A smoother half-width given for records that are not smoothed.
+    #[error("{file}: a steady-state bench's samples are not smoothed (measured velocity, zero acceleration): leave out the smoother half-width (window)")]
+    WindowNotUsed {
+        /// The record.
+        file: String,
+    },
+    /// A cell is not a number.
+    #[error("{file}: row {row}, column '{column}': '{text}' is not a number")]
+    NotANumber {
+        /// The file.
+        file: String,
+        /// The row (1-based line).
+        row: usize,
+        /// The column header.
+        column: String,
+        /// The cell's text.
+        text: String,
+    },
+    /// A cell is NaN or infinite.
+    #[error("{file}: row {row}, column '{column}': value is not finite ({text})")]
+    NotFinite {
+        /// The file.
+        file: String,
+        /// The row (1-based line).
+        row: usize,
+        /// The column header.
+        column: String,
+        /// The cell's text.
+        text: String,
+    },
+    /// Time does not increase strictly.
+    #[error(
+        "{file}: row {row}, column '{column}': time {t} s does not increase (previous {prev} s)"
+    )]
+    TimeNotIncreasing {
+        /// The file.
+        file: String,
+        /// The row (1-based line).
+        row: usize,
+        /// The time column's header.
+        column: String,
+        /// This row's time \[s\].
+        t: f64,
+        /// The previous row's time \[s\].
+        prev: f64,
+    },
+    /// A column's unit contradicts the rig (a `command [V]` on a rig whose
+    /// command is a normalised spool demand; seconds under `time [ms]`).
+    #[error("{file}: row 1, column '{column}': {reason}")]
+    UnitContradictsRig {
+        /// The file.
+        file: String,
+        /// The column header.
+        column: String,
+        /// What contradicts what, and what to check.
+        reason: String,
+    },
+    /// Too few samples to do anything with.
+    #[error("{file}: only {n} samples (at least {min} needed)")]
+    TooShort {
+        /// The file.
+        file: String,
+        /// Samples found.
+        n: usize,
+        /// Samples needed.
+        min: usize,
+    },
+}

@@ -1,0 +1,409 @@
+//! Reading a record's CSV text: the header's columns (signals, units, a
+//! [`ColumnMap`]) and the values, by the plain numeric fast path or the
+//! full CSV reader.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use super::{ColumnMap, DataError, Record, Signal, MIN_SAMPLES};
+use crate::plaincsv::PlainCsv;
+
+/// Splits `name [unit]` into name and unit.
+fn split_header(h: &str) -> (String, Option<String>) {
+    let h = h.trim();
+    if let Some(open) = h.find('[') {
+        if h.ends_with(']') {
+            let name = h[..open].trim().to_string();
+            let unit = h[open + 1..h.len() - 1].trim().to_string();
+            return (name, Some(unit));
+        }
+    }
+    (h.to_string(), None)
+}
+
+/// The columns of a header: which signal each holds and its SI factor.
+struct Columns {
+    /// Column index → (signal, SI factor).
+    cols: Vec<Option<(Signal, f64)>>,
+    /// Signal → column index.
+    seen: BTreeMap<Signal, usize>,
+    /// Headers of the columns that are not signals.
+    ignored: Vec<String>,
+    /// Signal → the unit its header named.
+    units: BTreeMap<Signal, String>,
+}
+
+/// Why a header of one cell is not comma-separated CSV, when the cell
+/// shows another separator (`;` or a tab): "the file is separated by `;`;
+/// hydrocyl reads comma-separated CSV". Every CSV reader of hydrocyl
+/// (records, command files) gives this message for row 1.
+pub fn foreign_separator(headers: &[&str]) -> Option<String> {
+    let [cell] = headers else {
+        return None;
+    };
+    let sep = if cell.contains(';') {
+        "`;`"
+    } else if cell.contains('\t') {
+        "tabs"
+    } else {
+        return None;
+    };
+    Some(format!(
+        "the file is separated by {sep}; hydrocyl reads comma-separated CSV"
+    ))
+}
+
+/// Finds the signals among `headers` (trimmed), directly or through `map`.
+fn map_columns(file: &str, headers: &[&str], map: &ColumnMap) -> Result<Columns, DataError> {
+    if let Some(reason) = foreign_separator(headers) {
+        return Err(DataError::Malformed {
+            file: file.to_string(),
+            row: 1,
+            reason,
+        });
+    }
+    let mut cols: Vec<Option<(Signal, f64)>> = vec![None; headers.len()];
+    let mut seen: BTreeMap<Signal, usize> = BTreeMap::new();
+    let mut ignored = Vec::new();
+    let mut units = BTreeMap::new();
+    // Mapped signals first: header name → (signal, unit).
+    let mut mapped: BTreeMap<String, (Signal, Option<String>)> = BTreeMap::new();
+    for (sig, spec) in &map.0 {
+        let (name, unit) = split_header(spec);
+        mapped.insert(name, (*sig, unit));
+    }
+    for (j, h) in headers.iter().enumerate() {
+        let (name, unit) = split_header(h);
+        let hit = if let Some((sig, munit)) = mapped.get(h.trim()).or_else(|| mapped.get(&name)) {
+            // A mapped header: the map's unit wins, else the header's own.
+            Some((*sig, munit.clone().or(unit)))
+        } else {
+            Signal::from_name(&name)
+                .filter(|s| !map.0.contains_key(s))
+                .map(|s| (s, unit))
+        };
+        match hit {
+            Some((sig, unit)) => {
+                let factor = match &unit {
+                    None => 1.0,
+                    Some(u) => sig.unit_factor(u).ok_or_else(|| DataError::UnknownUnit {
+                        file: file.to_string(),
+                        column: h.to_string(),
+                        unit: u.clone(),
+                        accepted: sig.accepted_units().to_string(),
+                    })?,
+                };
+                if seen.insert(sig, j).is_some() {
+                    return Err(DataError::DuplicateSignal {
+                        file: file.to_string(),
+                        column: h.to_string(),
+                        signal: sig.name().to_string(),
+                    });
+                }
+                cols[j] = Some((sig, factor));
+                if let Some(u) = unit {
+                    units.insert(sig, u);
+                }
+            }
+            None => ignored.push(h.to_string()),
+        }
+    }
+    // A column the map names must be there: read by its own name instead,
+    // the record would say "missing column 'position'", not which header
+    // was looked for.
+    if let Some((sig, spec)) = map.0.iter().find(|(sig, _)| !seen.contains_key(sig)) {
+        return Err(DataError::MissingMappedColumn {
+            file: file.to_string(),
+            column: spec.clone(),
+            signal: sig.name().to_string(),
+            headers: headers.join(", "),
+        });
+    }
+    Ok(Columns {
+        cols,
+        seen,
+        ignored,
+        units,
+    })
+}
+
+impl Record {
+    /// Reads a CSV file in the measured-data format.
+    pub fn read(path: &Path) -> Result<Record, DataError> {
+        Self::read_mapped(path, &ColumnMap::default())
+    }
+
+    /// Reads a CSV file whose columns are found through `map`.
+    pub fn read_mapped(path: &Path, map: &ColumnMap) -> Result<Record, DataError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| DataError::Io {
+            file: file.clone(),
+            reason: e.to_string(),
+        })?;
+        Self::parse(&file, &text, map)
+    }
+
+    /// Parses CSV text; `file` names it in errors. Plain numeric text takes
+    /// the fast path of [`crate::plaincsv`]; anything else (and every error)
+    /// goes through the full CSV reader.
+    pub fn parse(file: &str, text: &str, map: &ColumnMap) -> Result<Record, DataError> {
+        if let Some(r) = Self::parse_plain(file, text, map) {
+            return Ok(r);
+        }
+        let mut rdr = csv::ReaderBuilder::new()
+            .has_headers(true)
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes());
+        let headers = rdr
+            .headers()
+            .map_err(|e| DataError::Malformed {
+                file: file.to_string(),
+                row: 1,
+                reason: e.to_string(),
+            })?
+            .clone();
+        if headers.iter().all(|h| h.trim().is_empty()) {
+            return Err(DataError::Malformed {
+                file: file.to_string(),
+                row: 1,
+                reason: "empty header".into(),
+            });
+        }
+        let header_list: Vec<&str> = headers.iter().collect();
+        let Columns {
+            cols,
+            seen,
+            ignored,
+            units,
+        } = map_columns(file, &header_list, map)?;
+        let time_col = match seen.get(&Signal::Time) {
+            Some(&j) => j,
+            None => {
+                return Err(DataError::MissingColumn {
+                    file: file.to_string(),
+                    column: map
+                        .0
+                        .get(&Signal::Time)
+                        .cloned()
+                        .unwrap_or_else(|| "time".into()),
+                })
+            }
+        };
+        let mut time = Vec::new();
+        let mut signals: BTreeMap<Signal, Vec<f64>> = seen
+            .keys()
+            .filter(|s| **s != Signal::Time)
+            .map(|s| (*s, Vec::new()))
+            .collect();
+        for (k, rec) in rdr.records().enumerate() {
+            let row = k + 2;
+            let rec = rec.map_err(|e| DataError::Malformed {
+                file: file.to_string(),
+                row,
+                reason: e.to_string(),
+            })?;
+            if rec.len() != headers.len() {
+                return Err(DataError::Malformed {
+                    file: file.to_string(),
+                    row,
+                    reason: format!("{} cells, header has {}", rec.len(), headers.len()),
+                });
+            }
+            for (j, col) in cols.iter().enumerate() {
+                let Some((sig, factor)) = col else { continue };
+                let cell = &rec[j];
+                let v: f64 = cell.parse().map_err(|_| DataError::NotANumber {
+                    file: file.to_string(),
+                    row,
+                    column: headers[j].to_string(),
+                    text: cell.to_string(),
+                })?;
+                if !v.is_finite() {
+                    return Err(DataError::NotFinite {
+                        file: file.to_string(),
+                        row,
+                        column: headers[j].to_string(),
+                        text: cell.to_string(),
+                    });
+                }
+                let v = v * factor;
+                if *sig == Signal::Time {
+                    if let Some(&prev) = time.last() {
+                        if v <= prev {
+                            return Err(DataError::TimeNotIncreasing {
+                                file: file.to_string(),
+                                row,
+                                column: headers[time_col].to_string(),
+                                t: v,
+                                prev,
+                            });
+                        }
+                    }
+                    time.push(v);
+                } else if let Some(s) = signals.get_mut(sig) {
+                    s.push(v);
+                }
+            }
+        }
+        if time.len() < MIN_SAMPLES {
+            return Err(DataError::TooShort {
+                file: file.to_string(),
+                n: time.len(),
+                min: MIN_SAMPLES,
+            });
+        }
+        Ok(Record {
+            source: file.to_string(),
+            time,
+            signals,
+            ignored,
+            units,
+        })
+    }
+
+    /// The fast path of [`Record::parse`]: `None` whenever the text is not
+    /// plain numeric CSV or anything is wrong with it (the full reader then
+    /// reports what).
+    fn parse_plain(file: &str, text: &str, map: &ColumnMap) -> Option<Record> {
+        let csv = PlainCsv::new(text)?;
+        let headers: Vec<&str> = csv.headers().collect();
+        let Columns {
+            cols,
+            seen,
+            ignored,
+            units,
+        } = map_columns(file, &headers, map).ok()?;
+        let time_col = *seen.get(&Signal::Time)?;
+        let wanted: Vec<usize> = std::iter::once(time_col)
+            .chain(seen.values().copied().filter(|&j| j != time_col))
+            .collect();
+        let mut values = csv.columns(&wanted)?.into_iter();
+        let scale = |j: usize, mut v: Vec<f64>| {
+            let factor = cols[j].map_or(1.0, |(_, f)| f);
+            if factor != 1.0 {
+                v.iter_mut().for_each(|x| *x *= factor);
+            }
+            v
+        };
+        let time = scale(time_col, values.next()?);
+        if time.len() < MIN_SAMPLES || time.windows(2).any(|w| w[1] <= w[0]) {
+            return None;
+        }
+        let mut signals = BTreeMap::new();
+        for (&j, v) in wanted[1..].iter().zip(values) {
+            let (sig, _) = cols[j]?;
+            signals.insert(sig, scale(j, v));
+        }
+        Some(Record {
+            source: file.to_string(),
+            time,
+            signals,
+            ignored,
+            units,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Record, DataError> {
+        Record::parse("t.csv", text, &ColumnMap::default())
+    }
+
+    #[test]
+    fn units_are_converted_to_si() {
+        let mut s = String::from("time [ms],position [mm],p1 [bar],p2 [psi],force [kN],other\n");
+        for i in 0..10 {
+            s.push_str(&format!("{},{},{},1,2,x\n", i * 10, i, 100 + i));
+        }
+        let r = parse(&s).unwrap();
+        assert_eq!(r.len(), 10);
+        assert!((r.time[3] - 0.03).abs() < 1e-15);
+        assert!((r.get(Signal::Position).unwrap()[4] - 4e-3).abs() < 1e-15);
+        assert!((r.get(Signal::P1).unwrap()[0] - 100e5).abs() < 1e-6);
+        assert!((r.get(Signal::P2).unwrap()[0] - 6894.757293168361).abs() < 1e-9);
+        assert!((r.get(Signal::Force).unwrap()[0] - 2000.0).abs() < 1e-12);
+        assert_eq!(r.ignored, vec!["other".to_string()]);
+    }
+
+    #[test]
+    fn a_semicolon_or_tab_file_is_named_as_such() {
+        for (text, sep) in [
+            ("time [s];command;position [mm]\n0;0;0\n1;0;0\n", "`;`"),
+            ("time\tcommand\tposition\n0\t0\t0\n1\t0\t0\n", "tabs"),
+        ] {
+            let e = parse(text).unwrap_err().to_string();
+            assert!(
+                e.contains("row 1") && e.contains(&format!("separated by {sep}")),
+                "{e}"
+            );
+        }
+    }
+
+    #[test]
+    fn errors_name_row_and_column() {
+        let ok = "time,position\n0,0\n1,0\n2,0\n3,0\n4,0\n5,0\n6,0\n7,0\n";
+        assert!(parse(ok).is_ok());
+        let e = parse("position\n0\n").unwrap_err();
+        assert!(matches!(e, DataError::MissingColumn { .. }), "{e}");
+        let e = parse(&ok.replace("3,0", "3,abc")).unwrap_err().to_string();
+        assert!(
+            e.contains("row 5") && e.contains("'position'") && e.contains("abc"),
+            "{e}"
+        );
+        let e = parse(&ok.replace("4,0", "4,NaN")).unwrap_err().to_string();
+        assert!(e.contains("row 6") && e.contains("not finite"), "{e}");
+        let e = parse(&ok.replace("5,0", "3.5,0")).unwrap_err().to_string();
+        assert!(
+            e.contains("row 7") && e.contains("does not increase"),
+            "{e}"
+        );
+        let e = parse(&ok.replace("position", "position [furlong]"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("unknown unit 'furlong'") && e.contains("row 1"),
+            "{e}"
+        );
+        let e = parse(&ok.replace("6,0", "6")).unwrap_err().to_string();
+        assert!(e.contains("row 8"), "{e}");
+        let e = parse("time,position\n0,0\n").unwrap_err();
+        assert!(matches!(e, DataError::TooShort { .. }));
+    }
+
+    #[test]
+    fn column_map_reads_foreign_headers() {
+        let mut map = ColumnMap::default();
+        map.0.insert(Signal::Time, "time_ms [ms]".into());
+        map.0.insert(Signal::P1, "pressure_bar_gauge [bar]".into());
+        let mut s = String::from("time_ms,pressure_bar_gauge,force_N\n");
+        for i in 0..10 {
+            s.push_str(&format!("{},{},5\n", i * 10, 2));
+        }
+        let r = Record::parse("x.csv", &s, &map).unwrap();
+        assert!((r.time[1] - 0.01).abs() < 1e-15);
+        assert!((r.get(Signal::P1).unwrap()[1] - 2e5).abs() < 1e-9);
+        assert_eq!(r.ignored, vec!["force_N".to_string()]);
+    }
+
+    /// A column map naming a header the file lacks: the error names the
+    /// header looked for (it said "missing column 'position'").
+    #[test]
+    fn a_mapped_column_that_is_missing_is_named_by_its_header() {
+        let mut map = ColumnMap::default();
+        map.0.insert(Signal::Position, "pos [mm]".into());
+        let mut s = String::from("time [s],command,position [mm]\n");
+        for i in 0..10 {
+            s.push_str(&format!("{},0,{}\n", i, i));
+        }
+        let e = Record::parse("x.csv", &s, &map).unwrap_err().to_string();
+        assert!(
+            e.contains("x.csv")
+                && e.contains("missing column 'pos [mm]'")
+                && e.contains("identify.columns.position"),
+            "{e}"
+        );
+    }
+}

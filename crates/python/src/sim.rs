@@ -5,7 +5,6 @@
 
 use crate::errors::{stopped, Failure, Outcome, RunWarning, Stop};
 use hydrocyl_energy::ledger::{ledger, Ledger, RodSide};
-use hydrocyl_integrators::SolveError;
 use hydrocyl_system::rig::{self, RigError};
 use hydrocyl_system::run::{
     Cause, DeepCavitation, Run, RunOptions, Setting, SettingWords, SimError, Solver,
@@ -194,20 +193,6 @@ fn whole_run_ledger(value: &Value, command: &Signal, run: &Run) -> Result<Ledger
     ledger(&c, run, 0, run.time.len() - 1, &RodSide::default()).map_err(|e| e.to_string())
 }
 
-/// The time a solver error names.
-fn failure_time(e: &SolveError) -> Option<f64> {
-    match e {
-        SolveError::StepTooSmall { t, .. }
-        | SolveError::TooManySteps { t, .. }
-        | SolveError::NonFinite { t, .. }
-        | SolveError::Singular { t }
-        | SolveError::EventStorm { t, .. }
-        | SolveError::Chattering { t, .. }
-        | SolveError::Interrupted { t, .. } => Some(*t),
-        SolveError::InvalidInput(_) => None,
-    }
-}
-
 /// Turns a failed run into a [`Failure::Solver`]: the rig's run is repeated
 /// (a fresh [`Simulation`], [`Simulation::try_run`] for the solver's own
 /// error) to get the solver's time, then integrated up to that time for the
@@ -233,7 +218,7 @@ fn locate_failure(
         let n = first.circuit().n_states();
         let names = first.circuit().state_names();
         let time = match first.try_run(t) {
-            Err(SimError::Solve { source, .. }) => failure_time(&source)?,
+            Err(SimError::Solve { source, .. }) => source.time()?,
             _ => return None,
         };
         // the state at the failure time, or — where the solver failed on a

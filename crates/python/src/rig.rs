@@ -303,9 +303,17 @@ impl Rig {
         Ok(d)
     }
 
-    /// The rig as the JSON text of a rig file (what `--print-rig` prints).
+    /// The rig as the JSON text of a rig file, as `--print-rig` prints
+    /// it: a netlist with every parameter and initial state written out
+    /// (defaults filled in, [`netlist::expanded`]).
     fn to_json(&self) -> PyResult<String> {
-        serde_json::to_string_pretty(&*self.snapshot()).map_err(|e| {
+        let v = self.snapshot();
+        let shown = if v.get("kind").and_then(Value::as_str) == Some(netlist::KIND) {
+            netlist::expanded(&v).map_err(input)?
+        } else {
+            (*v).clone()
+        };
+        serde_json::to_string_pretty(&shown).map_err(|e| {
             input(rig::RigError::Invalid {
                 path: "rig".into(),
                 why: e.to_string(),

@@ -268,3 +268,14 @@ def test_get_on_an_inner_path_gives_its_parameters_as_a_dict():
     # a prefix of a name is not a path
     with pytest.raises(ValueError, match="unknown rig parameter"):
         rig.get("cyl")
+
+
+@pytest.mark.parametrize("preset", ["leaney-moog", "wang-hybrid", "emps"])
+def test_to_json_is_what_print_rig_prints(cli, preset):
+    # every parameter written out, defaults filled in, as --print-rig does
+    # (it used to give the preset's file as written, defaults left out)
+    rig = hydrocyl.Rig.load(preset)
+    path = path_of(rig, "mass")
+    rig.set(path, 42.0)
+    _, out, _ = run_cli(cli, "simulate", "--rig", preset, "--set", f"{path}=42", "--print-rig")
+    assert json.loads(rig.to_json()) == json.loads(out)

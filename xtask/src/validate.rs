@@ -6,6 +6,7 @@ use crate::report::Section;
 
 mod chapter9;
 mod diagnose;
+mod doc_table;
 mod friction;
 mod hybrid;
 mod integrators;

@@ -12,7 +12,28 @@ use hydrocyl_identify::data::Record;
 use hydrocyl_identify::diagnose::{diagnose_bench, DiagnoseOptions, Outcome};
 use hydrocyl_identify::synth::{self, Foreign, Noise};
 
+use super::doc_table::DocTable;
 use crate::report::Section;
+
+/// The document whose tables of diagnose results are checked here.
+const DOC: &str = "docs/diagnose.md";
+
+/// The table of [`DOC`] whose header row starts with `header`, or a failed
+/// check saying it is not there.
+fn doc_table(s: &mut Section, header: &str) -> Option<DocTable> {
+    let table = std::fs::read_to_string(root().join(DOC))
+        .ok()
+        .and_then(|text| DocTable::find(DOC, &text, header));
+    if table.is_none() {
+        s.check(
+            &format!("{DOC}: the table `{header} ...`"),
+            "not found".into(),
+            "a table".into(),
+            false,
+        );
+    }
+    table
+}
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -43,6 +64,7 @@ fn ids(o: &Outcome) -> String {
 pub fn section() -> Section {
     let mut s = Section::new("diagnose");
     let dir = root().join("fixtures/measured");
+    let doc = doc_table(&mut s, "| fixture | planted | found | force NRMSE");
     s.note(&format!(
         "{:<40} {:<38} {:<38} {:>9} {:>9} {:>9}",
         "fixture", "planted", "found", "nrmse0", "nrmse1", "floor"
@@ -101,6 +123,9 @@ pub fn section() -> Section {
             "{:<40} {:<38} {:<38} {:>9.5} {:>9.5} {:>9.5}",
             case.name, planted, found_text, n0, n1, fl
         ));
+        if let Some(doc) = &doc {
+            doc.check_row(&mut s, &case.name, &[(3, vec![n0, n1]), (4, vec![fl])], &[]);
+        }
         let pass = match case.foreign {
             Foreign::None => {
                 let mut want: Vec<&str> = case.planted.iter().map(|e| e.id()).collect();
@@ -140,6 +165,7 @@ pub fn section() -> Section {
 fn valve(s: &mut Section, dir: &Path) {
     use hydrocyl_identify::valve::{diagnose_valve, set};
     use hydrocyl_system::valve_rig::ValveRig;
+    let doc = doc_table(s, "| fixture | planted | found | fitted");
     for (name, planted_id) in synth::valve_fixture_cases() {
         let planted = planted_id.map_or("none", |id| id.id());
         let res = Record::read(&dir.join(format!("{name}.csv")))
@@ -180,6 +206,9 @@ fn valve(s: &mut Section, dir: &Path) {
                     r.nrmse_before["p1"], r.nrmse_after["p1"], r.noise_floor["p1"],
                     r.nrmse_before["p2"], r.nrmse_after["p2"], r.noise_floor["p2"],
                 ));
+                if let Some(doc) = &doc {
+                    check_valve_row(s, doc, &name, &r);
+                }
                 s.check(
                     &format!("{name}: found / NRMSE"),
                     format!("{found}, {}", if within { "within" } else { "above" }),
@@ -225,6 +254,42 @@ fn valve(s: &mut Section, dir: &Path) {
             false,
         ),
     }
+}
+
+/// The row of a valve fixture in [`DOC`]'s table: the effects found, the
+/// fitted parameter with its 95 % half-width (the first effect's, named in
+/// the cell), and the NRMSE of p1, p2 and position before → after (floor).
+fn check_valve_row(
+    s: &mut Section,
+    doc: &DocTable,
+    name: &str,
+    r: &hydrocyl_identify::diagnose::Report,
+) {
+    let found: Vec<&str> = r.effects_added.iter().map(|e| e.id.as_str()).collect();
+    let found = if found.is_empty() {
+        "nothing".to_string()
+    } else {
+        found.join(" + ")
+    };
+    let mut numbers: Vec<(usize, Vec<f64>)> = ["p1", "p2", "position"]
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            (
+                4 + k,
+                vec![r.nrmse_before[*c], r.nrmse_after[*c], r.noise_floor[*c]],
+            )
+        })
+        .collect();
+    // the fitted cell names its parameter first: `Cl 1e-11 ± 1e-15`
+    let fitted = doc.cell(name, 3).unwrap_or_default();
+    if let (Some(param), Some(e)) = (fitted.split_whitespace().next(), r.effects_added.first()) {
+        if let Some(&v) = e.params.get(param) {
+            let ci = e.ci95.get(param).copied().flatten().unwrap_or(f64::NAN);
+            numbers.push((3, vec![v, ci]));
+        }
+    }
+    doc.check_row(s, name, &numbers, &[(2, found)]);
 }
 
 /// Reports a diagnose wall time against the goal. Wall time depends on

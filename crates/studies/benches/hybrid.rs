@@ -4,7 +4,7 @@
 //! and without the mass-balance quadratures, and with the finite-difference
 //! Jacobian in place of the circuit's analytic one. The goal is 500× real time.
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use hydrocyl_studies::chapter7::{Chapter7Test, Load, Shape};
 use hydrocyl_system::run::{RunOptions, Solver};
 use hydrocyl_system::simulation::Simulation;
@@ -40,6 +40,23 @@ fn square_period(c: &mut Criterion) {
             })
         });
     }
+    // the run alone: the rig built (netlist read, circuit assembled) in
+    // criterion's untimed setup, so that the solve is timed without the
+    // one-off build a sweep or an FMU pays once
+    let opts = RunOptions {
+        solver: Solver::Rosenbrock,
+        ..RunOptions::default()
+    };
+    g.bench_function("plain, run only", |b| {
+        b.iter_batched(
+            || {
+                Simulation::of_circuit(rig.build(test.command(&rig)).expect("rig"))
+                    .options(opts.clone())
+            },
+            |mut sim| black_box(sim.run(&t).expect("run").stats.steps),
+            BatchSize::SmallInput,
+        )
+    });
     g.finish();
 }
 

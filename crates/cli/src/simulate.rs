@@ -206,10 +206,7 @@ fn run_bench(
     value: &serde_json::Value,
 ) -> Result<(), CliError> {
     if args.print_rig {
-        let shown = hydrocyl_system::netlist::expanded(value)
-            .map_err(|e| CliError::Input(e.to_string()))?;
-        let text = serde_json::to_string_pretty(&shown)
-            .map_err(|e| CliError::Input(format!("rig: {e}")))?;
+        let text = rig::printed(value).map_err(|e| CliError::Input(e.to_string()))?;
         return crate::console::print(&format!("{text}\n"));
     }
     let (Some(input), Some(out)) = (&args.command, &args.out) else {
@@ -426,7 +423,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
     for s in &args.set {
         rig::apply_set(&mut value, s).map_err(rig_err)?;
     }
-    let kind = value.get("kind").and_then(|k| k.as_str());
     crate::progress::mark("rig loaded");
     let checked = crate::rigfile::check(&value, &args.rig, &args.set)?;
     check_initial_pressures(&checked)?;
@@ -439,13 +435,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .map_err(|e| CliError::Input(e.to_string()))?;
         // a netlist is printed with every parameter written out (defaults
         // filled in), under the paths `--set` takes
-        let shown = if kind == Some(hydrocyl_system::netlist::KIND) {
-            hydrocyl_system::netlist::expanded(&value).map_err(rig_err)?
-        } else {
-            value.clone()
-        };
-        let text = serde_json::to_string_pretty(&shown)
-            .map_err(|e| CliError::Input(format!("rig: {e}")))?;
+        let text = rig::printed(&value).map_err(rig_err)?;
         return crate::console::print(&format!("{text}\n"));
     }
     let solver = Solver::parse_or_why(&args.solver)

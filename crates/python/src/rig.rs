@@ -305,20 +305,9 @@ impl Rig {
 
     /// The rig as the JSON text of a rig file, as `--print-rig` prints
     /// it: a netlist with every parameter and initial state written out
-    /// (defaults filled in, [`netlist::expanded`]).
+    /// (defaults filled in, [`rig::printed`]).
     fn to_json(&self) -> PyResult<String> {
-        let v = self.snapshot();
-        let shown = if v.get("kind").and_then(Value::as_str) == Some(netlist::KIND) {
-            netlist::expanded(&v).map_err(input)?
-        } else {
-            (*v).clone()
-        };
-        serde_json::to_string_pretty(&shown).map_err(|e| {
-            input(rig::RigError::Invalid {
-                path: "rig".into(),
-                why: e.to_string(),
-            })
-        })
+        rig::printed(&self.snapshot()).map_err(input)
     }
 
     /// A copy (edits of the copy leave this rig alone).

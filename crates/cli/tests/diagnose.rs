@@ -278,12 +278,7 @@ fn valve_rig_finds_the_planted_leak() {
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(json["rig_kind"], "netlist");
     // where each effect acts, as `<component>.<parameter>` paths
-    let leak = json["effects_applicable"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|e| e["id"] == "internal_leakage")
-        .unwrap();
+    let leak = listed(&json, "effects_applicable", "internal_leakage");
     assert_eq!(leak["paths"][0], "cylinder.internal_leakage");
     assert_eq!(json["effects_added"][0]["id"], "internal_leakage");
     for ch in ["position", "velocity", "p1", "p2"] {
@@ -392,6 +387,18 @@ fn assert_partition(json: &serde_json::Value) {
     assert_eq!(added.len() + rejected.len() + na.len(), ids.len());
 }
 
+/// The entry of effect `id` in the report's list `list`
+/// (`effects_applicable`, `effects_not_applicable`, ...); panics when the
+/// list does not hold it.
+fn listed<'a>(json: &'a serde_json::Value, list: &str, id: &str) -> &'a serde_json::Value {
+    json[list]
+        .as_array()
+        .unwrap_or_else(|| panic!("no list `{list}` in the report"))
+        .iter()
+        .find(|e| e["id"] == id)
+        .unwrap_or_else(|| panic!("{id} is not listed in `{list}`"))
+}
+
 fn diagnose_json(args: &[&std::ffi::OsStr]) -> serde_json::Value {
     let dir = tempfile::tempdir().unwrap();
     let report = dir.path().join("r.json");
@@ -422,18 +429,10 @@ fn the_lists_partition_the_catalog_on_the_valve_rig() {
         data.as_os_str(),
     ]);
     assert_partition(&json);
-    let visc = json["effects_not_applicable"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|e| e["id"] == "viscous")
-        .expect("viscous listed");
+    let why = listed(&json, "effects_not_applicable", "viscous")["why"].as_str();
     assert!(
-        visc["why"]
-            .as_str()
-            .unwrap()
-            .contains("already on in the declared rig"),
-        "{visc}"
+        why.unwrap().contains("already on in the declared rig"),
+        "{why:?}"
     );
 }
 
@@ -450,26 +449,13 @@ fn the_lists_partition_the_catalog_on_a_bench_rig() {
         data.as_os_str(),
     ]);
     assert_partition(&json);
-    let visc = json["effects_not_applicable"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|e| e["id"] == "viscous")
-        .expect("viscous listed");
+    let why = listed(&json, "effects_not_applicable", "viscous")["why"].as_str();
     assert!(
-        visc["why"]
-            .as_str()
-            .unwrap()
-            .contains("already on in the declared rig"),
-        "{visc}"
+        why.unwrap().contains("already on in the declared rig"),
+        "{why:?}"
     );
     // the tried effects' parameters by their `--set` paths on this rig
-    let pv = json["effects_applicable"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|e| e["id"] == "pressure_viscous")
-        .expect("pressure_viscous listed");
+    let pv = listed(&json, "effects_applicable", "pressure_viscous");
     assert_eq!(pv["paths"], serde_json::json!(["friction.seal.k_pressure"]));
 }
 

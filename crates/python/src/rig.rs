@@ -305,20 +305,9 @@ impl Rig {
 
     /// The rig as the JSON text of a rig file, as `--print-rig` prints
     /// it: a netlist with every parameter and initial state written out
-    /// (defaults filled in, [`netlist::expanded`]).
+    /// (defaults filled in, [`rig::printed`]).
     fn to_json(&self) -> PyResult<String> {
-        let v = self.snapshot();
-        let shown = if v.get("kind").and_then(Value::as_str) == Some(netlist::KIND) {
-            netlist::expanded(&v).map_err(input)?
-        } else {
-            (*v).clone()
-        };
-        serde_json::to_string_pretty(&shown).map_err(|e| {
-            input(rig::RigError::Invalid {
-                path: "rig".into(),
-                why: e.to_string(),
-            })
-        })
+        rig::printed(&self.snapshot()).map_err(input)
     }
 
     /// A copy (edits of the copy leave this rig alone).
@@ -366,7 +355,7 @@ impl Rig {
     /// `solver`: "auto" (default, as the CLI's: Dormand–Prince while the
     /// run is not stiff, Rosenbrock while it is), "dp45", "rosenbrock",
     /// "rk4" or "exponential"; `rtol`: relative tolerance of the adaptive
-    /// methods; `rk4_step` [s]: the step of the fixed-step methods; `h_max`:
+    /// methods, in [1e-14, 1) as the CLI's `--rtol`; `rk4_step` [s]: the step of the fixed-step methods; `h_max`:
     /// largest step [s] (default 0.01); `ledger=True` adds the energy ledger
     /// (`run.ledger`). The run is of the rig as it is when called (a `set`
     /// from another thread meanwhile does not change it); the GIL is

@@ -361,6 +361,23 @@ pub fn check(v: &Value) -> Result<(), RigError> {
     (kind_of(&v)?.check)(&v)
 }
 
+/// The rig as `--print-rig` prints it (and `hydrocyl.Rig.to_json` gives
+/// it): the JSON text, pretty-printed, of a netlist with every parameter
+/// and initial state written out under the paths `--set` takes (defaults
+/// filled in, [`netlist::expanded`](crate::netlist::expanded)); a rig of
+/// another kind as it is given.
+pub fn printed(v: &Value) -> Result<String, RigError> {
+    let expanded;
+    let shown = if v.get("kind").and_then(Value::as_str) == Some(crate::netlist::KIND) {
+        expanded = crate::netlist::expanded(v)?;
+        &expanded
+    } else {
+        v
+    };
+    // a `Value` always serializes (string keys, finite numbers)
+    Ok(serde_json::to_string_pretty(shown).expect("a JSON value serializes"))
+}
+
 /// Simulates a rig value of any kind: [`Simulation::new`](crate::simulation::Simulation::new)
 /// then [`Simulation::run`](crate::simulation::Simulation::run).
 pub fn simulate(

@@ -32,7 +32,7 @@ pub use physical::{
     Unphysical, ABSURD_PRESSURE_PA, AIR_PARAMETER, LIQUID_TENSION_LIMIT_PA,
 };
 pub use probes::{ProbeReader, ProbeSet};
-pub use settings::{Setting, Solver};
+pub use settings::{Setting, Solver, RTOL_FLOOR};
 
 /// Why a run failed.
 #[derive(Debug, Error)]

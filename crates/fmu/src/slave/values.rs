@@ -111,7 +111,10 @@ impl Slave {
                     SolverParam::Rk4Step => setting_rule(Setting::Rk4Step, value),
                 };
                 if !ok {
-                    return Err(format!("parameter `{name}` = {value} rejected: {rule}"));
+                    return Err(format!(
+                        "parameter `{name}` = {} rejected: {rule}",
+                        Setting::shown(value)
+                    ));
                 }
             }
             Role::Parameter(path) => {
@@ -175,9 +178,13 @@ impl Slave {
     }
 }
 
-/// Whether a solver parameter's `value` meets `setting`'s rule, and the rule.
+/// Whether a solver parameter's `value` meets `setting`'s rules, and the
+/// rule it breaks ([`Setting::check`]).
 fn setting_rule(setting: Setting, value: f64) -> (bool, String) {
-    (setting.holds(value), setting.rule().into())
+    match setting.check(value) {
+        Ok(_) => (true, String::new()),
+        Err(rule) => (false, rule.into()),
+    }
 }
 
 /// The rules a rig parameter's value must meet on its own, whatever the
@@ -260,6 +267,7 @@ mod tests {
         // solver parameters: the message is the rule, not the description
         for (name, bad, rule) in [
             ("solver.rtol", 0.0, "must be in (0, 1)"),
+            ("solver.rtol", 1e-300, "= 1e-300 rejected: below 1e-14"),
             ("solver.h_max", -1.0, "must be > 0 [s]"),
             (
                 "solver.rk4_step",

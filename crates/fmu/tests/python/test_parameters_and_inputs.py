@@ -122,5 +122,9 @@ def test_a_refused_solver_parameter_states_its_rule(export):
     with pytest.raises(FMICallException):
         s.setReal([vr["solver.rtol"]], [0.0])
     assert "solver.rtol" in messages[-1] and "must be in (0, 1)" in messages[-1], messages
+    # below what double precision meets: refused as the CLI and Python refuse it
+    with pytest.raises(FMICallException):
+        s.setReal([vr["solver.rtol"]], [1e-300])
+    assert "solver.rtol` = 1e-300 rejected: below 1e-14" in messages[-1], messages
     s.freeInstance()
     shutil.rmtree(d, ignore_errors=True)

@@ -251,48 +251,18 @@ impl FrictionBench {
             paths: BTreeMap::new(),
         };
         // where each parameter is in this netlist (its `--set` paths),
-        // kept where that is not the bench circuit's path
+        // kept where that is not the bench circuit's path: the law's
+        // parameters as the netlist's friction-bench view names them
         let stribeck = rig.has(EffectId::Stribeck);
-        let at = |q: &str| format!("{}.{q}", law.name);
-        let both = |q: &str| {
-            vec![
-                at(&format!("extending.{q}")),
-                at(&format!("retracting.{q}")),
-            ]
-        };
         let law_paths = |p: &ParamRef| -> Vec<String> {
-            let seal = |q: &str| law.ty.param(q).map_or_else(Vec::new, |_| vec![at(q)]);
-            match (law.ty.name, p) {
-                (_, ParamRef::Mass) => vec![format!("{}.mass", drive.name)],
-                ("friction_bench", p) => {
-                    let path = p.path();
-                    vec![at(path.split_once('.').map_or("", |(_, q)| q))]
-                }
-                ("friction_coulomb_viscous", ParamRef::Coulomb) => vec![at("coulomb")],
-                ("friction_coulomb_viscous", ParamRef::Effect(EffectId::Viscous, _)) => {
-                    vec![at("viscous")]
-                }
-                // no Stribeck hump: the stiction level is the Coulomb level
-                ("friction_lugre", ParamRef::Coulomb) if !stribeck => {
-                    [both("curve.coulomb"), both("curve.stiction")].concat()
-                }
-                ("friction_lugre", ParamRef::Coulomb) => both("curve.coulomb"),
-                ("friction_lugre", ParamRef::Effect(id, q)) => match (id, q.as_str()) {
-                    (EffectId::Stribeck, "Fs") => both("curve.stiction"),
-                    (EffectId::Stribeck, "vs") => both("curve.stribeck_velocity"),
-                    (EffectId::Stribeck, "alpha") => both("curve.stribeck_exponent"),
-                    (EffectId::LugreDynamics, q) => vec![at(q)],
-                    (EffectId::Viscous, _) => both("sigma2"),
-                    (EffectId::PressureViscous, _) => seal("seal.k_pressure"),
-                    (EffectId::AccelerationFriction, _) => seal("seal.h_acceleration"),
-                    _ => Vec::new(),
-                },
-                (_, ParamRef::Effect(EffectId::PressureViscous, _)) => seal("seal.k_pressure"),
-                (_, ParamRef::Effect(EffectId::AccelerationFriction, _)) => {
-                    seal("seal.h_acceleration")
-                }
-                _ => Vec::new(),
+            if *p == ParamRef::Mass {
+                return vec![format!("{}.mass", drive.name)];
             }
+            hydrocyl_system::netlist::identify::bench_law_params(law.ty.name, &p.label(), stribeck)
+                .expect("the law's type was matched above")
+                .iter()
+                .map(|q| format!("{}.{q}", law.name))
+                .collect()
         };
         let mut all = vec![ParamRef::Coulomb, ParamRef::Mass];
         for id in super::BENCH_EFFECTS {
@@ -479,6 +449,106 @@ mod tests {
             }
         }
     }
+
+    /// The `--set` paths each bench rig under `fixtures/` keeps for its
+    /// parameters (`FrictionBench::paths`, where a parameter is not at its
+    /// bench-circuit path), recorded: the presets' files in `rigs/` (a LuGre
+    /// law with one set per direction, a Coulomb + viscous law), every other
+    /// bench rig file (a `friction_bench` law, which keeps none), and
+    /// `tudelft-seal-25` with a Stribeck hump set (its stiction level no
+    /// longer the Coulomb level).
+    #[test]
+    fn the_set_paths_of_every_bench_rig_are_as_recorded() {
+        let mut rigs: Vec<(String, serde_json::Value)> = vec![];
+        let mut hump = hydrocyl_system::rig::preset("tudelft-seal-25").unwrap();
+        for d in ["extending", "retracting"] {
+            let set = format!("friction.{d}.curve.stiction=6");
+            hydrocyl_system::rig::apply_set(&mut hump, &set).unwrap();
+        }
+        rigs.push(("tudelft-seal-25 with a Stribeck hump".into(), hump));
+        let mut files = vec![];
+        let mut dirs = vec![fixtures()];
+        while let Some(d) = dirs.pop() {
+            for e in std::fs::read_dir(&d).unwrap() {
+                let p = e.unwrap().path();
+                if p.is_dir() {
+                    dirs.push(p);
+                } else if p.extension().is_some_and(|x| x == "json") {
+                    files.push(p);
+                }
+            }
+        }
+        files.sort();
+        for f in files {
+            let Ok(v) = hydrocyl_system::rig::load(f.to_str().unwrap()) else {
+                continue; // not a rig file
+            };
+            if is_bench_rig(&v) {
+                let name = f.strip_prefix(fixtures()).unwrap().display().to_string();
+                rigs.push((name, v));
+            }
+        }
+        let mut got = String::new();
+        for (name, v) in &rigs {
+            let b = FrictionBench::from_rig(v).unwrap_or_else(|e| panic!("{name}: {e}"));
+            got += &format!("{name}:\n");
+            for (p, paths) in &b.paths {
+                got += &format!("  {} -> {}\n", p.path(), paths.join(" "));
+            }
+        }
+        assert_eq!(got, RECORDED_PATHS, "{got}");
+    }
+
+    const RECORDED_PATHS: &str = concat!(
+        "tudelft-seal-25 with a Stribeck hump:\n",
+        "  friction.coulomb -> friction.extending.curve.coulomb friction.retracting.curve.coulomb\n",
+        "  friction.asymmetry -> \n",
+        "  friction.stiction -> friction.extending.curve.stiction friction.retracting.curve.stiction\n",
+        "  friction.stribeck_exponent -> friction.extending.curve.stribeck_exponent friction.retracting.curve.stribeck_exponent\n",
+        "  friction.stribeck_velocity -> friction.extending.curve.stribeck_velocity friction.retracting.curve.stribeck_velocity\n",
+        "  friction.viscous -> friction.extending.sigma2 friction.retracting.sigma2\n",
+        "  friction.external_force -> \n",
+        "legacy/bench-acceleration_friction.rig.json:\n",
+        "legacy/mr-damper.rig.json:\n",
+        "legacy/wang-table-5-3.steady.rig.json:\n",
+        "measured/bench-acceleration_friction.rig.json:\n",
+        "measured/bench-coulomb_asymmetry.rig.json:\n",
+        "measured/bench-external_force.rig.json:\n",
+        "measured/bench-foreign-delay.rig.json:\n",
+        "measured/bench-foreign-spring.rig.json:\n",
+        "measured/bench-lugre_dynamics.rig.json:\n",
+        "measured/bench-none.rig.json:\n",
+        "measured/bench-pressure_viscous+external_force.rig.json:\n",
+        "measured/bench-pressure_viscous.rig.json:\n",
+        "measured/bench-stribeck.rig.json:\n",
+        "measured/bench-viscous.rig.json:\n",
+        "measured/mr-damper.rig.json:\n",
+        "measured/wang-table-5-3.steady.rig.json:\n",
+        "rigs/emps.json:\n",
+        "  friction.asymmetry -> \n",
+        "  friction.stiction -> \n",
+        "  friction.stribeck_exponent -> \n",
+        "  friction.stribeck_velocity -> \n",
+        "  friction.sigma0 -> \n",
+        "  friction.sigma1 -> \n",
+        "  friction.external_force -> \n",
+        "rigs/tudelft-seal-25.json:\n",
+        "  friction.coulomb -> friction.extending.curve.coulomb friction.retracting.curve.coulomb friction.extending.curve.stiction friction.retracting.curve.stiction\n",
+        "  friction.asymmetry -> \n",
+        "  friction.stiction -> friction.extending.curve.stiction friction.retracting.curve.stiction\n",
+        "  friction.stribeck_exponent -> friction.extending.curve.stribeck_exponent friction.retracting.curve.stribeck_exponent\n",
+        "  friction.stribeck_velocity -> friction.extending.curve.stribeck_velocity friction.retracting.curve.stribeck_velocity\n",
+        "  friction.viscous -> friction.extending.sigma2 friction.retracting.sigma2\n",
+        "  friction.external_force -> \n",
+        "rigs/tudelft-seal-257.json:\n",
+        "  friction.coulomb -> friction.extending.curve.coulomb friction.retracting.curve.coulomb friction.extending.curve.stiction friction.retracting.curve.stiction\n",
+        "  friction.asymmetry -> \n",
+        "  friction.stiction -> friction.extending.curve.stiction friction.retracting.curve.stiction\n",
+        "  friction.stribeck_exponent -> friction.extending.curve.stribeck_exponent friction.retracting.curve.stribeck_exponent\n",
+        "  friction.stribeck_velocity -> friction.extending.curve.stribeck_velocity friction.retracting.curve.stribeck_velocity\n",
+        "  friction.viscous -> friction.extending.sigma2 friction.retracting.sigma2\n",
+        "  friction.external_force -> \n"
+    );
 
     /// A netlist that is not a friction bench is refused by path.
     #[test]

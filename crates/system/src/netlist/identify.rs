@@ -112,6 +112,114 @@ fn err<T>(path: impl Into<String>, why: impl Into<String>) -> Result<T, NetlistE
 /// motion drives.
 pub const BENCH_DRIVE: &str = "drive";
 
+/// A friction law's parameters as the friction-bench model's catalog
+/// parameters: each catalog parameter with the law's parameters that are
+/// it (see [`bench_law_params`]).
+struct BenchLaw {
+    /// The law's component type.
+    ty: &'static str,
+    /// `(catalog parameter, the law's parameters that are it)`, in the
+    /// order a fitted value is set; a catalog parameter not listed is not
+    /// in the law.
+    params: &'static [(&'static str, &'static [&'static str])],
+    /// Without a Stribeck hump the law's stiction level is its Coulomb
+    /// level (a bench reads the hump as the `stribeck` effect only where
+    /// they differ), so `Fc` is `stribeck.Fs`'s parameters too.
+    stiction_is_coulomb: bool,
+}
+
+/// The additive seal terms every friction law carries.
+const SEAL_TERMS: [(&str, &[&str]); 2] = [
+    ("pressure_viscous.K", &["seal.k_pressure"]),
+    ("acceleration_friction.H", &["seal.h_acceleration"]),
+];
+
+/// The friction laws other than `friction_bench` that a friction bench's
+/// netlist may carry.
+const BENCH_LAWS: [BenchLaw; 2] = [
+    BenchLaw {
+        ty: "friction_coulomb_viscous",
+        params: &[
+            ("Fc", &["coulomb"]),
+            ("viscous.b", &["viscous"]),
+            SEAL_TERMS[0],
+            SEAL_TERMS[1],
+        ],
+        stiction_is_coulomb: false,
+    },
+    BenchLaw {
+        ty: "friction_lugre",
+        params: &[
+            (
+                "Fc",
+                &["extending.curve.coulomb", "retracting.curve.coulomb"],
+            ),
+            (
+                "stribeck.Fs",
+                &["extending.curve.stiction", "retracting.curve.stiction"],
+            ),
+            (
+                "stribeck.vs",
+                &[
+                    "extending.curve.stribeck_velocity",
+                    "retracting.curve.stribeck_velocity",
+                ],
+            ),
+            (
+                "stribeck.alpha",
+                &[
+                    "extending.curve.stribeck_exponent",
+                    "retracting.curve.stribeck_exponent",
+                ],
+            ),
+            ("lugre_dynamics.sigma0", &["sigma0"]),
+            ("lugre_dynamics.sigma1", &["sigma1"]),
+            ("viscous.b", &["extending.sigma2", "retracting.sigma2"]),
+            SEAL_TERMS[0],
+            SEAL_TERMS[1],
+        ],
+        stiction_is_coulomb: true,
+    },
+];
+
+/// The parameters of a friction law of type `ty` (the friction bench's
+/// law, `friction_coulomb_viscous`, `friction_lugre` or `friction_bench`)
+/// that are the friction-bench model's catalog parameter `catalog` — `Fc`,
+/// or an effect's `effect.param` such as `viscous.b`, as a friction-bench
+/// file names them — in the order a fitted value is set: two for a law
+/// with one set per direction, none for one the law does not have.
+/// `stribeck`: the bench declares the Stribeck effect (without it, a
+/// LuGre law's stiction level is its Coulomb level, so `Fc` is both).
+/// `friction_bench`'s parameters are the catalog's: `coulomb` and
+/// [`EFFECT_PARAMS`](super::migrate::bench::EFFECT_PARAMS). `None`: a
+/// type with no friction-bench view.
+pub fn bench_law_params(ty: &str, catalog: &str, stribeck: bool) -> Option<Vec<&'static str>> {
+    if ty == "friction_bench" {
+        let (effect, param) = catalog.split_once('.').unwrap_or(("", catalog));
+        return Some(if catalog == "Fc" {
+            vec!["coulomb"]
+        } else {
+            super::migrate::bench::EFFECT_PARAMS
+                .iter()
+                .filter(|(e, p, _)| *e == effect && *p == param)
+                .map(|(_, _, target)| *target)
+                .collect()
+        });
+    }
+    let law = BENCH_LAWS.iter().find(|l| l.ty == ty)?;
+    let of = |c: &str| {
+        law.params
+            .iter()
+            .find(|(q, _)| *q == c)
+            .map_or(&[][..], |(_, ps)| *ps)
+    };
+    let mut ps = of(catalog).to_vec();
+    if catalog == "Fc" && law.stiction_is_coulomb && !stribeck {
+        ps.extend(of("stribeck.Fs"));
+    }
+    Some(ps)
+}
+
 /// Reads and checks the `identify` value of a netlist whose components are
 /// `instances`.
 pub fn read(v: &Value, instances: &[Instance]) -> Result<Identify, NetlistError> {
@@ -308,6 +416,28 @@ mod tests {
     use crate::netlist::read;
     use crate::rig::RigError;
     use serde_json::{json, Value};
+
+    /// Every law parameter the friction-bench view names is a parameter of
+    /// its law's component type.
+    #[test]
+    fn the_bench_laws_parameters_are_their_types() {
+        for law in &super::BENCH_LAWS {
+            let ty = crate::netlist::registry::lookup(law.ty).unwrap();
+            for (catalog, ps) in law.params {
+                for p in *ps {
+                    assert!(ty.param(p).is_some(), "{}: {catalog}: {p}", law.ty);
+                }
+            }
+        }
+        let ty = crate::netlist::registry::lookup("friction_bench").unwrap();
+        for (e, p, _) in crate::netlist::migrate::bench::EFFECT_PARAMS {
+            let catalog = format!("{e}.{p}");
+            for q in super::bench_law_params("friction_bench", &catalog, false).unwrap() {
+                assert!(ty.param(q).is_some(), "friction_bench: {catalog}: {q}");
+            }
+        }
+        assert_eq!(super::bench_law_params("friction_wang", "Fc", false), None);
+    }
 
     /// A friction-bench netlist (the migration of a `friction-bench` file).
     fn bench() -> Value {

@@ -88,6 +88,15 @@ impl From<Method> for Solver {
     }
 }
 
+/// The smallest relative tolerance taken ([`Setting::Rtol`]): below it
+/// (about 50 machine epsilons) the error estimates are rounding noise and
+/// the step falls to nothing, which the solver would report as a rate out
+/// of its physical range.
+pub const RTOL_FLOOR: f64 = 1e-14;
+
+/// The rule a relative tolerance in (0, [`RTOL_FLOOR`]) breaks.
+const RTOL_BELOW_FLOOR: &str = "below 1e-14 (about 50 machine epsilons), a tolerance double precision cannot meet; use a value in [1e-14, 1), e.g. 1e-6";
+
 /// A number a user sets a run with, and the rule it must meet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Setting {
@@ -102,7 +111,8 @@ pub enum Setting {
 
 impl Setting {
     /// The rule, as a user reads it after the value: "must be in (0, 1),
-    /// e.g. 1e-6".
+    /// e.g. 1e-6". A relative tolerance in that range but below
+    /// [`RTOL_FLOOR`] breaks a rule of its own ([`Setting::check`]).
     pub fn rule(self) -> &'static str {
         match self {
             Setting::Rtol => "must be in (0, 1), e.g. 1e-6",
@@ -110,28 +120,45 @@ impl Setting {
             Setting::Rk4Step => "must be finite and > 0 [s], e.g. 2e-5",
         }
     }
-    /// Whether `value` meets the rule.
+    /// Whether `value` meets the rules ([`Setting::check`]).
     pub fn holds(self, value: f64) -> bool {
-        match self {
+        self.check(value).is_ok()
+    }
+    /// `value`, or the rule it breaks: [`Setting::rule`], or for a relative
+    /// tolerance below [`RTOL_FLOOR`] that it asks for more digits than
+    /// double precision carries.
+    pub fn check(self, value: f64) -> Result<f64, &'static str> {
+        let in_range = match self {
             Setting::Rtol => value > 0.0 && value < 1.0,
             Setting::HMax => value > 0.0,
             Setting::Rk4Step => value > 0.0 && value.is_finite(),
-        }
-    }
-    /// `value`, or the rule it breaks ([`Setting::rule`]).
-    pub fn check(self, value: f64) -> Result<f64, &'static str> {
-        if self.holds(value) {
-            Ok(value)
-        } else {
+        };
+        if !in_range {
             Err(self.rule())
+        } else if self == Setting::Rtol && value < RTOL_FLOOR {
+            Err(RTOL_BELOW_FLOOR)
+        } else {
+            Ok(value)
         }
     }
     /// `value`, or the message every front end gives, with the setting as
     /// the front end names it: "`--rtol` 0: must be in (0, 1), e.g. 1e-6"
-    /// (`name` = `--rtol`; `rtol` in Python and in `RunOptions`).
+    /// (`name` = `--rtol`; `rtol` in Python and in `RunOptions`), the value
+    /// as [`Setting::shown`].
     pub fn check_named(self, name: &str, value: f64) -> Result<f64, String> {
         self.check(value)
-            .map_err(|rule| format!("{name} {value}: {rule}"))
+            .map_err(|rule| format!("{name} {}: {rule}", Setting::shown(value)))
+    }
+    /// A setting's value in a message: as Rust writes it (`0`, `-1`, `2e-5`
+    /// as `0.00002`), but in exponent form where that would be a long run
+    /// of zeros (`1e-300`, not 300 digits).
+    pub fn shown(value: f64) -> String {
+        let a = value.abs();
+        if a != 0.0 && a.is_finite() && !(1e-6..1e16).contains(&a) {
+            format!("{value:e}")
+        } else {
+            format!("{value}")
+        }
     }
 }
 
@@ -157,6 +184,22 @@ mod tests {
             assert_eq!(Setting::Rtol.check(v), Err(Setting::Rtol.rule()));
         }
         assert_eq!(Setting::Rtol.check(1e-6), Ok(1e-6));
+        // below the floor: its own rule, the value in exponent form
+        assert_eq!(Setting::Rtol.check(RTOL_FLOOR), Ok(RTOL_FLOOR));
+        for v in [1e-15, 1e-300, f64::MIN_POSITIVE] {
+            assert_eq!(Setting::Rtol.check(v), Err(RTOL_BELOW_FLOOR));
+            assert!(!Setting::Rtol.holds(v));
+        }
+        assert!(RTOL_BELOW_FLOOR.starts_with(&format!("below {RTOL_FLOOR:e} ")));
+        assert!(RTOL_BELOW_FLOOR.contains(&format!("[{RTOL_FLOOR:e}, 1)")));
+        assert_eq!(
+            Setting::Rtol.check_named("--rtol", 1e-300).unwrap_err(),
+            format!("--rtol 1e-300: {RTOL_BELOW_FLOOR}")
+        );
+        assert_eq!(
+            Setting::Rtol.check_named("rtol", 0.0).unwrap_err(),
+            "rtol 0: must be in (0, 1), e.g. 1e-6"
+        );
         for s in [Setting::HMax, Setting::Rk4Step] {
             for v in [0.0, -1.0, f64::NAN] {
                 assert!(s.check(v).is_err(), "{s:?} {v}");

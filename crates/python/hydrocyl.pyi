@@ -119,7 +119,8 @@ class Rig:
     ) -> Run:
         """Simulates on the command ``u`` at times ``t`` [s] (linear between
         samples) and samples the run at ``t``; ``t`` and ``u`` are 1-D
-        (ValueError naming the argument otherwise). ``u``: normalised spool
+        (ValueError naming the argument otherwise). ``rtol`` in [1e-14, 1)
+        (below 1e-14 double precision cannot meet it: ValueError). ``u``: normalised spool
         demand (valve rigs) or drive voltage [V] (pump rigs). ``rk4_step``
         and ``h_max`` (default 0.01) in s. ``ledger=True`` adds
         ``run.ledger``. Releases the GIL; runs the rig as it is when called

@@ -214,12 +214,16 @@ impl Variables {
             None,
             "integration method: 0 dp45 (Dormand-Prince 5(4)), 1 rosenbrock (stiff Rodas4), 2 rk4 (fixed step)",
         ));
+        let rtol = format!(
+            "relative tolerance of the adaptive methods, in [{:e}, 1) (absolute: rtol times each state's scale)",
+            hydrocyl_system::run::RTOL_FLOOR
+        );
         list.push(solver(
             "solver.rtol",
             SolverParam::Rtol,
             d.rtol,
             None,
-            "relative tolerance of the adaptive methods (absolute: rtol times each state's scale)",
+            &rtol,
         ));
         list.push(solver(
             "solver.h_max",

@@ -355,8 +355,9 @@ impl Rig {
     /// `solver`: "auto" (default, as the CLI's: Dormand–Prince while the
     /// run is not stiff, Rosenbrock while it is), "dp45", "rosenbrock",
     /// "rk4" or "exponential"; `rtol`: relative tolerance of the adaptive
-    /// methods, in [1e-14, 1) as the CLI's `--rtol`; `rk4_step` [s]: the step of the fixed-step methods; `h_max`:
-    /// largest step [s] (default 0.01); `ledger=True` adds the energy ledger
+    /// methods, in [1e-14, 1) as the CLI's `--rtol`; `rk4_step` [s]: the
+    /// step of the fixed-step methods; `h_max`: largest step [s] (default
+    /// 0.01); `ledger=True` adds the energy ledger
     /// (`run.ledger`). The run is of the rig as it is when called (a `set`
     /// from another thread meanwhile does not change it); the GIL is
     /// released while it runs, and Ctrl-C (SIGINT) stops it within a few

@@ -450,15 +450,11 @@ mod tests {
         }
     }
 
-    /// The `--set` paths each bench rig under `fixtures/` keeps for its
-    /// parameters (`FrictionBench::paths`, where a parameter is not at its
-    /// bench-circuit path), recorded: the presets' files in `rigs/` (a LuGre
-    /// law with one set per direction, a Coulomb + viscous law), every other
-    /// bench rig file (a `friction_bench` law, which keeps none), and
-    /// `tudelft-seal-25` with a Stribeck hump set (its stiction level no
-    /// longer the Coulomb level).
-    #[test]
-    fn the_set_paths_of_every_bench_rig_are_as_recorded() {
+    /// The bench rigs the recording tests read: `tudelft-seal-25` with a
+    /// Stribeck hump set (its stiction level no longer the Coulomb level),
+    /// then every bench rig file under `fixtures/` (the presets' files in
+    /// `rigs/`, the generated and kept rig files), by path.
+    fn bench_rigs() -> Vec<(String, serde_json::Value)> {
         let mut rigs: Vec<(String, serde_json::Value)> = vec![];
         let mut hump = hydrocyl_system::rig::preset("tudelft-seal-25").unwrap();
         for d in ["extending", "retracting"] {
@@ -488,6 +484,19 @@ mod tests {
                 rigs.push((name, v));
             }
         }
+        rigs
+    }
+
+    /// The `--set` paths each bench rig under `fixtures/` keeps for its
+    /// parameters (`FrictionBench::paths`, where a parameter is not at its
+    /// bench-circuit path), recorded: the presets' files in `rigs/` (a LuGre
+    /// law with one set per direction, a Coulomb + viscous law), every other
+    /// bench rig file (a `friction_bench` law, which keeps none), and
+    /// `tudelft-seal-25` with a Stribeck hump set (its stiction level no
+    /// longer the Coulomb level).
+    #[test]
+    fn the_set_paths_of_every_bench_rig_are_as_recorded() {
+        let rigs = bench_rigs();
         let mut got = String::new();
         for (name, v) in &rigs {
             let b = FrictionBench::from_rig(v).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -548,6 +557,212 @@ mod tests {
         "  friction.stribeck_velocity -> friction.extending.curve.stribeck_velocity friction.retracting.curve.stribeck_velocity\n",
         "  friction.viscous -> friction.extending.sigma2 friction.retracting.sigma2\n",
         "  friction.external_force -> \n"
+    );
+
+    /// What `FrictionBench::from_rig` reads of each bench rig under
+    /// `fixtures/` (areas, mass, load-cell sign, the friction law's Coulomb
+    /// level, smoothing velocity and declared effects), and of the preset
+    /// netlists with a law value changed by `--set` (a seal term on each
+    /// law, a direction's value apart from the other's, a `friction_bench`
+    /// law's effects given), recorded: so the
+    /// friction law's view is read the same way whatever table says it.
+    #[test]
+    fn what_every_bench_rig_reads_as_is_recorded() {
+        let mut rigs = bench_rigs();
+        for (preset, sets) in [
+            ("emps", &["friction.seal.k_pressure=2e-9"][..]),
+            ("emps", &["friction.seal.h_acceleration=3"][..]),
+            ("tudelft-seal-25", &["friction.seal.k_pressure=2e-9"][..]),
+            ("tudelft-seal-25", &["friction.seal.h_acceleration=3"][..]),
+            (
+                "tudelft-seal-25",
+                &["friction.retracting.curve.coulomb=4"][..],
+            ),
+            ("tudelft-seal-25", &["friction.retracting.sigma2=7"][..]),
+            (
+                "tudelft-seal-25",
+                &[
+                    "friction.extending.curve.stribeck_velocity=0.02",
+                    "friction.retracting.curve.stiction=6",
+                ][..],
+            ),
+            (
+                "measured/bench-none.rig.json",
+                &[
+                    "friction.stiction=30",
+                    "friction.sigma0=1e4",
+                    "friction.asymmetry=1",
+                    "friction.external_force=2",
+                    "friction.seal.h_acceleration=-2",
+                ][..],
+            ),
+            (
+                "measured/bench-none.rig.json",
+                &["friction.sigma1=5", "friction.seal.h_acceleration=4"][..],
+            ),
+        ] {
+            let mut v = match hydrocyl_system::rig::preset(preset) {
+                Some(v) => v,
+                None => {
+                    hydrocyl_system::rig::load(fixtures().join(preset).to_str().unwrap()).unwrap()
+                }
+            };
+            for s in sets {
+                hydrocyl_system::rig::apply_set(&mut v, s).unwrap();
+            }
+            rigs.push((format!("{preset} --set {}", sets.join(" --set ")), v));
+        }
+        let mut got = String::new();
+        for (name, v) in &rigs {
+            got += &format!("{name}:\n");
+            match FrictionBench::from_rig(v) {
+                Ok(b) => {
+                    got += &format!(
+                        "  area1 {:?} area2 {:?} mass {:?} force_sign {:?}\n",
+                        b.area1, b.area2, b.mass, b.force_sign
+                    );
+                    got += &format!(
+                        "  coulomb {:?} smoothing_velocity {:?}\n",
+                        b.friction.coulomb, b.friction.smoothing_velocity
+                    );
+                    for (id, ps) in &b.friction.effects {
+                        got += &format!("  {id:?} {ps:?}\n");
+                    }
+                }
+                Err(e) => got += &format!("  error: {e}\n"),
+            }
+        }
+        assert_eq!(got, RECORDED_READS, "{got}");
+    }
+
+    const RECORDED_READS: &str = concat!(
+        "tudelft-seal-25 with a Stribeck hump:\n",
+        "  area1 0.0 area2 0.0004908738521234052 mass 0.1 force_sign 1.0\n",
+        "  coulomb 5.0 smoothing_velocity 0.0001\n",
+        "  Stribeck {\"Fs\": 6.0, \"alpha\": 1.0, \"vs\": 0.001}\n",
+        "  Viscous {\"b\": 0.0}\n",
+        "  LugreDynamics {\"sigma0\": 100000.0, \"sigma1\": 0.0}\n",
+        "legacy/bench-acceleration_friction.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "  PressureViscous {\"K\": 1e-9}\n",
+        "legacy/mr-damper.rig.json:\n",
+        "  area1 0.0 area2 0.0 mass 0.0 force_sign -1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "legacy/wang-table-5-3.steady.rig.json:\n",
+        "  area1 0.0 area2 0.0 mass 0.0 force_sign 1.0\n",
+        "  coulomb 100.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 1000.0}\n",
+        "measured/bench-acceleration_friction.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "  PressureViscous {\"K\": 1e-9}\n",
+        "measured/bench-coulomb_asymmetry.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-external_force.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-foreign-delay.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-foreign-spring.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-lugre_dynamics.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-none.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-pressure_viscous+external_force.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-pressure_viscous.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-stribeck.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-viscous.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "measured/mr-damper.rig.json:\n",
+        "  area1 0.0 area2 0.0 mass 0.0 force_sign -1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/wang-table-5-3.steady.rig.json:\n",
+        "  area1 0.0 area2 0.0 mass 0.0 force_sign 1.0\n",
+        "  coulomb 100.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 1000.0}\n",
+        "rigs/emps.json:\n",
+        "  area1 0.0 area2 0.0 mass 50.0 force_sign 1.0\n",
+        "  coulomb 10.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 100.0}\n",
+        "rigs/tudelft-seal-25.json:\n",
+        "  area1 0.0 area2 0.0004908738521234052 mass 0.1 force_sign 1.0\n",
+        "  coulomb 5.0 smoothing_velocity 0.0001\n",
+        "  Viscous {\"b\": 0.0}\n",
+        "  LugreDynamics {\"sigma0\": 100000.0, \"sigma1\": 0.0}\n",
+        "rigs/tudelft-seal-257.json:\n",
+        "  area1 0.0 area2 0.0005187476329423806 mass 0.1 force_sign 1.0\n",
+        "  coulomb 5.0 smoothing_velocity 0.0001\n",
+        "  Viscous {\"b\": 0.0}\n",
+        "  LugreDynamics {\"sigma0\": 100000.0, \"sigma1\": 0.0}\n",
+        "emps --set friction.seal.k_pressure=2e-9:\n",
+        "  area1 0.0 area2 0.0 mass 50.0 force_sign 1.0\n",
+        "  coulomb 10.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 100.0}\n",
+        "  PressureViscous {\"K\": 2e-9}\n",
+        "emps --set friction.seal.h_acceleration=3:\n",
+        "  area1 0.0 area2 0.0 mass 50.0 force_sign 1.0\n",
+        "  coulomb 10.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 100.0}\n",
+        "  AccelerationFriction {\"H\": 3.0}\n",
+        "tudelft-seal-25 --set friction.seal.k_pressure=2e-9:\n",
+        "  area1 0.0 area2 0.0004908738521234052 mass 0.1 force_sign 1.0\n",
+        "  coulomb 5.0 smoothing_velocity 0.0001\n",
+        "  Viscous {\"b\": 0.0}\n",
+        "  PressureViscous {\"K\": 2e-9}\n",
+        "  LugreDynamics {\"sigma0\": 100000.0, \"sigma1\": 0.0}\n",
+        "tudelft-seal-25 --set friction.seal.h_acceleration=3:\n",
+        "  area1 0.0 area2 0.0004908738521234052 mass 0.1 force_sign 1.0\n",
+        "  coulomb 5.0 smoothing_velocity 0.0001\n",
+        "  Viscous {\"b\": 0.0}\n",
+        "  AccelerationFriction {\"H\": 3.0}\n",
+        "  LugreDynamics {\"sigma0\": 100000.0, \"sigma1\": 0.0}\n",
+        "tudelft-seal-25 --set friction.retracting.curve.coulomb=4:\n",
+        "  error: components.friction.extending.curve.coulomb: the bench's law has one set for both directions (5 ≠ 4)\n",
+        "tudelft-seal-25 --set friction.retracting.sigma2=7:\n",
+        "  error: components.friction.extending.sigma2: the bench's law has one set for both directions (0 ≠ 7)\n",
+        "tudelft-seal-25 --set friction.extending.curve.stribeck_velocity=0.02 --set friction.retracting.curve.stiction=6:\n",
+        "  error: components.friction.extending.curve.stiction: the bench's law has one set for both directions (5 ≠ 6)\n",
+        "measured/bench-none.rig.json --set friction.stiction=30 --set friction.sigma0=1e4 --set friction.asymmetry=1 --set friction.external_force=2 --set friction.seal.h_acceleration=-2:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  CoulombAsymmetry {\"dFc\": 1.0}\n",
+        "  Stribeck {\"Fs\": 30.0, \"alpha\": 1.0, \"vs\": 0.01}\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "  AccelerationFriction {\"H\": -2.0}\n",
+        "  LugreDynamics {\"sigma0\": 10000.0, \"sigma1\": 0.0}\n",
+        "  ExternalForce {\"F0\": 2.0}\n",
+        "measured/bench-none.rig.json --set friction.sigma1=5 --set friction.seal.h_acceleration=4:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "  AccelerationFriction {\"H\": 4.0}\n"
     );
 
     /// A netlist that is not a friction bench is refused by path.

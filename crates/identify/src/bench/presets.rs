@@ -10,7 +10,6 @@ use std::collections::BTreeMap;
 use super::{BenchFriction, FrictionBench, ParamRef, KIND};
 use crate::catalog::EffectId;
 use crate::data::{ColumnMap, Signal};
-use hydrocyl_system::netlist::migrate::bench as net;
 
 /// Names of the built-in friction-bench presets: netlist files in
 /// `fixtures/rigs/` listed in `hydrocyl_system::rig::PRESETS`.
@@ -98,10 +97,14 @@ impl FrictionBench {
     /// `imposed_motion` drive (mass, load-cell sign), at most one `piston`
     /// (areas) and one friction law on the rod, `friction_coulomb_viscous`
     /// or `friction_lugre` with equal extending and retracting sets (a
-    /// stiction level above the Coulomb level is the `stribeck` effect).
+    /// stiction level above the Coulomb level is the `stribeck` effect),
+    /// or `friction_bench`; which of the law's parameters is which catalog
+    /// parameter is the netlist's friction-bench view
+    /// (`hydrocyl_system::netlist::identify::bench_law_params`).
     /// `smoothing_velocity` is the static law's tanh velocity where the
     /// netlist's law has none (LuGre). Another circuit is refused by path.
     pub fn from_netlist(v: &serde_json::Value, smoothing_velocity: f64) -> Result<Self, String> {
+        use hydrocyl_system::netlist::identify::{bench_law_params, bench_law_stiction_is_coulomb};
         let s = hydrocyl_system::netlist::read(v)
             .map_err(|e| hydrocyl_system::rig::RigError::from(e).to_string())?;
         let of = |ty: &str| -> Vec<&hydrocyl_system::netlist::registry::Instance> {
@@ -141,98 +144,80 @@ impl FrictionBench {
             ));
         }
         let here = |p: &str| format!("components.{}.{p}", law.name);
-        let mut effects = BTreeMap::new();
-        let mut on = |id: EffectId, params: &[(&str, f64)]| {
-            effects.insert(
-                id,
-                params.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
-            );
+        // the law's parameters that are a catalog parameter (`Fc`,
+        // `viscous.b`, ...): the netlist's friction-bench view
+        // (`bench_law_params`), two for a law with one set per direction,
+        // none for an effect the law does not have
+        let view = |catalog: &str| bench_law_params(law.ty.name, catalog, true);
+        let Some(coulomb) = view("Fc").and_then(|ps| ps.first().map(|q| law.get(q))) else {
+            return Err(format!(
+                "components.{}.type: `{}` has no friction-bench view (friction_coulomb_viscous, friction_lugre or friction_bench)",
+                law.name, law.ty.name
+            ));
         };
-        let (coulomb, vt) = match law.ty.name {
-            "friction_coulomb_viscous" => {
-                on(EffectId::Viscous, &[("b", law.get("viscous"))]);
-                (law.get("coulomb"), law.get("smoothing_velocity"))
-            }
-            "friction_lugre" => {
-                for p in [
-                    "curve.coulomb",
-                    "curve.stiction",
-                    "curve.stribeck_velocity",
-                    "curve.stribeck_exponent",
-                    "sigma2",
-                ] {
-                    let (e, r) = (format!("extending.{p}"), format!("retracting.{p}"));
-                    if law.get(&e) != law.get(&r) {
-                        return Err(format!(
-                            "{}: the bench's law has one set for both directions ({} ≠ {})",
-                            here(&e),
-                            law.get(&e),
-                            law.get(&r)
-                        ));
-                    }
-                }
-                let fc = law.get("extending.curve.coulomb");
-                let fs = law.get("extending.curve.stiction");
-                if fs != fc {
-                    on(
-                        EffectId::Stribeck,
-                        &[
-                            ("Fs", fs),
-                            ("vs", law.get("extending.curve.stribeck_velocity")),
-                            ("alpha", law.get("extending.curve.stribeck_exponent")),
-                        ],
-                    );
-                }
-                on(
-                    EffectId::LugreDynamics,
-                    &[("sigma0", law.get("sigma0")), ("sigma1", law.get("sigma1"))],
-                );
-                on(EffectId::Viscous, &[("b", law.get("extending.sigma2"))]);
-                (fc, smoothing_velocity)
-            }
-            "friction_bench" => {
-                // an effect is declared when the law has it: its first
-                // parameter ([`net::EFFECT_PARAMS`]: the Stribeck hump's
-                // stiction level, σ0, b, ...) given off the type's default
-                // (so a netlist printed with every default written out,
-                // `--print-rig`, declares what the file declared)
-                let mut ids: Vec<&str> = net::EFFECT_PARAMS.iter().map(|(e, _, _)| *e).collect();
-                ids.dedup();
-                for id in ids {
-                    let params: Vec<(&str, &str)> = net::EFFECT_PARAMS
-                        .iter()
-                        .filter(|(e, _, _)| *e == id)
-                        .map(|(_, p, target)| (*p, *target))
-                        .collect();
-                    let first = params[0].1;
-                    let default = law.ty.param(first).and_then(|p| match p.default {
-                        hydrocyl_system::netlist::registry::Default::Value(d) => Some(d),
-                        _ => None,
-                    });
-                    let declared = law.opt(first).is_some_and(|x| Some(x) != default);
-                    if let (Some(eid), true) = (EffectId::from_id(id), declared) {
-                        let vals: Vec<(&str, f64)> =
-                            params.iter().map(|(p, t)| (*p, law.get(t))).collect();
-                        on(eid, &vals);
-                    }
-                }
-                (law.get("coulomb"), law.get("smoothing_velocity"))
-            }
-            other => {
+        let law_params = |catalog: &str| view(catalog).unwrap_or_default();
+        let effect_params = |id: EffectId| -> Vec<(&'static str, Vec<&'static str>)> {
+            id.params()
+                .iter()
+                .map(|q| (q.name, law_params(&format!("{}.{}", id.id(), q.name))))
+                .collect()
+        };
+        // one set for both directions: each catalog parameter's law
+        // parameters hold one value
+        let mut catalog = vec![law_params("Fc")];
+        for id in super::BENCH_EFFECTS {
+            catalog.extend(effect_params(id).into_iter().map(|(_, ps)| ps));
+        }
+        for ps in &catalog {
+            if let Some(q) = ps.iter().find(|q| law.get(q) != law.get(ps[0])) {
                 return Err(format!(
-                    "components.{}.type: `{other}` has no friction-bench view (friction_coulomb_viscous, friction_lugre or friction_bench)",
-                    law.name
-                ))
+                    "{}: the bench's law has one set for both directions ({} ≠ {})",
+                    here(ps[0]),
+                    law.get(ps[0]),
+                    law.get(q)
+                ));
             }
+        }
+        // an effect is declared when the law has it: its first parameter
+        // given off the type's default (a required one always: the
+        // Coulomb + viscous law's `viscous`, LuGre's σ0 and σ2; so a
+        // netlist printed with every default written out, `--print-rig`,
+        // declares what the file declared) and, for a law whose stiction
+        // level is its Coulomb level where there is no Stribeck hump
+        // (LuGre), the stiction level not the Coulomb level
+        let hump_at_coulomb = bench_law_stiction_is_coulomb(law.ty.name);
+        let mut effects = BTreeMap::new();
+        for id in super::BENCH_EFFECTS {
+            let params = effect_params(id);
+            let Some(firsts) = params
+                .iter()
+                .map(|(_, ps)| ps.first().copied())
+                .collect::<Option<Vec<&str>>>()
+            else {
+                continue; // not in this law
+            };
+            let first = firsts[0];
+            let default = law.ty.param(first).and_then(|p| match p.default {
+                hydrocyl_system::netlist::registry::Default::Value(d) => Some(d),
+                _ => None,
+            });
+            let declared = law.opt(first).is_some_and(|x| Some(x) != default)
+                && !(hump_at_coulomb && id == EffectId::Stribeck && law.get(first) == coulomb);
+            if declared {
+                let vals = params.iter().zip(&firsts);
+                effects.insert(
+                    id,
+                    vals.map(|((name, _), q)| (name.to_string(), law.get(q)))
+                        .collect(),
+                );
+            }
+        }
+        // the static law's tanh velocity: the law's own, or where it has
+        // none (LuGre) the one given
+        let vt = match law.ty.param("smoothing_velocity") {
+            Some(_) => law.get("smoothing_velocity"),
+            None => smoothing_velocity,
         };
-        let k = law.opt("seal.k_pressure").unwrap_or(0.0);
-        let h = law.opt("seal.h_acceleration").unwrap_or(0.0);
-        if k > 0.0 {
-            on(EffectId::PressureViscous, &[("K", k)]);
-        }
-        if h != 0.0 {
-            on(EffectId::AccelerationFriction, &[("H", h)]);
-        }
         let mut rig = FrictionBench {
             kind: KIND.into(),
             name: s.name.clone(),
@@ -258,8 +243,8 @@ impl FrictionBench {
             if *p == ParamRef::Mass {
                 return vec![format!("{}.mass", drive.name)];
             }
-            hydrocyl_system::netlist::identify::bench_law_params(law.ty.name, &p.label(), stribeck)
-                .expect("the law's type was matched above")
+            bench_law_params(law.ty.name, &p.label(), stribeck)
+                .expect("the law's type has a friction-bench view (its Coulomb level was read)")
                 .iter()
                 .map(|q| format!("{}.{q}", law.name))
                 .collect()
@@ -450,15 +435,11 @@ mod tests {
         }
     }
 
-    /// The `--set` paths each bench rig under `fixtures/` keeps for its
-    /// parameters (`FrictionBench::paths`, where a parameter is not at its
-    /// bench-circuit path), recorded: the presets' files in `rigs/` (a LuGre
-    /// law with one set per direction, a Coulomb + viscous law), every other
-    /// bench rig file (a `friction_bench` law, which keeps none), and
-    /// `tudelft-seal-25` with a Stribeck hump set (its stiction level no
-    /// longer the Coulomb level).
-    #[test]
-    fn the_set_paths_of_every_bench_rig_are_as_recorded() {
+    /// The bench rigs the recording tests read: `tudelft-seal-25` with a
+    /// Stribeck hump set (its stiction level no longer the Coulomb level),
+    /// then every bench rig file under `fixtures/` (the presets' files in
+    /// `rigs/`, the generated and kept rig files), by path.
+    fn bench_rigs() -> Vec<(String, serde_json::Value)> {
         let mut rigs: Vec<(String, serde_json::Value)> = vec![];
         let mut hump = hydrocyl_system::rig::preset("tudelft-seal-25").unwrap();
         for d in ["extending", "retracting"] {
@@ -488,6 +469,19 @@ mod tests {
                 rigs.push((name, v));
             }
         }
+        rigs
+    }
+
+    /// The `--set` paths each bench rig under `fixtures/` keeps for its
+    /// parameters (`FrictionBench::paths`, where a parameter is not at its
+    /// bench-circuit path), recorded: the presets' files in `rigs/` (a LuGre
+    /// law with one set per direction, a Coulomb + viscous law), every other
+    /// bench rig file (a `friction_bench` law, which keeps none), and
+    /// `tudelft-seal-25` with a Stribeck hump set (its stiction level no
+    /// longer the Coulomb level).
+    #[test]
+    fn the_set_paths_of_every_bench_rig_are_as_recorded() {
+        let rigs = bench_rigs();
         let mut got = String::new();
         for (name, v) in &rigs {
             let b = FrictionBench::from_rig(v).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -548,6 +542,212 @@ mod tests {
         "  friction.stribeck_velocity -> friction.extending.curve.stribeck_velocity friction.retracting.curve.stribeck_velocity\n",
         "  friction.viscous -> friction.extending.sigma2 friction.retracting.sigma2\n",
         "  friction.external_force -> \n"
+    );
+
+    /// What `FrictionBench::from_rig` reads of each bench rig under
+    /// `fixtures/` (areas, mass, load-cell sign, the friction law's Coulomb
+    /// level, smoothing velocity and declared effects), and of the preset
+    /// netlists with a law value changed by `--set` (a seal term on each
+    /// law, a direction's value apart from the other's, a `friction_bench`
+    /// law's effects given), recorded: so the
+    /// friction law's view is read the same way whatever table says it.
+    #[test]
+    fn what_every_bench_rig_reads_as_is_recorded() {
+        let mut rigs = bench_rigs();
+        for (preset, sets) in [
+            ("emps", &["friction.seal.k_pressure=2e-9"][..]),
+            ("emps", &["friction.seal.h_acceleration=3"][..]),
+            ("tudelft-seal-25", &["friction.seal.k_pressure=2e-9"][..]),
+            ("tudelft-seal-25", &["friction.seal.h_acceleration=3"][..]),
+            (
+                "tudelft-seal-25",
+                &["friction.retracting.curve.coulomb=4"][..],
+            ),
+            ("tudelft-seal-25", &["friction.retracting.sigma2=7"][..]),
+            (
+                "tudelft-seal-25",
+                &[
+                    "friction.extending.curve.stribeck_velocity=0.02",
+                    "friction.retracting.curve.stiction=6",
+                ][..],
+            ),
+            (
+                "measured/bench-none.rig.json",
+                &[
+                    "friction.stiction=30",
+                    "friction.sigma0=1e4",
+                    "friction.asymmetry=1",
+                    "friction.external_force=2",
+                    "friction.seal.h_acceleration=-2",
+                ][..],
+            ),
+            (
+                "measured/bench-none.rig.json",
+                &["friction.sigma1=5", "friction.seal.h_acceleration=4"][..],
+            ),
+        ] {
+            let mut v = match hydrocyl_system::rig::preset(preset) {
+                Some(v) => v,
+                None => {
+                    hydrocyl_system::rig::load(fixtures().join(preset).to_str().unwrap()).unwrap()
+                }
+            };
+            for s in sets {
+                hydrocyl_system::rig::apply_set(&mut v, s).unwrap();
+            }
+            rigs.push((format!("{preset} --set {}", sets.join(" --set ")), v));
+        }
+        let mut got = String::new();
+        for (name, v) in &rigs {
+            got += &format!("{name}:\n");
+            match FrictionBench::from_rig(v) {
+                Ok(b) => {
+                    got += &format!(
+                        "  area1 {:?} area2 {:?} mass {:?} force_sign {:?}\n",
+                        b.area1, b.area2, b.mass, b.force_sign
+                    );
+                    got += &format!(
+                        "  coulomb {:?} smoothing_velocity {:?}\n",
+                        b.friction.coulomb, b.friction.smoothing_velocity
+                    );
+                    for (id, ps) in &b.friction.effects {
+                        got += &format!("  {id:?} {ps:?}\n");
+                    }
+                }
+                Err(e) => got += &format!("  error: {e}\n"),
+            }
+        }
+        assert_eq!(got, RECORDED_READS, "{got}");
+    }
+
+    const RECORDED_READS: &str = concat!(
+        "tudelft-seal-25 with a Stribeck hump:\n",
+        "  area1 0.0 area2 0.0004908738521234052 mass 0.1 force_sign 1.0\n",
+        "  coulomb 5.0 smoothing_velocity 0.0001\n",
+        "  Stribeck {\"Fs\": 6.0, \"alpha\": 1.0, \"vs\": 0.001}\n",
+        "  Viscous {\"b\": 0.0}\n",
+        "  LugreDynamics {\"sigma0\": 100000.0, \"sigma1\": 0.0}\n",
+        "legacy/bench-acceleration_friction.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "  PressureViscous {\"K\": 1e-9}\n",
+        "legacy/mr-damper.rig.json:\n",
+        "  area1 0.0 area2 0.0 mass 0.0 force_sign -1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "legacy/wang-table-5-3.steady.rig.json:\n",
+        "  area1 0.0 area2 0.0 mass 0.0 force_sign 1.0\n",
+        "  coulomb 100.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 1000.0}\n",
+        "measured/bench-acceleration_friction.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "  PressureViscous {\"K\": 1e-9}\n",
+        "measured/bench-coulomb_asymmetry.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-external_force.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-foreign-delay.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-foreign-spring.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-lugre_dynamics.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-none.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-pressure_viscous+external_force.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-pressure_viscous.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-stribeck.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/bench-viscous.rig.json:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "measured/mr-damper.rig.json:\n",
+        "  area1 0.0 area2 0.0 mass 0.0 force_sign -1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "measured/wang-table-5-3.steady.rig.json:\n",
+        "  area1 0.0 area2 0.0 mass 0.0 force_sign 1.0\n",
+        "  coulomb 100.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 1000.0}\n",
+        "rigs/emps.json:\n",
+        "  area1 0.0 area2 0.0 mass 50.0 force_sign 1.0\n",
+        "  coulomb 10.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 100.0}\n",
+        "rigs/tudelft-seal-25.json:\n",
+        "  area1 0.0 area2 0.0004908738521234052 mass 0.1 force_sign 1.0\n",
+        "  coulomb 5.0 smoothing_velocity 0.0001\n",
+        "  Viscous {\"b\": 0.0}\n",
+        "  LugreDynamics {\"sigma0\": 100000.0, \"sigma1\": 0.0}\n",
+        "rigs/tudelft-seal-257.json:\n",
+        "  area1 0.0 area2 0.0005187476329423806 mass 0.1 force_sign 1.0\n",
+        "  coulomb 5.0 smoothing_velocity 0.0001\n",
+        "  Viscous {\"b\": 0.0}\n",
+        "  LugreDynamics {\"sigma0\": 100000.0, \"sigma1\": 0.0}\n",
+        "emps --set friction.seal.k_pressure=2e-9:\n",
+        "  area1 0.0 area2 0.0 mass 50.0 force_sign 1.0\n",
+        "  coulomb 10.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 100.0}\n",
+        "  PressureViscous {\"K\": 2e-9}\n",
+        "emps --set friction.seal.h_acceleration=3:\n",
+        "  area1 0.0 area2 0.0 mass 50.0 force_sign 1.0\n",
+        "  coulomb 10.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 100.0}\n",
+        "  AccelerationFriction {\"H\": 3.0}\n",
+        "tudelft-seal-25 --set friction.seal.k_pressure=2e-9:\n",
+        "  area1 0.0 area2 0.0004908738521234052 mass 0.1 force_sign 1.0\n",
+        "  coulomb 5.0 smoothing_velocity 0.0001\n",
+        "  Viscous {\"b\": 0.0}\n",
+        "  PressureViscous {\"K\": 2e-9}\n",
+        "  LugreDynamics {\"sigma0\": 100000.0, \"sigma1\": 0.0}\n",
+        "tudelft-seal-25 --set friction.seal.h_acceleration=3:\n",
+        "  area1 0.0 area2 0.0004908738521234052 mass 0.1 force_sign 1.0\n",
+        "  coulomb 5.0 smoothing_velocity 0.0001\n",
+        "  Viscous {\"b\": 0.0}\n",
+        "  AccelerationFriction {\"H\": 3.0}\n",
+        "  LugreDynamics {\"sigma0\": 100000.0, \"sigma1\": 0.0}\n",
+        "tudelft-seal-25 --set friction.retracting.curve.coulomb=4:\n",
+        "  error: components.friction.extending.curve.coulomb: the bench's law has one set for both directions (5 ≠ 4)\n",
+        "tudelft-seal-25 --set friction.retracting.sigma2=7:\n",
+        "  error: components.friction.extending.sigma2: the bench's law has one set for both directions (0 ≠ 7)\n",
+        "tudelft-seal-25 --set friction.extending.curve.stribeck_velocity=0.02 --set friction.retracting.curve.stiction=6:\n",
+        "  error: components.friction.extending.curve.stiction: the bench's law has one set for both directions (5 ≠ 6)\n",
+        "measured/bench-none.rig.json --set friction.stiction=30 --set friction.sigma0=1e4 --set friction.asymmetry=1 --set friction.external_force=2 --set friction.seal.h_acceleration=-2:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  CoulombAsymmetry {\"dFc\": 1.0}\n",
+        "  Stribeck {\"Fs\": 30.0, \"alpha\": 1.0, \"vs\": 0.01}\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "  AccelerationFriction {\"H\": -2.0}\n",
+        "  LugreDynamics {\"sigma0\": 10000.0, \"sigma1\": 0.0}\n",
+        "  ExternalForce {\"F0\": 2.0}\n",
+        "measured/bench-none.rig.json --set friction.sigma1=5 --set friction.seal.h_acceleration=4:\n",
+        "  area1 0.0 area2 0.001963495408493621 mass 2.0 force_sign 1.0\n",
+        "  coulomb 20.0 smoothing_velocity 0.001\n",
+        "  Viscous {\"b\": 300.0}\n",
+        "  AccelerationFriction {\"H\": 4.0}\n"
     );
 
     /// A netlist that is not a friction bench is refused by path.

@@ -220,6 +220,17 @@ pub fn bench_law_params(ty: &str, catalog: &str, stribeck: bool) -> Option<Vec<&
     Some(ps)
 }
 
+/// Whether a friction law of type `ty`'s stiction level is its Coulomb
+/// level where the bench declares no Stribeck hump (`friction_lugre`: its
+/// curves always carry a stiction level), so a bench reads the hump as
+/// declared only where the two differ. `false` for a law whose hump is a
+/// parameter of its own (`friction_bench`) or that has none.
+pub fn bench_law_stiction_is_coulomb(ty: &str) -> bool {
+    BENCH_LAWS
+        .iter()
+        .any(|l| l.ty == ty && l.stiction_is_coulomb)
+}
+
 /// Reads and checks the `identify` value of a netlist whose components are
 /// `instances`.
 pub fn read(v: &Value, instances: &[Instance]) -> Result<Identify, NetlistError> {

@@ -42,7 +42,7 @@ impl DocTable {
     }
 
     /// Checks the row of `fixture`: each `(column, values)` cell shows
-    /// `values`, in order, at its printed precision ([`shows`]), and the
+    /// `values`, in order, at its printed precision ([`Shown::shows`]), and the
     /// `(column, text)` cells read `text`.
     pub fn check_row(
         &self,

@@ -64,7 +64,7 @@ impl Ends {
             )));
         }
         circuit.set_ledger(true);
-        let l = ledger_between(&circuit, (*t0, x0), (*t1, x1), &RodSide::default())
+        let l = ledger_between(&circuit, (*t0, x0), (*t1, x1), &RodSide::of(&circuit))
             .map_err(|e| bad(e.to_string()))?;
         let mut text = serde_json::to_vec_pretty(&l.to_json())
             .map_err(|e| bad(format!("writing JSON: {e}")))?;

@@ -67,7 +67,7 @@ fn library(t: &[f64], u: &[f64], k0: usize) -> Value {
     let run = rig::simulate(&value, signal.clone(), t, &opts).unwrap();
     let mut c = rig::circuit(&value, signal).unwrap();
     c.set_ledger(true);
-    ledger(&c, &run, k0, t.len() - 1, &RodSide::default())
+    ledger(&c, &run, k0, t.len() - 1, &RodSide::of(&c))
         .unwrap()
         .to_json()
 }

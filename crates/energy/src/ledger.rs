@@ -238,22 +238,51 @@ impl Ledger {
     }
 }
 
-/// Where the rod lives in the circuit: the mechanical node and the
-/// components acting on it whose powers make the cylinder's output (eq 8.7).
-#[derive(Clone, Debug)]
+/// Where the rod lives in the circuit: the mechanical nodes the cylinders
+/// drive and the components on them whose powers make the cylinders'
+/// output (eq 8.7).
+#[derive(Clone, Debug, PartialEq)]
 pub struct RodSide {
-    /// The mechanical node (`rod` in both rigs).
+    /// The mechanical nodes, comma-separated, as the netlist names them (a
+    /// named node, `rod` on the hybrid preset, or after a port on it,
+    /// `load.rod` on the valve preset).
     pub node: String,
-    /// The components on the rod other than the cylinder: the mass and the
-    /// friction law (`load`, `friction` in both rigs).
+    /// The components on the rods other than the cylinders: the masses and
+    /// the friction laws (`load`, `friction` in the presets).
     pub components: Vec<String>,
 }
 
-impl Default for RodSide {
-    fn default() -> Self {
+impl RodSide {
+    /// The rod side of `circuit`, found by its connections, whatever the
+    /// components are named: every mechanical node an actuator
+    /// ([`Circuit::is_actuator`]: a cylinder, a bench's piston) drives, and
+    /// every other component attached to one of them (masses, friction
+    /// laws). Empty where the circuit has no actuator.
+    pub fn of(circuit: &Circuit) -> Self {
+        let n = circuit.components().count();
+        let mut nodes: Vec<&str> = Vec::new();
+        for i in (0..n).filter(|&i| circuit.is_actuator(i)) {
+            for m in circuit.mechanical_nodes(i) {
+                if !nodes.contains(&m.as_str()) {
+                    nodes.push(m);
+                }
+            }
+        }
+        let components = circuit
+            .components()
+            .enumerate()
+            .filter(|(i, _)| {
+                !circuit.is_actuator(*i)
+                    && circuit
+                        .mechanical_nodes(*i)
+                        .iter()
+                        .any(|m| nodes.contains(&m.as_str()))
+            })
+            .map(|(_, c)| c.name().to_string())
+            .collect();
         Self {
-            node: "rod".into(),
-            components: vec!["load".into(), "friction".into()],
+            node: nodes.join(", "),
+            components,
         }
     }
 }

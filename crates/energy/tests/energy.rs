@@ -94,7 +94,7 @@ mod model_forms {
         let run = hydrocyl_system::rig::simulate(&v, u.clone(), &t, &opts).unwrap();
         let mut c = hydrocyl_system::rig::circuit(&v, u).unwrap();
         c.set_ledger(true);
-        ledger(&c, &run, 0, t.len() - 1, &RodSide::default()).unwrap()
+        ledger(&c, &run, 0, t.len() - 1, &RodSide::of(&c)).unwrap()
     }
 
     #[test]
@@ -137,7 +137,14 @@ mod events_and_moving_walls {
                 ..RunOptions::dp45()
             });
         let run = sim.run(&t).unwrap();
-        let l = ledger(sim.circuit(), &run, 0, t.len() - 1, &RodSide::default()).unwrap();
+        let l = ledger(
+            sim.circuit(),
+            &run,
+            0,
+            t.len() - 1,
+            &RodSide::of(sim.circuit()),
+        )
+        .unwrap();
         (run, l)
     }
 
@@ -205,6 +212,84 @@ mod events_and_moving_walls {
     }
 }
 
+/// The rod side is found by the connections, not by the names.
+mod rod_side {
+    use super::*;
+    use hydrocyl_system::signal::Signal;
+
+    /// The ledger of the rig in `text` (a netlist) over 0.3 s of a half-open
+    /// spool.
+    fn ledger_of(text: &str) -> (RodSide, hydrocyl_energy::ledger::Ledger) {
+        let v: serde_json::Value = serde_json::from_str(text).unwrap();
+        let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-3).collect();
+        let u = Signal::Constant { value: 0.5 };
+        let opts = RunOptions {
+            rtol: 1e-9,
+            ledger: true,
+            ..RunOptions::dp45()
+        };
+        let run = hydrocyl_system::rig::simulate(&v, u.clone(), &t, &opts).unwrap();
+        let mut c = hydrocyl_system::rig::circuit(&v, u).unwrap();
+        c.set_ledger(true);
+        let rod = RodSide::of(&c);
+        let l = ledger(&c, &run, 0, t.len() - 1, &rod).unwrap();
+        (rod, l)
+    }
+
+    /// `name` renamed `to` in a netlist's text: the component's key and
+    /// every `name.port` that refers to it.
+    fn renamed(text: &str, name: &str, to: &str) -> String {
+        text.replace(&format!("\"{name}\""), &format!("\"{to}\""))
+            .replace(&format!("\"{name}."), &format!("\"{to}."))
+    }
+
+    #[test]
+    fn the_presets_rod_side_is_their_load_and_friction() {
+        for (preset, node) in [("leaney-moog", "load.rod"), ("wang-hybrid", "rod")] {
+            let v = hydrocyl_system::rig::preset(preset).unwrap();
+            let c = hydrocyl_system::rig::circuit(&v, Signal::Constant { value: 0.0 }).unwrap();
+            let mut rod = RodSide::of(&c);
+            rod.components.sort();
+            assert_eq!(rod.components, ["friction", "load"], "{preset}");
+            assert_eq!(rod.node, node, "{preset}");
+        }
+    }
+
+    #[test]
+    fn renaming_the_mass_and_the_friction_leaves_the_cylinders_output() {
+        let text = std::fs::read_to_string(fixture("examples/meter-out-needle.json")).unwrap();
+        let (_, before) = ledger_of(&text);
+        assert!(before.cylinder_out_j > 0.0, "{before:?}");
+        let other = renamed(&renamed(&text, "friction", "fr"), "load", "mass1");
+        let (rod, after) = ledger_of(&other);
+        assert!(rod.components.contains(&"fr".to_string()), "{rod:?}");
+        assert!(rod.components.contains(&"mass1".to_string()), "{rod:?}");
+        assert_eq!(after.cylinder_out_j, before.cylinder_out_j);
+        assert_eq!(after.efficiency(), before.efficiency());
+    }
+
+    #[test]
+    fn two_cylinders_give_their_output_together() {
+        let text =
+            std::fs::read_to_string(fixture("examples/two-cylinders-parallel.json")).unwrap();
+        let (rod, l) = ledger_of(&text);
+        let mut on_rods = rod.components.clone();
+        on_rods.sort();
+        assert_eq!(on_rods, ["friction_1", "friction_2", "load_1", "load_2"]);
+        // the two rods' components, term by term
+        let part = |name: &str| {
+            l.components
+                .iter()
+                .find(|c| c.name == name)
+                .map(|c| c.energy_j[1] + c.energy_j[2] + c.energy_j[3])
+                .unwrap()
+        };
+        let sum: f64 = on_rods.iter().map(|n| part(n)).sum();
+        assert!(l.cylinder_out_j > 0.0, "{l:?}");
+        assert!((l.cylinder_out_j - sum).abs() <= 1e-12 * sum.abs(), "{l:?}");
+    }
+}
+
 mod bad_input {
     use super::*;
 
@@ -215,7 +300,7 @@ mod bad_input {
         let t = [0.0, 0.01, 0.02];
         let mut sim = Simulation::of_circuit(c).options(RunOptions::dp45());
         let r = sim.run(&t).unwrap();
-        let e = ledger(sim.circuit(), &r, 0, 2, &RodSide::default()).unwrap_err();
+        let e = ledger(sim.circuit(), &r, 0, 2, &RodSide::of(sim.circuit())).unwrap_err();
         assert!(e.to_string().contains("ledger: true"), "{e}");
     }
 

@@ -190,7 +190,7 @@ fn unphysical(
 fn whole_run_ledger(value: &Value, command: &Signal, run: &Run) -> Result<Ledger, String> {
     let mut c = rig::circuit(value, command.clone()).map_err(|e| e.to_string())?;
     c.set_ledger(true);
-    ledger(&c, run, 0, run.time.len() - 1, &RodSide::default()).map_err(|e| e.to_string())
+    ledger(&c, run, 0, run.time.len() - 1, &RodSide::of(&c)).map_err(|e| e.to_string())
 }
 
 /// Turns a failed run into a [`Failure::Solver`]: the rig's run is repeated

@@ -425,7 +425,7 @@ pub fn run_scenario(drive: &Drive, sc: &Scenario, plan: &Plan) -> Result<Outcome
     let wall_s = start.elapsed().as_secs_f64();
     let circuit = sim.circuit();
     let (k0, k1) = (n_per * plan.warmup_periods, n);
-    let rod = RodSide::default();
+    let rod = RodSide::of(circuit);
     let led = ledger(circuit, &out, k0, k1, &rod)?;
     // power traces: the ledger's integrands at each sample
     let names: Vec<String> = circuit.components().map(|c| c.name().to_string()).collect();

@@ -9,6 +9,7 @@ use thiserror::Error;
 
 use crate::series::{SeriesGroup, Step};
 
+mod attachments;
 mod component;
 mod jacobian;
 pub use component::{Component, PowerTerms, Probe};
@@ -97,6 +98,8 @@ pub struct Circuit {
     /// Units given to probes by [`Circuit::set_probe_unit`]:
     /// `(component, probe, unit)`.
     probe_units: Vec<(String, String, &'static str)>,
+    /// The nodes each component is attached to.
+    attachments: attachments::Attachments,
     /// Every component has tangents and the analytic Jacobian is wanted.
     analytic: bool,
     tangents: RefCell<Tangents>,
@@ -181,6 +184,7 @@ impl Circuit {
         }
         let (order, groups) = crate::series::evaluation_order(&net)?;
         let n = comps.len();
+        let attachments = attachments::Attachments::of(&net, n);
         // components that read complete accumulators go last, in order
         let (mut order, last): (Vec<Step>, Vec<Step>) = order
             .into_iter()
@@ -231,6 +235,7 @@ impl Circuit {
             publisher,
             probe_names: None,
             probe_units: Vec::new(),
+            attachments,
             analytic,
             tangents: RefCell::new(Tangents::default()),
             filled: RefCell::new(FillKey::default()),

@@ -148,7 +148,7 @@ pub fn run_case(rig: &Value, case: &Case) -> Result<Measured, EnergyError> {
     let mut sim = Simulation::new(&v, cmd).map_err(err)?.options(opts);
     let out = sim.run(&t).map_err(err)?;
     let (k0, k1) = (n_per, 3 * n_per);
-    let led = ledger(sim.circuit(), &out, k0, k1, &RodSide::default())?;
+    let led = ledger(sim.circuit(), &out, k0, k1, &RodSide::of(sim.circuit()))?;
     let mut losses: Vec<(String, f64)> = led
         .losses
         .iter()

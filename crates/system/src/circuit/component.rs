@@ -116,6 +116,14 @@ pub trait Component {
     /// The circuit zeroes the accumulators before the first `publish`.
     fn publish(&self, _t: f64, _x: &[f64], _w: &mut Wires) {}
 
+    /// Whether the component is an actuator: it turns hydraulic power into
+    /// the mechanical power on its rod (a cylinder, a bench's piston). The
+    /// energy ledger's cylinder output is the work the other components on
+    /// an actuator's rod take ([`Circuit::is_actuator`](super::Circuit::is_actuator)).
+    fn is_actuator(&self) -> bool {
+        false
+    }
+
     /// Computes flows and forces from the efforts at its ports and adds them
     /// to the node accumulators; writes [`Causality::Algebraic`](super::Causality::Algebraic) wires.
     /// Every wire other than an accumulator that it writes here it writes on

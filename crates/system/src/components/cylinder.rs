@@ -135,6 +135,9 @@ impl TwoChamberCylinder {
 }
 
 impl Component for TwoChamberCylinder {
+    fn is_actuator(&self) -> bool {
+        true
+    }
     fn name(&self) -> &str {
         &self.name
     }

@@ -130,6 +130,9 @@ impl GeneralisedCylinder {
 }
 
 impl Component for GeneralisedCylinder {
+    fn is_actuator(&self) -> bool {
+        true
+    }
     fn name(&self) -> &str {
         &self.name
     }

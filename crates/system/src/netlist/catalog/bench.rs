@@ -185,6 +185,9 @@ pub struct Piston {
 }
 
 impl Component for Piston {
+    fn is_actuator(&self) -> bool {
+        true
+    }
     fn name(&self) -> &str {
         &self.name
     }

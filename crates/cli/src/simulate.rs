@@ -747,7 +747,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             } else {
                 "no chamber pressure among the outputs".to_string()
             };
-            format!("CAVITATION: a cylinder chamber fell below its cavitation pressure, or a line volume below absolute vacuum, {cav} times between the output samples ({lowest}; the components' cavitation_entries say which)")
+            let which: Vec<String> = run
+                .cavitation_by_chamber()
+                .iter()
+                .map(|(n, k)| format!("{n} {k}"))
+                .collect();
+            format!("CAVITATION: a cylinder chamber fell below its cavitation pressure, or a line volume below absolute vacuum, {cav} times between the output samples ({lowest}; {})", which.join(", "))
         } else {
             "no cavitation".to_string()
         }

@@ -40,19 +40,27 @@ pub fn load(
         FrictionBench::from_rig(net).map_err(|e| CliError::Input(format!("{spec}: {e}")))
     };
     let as_json = |b: &FrictionBench| serde_json::to_value(b).ok();
+    // a value out of range blames the `--set` that gave it, not the file
+    let check = |net: &serde_json::Value| {
+        rig::check(net).map_err(|e| err(crate::rigfile::at_line_or_set(e, spec, sets)))
+    };
     for s in sets {
         let before = as_json(&read(&net)?);
         let old = net.clone();
         rig::apply_set(&mut net, s).map_err(err)?;
+        if net == old {
+            continue;
+        }
+        check(&net)?;
         // the bench runs as its standard circuit, read into `FrictionBench`:
         // a set that changes the file but not the bench would be dropped
-        if net != old && as_json(&read(&net)?) == before {
+        if as_json(&read(&net)?) == before {
             return Err(CliError::Input(format!(
                 "--set {s}: the friction-bench model does not use this parameter (a bench runs as its standard circuit: the drive's mass and load-cell sign, the piston's areas, the friction law; `--print-rig` lists the rest)"
             )));
         }
     }
-    rig::check(&net).map_err(|e| err(crate::rigfile::at_line_or_set(e, spec, sets)))?;
+    check(&net)?;
     let bench = read(&net)?;
     Ok(Some((bench, net)))
 }

@@ -127,3 +127,22 @@ fn quiet_is_quiet_on_a_bench() {
     assert!(st.status.success());
     assert!(String::from_utf8_lossy(&st.stderr).contains("simulated the friction bench"));
 }
+
+/// A `--set` value out of range is blamed on the `--set`, as on any rig
+/// file, not on the file.
+#[test]
+fn a_bad_set_value_is_blamed_on_the_set() {
+    let dir = tempfile::tempdir().unwrap();
+    let vel = velocity_record(dir.path());
+    let out = dir.path().join("q.csv");
+    let rig = bench_rig();
+    let st = simulate(&rig, &vel, &out, &["--set", "friction.coulomb=-5"]);
+    let err = refused(&st, &out);
+    assert_eq!(
+        err.trim_end(),
+        format!(
+            "hydrocyl: error: rig `components.friction.coulomb`: -5 [N] is out of range: must be ≥ 0 (set by --set friction.coulomb=-5 on {})",
+            rig.display()
+        )
+    );
+}

@@ -146,3 +146,49 @@ fn a_bad_set_value_is_blamed_on_the_set() {
         )
     );
 }
+
+/// A parameter of an effect that is off (the Stribeck shape without
+/// `stiction`, σ1 with σ0 = 0) is refused with the condition that turns it
+/// on; with that condition set, the same `--set` runs.
+#[test]
+fn a_parameter_of_an_effect_that_is_off_names_what_turns_it_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let vel = velocity_record(dir.path());
+    let out = dir.path().join("q.csv");
+    let rig = bench_rig();
+    let st = simulate(
+        &rig,
+        &vel,
+        &out,
+        &["--set", "friction.stribeck_velocity=0.02"],
+    );
+    let err = refused(&st, &out);
+    assert!(
+        err.contains("only where `friction.stiction` is set")
+            && err.contains("--set friction.stiction=")
+            && !err.contains("does not use this parameter"),
+        "{err}"
+    );
+    let st = simulate(&rig, &vel, &out, &["--set", "friction.sigma1=100"]);
+    let err = refused(&st, &out);
+    assert!(
+        err.contains("only where `friction.sigma0` is set off its default 0"),
+        "{err}"
+    );
+    let st = simulate(
+        &rig,
+        &vel,
+        &out,
+        &[
+            "--set",
+            "friction.stiction=30",
+            "--set",
+            "friction.stribeck_velocity=0.02",
+        ],
+    );
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+}

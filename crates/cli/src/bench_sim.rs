@@ -40,21 +40,76 @@ pub fn load(
         FrictionBench::from_rig(net).map_err(|e| CliError::Input(format!("{spec}: {e}")))
     };
     let as_json = |b: &FrictionBench| serde_json::to_value(b).ok();
+    // a value out of range blames the `--set` that gave it, not the file
+    let check = |net: &serde_json::Value| {
+        rig::check(net).map_err(|e| err(crate::rigfile::at_line_or_set(e, spec, sets)))
+    };
     for s in sets {
         let before = as_json(&read(&net)?);
         let old = net.clone();
         rig::apply_set(&mut net, s).map_err(err)?;
+        if net == old {
+            continue;
+        }
+        check(&net)?;
         // the bench runs as its standard circuit, read into `FrictionBench`:
         // a set that changes the file but not the bench would be dropped
-        if net != old && as_json(&read(&net)?) == before {
-            return Err(CliError::Input(format!(
-                "--set {s}: the friction-bench model does not use this parameter (a bench runs as its standard circuit: the drive's mass and load-cell sign, the piston's areas, the friction law; `--print-rig` lists the rest)"
-            )));
+        if as_json(&read(&net)?) == before {
+            return Err(CliError::Input(match switched_off_by(&old, s) {
+                Some(why) => format!("--set {s}: {why}"),
+                None => format!(
+                    "--set {s}: the friction-bench model does not use this parameter (a bench runs as its standard circuit: the drive's mass and load-cell sign, the piston's areas, the friction law; `--print-rig` lists the rest)"
+                ),
+            }));
         }
     }
-    rig::check(&net).map_err(|e| err(crate::rigfile::at_line_or_set(e, spec, sets)))?;
+    check(&net)?;
     let bench = read(&net)?;
     Ok(Some((bench, net)))
+}
+
+/// Why a `--set` of a friction law's parameter (`friction.stribeck_velocity`)
+/// left the bench unchanged where the parameter belongs to an effect that is
+/// off in `net` (the netlist before the set): the bench reads an effect as
+/// on only where its first parameter (`stiction`, `sigma0`) is given off
+/// its default ([`FrictionBench::from_rig`]), so the others are unused until
+/// it is. `None` for any other parameter.
+fn switched_off_by(net: &serde_json::Value, set: &str) -> Option<String> {
+    use hydrocyl_identify::bench::BENCH_EFFECTS;
+    use hydrocyl_system::netlist::identify::{bench_law_params, bench_law_stiction_is_coulomb};
+    use hydrocyl_system::netlist::registry::{self, Default};
+    let path = set.split_once('=')?.0.trim();
+    let path = path.strip_prefix("components.").unwrap_or(path);
+    let (comp, param) = path.split_once('.')?;
+    let ty = net.get("components")?.get(comp)?.get("type")?.as_str()?;
+    let law = |catalog: String| bench_law_params(ty, &catalog, true).unwrap_or_default();
+    BENCH_EFFECTS.iter().find_map(|&id| {
+        let (first, rest) = id.params().split_first()?;
+        rest.iter()
+            .any(|q| law(format!("{}.{}", id.id(), q.name)).contains(&param))
+            .then_some(())?;
+        let on = law(format!("{}.{}", id.id(), first.name));
+        let on = on.first()?;
+        let spec = registry::lookup(ty)?.param(on)?;
+        let unit = if spec.unit.is_empty() || spec.unit == "-" {
+            String::new()
+        } else {
+            format!(", in {}", spec.unit)
+        };
+        let given = match spec.default {
+            Default::Value(d) => format!("set off its default {d}"),
+            _ => "set".to_string(),
+        };
+        let coulomb = if bench_law_stiction_is_coulomb(ty) && on.contains("stiction") {
+            " and differs from the Coulomb level"
+        } else {
+            ""
+        };
+        Some(format!(
+            "the friction-bench model uses `{comp}.{param}` only where `{comp}.{on}` is {given}{coulomb} (the `{}` effect is off without it, as in this file): set it too (--set {comp}.{on}=VALUE{unit})",
+            id.id()
+        ))
+    })
 }
 
 /// `true` when `simulate` runs the rig `spec` on a record's motion

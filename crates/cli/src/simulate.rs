@@ -193,8 +193,25 @@ pub fn column_headers(run: &Run) -> Vec<String> {
         .collect()
 }
 
+/// The run's `--solver`, `--rtol` and `--rk4-step`, checked (the same
+/// messages on every kind of rig): the solver.
+fn run_settings(args: &Args) -> Result<Solver, CliError> {
+    let solver = Solver::parse_or_why(&args.solver)
+        .map_err(|why| CliError::Input(format!("--solver: {why}")))?;
+    for (flag, setting, value) in [
+        ("--rtol", Setting::Rtol, args.rtol),
+        ("--rk4-step", Setting::Rk4Step, args.rk4_step),
+    ] {
+        setting.check_named(flag, value).map_err(CliError::Input)?;
+    }
+    Ok(solver)
+}
+
 /// `hydrocyl simulate` on a friction bench: the `--command` file carries the
-/// imposed motion (see [`crate::bench_sim`]).
+/// imposed motion (see [`crate::bench_sim`]). The bench fixes its own
+/// integration (one exponential Rosenbrock–Euler step per sample, as its fit
+/// runs it), so `--solver`, `--rtol` and `--rk4-step` are checked as for any
+/// rig and then refused unless they are the defaults.
 fn run_bench(
     args: &Args,
     bench: &FrictionBench,
@@ -203,6 +220,13 @@ fn run_bench(
     if args.print_rig {
         let text = rig::printed(value).map_err(|e| CliError::Input(e.to_string()))?;
         return crate::console::print(&format!("{text}\n"));
+    }
+    let solver = run_settings(args)?;
+    let default = RunOptions::default();
+    if solver != default.solver || args.rtol != default.rtol || args.rk4_step != default.rk4_step {
+        return Err(CliError::Input(
+            "--solver, --rtol, --rk4-step: the friction-bench model fixes its own integration (one step per sample of the imposed motion); to choose them, simulate a netlist of the bench (e.g. the tudelft-seal-25 preset)".into(),
+        ));
     }
     let (Some(input), Some(out)) = (&args.command, &args.out) else {
         return Err(CliError::Input("--command and --out are required".into()));
@@ -217,11 +241,13 @@ fn run_bench(
     let text = crate::bench_sim::simulate(bench, input)?;
     outputs.write(id, text.as_bytes())?;
     outputs.commit(args.fsync)?;
-    crate::console::note(format_args!(
-        "hydrocyl: simulated the friction bench on {} samples of {}",
-        text.lines().count() - 1,
-        input.display()
-    ));
+    if !args.quiet {
+        crate::console::note(format_args!(
+            "hydrocyl: simulated the friction bench on {} samples of {}",
+            text.lines().count() - 1,
+            input.display()
+        ));
+    }
     Ok(())
 }
 
@@ -433,14 +459,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let text = rig::printed(&value).map_err(rig_err)?;
         return crate::console::print(&format!("{text}\n"));
     }
-    let solver = Solver::parse_or_why(&args.solver)
-        .map_err(|why| CliError::Input(format!("--solver: {why}")))?;
-    for (flag, setting, value) in [
-        ("--rtol", Setting::Rtol, args.rtol),
-        ("--rk4-step", Setting::Rk4Step, args.rk4_step),
-    ] {
-        setting.check_named(flag, value).map_err(CliError::Input)?;
-    }
+    let solver = run_settings(&args)?;
     let (Some(cmd_path), Some(out)) = (args.command, args.out) else {
         return Err(CliError::Input("--command and --out are required".into()));
     };

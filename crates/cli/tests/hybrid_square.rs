@@ -232,3 +232,17 @@ fn without_the_pilot_shift_pressure_the_charging_interval_goes() {
         assert!(r.charging < 1.5e-3, "{r:?}");
     }
 }
+
+/// The catalog gives the pilot valve's overlap as `≥ 0`, and the reader
+/// takes 0 (a critically lapped spool, shift pressure `k_s x_o` = 0): the
+/// run goes, and with no shift pressure to charge the lines to the four-way
+/// valve opens at once on each reversal.
+#[test]
+fn a_zero_overlap_pilot_valve_is_accepted_and_has_no_charging_interval() {
+    let c = simulate_square(&["pilot_valve.overlap=0"]);
+    let revs = reversals(&c);
+    assert_eq!(revs.len(), 5);
+    for r in &revs {
+        assert!(r.charging < 1.5e-3, "{r:?}");
+    }
+}

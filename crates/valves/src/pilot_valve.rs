@@ -39,7 +39,7 @@
 //! is the same thing when the valve is wide open (its `K_T` is 14 times the
 //! needle valve's coefficient) and the right thing while it opens.
 
-use crate::check::{positive, ParameterError};
+use crate::check::{non_negative, positive, ParameterError};
 use crate::orifice::{signed_sqrt_regularised, DEFAULT_DP_TRANSITION};
 use hydrocyl_ports::{Position, Power, Pressure, VolumeFlow};
 use serde::{Deserialize, Serialize};
@@ -136,11 +136,12 @@ impl PilotFourWay {
         }
     }
 
-    /// Checks every parameter is finite and positive.
+    /// Checks every parameter is finite and positive (the overlap may be
+    /// zero: a critically lapped spool that opens at any pilot difference).
     pub fn validate(&self) -> Result<(), ParameterError> {
         const C: &str = "pilot four-way valve";
         positive(C, "spring_rate", self.spring_rate)?;
-        positive(C, "overlap", self.overlap.si())?;
+        non_negative(C, "overlap", self.overlap.si())?;
         positive(C, "stroke", self.stroke.si())?;
         positive(C, "hole_radius", self.hole_radius.si())?;
         positive(C, "k_p", self.k_p)?;

@@ -264,22 +264,6 @@ impl Run {
         &self.states[k * self.dim..(k + 1) * self.dim]
     }
 
-    /// Number of cavitation entries of all chambers (0 = none).
-    pub fn cavitation_entries(&self) -> usize {
-        self.cavitation_by_chamber().iter().map(|(_, k)| k).sum()
-    }
-
-    /// The chambers that cavitated and how often, by their diagnostics'
-    /// names (`cylinder_1.cavitation_entries_2`, `line_1.cavitation_entries`),
-    /// in component order; empty when none did.
-    pub fn cavitation_by_chamber(&self) -> Vec<(&str, usize)> {
-        self.diagnostics
-            .iter()
-            .filter(|(n, v)| n.contains("cavitation_entries") && *v > 0.0)
-            .map(|(n, v)| (n.as_str(), *v as usize))
-            .collect()
-    }
-
     /// Lowest value of the chamber pressure channels \[Pa\]: every
     /// cylinder's `p1`, `p2` probes, whatever their columns are called
     /// ([`chamber_of`]); infinite when the outputs hold none.

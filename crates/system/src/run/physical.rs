@@ -346,6 +346,22 @@ impl Run {
     pub fn deep_cavitation(&self) -> Option<DeepCavitation> {
         self.physical().ok().flatten()
     }
+
+    /// Number of cavitation entries of all chambers (0 = none).
+    pub fn cavitation_entries(&self) -> usize {
+        self.cavitation_by_chamber().iter().map(|(_, k)| k).sum()
+    }
+
+    /// The chambers that cavitated and how often, by their diagnostics'
+    /// names (`cylinder_1.cavitation_entries_2`, `line_1.cavitation_entries`),
+    /// in component order; empty when none did.
+    pub fn cavitation_by_chamber(&self) -> Vec<(&str, usize)> {
+        self.diagnostics
+            .iter()
+            .filter(|(n, v)| n.contains("cavitation_entries") && *v > 0.0)
+            .map(|(n, v)| (n.as_str(), *v as usize))
+            .collect()
+    }
 }
 
 #[cfg(test)]

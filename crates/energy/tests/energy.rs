@@ -34,6 +34,25 @@ fn charging_circuit(ps: f64, volume: f64, b: f64, via: Box<dyn Component>) -> Ci
     .unwrap()
 }
 
+/// The ledger of rig `v` over 0.3 s of a half-open spool (rtol 1e-9), with
+/// the rod side it was taken on.
+fn half_open_ledger(v: &serde_json::Value) -> (RodSide, hydrocyl_energy::ledger::Ledger) {
+    use hydrocyl_system::signal::Signal;
+    let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-3).collect();
+    let u = Signal::Constant { value: 0.5 };
+    let opts = RunOptions {
+        rtol: 1e-9,
+        ledger: true,
+        ..RunOptions::dp45()
+    };
+    let run = hydrocyl_system::rig::simulate(v, u.clone(), &t, &opts).unwrap();
+    let mut c = hydrocyl_system::rig::circuit(v, u).unwrap();
+    c.set_ledger(true);
+    let rod = RodSide::of(&c);
+    let l = ledger(&c, &run, 0, t.len() - 1, &rod).unwrap();
+    (rod, l)
+}
+
 mod closed_forms {
     use super::*;
 
@@ -79,22 +98,10 @@ mod closed_forms {
 
 mod model_forms {
     use super::*;
-    use hydrocyl_system::signal::Signal;
 
     /// The ledger of `preset` over 0.3 s of a half-open spool, at rtol 1e-9.
     fn preset_ledger(preset: &str) -> hydrocyl_energy::ledger::Ledger {
-        let v = hydrocyl_system::rig::preset(preset).unwrap();
-        let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-3).collect();
-        let u = Signal::Constant { value: 0.5 };
-        let opts = RunOptions {
-            rtol: 1e-9,
-            ledger: true,
-            ..RunOptions::dp45()
-        };
-        let run = hydrocyl_system::rig::simulate(&v, u.clone(), &t, &opts).unwrap();
-        let mut c = hydrocyl_system::rig::circuit(&v, u).unwrap();
-        c.set_ledger(true);
-        ledger(&c, &run, 0, t.len() - 1, &RodSide::of(&c)).unwrap()
+        half_open_ledger(&hydrocyl_system::rig::preset(preset).unwrap()).1
     }
 
     #[test]
@@ -220,20 +227,7 @@ mod rod_side {
     /// The ledger of the rig in `text` (a netlist) over 0.3 s of a half-open
     /// spool.
     fn ledger_of(text: &str) -> (RodSide, hydrocyl_energy::ledger::Ledger) {
-        let v: serde_json::Value = serde_json::from_str(text).unwrap();
-        let t: Vec<f64> = (0..=300).map(|k| k as f64 * 1e-3).collect();
-        let u = Signal::Constant { value: 0.5 };
-        let opts = RunOptions {
-            rtol: 1e-9,
-            ledger: true,
-            ..RunOptions::dp45()
-        };
-        let run = hydrocyl_system::rig::simulate(&v, u.clone(), &t, &opts).unwrap();
-        let mut c = hydrocyl_system::rig::circuit(&v, u).unwrap();
-        c.set_ledger(true);
-        let rod = RodSide::of(&c);
-        let l = ledger(&c, &run, 0, t.len() - 1, &rod).unwrap();
-        (rod, l)
+        half_open_ledger(&serde_json::from_str(text).unwrap())
     }
 
     /// `name` renamed `to` in a netlist's text: the component's key and

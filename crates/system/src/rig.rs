@@ -210,8 +210,10 @@ pub fn parse(text: &str, source: &str) -> Result<Value, RigError> {
     })?;
     if let Some((key, line)) = crate::netlist::locate::scan(text).duplicate {
         return Err(RigError::Invalid {
-            path: format!("{source}: {key}"),
-            why: format!("duplicate key at line {line} (a key may appear once in an object)"),
+            path: key,
+            why: format!(
+                "duplicate key (a key may appear once in an object) (line {line} of {source})"
+            ),
         });
     }
     if v.get("kind").and_then(Value::as_str) == Some(RETIRED_VARIANT_KIND) {
@@ -293,10 +295,13 @@ pub fn set_form(e: RigError, rig: &Value) -> RigError {
 /// [`at_line`] on the rig's text `text`, named `source` in the message.
 pub fn at_line_in(e: RigError, text: &str, source: &str) -> RigError {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    // an error about the file itself (it does not read, a duplicate key)
-    // names it already
-    if let RigError::Invalid { path, .. } = &e {
-        if path == source || path.starts_with(&format!("{source}: ")) {
+    // an error about the file itself (it does not read) or one placed
+    // already (a duplicate key, at its line) names it
+    if let RigError::Invalid { path, why } = &e {
+        if path == source
+            || path.starts_with(&format!("{source}: "))
+            || why.ends_with(&format!(" of {source})"))
+        {
             return e;
         }
     }
@@ -723,12 +728,25 @@ mod tests {
             parse(&format!("\u{feff}{text}"), "JSON text").unwrap(),
             plain
         );
-        // a duplicate key is refused with its line, as in a file
+        // a duplicate key is refused with its line, as in a file, in the
+        // shape of every other error: the path, then `(line N of source)`
         let twice = text.replacen("\"mass\": 100.0", "\"mass\": 100.0, \"mass\": 5.0", 1);
-        let e = parse(&twice, "JSON text").unwrap_err().to_string();
-        assert!(
-            e.contains("JSON text: ") && e.contains("duplicate key at line"),
-            "{e}"
+        let e = parse(&twice, "JSON text").unwrap_err();
+        let line = twice
+            .lines()
+            .position(|l| l.contains("\"mass\": 5.0"))
+            .unwrap()
+            + 1;
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "rig `components.load.mass`: duplicate key (a key may appear once in an object) \
+                 (line {line} of JSON text)"
+            )
+        );
+        assert_eq!(
+            at_line_in(e.clone(), &twice, "JSON text").to_string(),
+            e.to_string()
         );
         // a path's line is found in the text
         let mut bad = plain.clone();

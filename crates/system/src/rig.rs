@@ -327,13 +327,25 @@ pub fn at_line_in(e: RigError, text: &str, source: &str) -> RigError {
 
 /// The kind entry of a rig value.
 pub fn kind_of(v: &Value) -> Result<&'static RigKind, RigError> {
-    let k = v
-        .get("kind")
-        .and_then(Value::as_str)
-        .ok_or_else(|| RigError::Invalid {
-            path: "kind".into(),
-            why: "missing (a rig file names its kind)".into(),
-        })?;
+    let k = match v.get("kind") {
+        Some(Value::String(k)) => k.as_str(),
+        None => {
+            return Err(RigError::Invalid {
+                path: "kind".into(),
+                why: "missing (a rig file names its kind)".into(),
+            })
+        }
+        Some(other) => {
+            return Err(RigError::Invalid {
+                path: "kind".into(),
+                why: format!(
+                    "must be a string (the rig's kind, e.g. `{}`), got {}",
+                    crate::netlist::KIND,
+                    crate::netlist::reader::kind_of(other)
+                ),
+            })
+        }
+    };
     RIG_KINDS
         .iter()
         .find(|r| r.kind == k)
@@ -718,6 +730,21 @@ mod tests {
             crate::simulation::Simulation::of_circuit(c).command_limit(),
             None
         );
+    }
+
+    #[test]
+    fn a_kind_that_is_not_a_string_is_named_so_not_missing() {
+        let e = check(&serde_json::json!({"kind": 5}))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "rig `kind`: must be a string (the rig's kind, e.g. `netlist`), got a number"
+        );
+        let e = check(&serde_json::json!({"name": "n"}))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "rig `kind`: missing (a rig file names its kind)");
     }
 
     #[test]

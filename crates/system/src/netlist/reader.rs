@@ -57,7 +57,7 @@ fn valid_name(s: &str) -> bool {
 }
 
 /// What a JSON value is, for messages (`a string`, `an array`, ...).
-pub(super) fn kind_of(v: &Value) -> &'static str {
+pub(crate) fn kind_of(v: &Value) -> &'static str {
     match v {
         Value::Null => "null",
         Value::Bool(_) => "a boolean",

@@ -412,6 +412,21 @@ pub fn expanded(v: &Value) -> Result<Value, RigError> {
 mod tests {
     use serde_json::json;
 
+    /// The netlist's name is a string: another value is refused at `name`,
+    /// not passed over for the default name.
+    #[test]
+    fn a_name_that_is_not_a_string_is_refused() {
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        v["name"] = json!(5);
+        let e = super::read(&v).unwrap_err();
+        assert_eq!(
+            (e.path.as_str(), e.why.as_str()),
+            ("name", "must be a string, got a number")
+        );
+        v.as_object_mut().unwrap().remove("name");
+        assert_eq!(super::read(&v).unwrap().name, "netlist");
+    }
+
     /// What only the assembly finds is refused where a rig is checked:
     /// a controller reading its own command is an algebraic loop of one.
     #[test]

@@ -136,11 +136,11 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
             );
         }
     }
-    let name = root
-        .get("name")
-        .and_then(Value::as_str)
-        .unwrap_or("netlist")
-        .to_string();
+    let name = match root.get("name") {
+        None => "netlist".to_string(),
+        Some(Value::String(s)) => s.clone(),
+        Some(other) => return err("name", format!("must be a string, got {}", kind_of(other))),
+    };
     let Some(Value::Object(comps)) = root.get("components") else {
         return err("components", "missing: an object of named components");
     };

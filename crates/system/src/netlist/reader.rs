@@ -432,18 +432,22 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                     return err(at, format!("no component named `{c}`"));
                 };
                 if !inst.ty.probes.iter().any(|(n, _)| *n == pr) {
-                    return err(
-                        at,
+                    let has = if inst.ty.probes.is_empty() {
+                        "it has no outputs".to_string()
+                    } else {
                         format!(
-                            "`{c}` ({}) has no output `{pr}` (its outputs: {})",
-                            inst.ty.name,
+                            "its outputs: {}",
                             inst.ty
                                 .probes
                                 .iter()
                                 .map(|(n, _)| *n)
                                 .collect::<Vec<_>>()
                                 .join(", ")
-                        ),
+                        )
+                    };
+                    return err(
+                        at,
+                        format!("`{c}` ({}) has no output `{pr}` ({has})", inst.ty.name),
                     );
                 }
                 if let Some((first, _)) = outputs.iter().find(|(_, q)| q == p) {

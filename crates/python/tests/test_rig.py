@@ -219,7 +219,7 @@ def test_from_json_reads_the_text_as_load_reads_a_file(repo, tmp_path):
     assert lines[2].lstrip().startswith('"name"')
     duplicated = "\n".join([*lines[:3], lines[2], *lines[3:]])
     retired = '{"kind": "hybrid-variant"}'
-    for text, message in [(duplicated, "duplicate key at line 4"), (retired, "hybrid-variant` kind is retired")]:
+    for text, message in [(duplicated, r"`name`: duplicate key .*\(line 4 of "), (retired, "hybrid-variant` kind is retired")]:
         f = tmp_path / "rig.json"
         f.write_text(text)
         with pytest.raises(ValueError, match=message) as from_file:

@@ -108,7 +108,7 @@ def test_to_pandas_uses_pandas_when_there_and_says_so_when_not(step, monkeypatch
     "kwargs, message",
     [
         ({"solver": "euler"}, "solver: unknown method `euler` (use auto, dp45, rosenbrock, rk4 or exponential)"),
-        ({"rtol": 0.0}, "rtol 0: must be in (0, 1), e.g. 1e-6"),
+        ({"rtol": 0.0}, "rtol 0: must be in [1e-14, 1), e.g. 1e-6"),
         ({"rtol": 1e-300}, "rtol 1e-300: below 1e-14 (about 50 machine epsilons), a tolerance double precision "
                            "cannot meet; use a value in [1e-14, 1), e.g. 1e-6"),
         ({"rk4_step": -1.0}, "rk4_step -1: must be finite and > 0 [s], e.g. 2e-5"),

@@ -210,8 +210,10 @@ pub fn parse(text: &str, source: &str) -> Result<Value, RigError> {
     })?;
     if let Some((key, line)) = crate::netlist::locate::scan(text).duplicate {
         return Err(RigError::Invalid {
-            path: format!("{source}: {key}"),
-            why: format!("duplicate key at line {line} (a key may appear once in an object)"),
+            path: key,
+            why: format!(
+                "duplicate key (a key may appear once in an object) (line {line} of {source})"
+            ),
         });
     }
     if v.get("kind").and_then(Value::as_str) == Some(RETIRED_VARIANT_KIND) {
@@ -293,10 +295,13 @@ pub fn set_form(e: RigError, rig: &Value) -> RigError {
 /// [`at_line`] on the rig's text `text`, named `source` in the message.
 pub fn at_line_in(e: RigError, text: &str, source: &str) -> RigError {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    // an error about the file itself (it does not read, a duplicate key)
-    // names it already
-    if let RigError::Invalid { path, .. } = &e {
-        if path == source || path.starts_with(&format!("{source}: ")) {
+    // an error about the file itself (it does not read) or one placed
+    // already (a duplicate key, at its line) names it
+    if let RigError::Invalid { path, why } = &e {
+        if path == source
+            || path.starts_with(&format!("{source}: "))
+            || why.ends_with(&format!(" of {source})"))
+        {
             return e;
         }
     }
@@ -322,13 +327,25 @@ pub fn at_line_in(e: RigError, text: &str, source: &str) -> RigError {
 
 /// The kind entry of a rig value.
 pub fn kind_of(v: &Value) -> Result<&'static RigKind, RigError> {
-    let k = v
-        .get("kind")
-        .and_then(Value::as_str)
-        .ok_or_else(|| RigError::Invalid {
-            path: "kind".into(),
-            why: "missing (a rig file names its kind)".into(),
-        })?;
+    let k = match v.get("kind") {
+        Some(Value::String(k)) => k.as_str(),
+        None => {
+            return Err(RigError::Invalid {
+                path: "kind".into(),
+                why: "missing (a rig file names its kind)".into(),
+            })
+        }
+        Some(other) => {
+            return Err(RigError::Invalid {
+                path: "kind".into(),
+                why: format!(
+                    "must be a string (the rig's kind, e.g. `{}`), got {}",
+                    crate::netlist::KIND,
+                    crate::netlist::reader::kind_of(other)
+                ),
+            })
+        }
+    };
     RIG_KINDS
         .iter()
         .find(|r| r.kind == k)
@@ -716,6 +733,21 @@ mod tests {
     }
 
     #[test]
+    fn a_kind_that_is_not_a_string_is_named_so_not_missing() {
+        let e = check(&serde_json::json!({"kind": 5}))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "rig `kind`: must be a string (the rig's kind, e.g. `netlist`), got a number"
+        );
+        let e = check(&serde_json::json!({"name": "n"}))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "rig `kind`: missing (a rig file names its kind)");
+    }
+
+    #[test]
     fn rig_text_reads_as_a_file_does_and_a_byte_order_mark_is_skipped() {
         let text = serde_json::to_string_pretty(&preset("leaney-moog").unwrap()).unwrap();
         let plain = parse(&text, "JSON text").unwrap();
@@ -723,12 +755,25 @@ mod tests {
             parse(&format!("\u{feff}{text}"), "JSON text").unwrap(),
             plain
         );
-        // a duplicate key is refused with its line, as in a file
+        // a duplicate key is refused with its line, as in a file, in the
+        // shape of every other error: the path, then `(line N of source)`
         let twice = text.replacen("\"mass\": 100.0", "\"mass\": 100.0, \"mass\": 5.0", 1);
-        let e = parse(&twice, "JSON text").unwrap_err().to_string();
-        assert!(
-            e.contains("JSON text: ") && e.contains("duplicate key at line"),
-            "{e}"
+        let e = parse(&twice, "JSON text").unwrap_err();
+        let line = twice
+            .lines()
+            .position(|l| l.contains("\"mass\": 5.0"))
+            .unwrap()
+            + 1;
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "rig `components.load.mass`: duplicate key (a key may appear once in an object) \
+                 (line {line} of JSON text)"
+            )
+        );
+        assert_eq!(
+            at_line_in(e.clone(), &twice, "JSON text").to_string(),
+            e.to_string()
         );
         // a path's line is found in the text
         let mut bad = plain.clone();

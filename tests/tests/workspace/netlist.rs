@@ -626,8 +626,11 @@ fn a_duplicate_key_is_refused_with_its_line() {
         .replacen("\"mass\": 100.0", "\"mass\": 100.0, \"mass\": 50.0", 1);
     std::fs::write(&f, text).unwrap();
     let err = rig::load(f.to_str().unwrap()).unwrap_err().to_string();
+    // the shape of every other error: the path alone, then the line and file
     assert!(
-        err.contains("components.load.mass") && err.contains("duplicate key at line"),
+        err.starts_with("rig `components.load.mass`: duplicate key")
+            && err.ends_with(&format!(" of {})", f.display()))
+            && err.contains("(line "),
         "{err}"
     );
 }

@@ -266,7 +266,7 @@ mod tests {
         assert_eq!(s.rig(), &rig::preset("leaney-moog").unwrap());
         // solver parameters: the message is the rule, not the description
         for (name, bad, rule) in [
-            ("solver.rtol", 0.0, "must be in (0, 1)"),
+            ("solver.rtol", 0.0, "must be in [1e-14, 1)"),
             ("solver.rtol", 1e-300, "= 1e-300 rejected: below 1e-14"),
             ("solver.h_max", -1.0, "must be > 0 [s]"),
             (

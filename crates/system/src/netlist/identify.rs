@@ -403,7 +403,8 @@ fn refit(a: &[Value], instances: &[Instance]) -> Result<Vec<String>, NetlistErro
             return err(
                 at,
                 format!(
-                    "`{path}`: `{comp}` is a {} and has no parameter `{param}` (its parameters: {})",
+                    "`{path}`: `{comp}` is {} {} and has no parameter `{param}` (its parameters: {})",
+                    super::a_or_an(inst.ty.name),
                     inst.ty.name,
                     inst.ty
                         .params

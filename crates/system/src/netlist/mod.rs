@@ -356,7 +356,8 @@ pub fn set(v: &mut Value, path: &str, value: Value) -> Result<(), RigError> {
         let mut all: Vec<String> = ty.params.iter().map(|p| p.name.to_string()).collect();
         all.extend(ty.states.iter().map(|s| format!("initial.{}", s.name)));
         return Err(unknown(format!(
-            " (`{comp}` is a {}; its parameters: {})",
+            " (`{comp}` is {} {}; its parameters: {})",
+            a_or_an(ty.name),
             ty.name,
             all.join(", ")
         )));
@@ -408,9 +409,52 @@ pub fn expanded(v: &Value) -> Result<Value, RigError> {
     Ok(out)
 }
 
+/// The indefinite article before `word` in a message: `an` before a
+/// vowel (`an orifice`, `an integral`), `a` otherwise (`a cylinder`).
+pub(crate) fn a_or_an(word: &str) -> &'static str {
+    match word.chars().next().map(|c| c.to_ascii_lowercase()) {
+        Some('a' | 'e' | 'i' | 'o' | 'u') => "an",
+        _ => "a",
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use serde_json::json;
+
+    /// A component's type is named with its article: `an orifice`,
+    /// `a cylinder`.
+    #[test]
+    fn a_type_is_named_with_a_or_an() {
+        assert_eq!(super::a_or_an("orifice"), "an");
+        assert_eq!(super::a_or_an("integral"), "an");
+        assert_eq!(super::a_or_an("cylinder"), "a");
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        v["components"]["needle"] = json!({"type": "orifice"});
+        let e = crate::rig::apply_set(&mut v, "needle.nope=1")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("(`needle` is an orifice; "), "{e}");
+        let e = crate::rig::apply_set(&mut v, "cylinder.nope=1")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("(`cylinder` is a "), "{e}");
+    }
+
+    /// The netlist's name is a string: another value is refused at `name`,
+    /// not passed over for the default name.
+    #[test]
+    fn a_name_that_is_not_a_string_is_refused() {
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        v["name"] = json!(5);
+        let e = super::read(&v).unwrap_err();
+        assert_eq!(
+            (e.path.as_str(), e.why.as_str()),
+            ("name", "must be a string, got a number")
+        );
+        v.as_object_mut().unwrap().remove("name");
+        assert_eq!(super::read(&v).unwrap().name, "netlist");
+    }
 
     /// What only the assembly finds is refused where a rig is checked:
     /// a controller reading its own command is an algebraic loop of one.

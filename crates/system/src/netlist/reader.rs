@@ -57,7 +57,7 @@ fn valid_name(s: &str) -> bool {
 }
 
 /// What a JSON value is, for messages (`a string`, `an array`, ...).
-pub(super) fn kind_of(v: &Value) -> &'static str {
+pub(crate) fn kind_of(v: &Value) -> &'static str {
     match v {
         Value::Null => "null",
         Value::Bool(_) => "a boolean",
@@ -136,11 +136,11 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
             );
         }
     }
-    let name = root
-        .get("name")
-        .and_then(Value::as_str)
-        .unwrap_or("netlist")
-        .to_string();
+    let name = match root.get("name") {
+        None => "netlist".to_string(),
+        Some(Value::String(s)) => s.clone(),
+        Some(other) => return err("name", format!("must be a string, got {}", kind_of(other))),
+    };
     let Some(Value::Object(comps)) = root.get("components") else {
         return err("components", "missing: an object of named components");
     };
@@ -432,18 +432,22 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                     return err(at, format!("no component named `{c}`"));
                 };
                 if !inst.ty.probes.iter().any(|(n, _)| *n == pr) {
-                    return err(
-                        at,
+                    let has = if inst.ty.probes.is_empty() {
+                        "it has no outputs".to_string()
+                    } else {
                         format!(
-                            "`{c}` ({}) has no output `{pr}` (its outputs: {})",
-                            inst.ty.name,
+                            "its outputs: {}",
                             inst.ty
                                 .probes
                                 .iter()
                                 .map(|(n, _)| *n)
                                 .collect::<Vec<_>>()
                                 .join(", ")
-                        ),
+                        )
+                    };
+                    return err(
+                        at,
+                        format!("`{c}` ({}) has no output `{pr}` ({has})", inst.ty.name),
                     );
                 }
                 if let Some((first, _)) = outputs.iter().find(|(_, q)| q == p) {

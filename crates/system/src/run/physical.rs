@@ -206,7 +206,9 @@ impl DeepCavitation {
             Some(p) => format!("give it entrained air ({})", (words.set)(&p)),
             None => format!(
                 "{q}{cylinder}{q}{} has no entrained-air parameter, so its chambers cannot be given air here (the component types that have {q}{AIR_PARAMETER}{q}: {})",
-                type_name.map(|t| format!(" (a {q}{t}{q})")).unwrap_or_default(),
+                type_name
+                    .map(|t| format!(" ({} {q}{t}{q})", crate::netlist::a_or_an(t)))
+                    .unwrap_or_default(),
                 chamber_types_with_air().join(", ")
             ),
         };

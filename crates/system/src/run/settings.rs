@@ -110,12 +110,13 @@ pub enum Setting {
 }
 
 impl Setting {
-    /// The rule, as a user reads it after the value: "must be in (0, 1),
-    /// e.g. 1e-6". A relative tolerance in that range but below
-    /// [`RTOL_FLOOR`] breaks a rule of its own ([`Setting::check`]).
+    /// The rule, as a user reads it after the value: "must be in [1e-14, 1),
+    /// e.g. 1e-6" (the range [`Setting::check`] enforces). A relative
+    /// tolerance in (0, [`RTOL_FLOOR`]) gets a message of its own, which
+    /// says why the floor is there.
     pub fn rule(self) -> &'static str {
         match self {
-            Setting::Rtol => "must be in (0, 1), e.g. 1e-6",
+            Setting::Rtol => "must be in [1e-14, 1), e.g. 1e-6",
             Setting::HMax => "must be > 0 [s] (inf: no bound), e.g. 1e-2",
             Setting::Rk4Step => "must be finite and > 0 [s], e.g. 2e-5",
         }
@@ -142,7 +143,7 @@ impl Setting {
         }
     }
     /// `value`, or the message every front end gives, with the setting as
-    /// the front end names it: "`--rtol` 0: must be in (0, 1), e.g. 1e-6"
+    /// the front end names it: "`--rtol` 0: must be in [1e-14, 1), e.g. 1e-6"
     /// (`name` = `--rtol`; `rtol` in Python and in `RunOptions`), the value
     /// as [`Setting::shown`].
     pub fn check_named(self, name: &str, value: f64) -> Result<f64, String> {
@@ -192,13 +193,17 @@ mod tests {
         }
         assert!(RTOL_BELOW_FLOOR.starts_with(&format!("below {RTOL_FLOOR:e} ")));
         assert!(RTOL_BELOW_FLOOR.contains(&format!("[{RTOL_FLOOR:e}, 1)")));
+        // the rule states the range the check enforces
+        assert!(Setting::Rtol
+            .rule()
+            .contains(&format!("[{RTOL_FLOOR:e}, 1)")));
         assert_eq!(
             Setting::Rtol.check_named("--rtol", 1e-300).unwrap_err(),
             format!("--rtol 1e-300: {RTOL_BELOW_FLOOR}")
         );
         assert_eq!(
             Setting::Rtol.check_named("rtol", 0.0).unwrap_err(),
-            "rtol 0: must be in (0, 1), e.g. 1e-6"
+            "rtol 0: must be in [1e-14, 1), e.g. 1e-6"
         );
         for s in [Setting::HMax, Setting::Rk4Step] {
             for v in [0.0, -1.0, f64::NAN] {

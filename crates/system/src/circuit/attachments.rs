@@ -1,48 +1,38 @@
-//! Which nodes each component of a circuit is attached to, as its binding
-//! declared them: what a study needs to find the parts of a circuit by
-//! their connections rather than by their names (the energy ledger's rod
-//! side: the components on a cylinder's rod).
+//! Which mechanical nodes each component of a circuit is attached to, as
+//! its binding declared them: what a study needs to find the parts of a
+//! circuit by their connections rather than by their names (the energy
+//! ledger's rod side: the components on a cylinder's rod).
 
 use super::Circuit;
 use crate::binding::Netlist;
 
-/// The hydraulic and mechanical nodes each component binds, by component
-/// index.
+/// The mechanical nodes each component binds, by component index.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Attachments {
-    hydraulic: Vec<Vec<String>>,
     mechanical: Vec<Vec<String>>,
 }
 
 impl Attachments {
     /// From a netlist every component has bound: a node is the part of a
-    /// wire's name (`hyd:<node>:p`, `mech:<node>:v`) between its domain and
-    /// its quantity, for every wire a component reads or writes.
+    /// wire's name (`mech:<node>:v`) between its domain and its quantity,
+    /// for every wire a component reads or writes.
     pub(super) fn of(net: &Netlist, n_components: usize) -> Self {
-        let mut a = Self {
-            hydraulic: vec![Vec::new(); n_components],
-            mechanical: vec![Vec::new(); n_components],
-        };
+        let mut mechanical = vec![Vec::<String>::new(); n_components];
         let touched = net
             .reads
             .iter()
             .map(|(c, w, _, _)| (*c, *w))
             .chain(net.writes.iter().copied());
         for (c, w) in touched {
-            let name = &net.names[w];
-            let (list, rest) = if let Some(rest) = name.strip_prefix("hyd:") {
-                (&mut a.hydraulic[c], rest)
-            } else if let Some(rest) = name.strip_prefix("mech:") {
-                (&mut a.mechanical[c], rest)
-            } else {
+            let Some(rest) = net.names[w].strip_prefix("mech:") else {
                 continue;
             };
             let node = rest.rsplit_once(':').map_or(rest, |(n, _)| n);
-            if !list.iter().any(|m| m == node) {
-                list.push(node.to_string());
+            if !mechanical[c].iter().any(|m| m == node) {
+                mechanical[c].push(node.to_string());
             }
         }
-        a
+        Self { mechanical }
     }
 }
 
@@ -55,12 +45,6 @@ impl Circuit {
             .mechanical
             .get(i)
             .map_or(&[], Vec::as_slice)
-    }
-
-    /// The hydraulic nodes component `i` is attached to, in the order it
-    /// bound them.
-    pub fn hydraulic_nodes(&self, i: usize) -> &[String] {
-        self.attachments.hydraulic.get(i).map_or(&[], Vec::as_slice)
     }
 
     /// Whether component `i` is an actuator

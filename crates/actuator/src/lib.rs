@@ -77,7 +77,7 @@ pub enum ActuatorError {
         value: f64,
     },
     /// A chamber would have no volume left at a stroke end.
-    #[error("chamber {chamber} volume at the stroke end is {volume} m^3: chamber_length_{chamber} must exceed half the stroke")]
+    #[error("chamber {chamber} volume at the stroke end is {volume:e} m^3: chamber_length_{chamber} must exceed half the stroke")]
     EmptyChamber {
         /// 1 or 2.
         chamber: u8,

@@ -69,11 +69,20 @@ impl Ends {
         let mut text = serde_json::to_vec_pretty(&l.to_json())
             .map_err(|e| bad(format!("writing JSON: {e}")))?;
         text.push(b'\n');
+        // where no energy comes in (a volume discharging, a mass braking)
+        // there is no efficiency, and the errors are of the largest term
+        let (efficiency, of) = if l.energy_in_j > 0.0 {
+            (format!("efficiency {:.4}", l.efficiency()), "the energy in")
+        } else {
+            (
+                "no efficiency: no energy in".to_string(),
+                "the largest term",
+            )
+        };
         let note = format!(
-            "energy ledger over t = {t0} … {t1} s: energy in {:.6e} J, out of the cylinder {:.6e} J (efficiency {:.4}), closure {:.3e} J ({:.1e} of the energy in), storage check {:.1e}",
+            "energy ledger over t = {t0} … {t1} s: energy in {:.6e} J, out of the cylinder {:.6e} J ({efficiency}), closure {:.3e} J ({:.1e} of {of}), storage check {:.1e}",
             l.energy_in_j,
             l.cylinder_out_j,
-            l.efficiency(),
             l.closure_j(),
             l.error,
             l.storage_error

@@ -12,6 +12,9 @@
 //! E_in = E_load + Σ E_loss + ΔE_stored          (balance error = residual / E_in)
 //! ```
 //!
+//! (where no energy comes in over the window, the errors are fractions of
+//! the largest other term instead: [`Ledger::reference_j`]).
+//!
 //! Two storage figures are kept: the integrated storage power (what closes the
 //! balance) and the change of the stored energy recomputed from the states at
 //! the window's ends (`½ V p²/B` per volume, `½ (m + c) v²` for the load with
@@ -79,11 +82,18 @@ pub struct Ledger {
     /// `p V/B dp` (what closes the balance); its stored energy as a function
     /// of the state, `½ V p²/B`, also moves with the walls.
     pub moving_walls_j: f64,
+    /// The energy [`Ledger::error`] and [`Ledger::storage_error`] are
+    /// fractions of \[J\]: `energy_in_j` where energy comes in; where none
+    /// does over the window (a volume discharging to tank, a mass braking,
+    /// a hydraulic spring swinging), the largest of the balance's other
+    /// terms (the load's, the losses' and the storage's, each summed in
+    /// magnitude); 0 where nothing moved (the errors are then in J).
+    pub reference_j: f64,
     /// Balance residual `E_in − E_load − Σ E_loss − Σ storage` as a fraction
-    /// of `E_in` \[-\].
+    /// of [`Ledger::reference_j`] (of `E_in` where energy comes in) \[-\].
     pub error: f64,
     /// `(Σ storage + moving_walls − stored_change_from_states)` as a fraction
-    /// of `E_in` \[-\]: the integration's error alone.
+    /// of [`Ledger::reference_j`] \[-\]: the integration's error alone.
     pub storage_error: f64,
     /// The components whose model form does not conserve energy
     /// ([`Component::energy_consistent`](hydrocyl_system::Component::energy_consistent)):
@@ -106,19 +116,25 @@ impl Ledger {
         self.storage.iter().map(|t| t.energy_j).sum()
     }
 
-    /// The efficiency of eqs 8.1–8.7: cylinder output over energy in \[-\].
+    /// The efficiency of eqs 8.1–8.7: cylinder output over energy in \[-\];
+    /// NaN (`null` in [`Ledger::to_json`]) where no energy comes in over
+    /// the window.
     pub fn efficiency(&self) -> f64 {
-        self.cylinder_out_j / self.energy_in_j
+        if self.energy_in_j > 0.0 {
+            self.cylinder_out_j / self.energy_in_j
+        } else {
+            f64::NAN
+        }
     }
 
     /// The balance residual `E_in − E_load − Σ E_loss − Σ storage` \[J\]
-    /// ([`Ledger::error`] times the energy in).
+    /// ([`Ledger::error`] times [`Ledger::reference_j`]).
     pub fn closure_j(&self) -> f64 {
         self.energy_in_j - self.load_out_j - self.total_loss_j() - self.total_storage_j()
     }
 
     /// The storage check `Σ storage + moving_walls − ΔE_stored(states)`
-    /// \[J\] ([`Ledger::storage_error`] times the energy in).
+    /// \[J\] ([`Ledger::storage_error`] times [`Ledger::reference_j`]).
     pub fn storage_check_j(&self) -> f64 {
         self.total_storage_j() + self.moving_walls_j - self.stored_change_from_states_j
     }
@@ -138,8 +154,8 @@ impl Ledger {
     /// The ledger as one JSON object, what `hydrocyl simulate --ledger`
     /// writes and Python's `run.ledger` is (the same keys): every energy in
     /// J under a key ending `_j` (in an object under such a key, each value),
-    /// times in s under `_s`, fractions of the energy in dimensionless (the
-    /// `units` entry says so):
+    /// times in s under `_s`, fractions of `reference_j` (the energy in,
+    /// where energy comes in) dimensionless (the `units` entry says so):
     ///
     /// * `components_j`: each component's quadratures by
     ///   [`LEDGER_TERM_NAMES`], `totals_j` their sums;
@@ -148,7 +164,9 @@ impl Ledger {
     ///   `stored_change_from_states_j`, `moving_walls_j`;
     /// * `closure_j` ([`Ledger::closure_j`]) and `closure_relative` (=
     ///   `error`), `storage_check_j` ([`Ledger::storage_check_j`]) and
-    ///   `storage_check_relative` (= `storage_error`), `efficiency`;
+    ///   `storage_check_relative` (= `storage_error`), `reference_j`
+    ///   ([`Ledger::reference_j`]), `efficiency` (`null` where no energy
+    ///   comes in);
     /// * `not_energy_consistent`: the components over which the closure
     ///   measures the model form, not the bookkeeping.
     pub fn to_json(&self) -> Value {
@@ -177,11 +195,11 @@ impl Ledger {
             "units": {
                 "_j": "J (every value under a key ending _j)",
                 "_s": "s",
-                "closure_relative": "1 (fraction of energy_in_j)",
-                "storage_check_relative": "1 (fraction of energy_in_j)",
-                "error": "1 (fraction of energy_in_j)",
-                "storage_error": "1 (fraction of energy_in_j)",
-                "efficiency": "1 (cylinder_out_j / energy_in_j)",
+                "closure_relative": REFERENCED,
+                "storage_check_relative": REFERENCED,
+                "error": REFERENCED,
+                "storage_error": REFERENCED,
+                "efficiency": "1 (cylinder_out_j / energy_in_j; null where no energy comes in)",
             },
             "window_s": [self.window_s.0, self.window_s.1],
             "term_names": LEDGER_TERM_NAMES,
@@ -201,6 +219,7 @@ impl Ledger {
             "storage_check_relative": self.storage_error,
             "error": self.error,
             "storage_error": self.storage_error,
+            "reference_j": self.reference_j,
             "efficiency": self.efficiency(),
             "not_energy_consistent": self.not_energy_consistent,
         })
@@ -287,8 +306,12 @@ impl RodSide {
     }
 }
 
-/// Energy (magnitudes) below this fraction of `E_in` is left out of the
-/// term lists as zero.
+/// What the relative figures of [`Ledger::to_json`] are fractions of.
+const REFERENCED: &str =
+    "1 (fraction of reference_j: energy_in_j where energy comes in, else the largest other term)";
+
+/// Energy (magnitudes) below this fraction of [`Ledger::reference_j`] is
+/// left out of the term lists as zero.
 const NEGLIGIBLE: f64 = 1e-12;
 
 /// The ledger of `run` (made with `RunOptions::ledger` on) over output
@@ -355,16 +378,18 @@ pub fn ledger(
             push(&mut storage, sto);
         }
     }
-    if !(e_in.is_finite() && e_in > 0.0) {
+    if !e_in.is_finite() {
         return Err(EnergyError::Ledger(format!(
-            "energy in over the window is {e_in} J: nothing to take a fraction of"
+            "energy in over the window is {e_in} J"
         )));
     }
-    let tiny = NEGLIGIBLE * e_in;
+    let reference = reference_energy(e_in, e_load, &losses, &storage);
+    let tiny = NEGLIGIBLE * reference;
     losses.retain(|t| t.energy_j.abs() > tiny);
     storage.retain(|t| t.energy_j.abs() > tiny);
     let sum_loss: f64 = losses.iter().map(|t| t.energy_j).sum();
     let sum_sto: f64 = storage.iter().map(|t| t.energy_j).sum();
+    let fraction = |e: f64| if reference > 0.0 { e / reference } else { e };
     let stored = |k: usize| stored_energy(circuit, run.time[k], run.state(k));
     let from_states = stored(k1) - stored(k0);
     Ok(Ledger {
@@ -377,8 +402,9 @@ pub fn ledger(
         storage,
         stored_change_from_states_j: from_states,
         moving_walls_j: e_moved,
-        error: (e_in - e_load - sum_loss - sum_sto) / e_in,
-        storage_error: (sum_sto + e_moved - from_states) / e_in,
+        reference_j: reference,
+        error: fraction(e_in - e_load - sum_loss - sum_sto),
+        storage_error: fraction(sum_sto + e_moved - from_states),
         not_energy_consistent: circuit
             .components()
             .filter(|c| !c.energy_consistent())
@@ -386,6 +412,21 @@ pub fn ledger(
             .collect(),
         components,
     })
+}
+
+/// The energy a ledger's relative figures are fractions of
+/// ([`Ledger::reference_j`]): the energy in where energy comes in, else the
+/// largest of the balance's other terms (what the load took, the losses, the
+/// storage, each summed in magnitude); 0 where nothing moved at all.
+fn reference_energy(e_in: f64, e_load: f64, losses: &[Term], storage: &[Term]) -> f64 {
+    if e_in > 0.0 {
+        return e_in;
+    }
+    let magnitude = |ts: &[Term]| ts.iter().map(|t| t.energy_j.abs()).sum::<f64>();
+    e_in.abs()
+        .max(e_load.abs())
+        .max(magnitude(losses))
+        .max(magnitude(storage))
 }
 
 /// The ledger between two states of a run made with `RunOptions::ledger`

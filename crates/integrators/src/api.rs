@@ -248,11 +248,27 @@ impl Solution {
     }
 }
 
+/// A time in an error message \[s\]: as it is where it reads well
+/// (0, or between 1 ms and 10⁷ s), in scientific notation where its
+/// decimals would run on (`4.39e-14`, not `0.0000000000000439…`).
+pub struct Seconds(pub f64);
+
+impl std::fmt::Display for Seconds {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let t = self.0;
+        if t == 0.0 || !t.is_finite() || (1e-3..1e7).contains(&t.abs()) {
+            write!(f, "{t}")
+        } else {
+            write!(f, "{t:e}")
+        }
+    }
+}
+
 /// Why a solve failed. Each variant says where (time) and, where it can, which state.
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum SolveError {
     /// The step size fell below `Options::h_min`.
-    #[error("step size {h:e} s fell below the minimum at t = {t} s: the solver cannot meet its tolerance")]
+    #[error("step size {h:e} s fell below the minimum at t = {} s: the solver cannot meet its tolerance", Seconds(*t))]
     StepTooSmall {
         /// Time reached.
         t: f64,
@@ -260,7 +276,7 @@ pub enum SolveError {
         h: f64,
     },
     /// `Options::max_steps` was reached.
-    #[error("the step budget ran out: more than {max} steps before t = {t} s")]
+    #[error("the step budget ran out: more than {max} steps before t = {} s", Seconds(*t))]
     TooManySteps {
         /// Time reached.
         t: f64,
@@ -268,7 +284,7 @@ pub enum SolveError {
         max: usize,
     },
     /// A state or derivative became NaN or infinite.
-    #[error("state {index} is not finite at t = {t} s")]
+    #[error("state {index} is not finite at t = {} s", Seconds(*t))]
     NonFinite {
         /// Time reached.
         t: f64,
@@ -276,7 +292,7 @@ pub enum SolveError {
         index: usize,
     },
     /// The stiff method's iteration matrix was singular.
-    #[error("singular iteration matrix at t = {t} s")]
+    #[error("singular iteration matrix at t = {} s", Seconds(*t))]
     Singular {
         /// Time reached.
         t: f64,
@@ -288,7 +304,7 @@ pub enum SolveError {
     /// ([`MAX_EVENTS_IN_A_ROW`](crate::MAX_EVENTS_IN_A_ROW)): the
     /// solution chatters, a step too long for a fixed-step method or a model
     /// that switches without end, and time stalls.
-    #[error("{count} events in a row up to t = {t} s, none with a step free of events between them (event function {which} the last): the solution chatters (a step too long for the rig, or a model that switches without end)")]
+    #[error("{count} events in a row up to t = {} s, none with a step free of events between them (event function {which} the last): the solution chatters (a step too long for the rig, or a model that switches without end)", Seconds(*t))]
     EventStorm {
         /// Time reached.
         t: f64,
@@ -302,7 +318,7 @@ pub enum SolveError {
     /// steps to reach its end than its budget (`Options::max_steps`) has
     /// left: the solution chatters (a model that switches without end, a
     /// valve or stop whose switching is faster than the tolerance resolves).
-    #[error("the solution chatters: {events} of the last {steps} steps ended on an event (event function {which} the last) and together advanced time by only {advanced:e} s up to t = {t} s; at that pace the run needs ~{needed:.1e} more steps, more than the {left} its step budget has left")]
+    #[error("the solution chatters: {events} of the last {steps} steps ended on an event (event function {which} the last) and together advanced time by only {advanced:e} s up to t = {} s; at that pace the run needs ~{needed:.1e} more steps, more than the {left} its step budget has left", Seconds(*t))]
     Chattering {
         /// Time reached.
         t: f64,
@@ -322,7 +338,7 @@ pub enum SolveError {
     /// The caller of a streamed solve ([`crate::solve_streaming`]) stopped
     /// it (its output could not be written, its input could not be read),
     /// or the `stop` of [`crate::solve_stoppable`] said so.
-    #[error("stopped at t = {t} s: {why}")]
+    #[error("stopped at t = {} s: {why}", Seconds(*t))]
     Interrupted {
         /// Time reached.
         t: f64,

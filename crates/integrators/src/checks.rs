@@ -39,9 +39,6 @@ pub(crate) fn check_inputs(
     fixed_step: bool,
 ) -> Result<Vec<f64>, SolveError> {
     let bad = |s: String| Err(SolveError::InvalidInput(s));
-    if n == 0 {
-        return bad("the system has no states (dim() = 0)".into());
-    }
     if x0.len() != n {
         return bad(format!(
             "x0 has {} entries but the system has {n} states",

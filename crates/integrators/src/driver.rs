@@ -17,7 +17,7 @@ use crate::checks::check_inputs;
 use crate::events::{locate_root, Bracket};
 use crate::pace::Pace;
 use std::borrow::Cow;
-use step_size::{error_norm, initial_step, ControlState};
+use step_size::{initial_step, split_error_norm, ControlState};
 
 /// Largest number of consecutive singular-matrix retries before giving up.
 const MAX_SINGULAR_RETRIES: usize = 8;
@@ -92,6 +92,62 @@ fn emit_t_eval<St: Stepper>(
     }
 }
 
+/// The solve of a system without states (`dim() = 0`: resistances between
+/// sources, its wires functions of time alone): nothing to integrate, so
+/// each step goes to the next output time, at most `h_max` ahead (as far
+/// as an adaptive step may, so that a streamed caller sees the time advance
+/// as in any solve), calling `between` before each step and once after the
+/// last, as [`run_with`] does.
+#[cold]
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn stateless<S: OdeSystem + ?Sized, B: Between<S>>(
+    sys: &mut S,
+    t0: f64,
+    t_end: f64,
+    opts: &Options,
+    t_eval: &mut Cow<'_, [f64]>,
+    next_out: &mut usize,
+    between: &mut B,
+    mut sol: Solution,
+) -> Result<Solution, SolveError> {
+    let mut stats = Stats::default();
+    let mut t = t0;
+    loop {
+        between.between(sys, t, t_eval, next_out, &mut sol)?;
+        // times a streamed caller added at or before t
+        while *next_out < t_eval.len() && t_eval[*next_out] <= t {
+            sol.t.push(t_eval[*next_out]);
+            *next_out += 1;
+        }
+        if t >= t_end {
+            break;
+        }
+        // no sliver of a last step (as `run_with`)
+        let ahead = if t + 1.01 * opts.h_max >= t_end {
+            t_end
+        } else {
+            t + opts.h_max
+        };
+        let t_new = match t_eval.get(*next_out) {
+            Some(&tk) if opts.t_eval.is_some() => tk.min(ahead),
+            _ => ahead,
+        };
+        if opts.t_eval.is_some() {
+            while *next_out < t_eval.len() && t_eval[*next_out] <= t_new {
+                sol.t.push(t_eval[*next_out]);
+                *next_out += 1;
+            }
+        } else {
+            sol.t.push(t_new);
+        }
+        stats.steps += 1;
+        t = t_new;
+    }
+    sol.stats = stats;
+    Ok(sol)
+}
+
 /// Runs one solve with the given stepper, calling `between` between the
 /// steps (see [`Between`]).
 #[allow(clippy::too_many_arguments)]
@@ -112,6 +168,8 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
     let rtol = opts.rtol;
     stepper.set_scale(&atol, rtol);
     let n_ev = sys.n_events();
+    // the states a step's error is normed over apart from the quadratures
+    let n_active = n - sys.n_quadratures().min(n);
 
     let mut sol = Solution {
         dim: n,
@@ -162,6 +220,19 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
     } else {
         sol.t.push(t0);
         sol.x.extend_from_slice(&x);
+    }
+
+    if n == 0 {
+        return stateless(
+            sys,
+            t,
+            t_end,
+            opts,
+            &mut t_eval,
+            &mut next_out,
+            between,
+            sol,
+        );
     }
 
     let mut ctrl = ControlState::new(controller);
@@ -303,7 +374,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
             continue;
         }
         let err_norm = if adaptive {
-            error_norm(&err, &x, &x_new, &atol, rtol)
+            split_error_norm(&err, &x, &x_new, &atol, rtol, n_active)
         } else {
             0.0
         };

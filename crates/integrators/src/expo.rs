@@ -164,48 +164,110 @@ impl Expm {
     }
 }
 
-/// `out = h φ₁(h J) f` for the `n × n` row-major `jac` (see the module doc).
+/// `φ₂(z) = (eᶻ − 1 − z)/z²`, with `φ₂(0) = 1/2`: its series where the
+/// closed form cancels.
+pub fn phi2(z: f64) -> f64 {
+    if z.abs() < 0.1 {
+        // Σ z^k/(k+2)!, to below an ulp at |z| < 0.1
+        let mut term = 0.5;
+        let mut sum = 0.5;
+        for k in 1..14 {
+            term *= z / (k + 2) as f64;
+            sum += term;
+        }
+        sum
+    } else if z < -700.0 {
+        (-1.0 - z) / (z * z)
+    } else {
+        (z.exp_m1() - z) / (z * z)
+    }
+}
+
+/// `out = h φ₁(h J) f` for the `n × n` row-major `jac` (see the module doc),
+/// the last `q` states quadratures: nothing depends on them (their columns
+/// of `J` are zero), so with `J = [[J_a, 0], [J_q, 0]]`
+///
+/// ```text
+/// h φ₁(hJ) f = [ h φ₁(hJ_a) f_a ;  h f_q + h J_q · h φ₂(hJ_a) f_a ]
+/// ```
+///
+/// and the matrix function is taken of the active block alone: `φ₁` and
+/// `φ₂` of it on `h f_a` as the last two columns of
+/// `exp([[hJ_a, h f_a, 0], [0, 0, 1], [0, 0, 0]])` (the exponential of the
+/// augmented matrix, Sidje's Expokit form). A ledger's five quadratures per
+/// component then cost a matrix product, not a cubed dimension.
 pub(crate) struct PhiStep {
     n: usize,
+    /// Active (non-quadrature) states: the first `na` of `n`.
+    na: usize,
     aug: Vec<f64>,
+    /// `h φ₂(hJ_a) f_a`.
+    phi2f: Vec<f64>,
     expm: Expm,
 }
 
 impl PhiStep {
-    pub(crate) fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize, quadratures: usize) -> Self {
+        let na = n - quadratures.min(n);
+        let m = Self::augmented(na, n);
         PhiStep {
             n,
-            aug: vec![0.0; (n + 1) * (n + 1)],
-            expm: Expm::new(n + 1),
+            na,
+            aug: vec![0.0; m * m],
+            phi2f: vec![0.0; na],
+            expm: Expm::new(m),
+        }
+    }
+
+    /// The augmented matrix's dimension: one column for `φ₁ f`, and one
+    /// more for `φ₂ f` where there are quadratures.
+    fn augmented(na: usize, n: usize) -> usize {
+        if na < n {
+            na + 2
+        } else {
+            na + 1
         }
     }
 
     /// Writes `h φ₁(h J) f` into `out`; `false` when the matrix function
     /// failed (not finite).
     pub(crate) fn apply(&mut self, h: f64, jac: &[f64], f: &[f64], out: &mut [f64]) -> bool {
-        let n = self.n;
-        let diagonal = (0..n).all(|i| (0..n).all(|j| i == j || jac[i * n + j] == 0.0));
+        let (n, na) = (self.n, self.na);
+        let diagonal = (0..na).all(|i| (0..na).all(|j| i == j || jac[i * n + j] == 0.0));
         if diagonal {
-            for i in 0..n {
-                out[i] = h * phi1(h * jac[i * n + i]) * f[i];
+            for i in 0..na {
+                let z = h * jac[i * n + i];
+                out[i] = h * phi1(z) * f[i];
+                self.phi2f[i] = h * phi2(z) * f[i];
             }
-            return out.iter().all(|v| v.is_finite());
-        }
-        let m = n + 1;
-        self.aug.fill(0.0);
-        for i in 0..n {
-            for j in 0..n {
-                self.aug[i * m + j] = h * jac[i * n + j];
+        } else {
+            let m = Self::augmented(na, n);
+            self.aug.fill(0.0);
+            for i in 0..na {
+                for j in 0..na {
+                    self.aug[i * m + j] = h * jac[i * n + j];
+                }
+                self.aug[i * m + na] = h * f[i];
             }
-            self.aug[i * m + n] = h * f[i];
+            if na < n {
+                self.aug[na * m + na + 1] = 1.0;
+            }
+            if !self.expm.exp(&mut self.aug) {
+                return false;
+            }
+            for i in 0..na {
+                out[i] = self.aug[i * m + na];
+                if na < n {
+                    self.phi2f[i] = self.aug[i * m + na + 1];
+                }
+            }
         }
-        if !self.expm.exp(&mut self.aug) {
-            return false;
+        for i in na..n {
+            let row = &jac[i * n..i * n + na];
+            let coupled: f64 = row.iter().zip(&self.phi2f).map(|(j, p)| j * p).sum();
+            out[i] = h * (f[i] + coupled);
         }
-        for i in 0..n {
-            out[i] = self.aug[i * m + n];
-        }
-        true
+        out.iter().all(|v| v.is_finite())
     }
 }
 
@@ -232,7 +294,7 @@ impl Exponential {
             jac: vec![0.0; n * n],
             y: z(),
             fy: z(),
-            phi: PhiStep::new(n),
+            phi: PhiStep::new(n, quadratures),
             x0: z(),
             x1: z(),
             quadratures,
@@ -360,7 +422,7 @@ mod tests {
         let jac = [-3e4, 0.0, 0.0, -0.7];
         let f = [2.0, -1.5];
         let h = 1e-3;
-        let mut p = PhiStep::new(2);
+        let mut p = PhiStep::new(2, 0);
         let mut fast = [0.0; 2];
         assert!(p.apply(h, &jac, &f, &mut fast));
         // the general path: the same matrix with an off-diagonal 0 made a
@@ -372,5 +434,71 @@ mod tests {
             assert!((a - b).abs() <= 1e-14 * a.abs(), "{a} vs {b}");
         }
         assert!((fast[0] - h * phi1(-30.0) * 2.0).abs() < 1e-18);
+    }
+
+    /// `φ₂` against its closed form, across the switch to the series.
+    #[test]
+    fn phi2_matches_its_closed_form() {
+        for z in [
+            -800.0f64, -30.0, -1.0, -0.1000001, -0.0999999, -1e-3, 0.0, 1e-8, 0.05, 2.0,
+        ] {
+            // the series, summed long, where the closed form cancels
+            let want = if z.abs() <= 1.0 {
+                let (mut term, mut sum) = (0.5, 0.5);
+                for k in 1..40 {
+                    term *= z / (k + 2) as f64;
+                    sum += term;
+                }
+                sum
+            } else {
+                (z.exp_m1() - z) / (z * z)
+            };
+            let tol = 1e-14;
+            assert!(
+                (phi2(z) - want).abs() <= tol * want.abs(),
+                "{z}: {} vs {want}",
+                phi2(z)
+            );
+        }
+    }
+
+    /// Quadratures (zero columns, the last `q` states) taken by `φ₂` of the
+    /// active block give what the whole matrix's exponential gives, with a
+    /// coupled and with a diagonal active block.
+    #[test]
+    fn quadratures_by_phi2_equal_the_whole_exponential() {
+        // 3 active states, 2 quadratures fed by them
+        let coupled = [
+            -40.0, 3.0, 0.5, 0.0, 0.0, //
+            2.0, -7.0, 1.0, 0.0, 0.0, //
+            0.0, -1.5, -0.2, 0.0, 0.0, //
+            0.3, -2.0, 4.0, 0.0, 0.0, //
+            1.0, 0.0, -0.5, 0.0, 0.0,
+        ];
+        let mut diagonal = coupled;
+        for i in 0..3 {
+            for j in 0..3 {
+                if i != j {
+                    diagonal[i * 5 + j] = 0.0;
+                }
+            }
+        }
+        let f = [1.0, -2.0, 0.5, 3.0, -0.7];
+        for jac in [coupled, diagonal] {
+            for h in [1e-4, 1e-2, 0.3] {
+                let (mut split, mut whole) = ([0.0; 5], [0.0; 5]);
+                assert!(PhiStep::new(5, 2).apply(h, &jac, &f, &mut split));
+                // the whole matrix, every state active
+                let mut general = jac;
+                general[3 * 5 + 3] = 1e-300; // not diagonal: the Padé path
+                assert!(PhiStep::new(5, 0).apply(h, &general, &f, &mut whole));
+                for (a, b) in split.iter().zip(whole) {
+                    assert!(
+                        (a - b).abs() <= 1e-13 * b.abs().max(1e-3 * h),
+                        "h {h}: {split:?} vs {whole:?}"
+                    );
+                }
+            }
+        }
     }
 }

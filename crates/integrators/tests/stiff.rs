@@ -186,22 +186,28 @@ fn declared_quadratures_skip_their_jacobian_columns_and_change_nothing_else() {
     };
     let (full, block) = (run(false), run(true));
     let (a, b) = (full.state(full.t.len() - 1), block.state(block.t.len() - 1));
-    // the block solve is the same linear algebra: the same steps, the same
-    // answer to round-off
-    assert_eq!(full.stats.steps, block.stats.steps);
-    assert_eq!(full.stats.rejected, block.stats.rejected);
+    // the block solve is the same linear algebra; the declared quadratures
+    // are normed apart from the states (each group's RMS, the larger taken),
+    // so the steps differ a little and the answers agree to the tolerance's
+    // global error
     for i in 0..4 {
         assert!(
-            (a[i] - b[i]).abs() <= 1e-9 * a[i].abs().max(1.0),
+            (a[i] - b[i]).abs() <= 1e-5 * a[i].abs().max(1.0),
             "state {i}: {} vs {}",
             a[i],
             b[i]
         );
     }
     // two fewer finite-difference columns per Jacobian
+    // (a Jacobian: f, ∂f/∂t, and one difference per column; a step five
+    // more stages; the start two)
     assert_eq!(
-        full.stats.rhs_evals - block.stats.rhs_evals,
-        2 * full.stats.jac_evals
+        block.stats.rhs_evals,
+        2 + 4 * block.stats.jac_evals + 5 * (block.stats.steps + block.stats.rejected)
+    );
+    assert_eq!(
+        full.stats.rhs_evals,
+        2 + 6 * full.stats.jac_evals + 5 * (full.stats.steps + full.stats.rejected)
     );
     // ∫x₁² dt is positive and grows with the limit cycle's |x₁| ≈ 1..2
     assert!(b[3] > 50.0 && b[2].is_finite(), "∫x₁² dt = {}", b[3]);

@@ -229,3 +229,45 @@ fn a_stoppable_solve_equals_the_plain_one_until_it_is_stopped() {
         }
     }
 }
+
+/// A system without states (resistances between sources, its wires
+/// functions of time alone).
+#[derive(Clone)]
+struct Stateless;
+
+impl OdeSystem for Stateless {
+    fn dim(&self) -> usize {
+        0
+    }
+    fn rhs(&self, _t: f64, _x: &[f64], _dx: &mut [f64]) {}
+}
+
+#[test]
+fn a_system_without_states_gives_its_output_times_streamed_or_not() {
+    let t_end = 2.0;
+    let times: Vec<f64> = (0..=200).map(|k| k as f64 * 1e-2).collect();
+    for method in [
+        Method::DormandPrince45,
+        Method::Rosenbrock,
+        Method::Auto,
+        Method::Rk4,
+        Method::Exponential,
+    ] {
+        let opts = Options {
+            h_max: 0.05,
+            h0: (method == Method::Rk4 || method == Method::Exponential).then_some(1e-3),
+            ..Options::default()
+        };
+        let (plain, c, _) = both(&Stateless, method, &[], t_end, &times, &opts);
+        assert_eq!(plain.t, times, "{method:?}");
+        assert!(plain.x.is_empty() && plain.dim == 0, "{method:?}");
+        assert_eq!(c.t, times, "{method:?}: streamed");
+        // steps of at most h_max between the outputs, to t_end
+        assert_eq!(plain.stats.steps, 200, "{method:?}");
+        // no output times: one per step, the last at t_end
+        let free = solve(method, &mut Stateless, 0.0, &[], t_end, &opts).unwrap();
+        assert_eq!(free.t.len(), 41, "{method:?}");
+        assert_eq!(*free.t.last().unwrap(), t_end, "{method:?}");
+        assert!(free.t.windows(2).all(|w| w[1] > w[0]), "{method:?}");
+    }
+}

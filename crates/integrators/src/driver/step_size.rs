@@ -107,6 +107,9 @@ impl ControlState {
 /// `‖e‖ = sqrt( (1/n) Σ (e_i / (atol_i + rtol·max(|x_i|, |x̂_i|)))² )`.
 pub(crate) fn error_norm(err: &[f64], x: &[f64], x_new: &[f64], atol: &[f64], rtol: f64) -> f64 {
     let n = err.len();
+    if n == 0 {
+        return 0.0;
+    }
     let (x, x_new, atol) = (&x[..n], &x_new[..n], &atol[..n]);
     let mut sum = 0.0;
     for i in 0..n {
@@ -115,6 +118,34 @@ pub(crate) fn error_norm(err: &[f64], x: &[f64], x_new: &[f64], atol: &[f64], rt
         sum += r * r;
     }
     (sum / n as f64).sqrt()
+}
+
+/// The error of a step whose last `n − active` states are quadratures
+/// ([`OdeSystem::n_quadratures`]): the [`error_norm`] of the states and that
+/// of the quadratures, each over its own, and the larger of the two (NaN if
+/// either is). Quadratures added to a system (a mass balance, an energy
+/// ledger) then never loosen the control of its states, as one RMS over
+/// both would (by `√(n/active)` where the quadratures' errors are small
+/// against their tolerances); they are controlled by their own.
+pub(crate) fn split_error_norm(
+    err: &[f64],
+    x: &[f64],
+    x_new: &[f64],
+    atol: &[f64],
+    rtol: f64,
+    active: usize,
+) -> f64 {
+    let states = error_norm(&err[..active], x, x_new, atol, rtol);
+    if active == err.len() {
+        return states;
+    }
+    let a = active;
+    let quadratures = error_norm(&err[a..], &x[a..], &x_new[a..], &atol[a..], rtol);
+    if states.is_nan() || quadratures.is_nan() {
+        f64::NAN
+    } else {
+        states.max(quadratures)
+    }
 }
 
 /// Hairer's starting-step heuristic (Hairer, Nørsett & Wanner I, §II.4):
@@ -135,14 +166,20 @@ pub(super) fn initial_step<S: OdeSystem + ?Sized>(
     stats: &mut Stats,
 ) -> f64 {
     let n = x.len();
+    // the states' norms alone, as the steps' errors (`split_error_norm`):
+    // quadratures added to a system leave its first step as it was
+    let active = match n - sys.n_quadratures().min(n) {
+        0 => n,
+        a => a,
+    };
     let sc = |i: usize| (atol[i] + rtol * x[i].abs()).max(f64::MIN_POSITIVE);
     let (mut d0, mut d1) = (0.0, 0.0);
-    for i in 0..n {
+    for i in 0..active {
         d0 += (x[i] / sc(i)).powi(2);
         d1 += (f0[i] / sc(i)).powi(2);
     }
-    let d0 = (d0 / n as f64).sqrt();
-    let d1 = (d1 / n as f64).sqrt();
+    let d0 = (d0 / active as f64).sqrt();
+    let d1 = (d1 / active as f64).sqrt();
     let mut h0 = if d0 < 1e-5 || d1 < 1e-5 {
         1e-6
     } else {
@@ -155,10 +192,10 @@ pub(super) fn initial_step<S: OdeSystem + ?Sized>(
     sys.rhs(t + h0, work_x, work_f);
     stats.rhs_evals += 1;
     let mut d2 = 0.0;
-    for i in 0..n {
+    for i in 0..active {
         d2 += ((work_f[i] - f0[i]) / sc(i)).powi(2);
     }
-    let d2 = (d2 / n as f64).sqrt() / h0;
+    let d2 = (d2 / active as f64).sqrt() / h0;
     let dmax = d1.max(d2);
     let h1 = if !dmax.is_finite() {
         h0

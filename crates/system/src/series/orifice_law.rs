@@ -242,8 +242,10 @@ mod tests {
             let p = 1e6 - drop;
             // h small against the drop and the transition: a difference
             // across the transition's edge (a jump in the second
-            // derivative) errs by ~h/transition
-            let h = 1e-6 * drop.abs().max(1.0).min(m.transition);
+            // derivative) errs by ~h/transition; and large against p's
+            // last bits (p ± h is rounded at p's ulp, ~1e-10 at 1 MPa: a
+            // step of 1e-6 Pa would carry a 1e-4 error)
+            let h = (1e-6 * drop.abs().max(1.0).min(m.transition)).max(1e-9 * p.abs());
             let q = |p: f64| m.k * signed_sqrt_regularised(m.other - p, m.transition);
             let fd = (q(p + h) - q(p - h)) / (2.0 * h);
             proptest::prop_assert!(m.slope(p) < 0.0);

@@ -139,17 +139,30 @@ pub fn readings() -> Vec<Reading> {
 /// shut. Every litre the pump moves while the drive runs is pushed against at
 /// least this difference, so the pump's input is at least `p_shift ∫|Q_p| dt`
 /// and the hybrid's efficiency is capped by `E_out / (p_shift ∫|Q_p| dt)`.
+/// Zero for a critically lapped spool (overlap 0, which the valve accepts).
 pub fn shift_pressure(rig: &WangHybrid) -> f64 {
-    rig.four_way.spring_rate * rig.four_way.overlap.si()
+    rig.four_way.shift_pressure().si()
 }
 
 /// The cap of [`shift_pressure`] on a square wave at steady speed with the
-/// friction `f_ext`, `f_ret` \[N\] as the only output: the pump delivers
-/// `A1 v` and `A2 v` against at least `p_shift`, the cylinder puts out
-/// `f v`, so `η ≤ (f_ext + f_ret) / (p_shift (A1 + A2))` \[-\].
+/// friction `f_ext`, `f_ret` \[N\] (magnitudes, ≥ 0) as the only output
+/// \[-\]: the pump delivers `A1 v` and `A2 v` against at least `p_shift`, the
+/// cylinder puts out `(f_ext + f_ret) v`, and the pump's input is also at
+/// least that output (energy is not made), so
+/// `η ≤ (f_ext + f_ret) / max(p_shift (A1 + A2), f_ext + f_ret)`.
+///
+/// The shift-pressure bound alone, `(f_ext + f_ret) / (p_shift (A1 + A2))`,
+/// exceeds 1 once `p_shift (A1 + A2) < f_ext + f_ret` and is infinite at
+/// overlap 0 (`p_shift` = 0: the valve then charges nothing, and only the
+/// energy bound is left), where the cap is 1; it goes to 1 continuously as
+/// the overlap goes to 0. With no friction there is no output: the cap is 0.
 pub fn square_cap(rig: &WangHybrid, f_ext: f64, f_ret: f64) -> f64 {
     let (a1, a2) = (rig.cylinder.area_1.si(), rig.cylinder.area_2.si());
-    (f_ext + f_ret) / (shift_pressure(rig) * (a1 + a2))
+    let out = (f_ext + f_ret).max(0.0);
+    if out == 0.0 {
+        return 0.0;
+    }
+    out / (shift_pressure(rig) * (a1 + a2)).max(out)
 }
 
 /// [`square_cap`] with the friction the rig measured at ±48/−49 mm/s
@@ -219,5 +232,49 @@ mod tests {
         // 382.2 N over 10.34 bar × 13.54 cm²
         let c = table_5_3_cap(&rig);
         assert!((c - 0.273).abs() < 1e-3, "{c}");
+    }
+
+    /// A critically lapped pilot valve (overlap 0, shift pressure 0) leaves
+    /// only the energy bound: the cap is 1, not infinite, and the cap of a
+    /// shrinking overlap rises to it and stays there (continuous at 0); the
+    /// preset's 0.273 is the shift-pressure bound's, below 1.
+    #[test]
+    fn the_cap_at_zero_overlap_is_the_energy_bound_and_continuous() {
+        use hydrocyl_ports::Position;
+        let with_overlap = |mm: f64| {
+            let mut rig = WangHybrid::preset();
+            rig.four_way.overlap = Position::from_mm(mm);
+            rig
+        };
+        let rig = with_overlap(0.0);
+        assert_eq!(shift_pressure(&rig), 0.0);
+        assert_eq!(table_5_3_cap(&rig), 1.0);
+        assert_eq!(square_cap(&rig, 0.0, 0.0), 0.0);
+        // the shift-pressure bound reaches 1 at x_o = F / (k_s (A1 + A2))
+        let pre = WangHybrid::preset();
+        let area = pre.cylinder.area_1.si() + pre.cylinder.area_2.si();
+        let t = hydrocyl_friction::seal::TABLE_5_3;
+        let f = t[0].1 - t[t.len() - 1].1;
+        let knee_mm = f / (pre.four_way.spring_rate * area) * 1e3;
+        assert!(knee_mm > 0.0 && knee_mm < 0.75, "{knee_mm}");
+        let mut last = table_5_3_cap(&pre);
+        for k in (0..=60).rev() {
+            let x = 0.75 * f64::from(k) / 60.0;
+            let c = table_5_3_cap(&with_overlap(x));
+            assert!(
+                c.is_finite() && c <= 1.0 && c >= last - 1e-15,
+                "{x} mm: {c}"
+            );
+            if x <= knee_mm {
+                assert_eq!(c, 1.0, "{x} mm");
+            }
+            last = c;
+        }
+        for x in [1e-3, 1e-6, 1e-9] {
+            assert!((table_5_3_cap(&with_overlap(x)) - 1.0).abs() < 1e-12);
+        }
+        // just above the knee the cap is just below 1
+        let c = table_5_3_cap(&with_overlap(knee_mm * (1.0 + 1e-9)));
+        assert!(c < 1.0 && 1.0 - c < 1e-8, "{c}");
     }
 }

@@ -41,12 +41,35 @@ pub enum RigError {
         /// The keys that exist there, formatted.
         hint: String,
     },
+    /// An error placed in the rig file (or text) it is about: its message,
+    /// then `(line N of <file>)`, or `(in <file>)` where there is no line
+    /// to name. Made by [`at_line_in`] (which leaves an error placed
+    /// already as it is) and by [`parse`] for a duplicate key, whose line
+    /// is the repeated key's, not the first's that its path would find.
+    #[error("{error} {}", placed_in(.file, *.line))]
+    InFile {
+        /// The error, unplaced: [`RigError::Invalid`] or
+        /// [`RigError::OutOfRange`].
+        error: Box<RigError>,
+        /// The file as the user named it (or `JSON text`).
+        file: String,
+        /// The 1-based line in `file`, where the error has one.
+        line: Option<usize>,
+    },
     /// Assembly failed.
     #[error("assembling the rig: {0}")]
     Build(#[from] BuildError),
     /// The simulation failed.
     #[error("simulation: {0}")]
     Sim(String),
+}
+
+/// Where an [`RigError::InFile`] is: `(line N of <file>)` or `(in <file>)`.
+fn placed_in(file: &str, line: Option<usize>) -> String {
+    match line {
+        Some(l) => format!("(line {l} of {file})"),
+        None => format!("(in {file})"),
+    }
 }
 
 /// Absolute vacuum on the gauge scale every rig uses \[Pa\]: no pressure
@@ -209,21 +232,25 @@ pub fn parse(text: &str, source: &str) -> Result<Value, RigError> {
         why: format!("not valid JSON: {e}"),
     })?;
     if let Some((key, line)) = crate::netlist::locate::scan(text).duplicate {
-        return Err(RigError::Invalid {
-            path: key,
-            why: format!(
-                "duplicate key (a key may appear once in an object) (line {line} of {source})"
-            ),
+        // placed at the repeated key, not at the first its path names
+        return Err(RigError::InFile {
+            error: Box::new(RigError::Invalid {
+                path: key,
+                why: "duplicate key (a key may appear once in an object)".into(),
+            }),
+            file: source.into(),
+            line: Some(line),
         });
     }
     if v.get("kind").and_then(Value::as_str) == Some(RETIRED_VARIANT_KIND) {
-        return Err(RigError::Invalid {
-            path: format!("{source}: kind"),
+        let e = RigError::Invalid {
+            path: "kind".into(),
             why: "the `hybrid-variant` kind is retired: its circuits are netlists now \
                   (fixtures/rigs/wang-hybrid-{solenoid,needle,improved}.json), and the needle \
                   opening per speed is the parameter `needle_valve.area` (`--set needle_valve.area=<m^2>`)"
                 .into(),
-        });
+        };
+        return Err(at_line_in(e, text, source));
     }
     // an older rig kind is read as its netlist
     match crate::netlist::migrate::migrate(&v) {
@@ -292,36 +319,28 @@ pub fn set_form(e: RigError, rig: &Value) -> RigError {
     }
 }
 
-/// [`at_line`] on the rig's text `text`, named `source` in the message.
+/// [`at_line`] on the rig's text `text`, named `source` in the message: an
+/// [`RigError::Invalid`] or [`RigError::OutOfRange`] becomes a
+/// [`RigError::InFile`] at the line of its JSON path (the file named alone
+/// where the path has none). An error placed already (an `InFile`, e.g. a
+/// duplicate key at its own line) and one about the file itself (its path
+/// is `source`: the text does not read) are left as they are.
 pub fn at_line_in(e: RigError, text: &str, source: &str) -> RigError {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    // an error about the file itself (it does not read) or one placed
-    // already (a duplicate key, at its line) names it
-    if let RigError::Invalid { path, why } = &e {
-        if path == source
-            || path.starts_with(&format!("{source}: "))
-            || why.ends_with(&format!(" of {source})"))
-        {
-            return e;
-        }
-    }
-    let located = crate::netlist::locate::scan(text);
-    // the file is named always, with the line where the path has one
-    let place = |path: &str| match located.line_of(path).filter(|_| !path.is_empty()) {
-        Some(l) => format!("(line {l} of {source})"),
-        None => format!("(in {source})"),
+    let path = match &e {
+        RigError::Invalid { path, .. } | RigError::OutOfRange { path, .. } => path,
+        _ => return e,
     };
-    match e {
-        RigError::Invalid { path, why } => RigError::Invalid {
-            why: format!("{why} {}", place(&path)),
-            path,
-        },
-        RigError::OutOfRange { path, value, why } => RigError::OutOfRange {
-            why: format!("{why} {}", place(&path)),
-            path,
-            value,
-        },
-        other => other,
+    if path == source {
+        return e;
+    }
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let line = Some(path)
+        .filter(|p| !p.is_empty())
+        .and_then(|p| crate::netlist::locate::scan(text).line_of(p));
+    RigError::InFile {
+        error: Box::new(e),
+        file: source.into(),
+        line,
     }
 }
 

@@ -456,6 +456,40 @@ mod tests {
         assert_eq!(super::read(&v).unwrap().name, "netlist");
     }
 
+    /// The description is free text, but text: a number, an object or
+    /// `null` is refused at `description` (in one line, at its line of the
+    /// file), not passed over.
+    #[test]
+    fn a_description_that_is_not_a_string_is_refused() {
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        for (d, got) in [
+            (json!(5), "a number"),
+            (json!({"text": "x"}), "an object"),
+            (json!(null), "null"),
+        ] {
+            v["description"] = d;
+            let e = super::read(&v).unwrap_err();
+            assert_eq!(
+                (e.path.as_str(), e.why.as_str()),
+                (
+                    "description",
+                    format!("must be a string, got {got}").as_str()
+                )
+            );
+        }
+        let text = "{\n  \"kind\": \"netlist\",\n  \"description\": 5\n}";
+        let e = crate::rig::parse(text, "rig.json").unwrap();
+        let e = crate::rig::at_line_in(crate::rig::check(&e).unwrap_err(), text, "rig.json");
+        assert_eq!(
+            e.to_string(),
+            "rig `description`: must be a string, got a number (line 3 of rig.json)"
+        );
+        v["description"] = json!("a rig");
+        assert!(super::read(&v).is_ok());
+        v.as_object_mut().unwrap().remove("description");
+        assert!(super::read(&v).is_ok());
+    }
+
     /// What only the assembly finds is refused where a rig is checked:
     /// a controller reading its own command is an algebraic loop of one.
     #[test]

@@ -141,6 +141,13 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
         Some(Value::String(s)) => s.clone(),
         Some(other) => return err("name", format!("must be a string, got {}", kind_of(other))),
     };
+    // free text for people, but text: a number or an object is a mistake
+    if let Some(d) = root.get("description").filter(|d| !d.is_string()) {
+        return err(
+            "description",
+            format!("must be a string, got {}", kind_of(d)),
+        );
+    }
     let Some(Value::Object(comps)) = root.get("components") else {
         return err("components", "missing: an object of named components");
     };

@@ -159,3 +159,76 @@ fn circuit_of_a_preset_has_its_initial_state() {
         );
     }
 }
+
+/// A duplicate key is placed at the repeated key's line, which its path
+/// would not find (it names the first): the error carries that line, so
+/// placing it again, under any name of the file, leaves it as it is.
+#[test]
+fn a_duplicate_key_keeps_its_own_line_when_placed_again() {
+    let text = "{\n  \"kind\": \"netlist\",\n  \"name\": \"a\",\n  \"name\": \"b\"\n}";
+    let e = parse(text, "rig.json").unwrap_err();
+    assert!(
+        matches!(&e, RigError::InFile { file, line: Some(4), .. } if file == "rig.json"),
+        "{e:?}"
+    );
+    let shown =
+        "rig `name`: duplicate key (a key may appear once in an object) (line 4 of rig.json)";
+    assert_eq!(e.to_string(), shown);
+    for source in ["rig.json", "./rig.json", "JSON text"] {
+        assert_eq!(at_line_in(e.clone(), text, source).to_string(), shown);
+    }
+}
+
+/// An error is placed once: its file named with the line of its path, or
+/// alone where the path has none, and not again when placed a second time;
+/// a message that merely ends like a placed one is placed all the same.
+#[test]
+fn an_error_is_placed_once_and_by_its_path_not_its_words() {
+    let text = "{\n  \"kind\": \"netlist\",\n  \"name\": \"a\"\n}";
+    let e = RigError::Invalid {
+        path: "name".into(),
+        why: "see the list (item 2 of rig.json)".into(),
+    };
+    let once = at_line_in(e, text, "rig.json");
+    assert_eq!(
+        once.to_string(),
+        "rig `name`: see the list (item 2 of rig.json) (line 3 of rig.json)"
+    );
+    assert_eq!(at_line_in(once.clone(), text, "rig.json"), once);
+    let e = RigError::OutOfRange {
+        path: String::new(),
+        value: -1.0,
+        why: "must be positive".into(),
+    };
+    let once = at_line_in(e, text, "rig.json");
+    assert_eq!(
+        once.to_string(),
+        "rig parameter `` = -1: must be positive (in rig.json)"
+    );
+    assert_eq!(at_line_in(once.clone(), text, "rig.json"), once);
+    // an error about the file itself names it as its path already
+    let e = parse("{", "rig.json").unwrap_err();
+    assert_eq!(at_line_in(e.clone(), "{", "rig.json"), e);
+}
+
+/// A retired `hybrid-variant` file is refused at its JSON path `kind`, the
+/// file named after the message as every rig error names it.
+#[test]
+fn a_retired_variant_is_named_at_its_kind_in_the_file() {
+    let text = "{\n  \"name\": \"x\",\n  \"kind\": \"hybrid-variant\"\n}";
+    let e = parse(text, "old.json").unwrap_err();
+    let RigError::InFile { error, file, line } = &e else {
+        panic!("{e:?}")
+    };
+    assert_eq!((file.as_str(), *line), ("old.json", Some(3)));
+    assert!(
+        matches!(&**error, RigError::Invalid { path, .. } if path == "kind"),
+        "{error:?}"
+    );
+    let shown = e.to_string();
+    assert!(
+        shown.starts_with("rig `kind`: the `hybrid-variant` kind is retired: ")
+            && shown.ends_with("(`--set needle_valve.area=<m^2>`) (line 3 of old.json)"),
+        "{shown}"
+    );
+}

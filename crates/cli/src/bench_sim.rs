@@ -4,16 +4,25 @@
 //! bench's input is not a command but the motion itself. The `--command` file
 //! is a record in the measured-data format (through the rig's column map) with
 //! `time`, `position` or `velocity`, and `p1`/`p2` where the bench has
-//! pressures; the output adds the predicted load-cell `force`:
-//! `time, position, velocity, p1, p2, force` (SI). Velocity and acceleration
+//! pressures; the output adds the predicted load-cell `force` and the
+//! friction on the rod: `time, position, velocity, p1, p2, force,
+//! friction_force`, or those of them the rig's `outputs` names, as a
+//! netlist's run is chosen (a name that is none of them is refused before
+//! the run); SI, each header with its unit (`force [N]`) and each value its
+//! shortest round-trip text, as every `simulate` output. Velocity and acceleration
 //! come from the same smoother `diagnose` uses; the bristle starts from the
 //! record's measured force when it has one, else at rest. The bench runs as
 //! its netlist through the one run path (`FrictionBench::simulate`:
 //! the record's velocity, acceleration and pressures are the netlist's inputs).
 
 use crate::error::CliError;
+use crate::output::Outputs;
+use crate::progress::Progress;
+use crate::simulate::{run_settings, Args};
 use hydrocyl_identify::bench::{self, bench_signals, BenchInputs, FrictionBench};
 use hydrocyl_identify::data::{Record, Signal};
+use hydrocyl_system::rig;
+use hydrocyl_system::run::RunOptions;
 use std::path::Path;
 
 /// A friction-bench rig file read for the CLI ([`bench::is_bench_rig`]),
@@ -25,7 +34,6 @@ pub fn load(
     spec: &str,
     sets: &[String],
 ) -> Result<Option<(FrictionBench, serde_json::Value)>, CliError> {
-    use hydrocyl_system::rig;
     if rig::preset(spec).is_some() {
         return Ok(None);
     }
@@ -68,48 +76,90 @@ pub fn load(
     Ok(Some((bench, net)))
 }
 
+/// `hydrocyl simulate` on a friction bench: the `--command` file carries the
+/// imposed motion ([`simulate`]). The bench fixes its own
+/// integration (one exponential Rosenbrock–Euler step per sample, as its fit
+/// runs it), so `--solver`, `--rtol` and `--rk4-step` are checked as for any
+/// rig and then refused unless they are the defaults. The rig's `outputs`
+/// choose the columns as on a netlist, the header carries the units
+/// ([`column_headers`](crate::simulate::column_headers)) and `--progress` shows the run's stages (reading,
+/// smoothing, simulating, writing) as the netlist run shows its rows.
+pub(crate) fn run(
+    args: &Args,
+    bench: &FrictionBench,
+    value: &serde_json::Value,
+) -> Result<(), CliError> {
+    if args.print_rig {
+        let text = rig::printed(value).map_err(|e| CliError::Input(e.to_string()))?;
+        return crate::console::print(&format!("{text}\n"));
+    }
+    let solver = run_settings(args)?;
+    let default = RunOptions::default();
+    if solver != default.solver || args.rtol != default.rtol || args.rk4_step != default.rk4_step {
+        return Err(CliError::Input(
+            "--solver, --rtol, --rk4-step: the friction-bench model fixes its own integration (one step per sample of the imposed motion); to choose them, simulate a netlist of the bench (e.g. the tudelft-seal-25 preset)".into(),
+        ));
+    }
+    let (Some(input), Some(out)) = (&args.command, &args.out) else {
+        return Err(CliError::Input("--command and --out are required".into()));
+    };
+    if args.ledger.is_some() {
+        return Err(CliError::Input(
+            "--ledger: a friction-bench rig file imposes its motion and has no energy ledger; use a netlist of the bench (e.g. the tudelft-seal-25 preset)".into(),
+        ));
+    }
+    // the channels the rig's `outputs` names, as on a netlist (all without)
+    let only = selection(bench, value)?;
+    let mut outputs = Outputs::new(&[("--command", input.as_path())]);
+    let id = outputs.file("--out", out)?;
+    let mut bar = Progress::new("simulate", 1, args.progress, args.quiet);
+    let (text, rows) = simulate(bench, input, only.as_deref(), &mut |stage, done, total| {
+        bar.set(stage, done, total)
+    })?;
+    outputs.write(id, &text)?;
+    outputs.commit(args.fsync)?;
+    bar.finish();
+    if !args.quiet {
+        crate::console::note(format_args!(
+            "hydrocyl: simulated the friction bench on {rows} samples of {}",
+            input.display()
+        ));
+    }
+    Ok(())
+}
+
 /// Why a `--set` of a friction law's parameter (`friction.stribeck_velocity`)
 /// left the bench unchanged where the parameter belongs to an effect that is
 /// off in `net` (the netlist before the set): the bench reads an effect as
-/// on only where its first parameter (`stiction`, `sigma0`) is given off
-/// its default ([`FrictionBench::from_rig`]), so the others are unused until
-/// it is. `None` for any other parameter.
+/// on by its switch ([`FrictionBench::effect_switch_of`], the rule
+/// [`FrictionBench::from_rig`] reads it by: its first parameter, `stiction`
+/// or `sigma0`, given off its default), so the others are unused until it
+/// is. `None` for any other parameter.
 fn switched_off_by(net: &serde_json::Value, set: &str) -> Option<String> {
-    use hydrocyl_identify::bench::BENCH_EFFECTS;
-    use hydrocyl_system::netlist::identify::{bench_law_params, bench_law_stiction_is_coulomb};
-    use hydrocyl_system::netlist::registry::{self, Default};
     let path = set.split_once('=')?.0.trim();
     let path = path.strip_prefix("components.").unwrap_or(path);
     let (comp, param) = path.split_once('.')?;
     let ty = net.get("components")?.get(comp)?.get("type")?.as_str()?;
-    let law = |catalog: String| bench_law_params(ty, &catalog, true).unwrap_or_default();
-    BENCH_EFFECTS.iter().find_map(|&id| {
-        let (first, rest) = id.params().split_first()?;
-        rest.iter()
-            .any(|q| law(format!("{}.{}", id.id(), q.name)).contains(&param))
-            .then_some(())?;
-        let on = law(format!("{}.{}", id.id(), first.name));
-        let on = on.first()?;
-        let spec = registry::lookup(ty)?.param(on)?;
-        let unit = if spec.unit.is_empty() || spec.unit == "-" {
-            String::new()
-        } else {
-            format!(", in {}", spec.unit)
-        };
-        let given = match spec.default {
-            Default::Value(d) => format!("set off its default {d}"),
-            _ => "set".to_string(),
-        };
-        let coulomb = if bench_law_stiction_is_coulomb(ty) && on.contains("stiction") {
-            " and differs from the Coulomb level"
-        } else {
-            ""
-        };
-        Some(format!(
-            "the friction-bench model uses `{comp}.{param}` only where `{comp}.{on}` is {given}{coulomb} (the `{}` effect is off without it, as in this file): set it too (--set {comp}.{on}=VALUE{unit})",
-            id.id()
-        ))
-    })
+    let switch = FrictionBench::effect_switch_of(ty, param).filter(|s| s.on != param)?;
+    let on = switch.on;
+    let unit = if switch.unit.is_empty() || switch.unit == "-" {
+        String::new()
+    } else {
+        format!(", in {}", switch.unit)
+    };
+    let given = match switch.default {
+        Some(d) => format!("set off its default {d}"),
+        None => "set".to_string(),
+    };
+    let coulomb = if switch.not_at_coulomb {
+        " and differs from the Coulomb level"
+    } else {
+        ""
+    };
+    Some(format!(
+        "the friction-bench model uses `{comp}.{param}` only where `{comp}.{on}` is {given}{coulomb} (the `{}` effect is off without it, as in this file): set it too (--set {comp}.{on}=VALUE{unit})",
+        switch.effect.id()
+    ))
 }
 
 /// `true` when `simulate` runs the rig `spec` on a record's motion
@@ -121,7 +171,6 @@ fn switched_off_by(net: &serde_json::Value, set: &str) -> Option<String> {
 /// simulated on a command as the preset is, by name, as a file or printed
 /// by `--print-rig`; `diagnose` reads each of them as the same bench.
 pub fn runs_on_motion(spec: &str) -> bool {
-    use hydrocyl_system::rig;
     rig::preset(spec).is_none()
         && rig::load(spec).is_ok_and(|v| {
             bench::is_bench_rig(&v)
@@ -135,8 +184,40 @@ pub fn runs_on_motion(spec: &str) -> bool {
         })
 }
 
-/// Simulates `bench` on the motion in `input`; returns the output CSV text.
-pub fn simulate(bench: &FrictionBench, input: &Path) -> Result<String, CliError> {
+/// The channels the rig's netlist `net` selects with its `outputs` (their
+/// column names), as a netlist run's are chosen: `None` (every channel)
+/// where it lists none. A name that is not one of the bench's channels is
+/// refused here, before any record is read, with the error of a run's
+/// selection ([`FrictionBench::check_channels`]).
+pub fn selection(
+    bench: &FrictionBench,
+    net: &serde_json::Value,
+) -> Result<Option<Vec<String>>, CliError> {
+    let s = hydrocyl_system::netlist::read(net)
+        .map_err(|e| CliError::Input(hydrocyl_system::rig::RigError::from(e).to_string()))?;
+    let only: Option<Vec<String>> =
+        (!s.outputs.is_empty()).then(|| s.outputs.into_iter().map(|(col, _)| col).collect());
+    bench
+        .check_channels(only.as_deref())
+        .map_err(|e| CliError::Input(format!("rig `outputs`: {e}")))?;
+    Ok(only)
+}
+
+/// Simulates `bench` on the motion in `input`: the output CSV text and its
+/// rows. The columns are the bench's channels named in `only` (every one
+/// for `None`; an unknown name is refused as on any run,
+/// [`hydrocyl_system::run::ProbeSet::selected`]), the header and the values
+/// written as every `simulate` output is ([`crate::simulate::column_headers`],
+/// shortest round-trip floats by [`hydrocyl_identify::plaincsv`]).
+/// `progress(stage, done, total)` is told of each stage as it starts.
+pub fn simulate(
+    bench: &FrictionBench,
+    input: &Path,
+    only: Option<&[String]>,
+    progress: &mut dyn FnMut(&str, u64, u64),
+) -> Result<(Vec<u8>, usize), CliError> {
+    const STAGES: u64 = 4;
+    progress("reading the record", 0, STAGES);
     let mut rec =
         Record::read_mapped(input, &bench.columns).map_err(|e| CliError::Input(e.to_string()))?;
     if rec.get(Signal::Position).is_none() && rec.get(Signal::Velocity).is_none() {
@@ -149,29 +230,32 @@ pub fn simulate(bench: &FrictionBench, input: &Path) -> Result<String, CliError>
     if !measured_force {
         rec.signals.insert(Signal::Force, vec![0.0; rec.len()]);
     }
+    progress("smoothing the motion", 1, STAGES);
     let (s, _) = bench_signals(&rec, None, bench.steady_state)
         .map_err(|e| CliError::Input(e.to_string()))?;
     let inputs = BenchInputs::of(&s).map_err(CliError::Input)?;
-    let force = if measured_force {
-        bench.simulate(&s, &inputs)
-    } else {
-        bench.simulate_from_rest(&s, &inputs)
+    progress("simulating", 2, STAGES);
+    let run = bench
+        .simulate_channels(&s, &inputs, !measured_force, only)
+        .map_err(|e| CliError::Input(format!("{}: {e}", input.display())))?;
+    for c in &run.channels {
+        if let Some(i) = c.values.iter().position(|f| !f.is_finite()) {
+            return Err(CliError::Input(format!(
+                "{}: the bench model gave a non-finite {} at row {} (t = {} s)",
+                input.display(),
+                c.name,
+                i + 2,
+                s.t[i]
+            )));
+        }
     }
-    .map_err(|e| CliError::Input(format!("{}: {e}", input.display())))?;
-    if let Some(i) = force.iter().position(|f| !f.is_finite()) {
-        return Err(CliError::Input(format!(
-            "{}: the bench model gave a non-finite force at row {} (t = {} s)",
-            input.display(),
-            i + 2,
-            s.t[i]
-        )));
-    }
-    let mut out = String::from("time,position,velocity,p1,p2,force\n");
-    for (i, f) in force.iter().enumerate() {
-        out.push_str(&format!(
-            "{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{f:.9e}\n",
-            s.t[i], s.x[i], s.v[i], s.p1[i], s.p2[i]
-        ));
-    }
-    Ok(out)
+    progress("writing", 3, STAGES);
+    let header = crate::simulate::column_headers(&run.channels);
+    let names: Vec<&str> = header.iter().map(String::as_str).collect();
+    let columns: Vec<&[f64]> = std::iter::once(run.time.as_slice())
+        .chain(run.channels.iter().map(|c| c.values.as_slice()))
+        .collect();
+    let text = hydrocyl_identify::plaincsv::write_columns(&names, &columns);
+    progress("written", STAGES, STAGES);
+    Ok((text, run.time.len()))
 }

@@ -22,7 +22,8 @@
 //! imposes the rod's velocity: their `command` column is that velocity
 //! \[m·s⁻¹\] and their output has the load-cell `force`. A `friction-bench`
 //! rig *file* (the identification format of `diagnose`) is driven by a
-//! measured record's motion instead: see [`crate::bench_sim`].
+//! measured record's motion instead, its output chosen, headed and written
+//! as every rig's: see [`crate::bench_sim`].
 //! A rig file of an older kind (`valve-cylinder`, `hybrid-pump`) is read as
 //! its netlist ([`rig::load`]): `--set` and `--print-rig` use the
 //! netlist's `<component>.<parameter>` paths on it as on every preset.
@@ -51,11 +52,10 @@ use crate::ledger::Ends;
 use crate::output::Outputs;
 use crate::progress::Progress;
 use crate::writer::{Block, Lows, Maker, Rows, Writer};
-use hydrocyl_identify::bench::FrictionBench;
 use hydrocyl_system::netlist::registry::ComponentType;
 use hydrocyl_system::rig;
 use hydrocyl_system::run::{
-    Cause, DeepCavitation, ProbeReader, Run, RunOptions, Setting, SettingWords, Solver,
+    Cause, Channel, DeepCavitation, ProbeReader, Run, RunOptions, Setting, SettingWords, Solver,
 };
 use hydrocyl_system::signal::{Signal, StreamedTable};
 use hydrocyl_system::simulation::Simulation;
@@ -83,31 +83,31 @@ Output columns (one row per command sample; the header gives each unit, e.g. `po
 pub struct Args {
     /// A preset name (`hydrocyl presets`) or a rig JSON file.
     #[arg(long)]
-    rig: String,
+    pub(crate) rig: String,
     /// (required) CSV with `time` and `command` columns (a closed-loop rig:
     /// `time` and `reference` [m or mm], the position set-point); the output
     /// is sampled at its times.
     #[arg(long, required_unless_present = "print_rig")]
-    command: Option<PathBuf>,
+    pub(crate) command: Option<PathBuf>,
     /// (required) Output CSV (measured-data format, units in the header).
     #[arg(long, required_unless_present = "print_rig")]
-    out: Option<PathBuf>,
+    pub(crate) out: Option<PathBuf>,
     /// Override a rig parameter by its path, e.g. `--set load.mass=50` or
     /// `--set cylinder.initial.p1=2.5e6` (repeatable; `hydrocyl simulate
     /// --print-rig` lists every path).
     #[arg(long = "set", value_name = "PATH=VALUE")]
-    set: Vec<String>,
+    pub(crate) set: Vec<String>,
     /// Integration method: auto (default: dp45 while the run is not stiff,
     /// rosenbrock while it is), dp45, rosenbrock, rk4 (fixed step, --rk4-step)
     /// or exponential (exponential Rosenbrock–Euler, fixed steps landing on
     /// the output times: for a mode stiff but linear over a step, e.g. a
     /// friction bench's LuGre bristle).
     #[arg(long, default_value = "auto")]
-    solver: String,
+    pub(crate) solver: String,
     /// Relative tolerance of the adaptive methods, in [1e-14, 1) (a smaller
     /// one asks for more digits than double precision carries).
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
-    rtol: f64,
+    pub(crate) rtol: f64,
     /// Fixed step of rk4, and the longest step of exponential \[s\].
     #[arg(
         long,
@@ -115,7 +115,7 @@ pub struct Args {
         allow_negative_numbers = true,
         help = "Fixed step of rk4, and the longest step of exponential [s]"
     )]
-    rk4_step: f64,
+    pub(crate) rk4_step: f64,
     /// Also integrate the energy ledger and write it to this JSON file (put
     /// in place with the CSV, checked before the run as --out is): per
     /// component the integrated source, dissipated, storage, load and moved
@@ -128,7 +128,7 @@ pub struct Args {
     /// ledger's quadratures, so its CSV may differ in the last digits from a
     /// run without it.
     #[arg(long, value_name = "FILE.json")]
-    ledger: Option<PathBuf>,
+    pub(crate) ledger: Option<PathBuf>,
     /// The ledger's window starts at the first output time at or after this
     /// time in s (default: the run's first; e.g. after a warm-up period, as
     /// `cargo xtask energy` does).
@@ -138,33 +138,33 @@ pub struct Args {
         requires = "ledger",
         allow_negative_numbers = true
     )]
-    ledger_from: Option<f64>,
+    pub(crate) ledger_from: Option<f64>,
     /// Print the rig (after --set) as JSON and exit: nothing is run or
     /// written, so --out and --ledger are refused with it; --command and the
     /// run's options (--solver, --rtol, ...) are not read.
     #[arg(long, conflicts_with_all = ["out", "ledger"])]
-    print_rig: bool,
+    pub(crate) print_rig: bool,
     /// Flush the output to the disk (fsync) before it is renamed into place.
     #[arg(long)]
-    fsync: bool,
+    pub(crate) fsync: bool,
     /// Show progress when stderr is not a terminal too (a CI log, a file):
     /// there as plain lines, one every 5 s at most after the first second,
     /// not a redrawn bar (on a terminal a bar shows without this flag).
     #[arg(long)]
-    progress: bool,
+    pub(crate) progress: bool,
     /// Print nothing but errors (no progress, no warnings, no summary).
     #[arg(long)]
-    quiet: bool,
+    pub(crate) quiet: bool,
     /// Command files larger than this many bytes are read a buffer at a time
     /// during the run instead of whole (tests set it low).
     #[arg(long, hide = true, default_value_t = 16 << 20)]
-    stream_above: u64,
+    pub(crate) stream_above: u64,
     /// While this many blocks wait for the writer thread, the solve's thread
     /// makes the next block's text itself (reading its probes on a circuit
     /// of its own) rather than queue it (default: the queue's bound; tests
     /// set 0: always).
     #[arg(long, hide = true, default_value_t = crate::writer::QUEUE)]
-    probes_behind: usize,
+    pub(crate) probes_behind: usize,
 }
 
 /// Output times per block of a streamed run: the memory a run needs grows
@@ -177,13 +177,14 @@ const BLOCK: usize = 1 << 8;
 /// Samples of the command window of a streamed command file.
 const WINDOW: usize = 1 << 18;
 
-/// The CSV header of a run: `time [s]`, then each channel as `name [unit]`
-/// (the in-memory channel names stay bare; the readers take both forms).
-/// The run's input is in the unit its readers take it in
-/// ([`hydrocyl_system::Circuit::set_probe_unit`]).
-pub fn column_headers(run: &Run) -> Vec<String> {
+/// The CSV header of a run's `channels`: `time [s]`, then each channel as
+/// `name [unit]` (the in-memory channel names stay bare; the readers take
+/// both forms): every `simulate` output's, a netlist's or a friction
+/// bench's ([`crate::bench_sim`]). The run's input is in the unit its
+/// readers take it in ([`hydrocyl_system::Circuit::set_probe_unit`]).
+pub fn column_headers(channels: &[Channel]) -> Vec<String> {
     std::iter::once("time [s]".to_string())
-        .chain(run.channels.iter().map(|c| {
+        .chain(channels.iter().map(|c| {
             if c.unit.is_empty() {
                 c.name.clone()
             } else {
@@ -195,7 +196,7 @@ pub fn column_headers(run: &Run) -> Vec<String> {
 
 /// The run's `--solver`, `--rtol` and `--rk4-step`, checked (the same
 /// messages on every kind of rig): the solver.
-fn run_settings(args: &Args) -> Result<Solver, CliError> {
+pub(crate) fn run_settings(args: &Args) -> Result<Solver, CliError> {
     let solver = Solver::parse_or_why(&args.solver)
         .map_err(|why| CliError::Input(format!("--solver: {why}")))?;
     for (flag, setting, value) in [
@@ -205,50 +206,6 @@ fn run_settings(args: &Args) -> Result<Solver, CliError> {
         setting.check_named(flag, value).map_err(CliError::Input)?;
     }
     Ok(solver)
-}
-
-/// `hydrocyl simulate` on a friction bench: the `--command` file carries the
-/// imposed motion (see [`crate::bench_sim`]). The bench fixes its own
-/// integration (one exponential Rosenbrock–Euler step per sample, as its fit
-/// runs it), so `--solver`, `--rtol` and `--rk4-step` are checked as for any
-/// rig and then refused unless they are the defaults.
-fn run_bench(
-    args: &Args,
-    bench: &FrictionBench,
-    value: &serde_json::Value,
-) -> Result<(), CliError> {
-    if args.print_rig {
-        let text = rig::printed(value).map_err(|e| CliError::Input(e.to_string()))?;
-        return crate::console::print(&format!("{text}\n"));
-    }
-    let solver = run_settings(args)?;
-    let default = RunOptions::default();
-    if solver != default.solver || args.rtol != default.rtol || args.rk4_step != default.rk4_step {
-        return Err(CliError::Input(
-            "--solver, --rtol, --rk4-step: the friction-bench model fixes its own integration (one step per sample of the imposed motion); to choose them, simulate a netlist of the bench (e.g. the tudelft-seal-25 preset)".into(),
-        ));
-    }
-    let (Some(input), Some(out)) = (&args.command, &args.out) else {
-        return Err(CliError::Input("--command and --out are required".into()));
-    };
-    if args.ledger.is_some() {
-        return Err(CliError::Input(
-            "--ledger: a friction-bench rig file imposes its motion and has no energy ledger; use a netlist of the bench (e.g. the tudelft-seal-25 preset)".into(),
-        ));
-    }
-    let mut outputs = Outputs::new(&[("--command", input.as_path())]);
-    let id = outputs.file("--out", out)?;
-    let text = crate::bench_sim::simulate(bench, input)?;
-    outputs.write(id, text.as_bytes())?;
-    outputs.commit(args.fsync)?;
-    if !args.quiet {
-        crate::console::note(format_args!(
-            "hydrocyl: simulated the friction bench on {} samples of {}",
-            text.lines().count() - 1,
-            input.display()
-        ));
-    }
-    Ok(())
 }
 
 /// The unit of a rig's input, from the netlist (the port that reads it,
@@ -429,7 +386,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let rig_err = |e: rig::RigError| CliError::Input(e.to_string());
     if crate::bench_sim::runs_on_motion(&args.rig) {
         if let Some((bench, net)) = crate::bench_sim::load(&args.rig, &args.set)? {
-            return run_bench(&args, &bench, &net);
+            return crate::bench_sim::run(&args, &bench, &net);
         }
     }
     // the command file is read (and parsed once the rig's unit is known) on
@@ -669,7 +626,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                             deep,
                         });
                         if !w.has_rows() {
-                            let mut header = column_headers(block).join(",").into_bytes();
+                            let mut header = column_headers(&block.channels).join(",").into_bytes();
                             header.push(b'\n');
                             w.rows(Rows::Channels(header));
                         }

@@ -93,7 +93,9 @@ impl Maker {
                 let deep = crate::simulate::check_solution(run, *solver, *rk4_step)?;
                 if seq == 0 {
                     out.extend_from_slice(
-                        crate::simulate::column_headers(run).join(",").as_bytes(),
+                        crate::simulate::column_headers(&run.channels)
+                            .join(",")
+                            .as_bytes(),
                     );
                     out.push(b'\n');
                 }

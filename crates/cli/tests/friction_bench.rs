@@ -1,7 +1,9 @@
 //! `hydrocyl simulate` on a friction-bench rig file (a netlist whose
 //! `identify.model` is `friction-bench`, run on a record's motion): the run's
-//! options are checked as on any rig, `--quiet` is honoured, and what the
-//! bench cannot take is refused in one line, nothing written.
+//! options are checked as on any rig, `--quiet` and `--progress` are
+//! honoured, the rig's `outputs` choose the columns, the output is written as
+//! a netlist run's (units in the header, shortest round-trip values), and
+//! what the bench cannot take is refused in one line, nothing written.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -191,4 +193,161 @@ fn a_parameter_of_an_effect_that_is_off_names_what_turns_it_on() {
         "{}",
         String::from_utf8_lossy(&st.stderr)
     );
+}
+
+/// The bench rig with its `outputs` replaced by `outputs` (JSON), written
+/// into `dir`.
+fn rig_with_outputs(dir: &Path, outputs: serde_json::Value) -> PathBuf {
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(bench_rig()).unwrap()).unwrap();
+    v["outputs"] = outputs;
+    let p = dir.join("bench-outputs.rig.json");
+    std::fs::write(&p, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    p
+}
+
+/// A good run's output text.
+fn ran(st: &Output, out: &Path) -> String {
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    std::fs::read_to_string(out).unwrap()
+}
+
+/// The rig's `outputs` choose the columns as on a netlist (in the run's
+/// channel order, whatever the file's); a name that is none of the bench's
+/// channels is refused before the run with a run's selection error, nothing
+/// written.
+#[test]
+fn the_rigs_outputs_choose_the_columns() {
+    let dir = tempfile::tempdir().unwrap();
+    let vel = velocity_record(dir.path());
+    let out = dir.path().join("q.csv");
+    let rig = rig_with_outputs(
+        dir.path(),
+        serde_json::json!({ "force": "drive.force", "position": "cylinder.position" }),
+    );
+    let text = ran(&simulate(&rig, &vel, &out, &[]), &out);
+    assert_eq!(text.lines().next(), Some("time [s],position [m],force [N]"));
+    assert!(text.lines().skip(1).all(|l| l.split(',').count() == 3));
+    // the file's own outputs: every channel, friction included
+    let text = ran(&simulate(&bench_rig(), &vel, &out, &[]), &out);
+    assert_eq!(
+        text.lines().next(),
+        Some("time [s],position [m],velocity [m/s],p1 [Pa],p2 [Pa],force [N],friction_force [N]")
+    );
+    std::fs::remove_file(&out).unwrap();
+    // a probe of the rig's netlist that the bench does not write
+    let rig = rig_with_outputs(
+        dir.path(),
+        serde_json::json!({ "force": "drive.force", "imposed": "drive.command" }),
+    );
+    let err = refused(&simulate(&rig, &vel, &out, &[]), &out);
+    assert_eq!(
+        err.trim_end(),
+        "hydrocyl: error: rig `outputs`: channel `imposed`: the circuit has no such output (it has velocity, force, p1, p2, position, friction_force)"
+    );
+}
+
+/// The header is the netlist path's (`name [unit]`, one formatter): the
+/// columns the bench shares with the tudelft-seal-25 preset's netlist run
+/// are headed alike.
+#[test]
+fn the_header_carries_units_as_a_netlist_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let vel = velocity_record(dir.path());
+    let out = dir.path().join("q.csv");
+    let text = ran(&simulate(&bench_rig(), &vel, &out, &["--quiet"]), &out);
+    let bench: Vec<String> = text
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .map(String::from)
+        .collect();
+    let cmd = dir.path().join("cmd.csv");
+    std::fs::write(&cmd, "time,command\n0,0\n0.01,0.001\n").unwrap();
+    let seal = dir.path().join("seal.csv");
+    let text = ran(
+        &simulate(Path::new("tudelft-seal-25"), &cmd, &seal, &["--quiet"]),
+        &seal,
+    );
+    let net: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let shared: Vec<&String> = bench.iter().filter(|h| net.contains(&h.as_str())).collect();
+    for h in [
+        "time [s]",
+        "position [m]",
+        "velocity [m/s]",
+        "force [N]",
+        "friction_force [N]",
+    ] {
+        assert!(shared.iter().any(|s| *s == h), "{h}: {bench:?} vs {net:?}");
+    }
+    assert!(bench[1..].iter().all(|h| h.ends_with(']')), "{bench:?}");
+}
+
+/// Values are written as every `simulate` output's: each its shortest
+/// round-trip text, so the text is what the CSV writer makes of the values
+/// it reads back (10 significant digits in exponent form were not).
+#[test]
+fn values_are_shortest_round_trip_as_on_a_netlist() {
+    use hydrocyl_identify::plaincsv::write_columns;
+    let dir = tempfile::tempdir().unwrap();
+    let vel = velocity_record(dir.path());
+    let out = dir.path().join("q.csv");
+    let text = ran(&simulate(&bench_rig(), &vel, &out, &["--quiet"]), &out);
+    let mut lines = text.lines();
+    let names: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let mut columns = vec![Vec::new(); names.len()];
+    for l in lines {
+        for (c, cell) in columns.iter_mut().zip(l.split(',')) {
+            c.push(cell.parse::<f64>().unwrap());
+        }
+    }
+    let cols: Vec<&[f64]> = columns.iter().map(Vec::as_slice).collect();
+    let again = String::from_utf8(write_columns(&names, &cols)).unwrap();
+    assert_eq!(again, text);
+    assert!(columns[0].len() == 200 && columns.iter().flatten().any(|v| *v != 0.0));
+}
+
+/// `--progress` shows the bench's stages as plain lines where stderr is not
+/// a terminal (as a netlist run shows its rows); without it, or with
+/// `--quiet`, none.
+#[test]
+fn progress_shows_the_stages_of_a_bench_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let vel = velocity_record(dir.path());
+    let out = dir.path().join("q.csv");
+    let run = |extra: &[&str]| {
+        let st = hydrocyl()
+            .env("HYDROCYL_PROGRESS_SECONDS", "0")
+            .args(["simulate", "--rig"])
+            .arg(bench_rig())
+            .arg("--command")
+            .arg(&vel)
+            .arg("--out")
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            st.status.success(),
+            "{}",
+            String::from_utf8_lossy(&st.stderr)
+        );
+        String::from_utf8_lossy(&st.stderr).into_owned()
+    };
+    let err = run(&["--progress"]);
+    for stage in [
+        "hydrocyl: simulate: reading the record 0/4",
+        "hydrocyl: simulate: smoothing the motion 1/4",
+        "hydrocyl: simulate: simulating 2/4",
+        "hydrocyl: simulate: writing 3/4",
+    ] {
+        assert!(err.contains(stage), "{stage}: {err}");
+    }
+    assert!(!run(&[]).contains("hydrocyl: simulate:"));
+    assert!(run(&["--progress", "--quiet"]).is_empty());
 }

@@ -367,7 +367,18 @@ fn friction_bench_is_simulated_from_its_motion() {
             String::from_utf8_lossy(&st.stderr)
         );
         let (h, sim) = read_csv(&out);
-        assert_eq!(h, ["time", "position", "velocity", "p1", "p2", "force"]);
+        assert_eq!(
+            h,
+            [
+                "time",
+                "position",
+                "velocity",
+                "p1",
+                "p2",
+                "force",
+                "friction_force"
+            ]
+        );
         let text = std::fs::read_to_string(fx.join(rec)).unwrap();
         let col = text
             .lines()

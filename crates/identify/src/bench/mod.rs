@@ -421,10 +421,12 @@ impl FrictionBench {
 mod model;
 mod presets;
 mod signals;
+mod switch;
 
 pub use model::{run_options, BenchInputs, BenchRun};
 pub use presets::{is_bench_rig, preset, PRESETS, SMOOTHING_VELOCITY};
 pub use signals::{bench_signals, BenchSignals};
+pub use switch::EffectSwitch;
 
 #[cfg(test)]
 mod tests {

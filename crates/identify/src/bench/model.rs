@@ -7,7 +7,7 @@
 use super::{BenchSignals, FrictionBench, ParamRef};
 use crate::catalog::EffectId;
 use hydrocyl_system::netlist::{self, migrate::bench as net};
-use hydrocyl_system::run::{RunOptions, Solver};
+use hydrocyl_system::run::{Channel, ProbeSet, Run, RunOptions, SimError, Solver};
 use hydrocyl_system::signal::Signal;
 use hydrocyl_system::simulation::Simulation;
 use hydrocyl_system::AnyWire;
@@ -81,6 +81,40 @@ impl FrictionBench {
     /// (limited to the steady range).
     pub fn simulate(&self, s: &BenchSignals, inputs: &BenchInputs) -> Result<Vec<f64>, String> {
         BenchRun::new(self, inputs)?.force(self, s, false)
+    }
+
+    /// The bench's output channels on record `s` as a run at the record's
+    /// times ([`BenchRun::channels`]): the channels of the bench's circuit
+    /// named in `only` (every one for `None`: `position`, `velocity`, `p1`,
+    /// `p2`, `force`, `friction_force`), chosen and ordered as any run's
+    /// ([`ProbeSet::selected`], whose error names a channel the circuit
+    /// lacks); the bristle from rest when `at_rest`, else from the record's
+    /// first forces.
+    pub fn simulate_channels(
+        &self,
+        s: &BenchSignals,
+        inputs: &BenchInputs,
+        at_rest: bool,
+        only: Option<&[String]>,
+    ) -> Result<Run, String> {
+        BenchRun::new(self, inputs)?.channels(self, s, at_rest, only)
+    }
+
+    /// Checks a channel selection (what [`FrictionBench::simulate_channels`]
+    /// takes) against the bench's circuit, its inputs held, before any
+    /// record is read: [`ProbeSet::selected`]'s error for a name the circuit
+    /// has no output of.
+    pub fn check_channels(&self, only: Option<&[String]>) -> Result<(), String> {
+        let v = self.netlist()?;
+        let schematic = netlist::schematic(&v).map_err(|e| e.to_string())?;
+        let held: Vec<(String, Signal)> = net::INPUTS
+            .iter()
+            .map(|n| (n.to_string(), Signal::Constant { value: 0.0 }))
+            .collect();
+        let circuit = netlist::assemble_inputs(&schematic, &held).map_err(|e| e.to_string())?;
+        ProbeSet::selected(&circuit, only)
+            .map(|_| ())
+            .map_err(selection_error)
     }
 
     /// Simulates the bench with the bristle deflection starting at zero (at
@@ -197,6 +231,14 @@ impl BenchRun {
         s: &BenchSignals,
         at_rest: bool,
     ) -> Result<Vec<f64>, String> {
+        self.reassemble_for(bench)?;
+        let wires = [self.force];
+        Ok(self.read(bench, s, at_rest, &wires)?.swap_remove(0))
+    }
+
+    /// Assembles the circuit again when the effects switched on in `bench`
+    /// are not those it was built for (a bristle or a hump added or removed).
+    fn reassemble_for(&mut self, bench: &FrictionBench) -> Result<(), String> {
         if !bench
             .friction
             .effects
@@ -206,26 +248,95 @@ impl BenchRun {
         {
             *self = BenchRun::new(bench, &self.inputs)?;
         }
+        Ok(())
+    }
+
+    /// The channels of the bench's circuit named in `only` (every one for
+    /// `None`) on record `s`, as a run at the record's times: chosen and
+    /// ordered by [`ProbeSet::selected`] (its error for a name the circuit
+    /// has no output of), each with its unit and probe. The position is
+    /// the record's (`s.x`): the run integrates no position (a static law
+    /// reads the load cell with no integration; the drive of a LuGre run
+    /// starts at 0); the velocity and pressures are the record's too, as
+    /// the circuit's inputs at the sample times.
+    pub fn channels(
+        &mut self,
+        bench: &FrictionBench,
+        s: &BenchSignals,
+        at_rest: bool,
+        only: Option<&[String]>,
+    ) -> Result<Run, String> {
+        self.reassemble_for(bench)?;
+        let chosen = ProbeSet::selected(self.sim.circuit(), only).map_err(selection_error)?;
+        let all = self.sim.circuit().probes();
+        let probes: Vec<_> = chosen
+            .names()
+            .filter_map(|n| all.iter().find(|p| p.name == n))
+            .collect();
+        let position = format!("{}.position", net::CYLINDER);
+        let wires: Vec<AnyWire> = probes
+            .iter()
+            .filter(|p| p.path != position)
+            .map(|p| p.wire)
+            .collect();
+        let mut values = self.read(bench, s, at_rest, &wires)?.into_iter();
+        let channels = probes
+            .into_iter()
+            .map(|p| {
+                let values = if p.path == position {
+                    s.x.clone()
+                } else {
+                    values.next().ok_or("a channel without its wire")?
+                };
+                Ok(Channel {
+                    name: p.name.clone(),
+                    unit: p.unit,
+                    probe: p.path.clone(),
+                    values,
+                })
+            })
+            .collect::<Result<_, String>>()?;
+        Ok(Run {
+            time: s.t.clone(),
+            channels,
+            ..Run::default()
+        })
+    }
+
+    /// `wires` of the circuit (assembled for `bench`'s effects) with
+    /// `bench`'s parameters on record `s`.
+    fn read(
+        &mut self,
+        bench: &FrictionBench,
+        s: &BenchSignals,
+        at_rest: bool,
+        wires: &[AnyWire],
+    ) -> Result<Vec<Vec<f64>>, String> {
         for (path, value) in bench.path_values() {
             self.sim
                 .set_parameter(&path, value)
                 .map_err(|e| e.to_string())?;
         }
         let err = |e: hydrocyl_system::rig::RigError| format!("{}: {e}", s.source);
-        let mut out = match self.z {
+        match self.z {
             Some(k) => {
                 let mut x0 = self.sim.circuit().initial_state();
                 x0[k] = if at_rest { 0.0 } else { bench.initial_z(s) };
                 self.sim.set_initial_state(x0);
                 self.sim.set_options(run_options(self.inputs.h_max));
-                self.sim.run_wires(&s.t, &[self.force]).map_err(err)?
+                self.sim.run_wires(&s.t, wires).map_err(err)
             }
-            None => self
-                .sim
-                .sample_state_free(&s.t, &[self.force])
-                .map_err(err)?,
-        };
-        Ok(out.swap_remove(0))
+            None => self.sim.sample_state_free(&s.t, wires).map_err(err),
+        }
+    }
+}
+
+/// A selection's error as its reason (`channel `x`: the circuit has no such
+/// output (it has …)`), without the run-settings prefix.
+fn selection_error(e: SimError) -> String {
+    match e {
+        SimError::Settings(why) => why,
+        e => e.to_string(),
     }
 }
 

@@ -100,11 +100,13 @@ impl FrictionBench {
     /// stiction level above the Coulomb level is the `stribeck` effect),
     /// or `friction_bench`; which of the law's parameters is which catalog
     /// parameter is the netlist's friction-bench view
-    /// (`hydrocyl_system::netlist::identify::bench_law_params`).
+    /// (`hydrocyl_system::netlist::identify::bench_law_params`); an
+    /// effect is on where its switch says so ([`FrictionBench::effect_switches`]:
+    /// its first parameter given off its default).
     /// `smoothing_velocity` is the static law's tanh velocity where the
     /// netlist's law has none (LuGre). Another circuit is refused by path.
     pub fn from_netlist(v: &serde_json::Value, smoothing_velocity: f64) -> Result<Self, String> {
-        use hydrocyl_system::netlist::identify::{bench_law_params, bench_law_stiction_is_coulomb};
+        use hydrocyl_system::netlist::identify::bench_law_params;
         let s = hydrocyl_system::netlist::read(v)
             .map_err(|e| hydrocyl_system::rig::RigError::from(e).to_string())?;
         let of = |ty: &str| -> Vec<&hydrocyl_system::netlist::registry::Instance> {
@@ -178,38 +180,16 @@ impl FrictionBench {
                 ));
             }
         }
-        // an effect is declared when the law has it: its first parameter
-        // given off the type's default (a required one always: the
-        // Coulomb + viscous law's `viscous`, LuGre's σ0 and σ2; so a
-        // netlist printed with every default written out, `--print-rig`,
-        // declares what the file declared) and, for a law whose stiction
-        // level is its Coulomb level where there is no Stribeck hump
-        // (LuGre), the stiction level not the Coulomb level
-        let hump_at_coulomb = bench_law_stiction_is_coulomb(law.ty.name);
+        // an effect is declared where its switch says so (the one rule,
+        // `FrictionBench::effect_switches`: its first parameter given off
+        // the type's default; a LuGre hump's stiction level not its Coulomb
+        // level), with the values its law parameters hold
         let mut effects = BTreeMap::new();
-        for id in super::BENCH_EFFECTS {
-            let params = effect_params(id);
-            let Some(firsts) = params
-                .iter()
-                .map(|(_, ps)| ps.first().copied())
-                .collect::<Option<Vec<&str>>>()
-            else {
-                continue; // not in this law
-            };
-            let first = firsts[0];
-            let default = law.ty.param(first).and_then(|p| match p.default {
-                hydrocyl_system::netlist::registry::Default::Value(d) => Some(d),
-                _ => None,
-            });
-            let declared = law.opt(first).is_some_and(|x| Some(x) != default)
-                && !(hump_at_coulomb && id == EffectId::Stribeck && law.get(first) == coulomb);
-            if declared {
-                let vals = params.iter().zip(&firsts);
-                effects.insert(
-                    id,
-                    vals.map(|((name, _), q)| (name.to_string(), law.get(q)))
-                        .collect(),
-                );
+        for switch in FrictionBench::effect_switches(law.ty.name) {
+            if switch.is_on(law.opt(switch.on), coulomb) {
+                let names = switch.effect.params().iter().map(|q| q.name.to_string());
+                let values = switch.params(law.ty.name).into_iter().map(|q| law.get(q));
+                effects.insert(switch.effect, names.zip(values).collect());
             }
         }
         // the static law's tanh velocity: the law's own, or where it has

@@ -52,6 +52,7 @@ pub fn load(
     let check = |net: &serde_json::Value| {
         rig::check(net).map_err(|e| err(crate::rigfile::at_line_or_set(e, spec, sets)))
     };
+    rig::each_path_once(sets).map_err(err)?;
     for s in sets {
         let before = as_json(&read(&net)?);
         let old = net.clone();
@@ -95,9 +96,13 @@ pub(crate) fn run(
     }
     let solver = run_settings(args)?;
     let default = RunOptions::default();
-    if solver != default.solver || args.rtol != default.rtol || args.rk4_step != default.rk4_step {
+    if solver != default.solver
+        || args.rtol != default.rtol
+        || args.rk4_step != default.rk4_step
+        || args.max_step.is_some()
+    {
         return Err(CliError::Input(
-            "--solver, --rtol, --rk4-step: the friction-bench model fixes its own integration (one step per sample of the imposed motion); to choose them, simulate a netlist of the bench (e.g. the tudelft-seal-25 preset)".into(),
+            "--solver, --rtol, --rk4-step, --max-step: the friction-bench model fixes its own integration (one step per sample of the imposed motion); to choose them, simulate a netlist of the bench (e.g. the tudelft-seal-25 preset)".into(),
         ));
     }
     let (Some(input), Some(out)) = (&args.command, &args.out) else {

@@ -59,9 +59,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let input = |e: &dyn std::fmt::Display| CliError::Input(e.to_string());
     // the rig first: its errors are the user's to fix, whatever the library
     let mut value = rig::load(&rig_arg).map_err(|e| input(&e))?;
-    for s in &args.set {
-        rig::apply_set(&mut value, s).map_err(|e| input(&e))?;
-    }
+    rig::apply_sets(&mut value, &args.set).map_err(|e| input(&e))?;
     // errors name the file and line of their JSON path
     rig::check(&value)
         .map_err(|e| input(&crate::rigfile::at_line_or_set(e, &rig_arg, &args.set)))?;

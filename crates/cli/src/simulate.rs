@@ -116,6 +116,12 @@ pub struct Args {
         help = "Fixed step of rk4, and the longest step of exponential [s]"
     )]
     pub(crate) rk4_step: f64,
+    /// Longest step of the adaptive methods \[s\] (default 0.01; `inf`: no
+    /// bound): a larger one lets a circuit at rest, or a long slow run,
+    /// take fewer steps; outputs and events are where they are whatever it
+    /// is.
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub(crate) max_step: Option<f64>,
     /// Also integrate the energy ledger and write it to this JSON file (put
     /// in place with the CSV, checked before the run as --out is): per
     /// component the integrated source, dissipated, storage, load and moved
@@ -194,16 +200,19 @@ pub fn column_headers(channels: &[Channel]) -> Vec<String> {
         .collect()
 }
 
-/// The run's `--solver`, `--rtol` and `--rk4-step`, checked (the same
-/// messages on every kind of rig): the solver.
+/// The run's `--solver`, `--rtol`, `--rk4-step` and `--max-step`, checked
+/// (the same messages on every kind of rig): the solver.
 pub(crate) fn run_settings(args: &Args) -> Result<Solver, CliError> {
     let solver = Solver::parse_or_why(&args.solver)
         .map_err(|why| CliError::Input(format!("--solver: {why}")))?;
     for (flag, setting, value) in [
-        ("--rtol", Setting::Rtol, args.rtol),
-        ("--rk4-step", Setting::Rk4Step, args.rk4_step),
+        ("--rtol", Setting::Rtol, Some(args.rtol)),
+        ("--rk4-step", Setting::Rk4Step, Some(args.rk4_step)),
+        ("--max-step", Setting::HMax, args.max_step),
     ] {
-        setting.check_named(flag, value).map_err(CliError::Input)?;
+        if let Some(value) = value {
+            setting.check_named(flag, value).map_err(CliError::Input)?;
+        }
     }
     Ok(solver)
 }
@@ -398,9 +407,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // meanwhile (the command is the longer task): the signal handler's thread
     crate::output::remove_temporaries_on_signal();
     let mut value = rig::load(&args.rig).map_err(rig_err)?;
-    for s in &args.set {
-        rig::apply_set(&mut value, s).map_err(rig_err)?;
-    }
+    rig::apply_sets(&mut value, &args.set).map_err(rig_err)?;
     crate::progress::mark("rig loaded");
     let checked = crate::rigfile::check(&value, &args.rig, &args.set)?;
     check_initial_pressures(&checked)?;
@@ -440,6 +447,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         solver,
         rtol: args.rtol,
         rk4_step: args.rk4_step,
+        h_max: args.max_step.unwrap_or(RunOptions::default().h_max),
         ledger: ledger_id.is_some(),
         ..RunOptions::default()
     };

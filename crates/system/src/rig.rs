@@ -598,6 +598,33 @@ pub fn parameters(v: &Value) -> Vec<Parameter> {
     out
 }
 
+/// Applies the overrides `sets` in turn ([`apply_set`]), each path once
+/// ([`each_path_once`]).
+pub fn apply_sets(rig: &mut Value, sets: &[String]) -> Result<(), RigError> {
+    each_path_once(sets)?;
+    sets.iter().try_for_each(|s| apply_set(rig, s))
+}
+
+/// Refuses overrides that give one path twice (its value would depend on
+/// the order they were written in), as a key given twice in a rig file is.
+pub fn each_path_once(sets: &[String]) -> Result<(), RigError> {
+    let path = |s: &str| s.split_once('=').map(|(p, _)| p.trim().to_string());
+    for (k, s) in sets.iter().enumerate() {
+        let Some(p) = path(s) else { continue };
+        if let Some(first) = sets[..k].iter().find(|e| path(e).as_ref() == Some(&p)) {
+            return Err(RigError::Invalid {
+                path: p,
+                why: format!(
+                    "set twice (`{}` and `{}`): give each path once",
+                    first.trim(),
+                    s.trim()
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Applies one `path=value` override (`cylinder.area_1_m2=1.2e-3`,
 /// `initial.p1=3e6`, `valve.dynamics.order="second"`; on a netlist
 /// `<component>.<parameter>`, see [`crate::netlist::set`]). The path must exist in

@@ -128,11 +128,14 @@ pub struct Args {
     /// energies in J (`components_j`), their totals, the energy in, the load's
     /// work, the losses and storage by component, and the closure
     /// `energy_in - load - losses - storage` in J and as a fraction of the
-    /// energy in (`closure_j`, `closure_relative`), with the storage check
+    /// energy in (`closure_j`, `closure_relative`; where none comes in, of
+    /// the largest term, `reference_j`, and no efficiency), with the storage check
     /// against the stored energy recomputed from the states (docs/energy.md;
-    /// the keys are those of Python's `run.ledger`). The run carries the
-    /// ledger's quadratures, so its CSV may differ in the last digits from a
-    /// run without it.
+    /// the keys are those of Python's `run.ledger`). The ledger's
+    /// quadratures are normed apart from the states: with dp45 the CSV is
+    /// the one a run without it writes; the stiff methods difference the
+    /// circuit while the ledger is on, so theirs may differ in the last
+    /// digits.
     #[arg(long, value_name = "FILE.json")]
     pub(crate) ledger: Option<PathBuf>,
     /// The ledger's window starts at the first output time at or after this

@@ -164,7 +164,9 @@ class Run:
         ``cylinder_out_j``, ``losses_j`` by component (a plastic impact at a
         stroke end is the mass's loss), ``moving_walls_j``, ``closure_j``,
         ...), ``closure_relative`` (= ``error``) and ``storage_error`` as
-        fractions of the energy in, ``efficiency``."""
+        fractions of ``reference_j`` (the energy in; where none comes in,
+        the largest other term), ``efficiency`` (None where no energy comes
+        in)."""
     def __getitem__(self, name: str) -> npt.NDArray[np.float64]: ...
     def __contains__(self, name: str) -> bool: ...
     def __iter__(self) -> Iterator[str]:

@@ -168,8 +168,10 @@ impl PyRun {
     /// `stored_change_from_states_j`, `moving_walls_j` [J], the balance
     /// `closure_j` and `closure_relative` (= `error`), the
     /// `storage_check_j` and `storage_check_relative` (= `storage_error`),
-    /// fractions of the energy in, and `efficiency` (cylinder output /
-    /// energy in). ValueError when the run has no energy in to account for.
+    /// fractions of `reference_j` (the energy in; where none comes in, the
+    /// largest other term), and `efficiency` (cylinder output / energy in;
+    /// None where no energy comes in). ValueError when the ledger cannot be
+    /// taken (an energy that is not finite).
     #[getter]
     fn ledger<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         match &self.ledger {

@@ -371,39 +371,43 @@ mod with_and_without {
 
 mod imposed_motion {
     use super::*;
+    use hydrocyl_system::run::Solver;
     use hydrocyl_system::signal::Signal;
 
     /// A 50 kg mass, friction off, driven from rest along a velocity ramp
     /// to 0.1 m/s over 1 s and held: the drive brings in exactly
-    /// `½ m v²` = 0.25 J. The acceleration (the drive force) jumps where the
-    /// ramp ends; the solve ends a step there (the velocity's kink), so the
-    /// energy in is exact to the tolerance, not off by a step's share of
-    /// the jump.
+    /// `½ m v²` = 0.25 J. The exponential method's steps land on the
+    /// outputs (the ramp's end among them) and take the drive's power at
+    /// each step's middle: exact. An adaptive method steps across the
+    /// corner where the acceleration (the drive force) jumps, and the
+    /// energy in carries about `h·m·Δa·v` for it (docs/energy.md): within
+    /// 1 % here, not exact.
     #[test]
     fn a_ramp_brings_in_the_kinetic_energy() {
         let mut v = hydrocyl_system::rig::preset("emps").unwrap();
         v["components"]["friction"]["coulomb"] = serde_json::json!(0.0);
         v["components"]["friction"]["viscous"] = serde_json::json!(0.0);
         let command = Signal::Table {
-            time_s: vec![0.0, 1.0, 2.0],
-            value: vec![0.0, 0.1, 0.1],
+            time_s: vec![0.0, 1.0, 2.0].into(),
+            value: vec![0.0, 0.1, 0.1].into(),
         };
         let t: Vec<f64> = (0..=200).map(|k| k as f64 * 1e-2).collect();
-        for opts in [RunOptions::dp45(), RunOptions::default()] {
+        for (solver, tol) in [(Solver::Exponential, 1e-9), (Solver::Dp45, 1e-2)] {
             let opts = RunOptions {
+                solver,
+                rk4_step: 1e-3,
                 ledger: true,
-                ..opts
+                ..RunOptions::default()
             };
             let run = hydrocyl_system::rig::simulate(&v, command.clone(), &t, &opts).unwrap();
             let mut c = hydrocyl_system::rig::circuit(&v, command.clone()).unwrap();
             c.set_ledger(true);
             let l = ledger(&c, &run, 0, t.len() - 1, &RodSide::of(&c)).unwrap();
             assert!(
-                (l.energy_in_j - 0.25).abs() < 1e-8,
-                "{:?}: {l:?}",
-                opts.solver
+                (l.energy_in_j - 0.25).abs() < tol * 0.25,
+                "{solver:?}: {l:?}"
             );
-            assert!(l.storage_error.abs() < 1e-8, "{:?}: {l:?}", opts.solver);
+            assert!(l.storage_error.abs() < tol, "{solver:?}: {l:?}");
         }
     }
 }

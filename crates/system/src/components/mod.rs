@@ -39,6 +39,6 @@ pub use mass::Mass;
 pub use orifice::FixedOrifice;
 pub use servo_needle::{OpeningLaw, ServoNeedle};
 pub use solenoid_four_way::{SolenoidFourWay, SolenoidLaw, SolenoidNodes};
-pub use sources::{CommandInput, KinkScan, PressureSource};
+pub use sources::{CommandInput, PressureSource};
 pub use spool::ServoSpool;
 pub use volume::Volume;

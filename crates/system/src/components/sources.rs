@@ -69,53 +69,12 @@ pub struct CommandInput {
     /// The signal.
     pub signal: Signal,
     hint: Cell<usize>,
-    /// The signal's kinks, the solve's breakpoints.
-    kinks: KinkScan,
-    out: Wire<f64>,
-}
-
-/// The kinks ([`kinks`]) of a signal a component holds, as a solve asks for
-/// its breakpoints ([`hydrocyl_integrators::OdeSystem::next_breakpoint`]):
-/// a whole signal's found on first use, a streamed table's scanned as its
-/// samples arrive.
-#[derive(Debug)]
-pub struct KinkScan {
-    /// A whole signal's kinks, found on first use.
+    /// The signal's kinks ([`kinks`]), found on first use.
     kinks: OnceCell<Vec<f64>>,
     /// A streamed table's scan: the index to resume from and the corner
     /// found last (`-∞` when none is pending).
     stream_scan: Cell<(usize, f64)>,
-}
-
-impl Default for KinkScan {
-    fn default() -> Self {
-        Self {
-            kinks: OnceCell::new(),
-            stream_scan: Cell::new((0, f64::NEG_INFINITY)),
-        }
-    }
-}
-
-impl KinkScan {
-    /// The first kink of `signal` after `t` (`∞` when there is none);
-    /// `signal` must be the same one on every call.
-    pub fn next_after(&self, signal: &Signal, t: f64) -> f64 {
-        if let Signal::Streamed(table) = signal {
-            // the window holds the samples ahead: scan only what is new
-            let (from, found) = self.stream_scan.get();
-            if found > t {
-                return found;
-            }
-            let (k, next) = table.next_kink(from, t, KINK_SHARE);
-            let pending = if k.is_finite() { k } else { f64::NEG_INFINITY };
-            self.stream_scan.set((next, pending));
-            return k;
-        }
-        let k = self.kinks.get_or_init(|| kinks(signal));
-        k.get(k.partition_point(|&b| b <= t))
-            .copied()
-            .unwrap_or(f64::INFINITY)
-    }
+    out: Wire<f64>,
 }
 
 /// A corner of a table counts as a kink when the change of slope at it, times
@@ -172,7 +131,8 @@ impl CommandInput {
             output_name: output.into(),
             signal,
             hint: Cell::new(0),
-            kinks: KinkScan::default(),
+            kinks: OnceCell::new(),
+            stream_scan: Cell::new((0, f64::NEG_INFINITY)),
             out: Wire::UNBOUND,
         }
     }
@@ -193,7 +153,21 @@ impl Component for CommandInput {
         w.set(self.out, self.signal.value_hinted(t, &self.hint));
     }
     fn next_breakpoint(&self, t: f64) -> f64 {
-        self.kinks.next_after(&self.signal, t)
+        if let Signal::Streamed(table) = &self.signal {
+            // the window holds the samples ahead: scan only what is new
+            let (from, found) = self.stream_scan.get();
+            if found > t {
+                return found;
+            }
+            let (k, next) = table.next_kink(from, t, KINK_SHARE);
+            let pending = if k.is_finite() { k } else { f64::NEG_INFINITY };
+            self.stream_scan.set((next, pending));
+            return k;
+        }
+        let k = self.kinks.get_or_init(|| kinks(&self.signal));
+        k.get(k.partition_point(|&b| b <= t))
+            .copied()
+            .unwrap_or(f64::INFINITY)
     }
     fn probes(&self) -> Vec<Probe> {
         vec![Probe::of("command", self.out)]

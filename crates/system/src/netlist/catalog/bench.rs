@@ -18,7 +18,6 @@ use crate::circuit::{
     BuildError, Component, HydraulicNode, MechanicalNode, Netlist, PowerTerms, Probe, Tangents,
     Wire, Wires,
 };
-use crate::components::KinkScan;
 use crate::signal::Signal;
 use hydrocyl_ports::{Force, Position, Velocity, VolumeFlow};
 use std::cell::Cell;
@@ -39,10 +38,6 @@ pub struct ImposedMotion {
     /// Initial position \[m\].
     pub initial_position: f64,
     hint: Cell<usize>,
-    /// The velocity's kinks: the solve ends its steps there, where the
-    /// imposed acceleration (the drive force, the energy it brings in)
-    /// jumps.
-    kinks: KinkScan,
     /// The signal giving the imposed acceleration \[m·s⁻²\], when port
     /// `acceleration` is connected (else the velocity's slope).
     acceleration_name: Option<String>,
@@ -122,9 +117,6 @@ impl Component for ImposedMotion {
     }
     fn evaluates_last(&self) -> bool {
         true
-    }
-    fn next_breakpoint(&self, t: f64) -> f64 {
-        self.kinks.next_after(&self.velocity, t)
     }
     fn evaluate(&self, t: f64, _x: &[f64], w: &mut Wires) {
         let f = self.force_sign * self.drive_force(t, w);
@@ -312,7 +304,6 @@ pub const TYPES: &[ComponentType] = &[
                 force_sign: s,
                 initial_position: i.initial("position").unwrap_or(0.0),
                 hint: Cell::new(0),
-                kinks: KinkScan::default(),
                 acceleration_name: i.connected("acceleration").then(|| i.node("acceleration").to_string()),
                 acceleration: None,
                 rod: MechanicalNode::UNBOUND,

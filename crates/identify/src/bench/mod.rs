@@ -254,7 +254,7 @@ impl FrictionBench {
                     file: rec.source.clone(),
                     column,
                     why: format!(
-                        "the rig's {name} is {area:e} m², so its model is driven by the chamber pressure {sig} (without it, it would run at 0 Pa)"
+                        "the rig's {name} is {area:.4e} m², so its model is driven by the chamber pressure {sig} (without it, it would run at 0 Pa)"
                     ),
                 });
             }

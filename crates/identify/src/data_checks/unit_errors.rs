@@ -9,7 +9,9 @@ use crate::data::{DataError, Record, Signal};
 /// normalised spool demand (or the other way round), and a time axis whose
 /// unit makes the piston move far faster than the rig can (seconds under
 /// `[ms]`: 1000 times). `problems` are the record's data problems (a
-/// position already found in the wrong unit says nothing about time).
+/// position already found in the wrong unit says nothing about time). One
+/// position sample that alone makes the piston that fast is an error
+/// naming its row and the position column.
 pub fn unit_errors(rec: &Record, f: &RigFacts, problems: &[DataProblem]) -> Result<(), DataError> {
     let column = |s: Signal| match rec.units.get(&s) {
         Some(u) => format!("{} [{u}]", s.name()),
@@ -39,12 +41,6 @@ pub fn unit_errors(rec: &Record, f: &RigFacts, problems: &[DataProblem]) -> Resu
                 ),
             });
         }
-    }
-    let position_bad = problems
-        .iter()
-        .any(|p| p.channel == Signal::Position.name() && p.kind == ProblemKind::Units);
-    if position_bad {
-        return Ok(());
     }
     let (Some(g), Some(u), Some(x)) = (
         f.velocity_gain,
@@ -81,6 +77,13 @@ pub fn unit_errors(rec: &Record, f: &RigFacts, problems: &[DataProblem]) -> Resu
                     ),
                 });
             }
+        }
+        // (a single sample is named whatever the position's data problems)
+        let position_bad = problems
+            .iter()
+            .any(|p| p.channel == Signal::Position.name() && p.kind == ProblemKind::Units);
+        if position_bad {
+            return Ok(());
         }
         let span = rec.time[n - 1] - rec.time[0];
         return Err(DataError::UnitContradictsRig {

@@ -145,9 +145,6 @@ pub fn simulate(bench: &FrictionBench, input: &Path) -> Result<String, CliError>
             input.display()
         )));
     }
-    bench
-        .require_inputs(&rec)
-        .map_err(|e| CliError::Input(e.to_string()))?;
     let measured_force = rec.get(Signal::Force).is_some();
     if !measured_force {
         rec.signals.insert(Signal::Force, vec![0.0; rec.len()]);

@@ -408,15 +408,15 @@ impl Ahead {
     }
 }
 
-/// The longest run a command file may span \[s\] (about 11.6 days): a
-/// longer span is a time column in the wrong unit or a typo (`1e300`),
-/// which would otherwise run until the solver's step limit.
-pub const MAX_SPAN_S: f64 = 1.0e6;
+use hydrocyl_identify::data::beyond_span;
+/// The longest run a command file may span \[s\] (about 11.6 days): the
+/// record reader's limit, one rule for both ([`beyond_span`]).
+pub use hydrocyl_identify::data::MAX_SPAN_S;
 
 /// Refuses sample `t` (at CSV row `row` of `file`) lying more than
 /// [`MAX_SPAN_S`] after the first sample `t0`.
 pub fn check_span(file: &str, row: usize, t0: f64, t: f64) -> Result<(), CliError> {
-    if t - t0 > MAX_SPAN_S {
+    if beyond_span(t0, t) {
         return Err(CliError::Input(format!(
             "{file}: row {row}, column `time`: {t:e} s is {:e} s after the first sample: a run spans at most {MAX_SPAN_S:e} s (about 11.6 days); is the time column in seconds?",
             t - t0
@@ -433,7 +433,9 @@ pub fn parse_command(
     unit: CommandUnit,
 ) -> Result<(Vec<f64>, Vec<f64>), CliError> {
     let (t, u) = parse_samples(file, bytes, unit)?;
-    if let Some(k) = t.iter().position(|&tk| tk - t[0] > MAX_SPAN_S) {
+    // the full reader checked each row at its line; what reaches here from
+    // the fast path has no blank line inside, so sample k is on line k + 2
+    if let Some(k) = t.iter().position(|&tk| beyond_span(t[0], tk)) {
         check_span(file, k + 2, t[0], t[k])?;
     }
     Ok((t, u))
@@ -463,8 +465,16 @@ fn parse_samples(
         return Ok(r);
     }
     let (mut t, mut u) = (Vec::new(), Vec::new());
-    for (k, rec) in rdr.records().enumerate() {
-        let row = k + 2;
+    // a row is the file's line: the CSV reader skips blank lines, which
+    // its record count would not see
+    let mut row = 1;
+    let mut lines = hydrocyl_identify::data::LineCounter::new(text);
+    for rec in rdr.records() {
+        let at = match &rec {
+            Ok(r) => r.position(),
+            Err(e) => e.position(),
+        };
+        row = at.map_or(row + 1, |p| lines.line_at(p.byte() as usize));
         let rec = rec.map_err(|e| match e.kind() {
             csv::ErrorKind::UnequalLengths {
                 expected_len, len, ..
@@ -499,6 +509,9 @@ fn parse_samples(
             Ok(v)
         };
         let tv = cell(c.time)? * c.time_factor;
+        if let Some(&t0) = t.first() {
+            check_span(file, row, t0, tv)?;
+        }
         if let Some(&prev) = t.last() {
             if tv <= prev {
                 return Err(CliError::Input(format!(
@@ -549,5 +562,21 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("two `command` columns (2 and 3)"), "{e}");
+    }
+
+    /// A row is the file's line after blank lines too (the `nan` on line 8
+    /// was "row 6"), for a bad cell and for the span.
+    #[test]
+    fn rows_are_file_lines_after_blank_lines() {
+        let text = "time,command\n0,0\n\n1,0\n2,0\n\n3,0\n4,nan\n";
+        let e = parse_command("f", text.as_bytes(), CommandUnit::Normalised)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("row 8, column `command`"), "{e}");
+        let text = "time,command\n0,0\n\n1,0\n\n2e6,0\n";
+        let e = parse_command("f", text.as_bytes(), CommandUnit::Normalised)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("row 6, column `time`"), "{e}");
     }
 }

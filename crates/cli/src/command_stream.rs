@@ -233,7 +233,7 @@ pub fn scan(
         }
         if let Some(k) = t
             .iter()
-            .position(|&tk| tk - s.t0 > crate::command::MAX_SPAN_S)
+            .position(|&tk| hydrocyl_identify::data::beyond_span(s.t0, tk))
         {
             crate::command::check_span(&path.display().to_string(), s.rows + k + 2, s.t0, t[k])?;
         }

@@ -14,9 +14,11 @@ use serde::{Deserialize, Serialize};
 
 mod error;
 mod read;
+mod time_axis;
 
 pub use error::DataError;
-pub use read::foreign_separator;
+pub use read::{foreign_separator, LineCounter};
+pub use time_axis::{beyond_span, MAX_GAP_FACTOR, MAX_SPAN_S};
 
 /// A signal of the measured-data format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
@@ -152,6 +154,10 @@ pub struct Record {
     /// are already in SI. The data checks compare it with the rig's (a
     /// `command [V]` on a rig whose command is a normalised spool demand).
     pub units: BTreeMap<Signal, String>,
+    /// The file line of each sample (header = row 1), for messages; empty
+    /// when sample `k` is on line `k + 2` (no blank line inside the data).
+    /// See [`Record::row`].
+    pub lines: Vec<usize>,
 }
 
 /// Minimum number of samples of a usable record.
@@ -166,6 +172,12 @@ impl Record {
     /// `true` when there are no samples (never for a record read from a file).
     pub fn is_empty(&self) -> bool {
         self.time.is_empty()
+    }
+
+    /// The row (file line, header = row 1, blank lines counted) of sample
+    /// `k`, as error messages and data problems name it.
+    pub fn row(&self, k: usize) -> usize {
+        self.lines.get(k).copied().unwrap_or(k + 2)
     }
 
     /// The samples of `signal`, if present.
@@ -203,6 +215,11 @@ impl Record {
                 .collect(),
             ignored: self.ignored.clone(),
             units: self.units.clone(),
+            lines: self
+                .lines
+                .get(range)
+                .map(<[usize]>::to_vec)
+                .unwrap_or_default(),
         }
     }
 }

@@ -16,11 +16,13 @@
 
 use serde::Serialize;
 
-use crate::data::{DataError, Record, Signal};
+use crate::data::{Record, Signal};
 use crate::smooth::noise_sigma;
 
 mod coverage;
+mod unit_errors;
 pub use coverage::{missing_channels, pressure_scale_problems, GAP_FACTOR, SCALE_FACTOR};
+pub use unit_errors::unit_errors;
 
 /// What the checks need to know about the rig (SI units).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -126,14 +128,18 @@ fn range(y: &[f64]) -> (f64, f64) {
 /// Resolution of a channel: its smallest step between distinct values that
 /// is not a rounding artefact (the 5th percentile of the steps between
 /// sorted distinct values), as a share of its range; with its level count.
+/// The range is the one between the 0.5th and 99.5th percentiles (the full
+/// range if that is zero), so that one outlier (1e300 in a pressure column)
+/// neither merges every other value into one level nor makes the steps
+/// look fine.
 fn resolution(y: &[f64]) -> Option<(f64, usize)> {
     let (lo, hi) = range(y);
-    let r = hi - lo;
-    if r <= 0.0 {
+    if hi - lo <= 0.0 {
         return None;
     }
     let mut v = y.to_vec();
     v.sort_by(f64::total_cmp);
+    let r = robust_range(&v, hi - lo);
     v.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * r);
     if v.len() < 2 {
         return None;
@@ -142,6 +148,28 @@ fn resolution(y: &[f64]) -> Option<(f64, usize)> {
     let k = steps.len() / 20;
     let q = *steps.select_nth_unstable_by(k, f64::total_cmp).1;
     Some((q / r, v.len()))
+}
+
+/// The range between the 0.5th and 99.5th percentiles of the sorted
+/// values `v` (`full` if that is zero): a few outliers do not count.
+fn robust_range(v: &[f64], full: f64) -> f64 {
+    let tail = v.len() / 200;
+    let r = v[v.len() - 1 - tail] - v[tail];
+    if r > 0.0 {
+        r
+    } else {
+        full
+    }
+}
+
+/// A value for a message: `0.5200` below 1e6 in magnitude, else `1.0000e305`
+/// (not a 300-digit number).
+fn num(v: f64) -> String {
+    if v.abs() < 1e6 {
+        format!("{v:.4}")
+    } else {
+        format!("{v:.4e}")
+    }
 }
 
 /// SI unit of a channel for messages.
@@ -222,7 +250,14 @@ fn channel_problem(
             format!("{name} reads {lo:.6e} {u} in every sample: a stuck or disconnected sensor? check the transducer, its wiring and the logged column"),
         ));
     }
-    let sigma = noise_sigma(t, y);
+    // the range without outliers (see `robust_range`): one 1e305 in the
+    // column would make the noise sigma, and each margin built on it, huge
+    let rr = {
+        let mut v = y.to_vec();
+        v.sort_by(f64::total_cmp);
+        robust_range(&v, r)
+    };
+    let sigma = noise_sigma(t, y).min(rr);
     // Unit and range checks against the rig.
     if let Some(f) = facts {
         match s {
@@ -232,7 +267,7 @@ fn channel_problem(
                     return Some(problem(
                         s,
                         ProblemKind::Units,
-                        format!("position spans {r:.4} m but the rig's stroke is {:.4} m: check the unit of the position column (mm written as m?) and the rig", f.stroke),
+                        format!("position spans {} m but the rig's stroke is {:.4} m: check the unit of the position column (mm written as m?) and the rig", num(r), f.stroke),
                     ));
                 }
                 let half = 0.5 * f.stroke + 5.0 * sigma + 0.02 * f.stroke;
@@ -240,7 +275,7 @@ fn channel_problem(
                     return Some(problem(
                         s,
                         ProblemKind::Units,
-                        format!("position reaches [{lo:.4}, {hi:.4}] m, outside the stroke ±{:.4} m: position must be measured from mid-stroke; check the transducer's zero and unit", 0.5 * f.stroke),
+                        format!("position reaches [{}, {}] m, outside the stroke ±{:.4} m: position must be measured from mid-stroke; check the transducer's zero and unit", num(lo), num(hi), 0.5 * f.stroke),
                     ));
                 }
             }
@@ -275,7 +310,9 @@ fn channel_problem(
     }
     // Clipping: many samples exactly at an extreme that is not a physical
     // limit of the rig (an end stop, the supply, the tank).
-    let tol = 1e-9 * r;
+    // (the tolerance on the range without outliers: one 1e305 would put
+    // every other sample "at the extreme")
+    let tol = 1e-9 * rr;
     let n = y.len() as f64;
     let at_hi = y.iter().filter(|v| (hi - **v).abs() <= tol).count() as f64;
     let at_lo = y.iter().filter(|v| (**v - lo).abs() <= tol).count() as f64;
@@ -436,91 +473,6 @@ fn balance_problems(rec: &Record, f: &RigFacts) -> Vec<DataProblem> {
         .collect()
 }
 
-/// A unit that contradicts the rig, as an error naming the file, row 1 and
-/// the column: a `command` written in volts on a rig whose command is a
-/// normalised spool demand (or the other way round), and a time axis whose
-/// unit makes the piston move far faster than the rig can (seconds under
-/// `[ms]`: 1000 times). `problems` are the record's data problems (a
-/// position already found in the wrong unit says nothing about time).
-pub fn unit_errors(rec: &Record, f: &RigFacts, problems: &[DataProblem]) -> Result<(), DataError> {
-    let column = |s: Signal| match rec.units.get(&s) {
-        Some(u) => format!("{} [{u}]", s.name()),
-        None => s.name().to_string(),
-    };
-    if let (Some(want), Some(got)) = (f.command_unit, rec.units.get(&Signal::Command)) {
-        let norm = |u: &str| {
-            if u == "1" {
-                "-".to_string()
-            } else {
-                u.to_string()
-            }
-        };
-        if norm(got) != norm(want) {
-            let what = |u: &str| match u {
-                "-" => "a normalised spool demand (unit `-`)",
-                "V" => "a drive voltage (unit `V`)",
-                _ => "in another unit",
-            };
-            return Err(DataError::UnitContradictsRig {
-                file: rec.source.clone(),
-                column: column(Signal::Command),
-                reason: format!(
-                    "the rig's command is {}, not {}: write the column as the rig takes it",
-                    what(want),
-                    what(got)
-                ),
-            });
-        }
-    }
-    let position_bad = problems
-        .iter()
-        .any(|p| p.channel == Signal::Position.name() && p.kind == ProblemKind::Units);
-    if position_bad {
-        return Ok(());
-    }
-    let (Some(g), Some(u), Some(x)) = (
-        f.velocity_gain,
-        rec.get(Signal::Command),
-        rec.get(Signal::Position),
-    ) else {
-        return Ok(());
-    };
-    let n = x.len();
-    if n < 50 || !(g.is_finite() && g > 0.0) {
-        return Ok(());
-    }
-    // the fastest the rig can move the piston on this record's command
-    let umax = u.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-    let vmax = g * umax;
-    // block means (noise averaged out), about 50 blocks
-    let b = (n / 50).max(5);
-    let means: Vec<(f64, f64)> = rec
-        .time
-        .chunks(b)
-        .zip(x.chunks(b))
-        .map(|(tc, xc)| {
-            let l = tc.len() as f64;
-            (tc.iter().sum::<f64>() / l, xc.iter().sum::<f64>() / l)
-        })
-        .collect();
-    let fastest = means
-        .windows(2)
-        .map(|w| (w[1].1 - w[0].1).abs() / (w[1].0 - w[0].0))
-        .fold(0.0, f64::max);
-    if fastest > GAIN_FACTOR * vmax {
-        let span = rec.time[n - 1] - rec.time[0];
-        return Err(DataError::UnitContradictsRig {
-            file: rec.source.clone(),
-            column: column(Signal::Time),
-            reason: format!(
-                "the piston would move at {fastest:.3e} m/s, {:.0} times the rig's fastest ({vmax:.3e} m/s at this command), over a record of {span:.4e} s: check the unit of the time column (seconds written under [ms]?)",
-                fastest / vmax
-            ),
-        });
-    }
-    Ok(())
-}
-
 /// The command-to-velocity gain of the record against the rig's: the sign
 /// (command up, piston down) and the magnitude (a position logged in the
 /// wrong unit moves the piston 1000 times too little per unit command).
@@ -592,6 +544,7 @@ mod tests {
             signals: cols.iter().cloned().collect::<BTreeMap<_, _>>(),
             ignored: vec![],
             units: Default::default(),
+            lines: Vec::new(),
         }
     }
 
@@ -738,5 +691,52 @@ mod tests {
         let x: Vec<f64> = (0..n).map(|i| (i as f64 * 1e-3 * 0.2).min(0.25)).collect();
         let r = rec(&[(Signal::Command, u), (Signal::Position, x)]);
         assert_eq!(check_record(&r, Some(&facts())), vec![]);
+    }
+
+    /// One huge value in a pressure column (1e300 bar, row 502) is not a
+    /// stuck or quantised sensor (it used to merge every other value into
+    /// one level: "2 distinct levels"); it is a value above the supply.
+    #[test]
+    fn one_outlier_is_neither_constant_nor_quantised() {
+        let (u, x) = moving(2000);
+        let mut p1 = pressure(2000, 3e6);
+        p1[500] = 1e305;
+        let probs = check_record(
+            &rec(&[
+                (Signal::Command, u),
+                (Signal::Position, x),
+                (Signal::P1, p1),
+                (Signal::P2, pressure(2000, 2e6)),
+            ]),
+            Some(&facts()),
+        );
+        let p1: Vec<_> = probs.iter().filter(|p| p.channel == "p1").collect();
+        assert_eq!(p1.len(), 1, "{probs:?}");
+        assert_eq!(p1[0].kind, ProblemKind::Units, "{probs:?}");
+    }
+
+    /// One position far off (1e305 m at row 502) is named at its row and
+    /// column, not blamed on the time column's unit at row 1, and its
+    /// ratio is written compactly (it was a 300-digit number).
+    #[test]
+    fn a_position_outlier_is_named_at_its_row() {
+        let (u, mut x) = moving(2000);
+        x[500] = 1e305;
+        let r = rec(&[(Signal::Command, u.clone()), (Signal::Position, x)]);
+        // the range check calls the position's range a unit problem
+        // (compactly); the outlier is named all the same
+        let probs = check_record(&r, Some(&facts()));
+        assert!(probs.iter().all(|p| p.message.len() < 300), "{probs:?}");
+        let e = unit_errors(&r, &facts(), &probs).unwrap_err().to_string();
+        assert!(
+            e.contains("row 502, column 'position'") && e.len() < 400,
+            "{e}"
+        );
+        // a whole record in ms under [s] is still the time unit
+        let (_, x) = moving(2000);
+        let mut r = rec(&[(Signal::Command, u), (Signal::Position, x)]);
+        r.time.iter_mut().for_each(|t| *t *= 1e-3);
+        let e = unit_errors(&r, &facts(), &[]).unwrap_err().to_string();
+        assert!(e.contains("row 1, column 'time'"), "{e}");
     }
 }

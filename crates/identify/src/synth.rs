@@ -201,6 +201,7 @@ pub fn record(
         signals,
         ignored: vec![],
         units: Default::default(),
+        lines: Vec::new(),
     }
 }
 
@@ -420,6 +421,7 @@ pub fn valve_record_with(
         signals,
         ignored: vec![],
         units: Default::default(),
+        lines: Vec::new(),
     })
 }
 
@@ -535,5 +537,6 @@ pub fn netlist_record(
         signals,
         ignored: vec![],
         units: Default::default(),
+        lines: Vec::new(),
     })
 }

@@ -232,6 +232,36 @@ impl ParamRef {
 }
 
 impl FrictionBench {
+    /// Checks that record `rec` holds the pressures the model needs: a
+    /// chamber area over zero makes its pressure an input of the bench
+    /// (without the column it would run at 0 Pa, and the pressure force it
+    /// lacks be "explained" as an effect). The error names the file and
+    /// the missing column (in the rig's column map, if it maps one).
+    pub fn require_inputs(&self, rec: &crate::data::Record) -> Result<(), crate::data::DataError> {
+        use crate::data::Signal;
+        for (sig, area, name) in [
+            (Signal::P1, self.area1, "area1"),
+            (Signal::P2, self.area2, "area2"),
+        ] {
+            if area > 0.0 && rec.get(sig).is_none() {
+                let column = self
+                    .columns
+                    .0
+                    .get(&sig)
+                    .cloned()
+                    .unwrap_or_else(|| sig.name().to_string());
+                return Err(crate::data::DataError::MissingInput {
+                    file: rec.source.clone(),
+                    column,
+                    why: format!(
+                        "the rig's {name} is {area:.4e} m², so its model is driven by the chamber pressure {sig} (without it, it would run at 0 Pa)"
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// Checks the declaration: every effect applicable, every parameter
     /// present, finite and within its catalog bounds.
     pub fn validate(&self) -> Result<(), RigError> {

@@ -124,6 +124,60 @@ pub enum DataError {
         /// The previous row's time \[s\].
         prev: f64,
     },
+    /// A time stamp lies more than [`super::MAX_SPAN_S`] after the first.
+    #[error("{file}: row {row}, column '{column}': time {t:.4e} s is {span:.4e} s after the first sample: a record spans at most {max:e} s (about 11.6 days); is the time column in seconds, or this time stamp a typo?", max = super::MAX_SPAN_S)]
+    SpanTooLong {
+        /// The file.
+        file: String,
+        /// The row (1-based line).
+        row: usize,
+        /// The time column's header.
+        column: String,
+        /// This row's time \[s\].
+        t: f64,
+        /// Its distance from the first sample \[s\].
+        span: f64,
+    },
+    /// An interval of the time axis over [`super::MAX_GAP_FACTOR`] times
+    /// the record's median interval.
+    #[error("{file}: row {row}, column '{column}': time {t:.6e} s is {step:.4e} s after the previous sample, {ratio:.3e} times the record's median interval ({median:.4e} s; at most {max} times): a time stamp typo, or a gap the model would run across on an input nobody measured; correct it or split the record at the gap", ratio = step / median, max = super::MAX_GAP_FACTOR)]
+    TimeGap {
+        /// The file.
+        file: String,
+        /// The row (1-based line) of the sample after the gap.
+        row: usize,
+        /// The time column's header.
+        column: String,
+        /// This row's time \[s\].
+        t: f64,
+        /// The interval before it \[s\].
+        step: f64,
+        /// The record's median interval \[s\].
+        median: f64,
+    },
+    /// One sample far off its neighbours, which the rig cannot have made (a
+    /// position that would move the piston far faster than the rig can).
+    #[error("{file}: row {row}, column '{column}': {reason}")]
+    Outlier {
+        /// The file.
+        file: String,
+        /// The row (1-based line).
+        row: usize,
+        /// The column header.
+        column: String,
+        /// What was seen and what to check.
+        reason: String,
+    },
+    /// A column the rig's model needs (an input) is not in the file.
+    #[error("{file}: row 1: missing column '{column}': {why}")]
+    MissingInput {
+        /// The file.
+        file: String,
+        /// The missing column's name.
+        column: String,
+        /// Why the model needs it.
+        why: String,
+    },
     /// A column's unit contradicts the rig (a `command [V]` on a rig whose
     /// command is a normalised spool demand; seconds under `time [ms]`).
     #[error("{file}: row 1, column '{column}': {reason}")]

@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::{ColumnMap, DataError, Record, Signal, MIN_SAMPLES};
+use super::{time_axis, ColumnMap, DataError, Record, Signal, MIN_SAMPLES};
 use crate::plaincsv::PlainCsv;
 
 /// Splits `name [unit]` into name and unit.
@@ -195,13 +195,27 @@ impl Record {
             .filter(|s| **s != Signal::Time)
             .map(|s| (*s, Vec::new()))
             .collect();
+        // the file line of each sample: the CSV reader skips blank lines,
+        // which its record count would not see
+        let mut lines = Vec::new();
+        let mut counter = LineCounter::new(text);
         for (k, rec) in rdr.records().enumerate() {
-            let row = k + 2;
-            let rec = rec.map_err(|e| DataError::Malformed {
-                file: file.to_string(),
-                row,
-                reason: e.to_string(),
+            let rec = rec.map_err(|e| {
+                let row = e
+                    .position()
+                    .map_or(lines.last().map_or(k + 2, |l| l + 1), |p| {
+                        counter.line_at(p.byte() as usize)
+                    });
+                DataError::Malformed {
+                    file: file.to_string(),
+                    row,
+                    reason: malformed_reason(&e),
+                }
             })?;
+            let row = rec
+                .position()
+                .map_or(k + 2, |p| counter.line_at(p.byte() as usize));
+            lines.push(row);
             if rec.len() != headers.len() {
                 return Err(DataError::Malformed {
                     file: file.to_string(),
@@ -227,6 +241,15 @@ impl Record {
                     });
                 }
                 let v = v * factor;
+                if !v.is_finite() {
+                    // finite as written, beyond f64 in SI (1e308 bar)
+                    return Err(DataError::NotFinite {
+                        file: file.to_string(),
+                        row,
+                        column: headers[j].to_string(),
+                        text: format!("{cell} is {v} in SI units"),
+                    });
+                }
                 if *sig == Signal::Time {
                     if let Some(&prev) = time.last() {
                         if v <= prev {
@@ -252,12 +275,18 @@ impl Record {
                 min: MIN_SAMPLES,
             });
         }
+        time_axis::check(file, &headers[time_col], &time, |k| lines[k])?;
+        // no blank line inside: sample k is on line k + 2 (see `Record::row`)
+        if lines.iter().enumerate().all(|(k, &l)| l == k + 2) {
+            lines = Vec::new();
+        }
         Ok(Record {
             source: file.to_string(),
             time,
             signals,
             ignored,
             units,
+            lines,
         })
     }
 
@@ -286,13 +315,22 @@ impl Record {
             v
         };
         let time = scale(time_col, values.next()?);
-        if time.len() < MIN_SAMPLES || time.windows(2).any(|w| w[1] <= w[0]) {
+        if time.len() < MIN_SAMPLES
+            || time.windows(2).any(|w| w[1] <= w[0])
+            || !time.iter().all(|t| t.is_finite())
+            || !time_axis::fine(&time)
+        {
             return None;
         }
         let mut signals = BTreeMap::new();
         for (&j, v) in wanted[1..].iter().zip(values) {
             let (sig, _) = cols[j]?;
-            signals.insert(sig, scale(j, v));
+            let v = scale(j, v);
+            // a value beyond f64 once in SI (1e308 bar): the full reader names it
+            if !v.iter().all(|x| x.is_finite()) {
+                return None;
+            }
+            signals.insert(sig, v);
         }
         Some(Record {
             source: file.to_string(),
@@ -300,7 +338,57 @@ impl Record {
             signals,
             ignored,
             units,
+            lines: Vec::new(),
         })
+    }
+}
+
+/// The file line (1-based, blank lines counted) of byte offsets of a text,
+/// asked in increasing order: the CSV reader's own line count skips the
+/// blank lines it skips. Shared by every CSV reader of hydrocyl.
+pub struct LineCounter<'a> {
+    text: &'a [u8],
+    byte: usize,
+    line: usize,
+}
+
+impl<'a> LineCounter<'a> {
+    /// A counter at the start of `text` (line 1).
+    pub fn new(text: &'a str) -> Self {
+        LineCounter {
+            text: text.as_bytes(),
+            byte: 0,
+            line: 1,
+        }
+    }
+
+    /// The line of the record starting at byte offset `byte` (not before
+    /// the last one asked): the CSV reader's offset of a record is before
+    /// the blank lines it skipped, which are passed over here.
+    pub fn line_at(&mut self, byte: usize) -> usize {
+        let mut to = byte.min(self.text.len());
+        while to < self.text.len() && matches!(self.text[to], b'\n' | b'\r') {
+            to += 1;
+        }
+        if to > self.byte {
+            self.line += self.text[self.byte..to]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            self.byte = to;
+        }
+        self.line
+    }
+}
+
+/// What a CSV error says, without the CSV reader's own record and line
+/// numbers (the message names the row once, as the file's line).
+fn malformed_reason(e: &csv::Error) -> String {
+    match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!("{len} cells, header has {expected_len}"),
+        _ => e.to_string(),
     }
 }
 
@@ -371,6 +459,59 @@ mod tests {
         assert!(e.contains("row 8"), "{e}");
         let e = parse("time,position\n0,0\n").unwrap_err();
         assert!(matches!(e, DataError::TooShort { .. }));
+    }
+
+    /// Blank lines are skipped, but a row is still the file's line (it was
+    /// the count of data rows: the `nan` on line 13 was "row 12").
+    #[test]
+    fn rows_are_file_lines_after_blank_lines() {
+        let mut s = String::from("time,p1 [bar]\n");
+        for i in 0..20 {
+            s.push_str(&format!("{i},1\n"));
+            if i == 5 || i == 7 {
+                s.push('\n');
+            }
+        }
+        let r = parse(&s).unwrap();
+        assert_eq!((r.row(0), r.row(5), r.row(6), r.row(8)), (2, 7, 9, 12));
+        let e = parse(&s.replace("10,1", "10,nan")).unwrap_err().to_string();
+        assert!(e.contains("row 14,"), "{e}");
+        let e = parse(&s.replace("10,1", "10,1,2")).unwrap_err().to_string();
+        assert!(e.contains("row 14:") && !e.contains("record"), "{e}");
+        let e = parse(&s.replace("19,1", "1e9,1")).unwrap_err().to_string();
+        assert!(
+            e.contains("row 23, column 'time'") && e.contains("1e6"),
+            "{e}"
+        );
+        // without blank lines the fast path reads it; rows are k + 2
+        let r = parse(&s.replace("\n\n", "\n")).unwrap();
+        assert!(r.lines.is_empty() && r.row(10) == 12);
+    }
+
+    /// A cell finite as written but infinite in SI (1e308 bar) is the
+    /// non-finite error of a `nan` cell; a last time stamp far from the
+    /// others is refused (it used to be simulated across, for minutes).
+    #[test]
+    fn values_beyond_f64_in_si_and_absurd_time_stamps_are_errors() {
+        let mut s = String::from("time [s],p1 [bar]\n");
+        for i in 0..2000 {
+            s.push_str(&format!("{},{}\n", i as f64 * 0.006, 50 + i % 7));
+        }
+        assert!(parse(&s).is_ok());
+        let e = parse(&s.replace("\n3,53", "\n3,1e308"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("row 502, column 'p1 [bar]'") && e.contains("not finite"),
+            "{e}"
+        );
+        let last = format!("{}", 1999.0 * 0.006);
+        for bad in ["1e308", "1e9", "1000000.5", "1000"] {
+            let e = parse(&s.replace(&format!("{last},"), &format!("{bad},")))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("row 2001, column 'time [s]'"), "{bad}: {e}");
+        }
     }
 
     #[test]

@@ -170,6 +170,7 @@ mod tests {
             signals: cols.iter().cloned().collect::<BTreeMap<_, _>>(),
             ignored: vec![],
             units: Default::default(),
+            lines: Vec::new(),
         }
     }
 

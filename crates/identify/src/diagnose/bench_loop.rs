@@ -78,6 +78,10 @@ pub fn diagnose_bench(
     if records.is_empty() {
         return Err(DiagnoseError::NoData);
     }
+    // a pressure the model is driven by must be measured
+    for r in records {
+        rig.require_inputs(r)?;
+    }
     // Data problems that need no rig facts; the bench's output is the force,
     // so a constant force leaves nothing to fit.
     let mut data_problems = Vec::new();

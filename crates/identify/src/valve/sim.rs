@@ -718,6 +718,7 @@ mod tests {
             signals,
             ignored: vec![],
             units: Default::default(),
+            lines: Vec::new(),
         };
         let (mut p, _) = prepare(&rec, None, &[], m.stroke()).unwrap();
         p.rtol = 1e-8;

@@ -556,3 +556,28 @@ fn presets_are_the_netlists_seen_as_benches() {
     );
     assert!(preset("leaney-moog").is_none());
 }
+
+/// A bench record without the pressure of a chamber whose area is over
+/// zero is refused, naming the file and the column (it was run at 0 Pa,
+/// and the missing pressure force "found" as an `external_force`).
+#[test]
+fn a_bench_record_without_its_chamber_pressure_is_refused() {
+    let dir = fixtures().join("measured");
+    let rig = FrictionBench::from_rig(&json(&dir.join("bench-none.rig.json"))).unwrap();
+    let text = std::fs::read_to_string(dir.join("bench-none.csv")).unwrap();
+    let rec = crate::data::Record::parse("b.csv", &text, &rig.columns).unwrap();
+    assert!(rig.require_inputs(&rec).is_ok());
+    let without: String = text
+        .lines()
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            format!("{},{},{}\n", c[0], c[1], c[3])
+        })
+        .collect();
+    let rec = crate::data::Record::parse("b.csv", &without, &rig.columns).unwrap();
+    let e = rig.require_inputs(&rec).unwrap_err().to_string();
+    assert!(
+        e.starts_with("b.csv: row 1: missing column 'p2'") && e.contains("area2"),
+        "{e}"
+    );
+}

@@ -120,7 +120,12 @@ pub struct Args {
     /// bound): a larger one lets a circuit at rest, or a long slow run,
     /// take fewer steps; outputs and events are where they are whatever it
     /// is.
-    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "S",
+        allow_negative_numbers = true,
+        help = "Longest step of the adaptive methods [s] (default 0.01; inf: no bound): a larger one lets a circuit at rest, or a long slow run, take fewer steps; outputs and events are where they are whatever it is"
+    )]
     pub(crate) max_step: Option<f64>,
     /// Also integrate the energy ledger and write it to this JSON file (put
     /// in place with the CSV, checked before the run as --out is): per

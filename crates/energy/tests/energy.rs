@@ -34,6 +34,18 @@ fn charging_circuit(ps: f64, volume: f64, b: f64, via: Box<dyn Component>) -> Ci
     .unwrap()
 }
 
+/// `c` run at the outputs `t` with the ledger on (DP45, rtol 1e-8).
+fn run_with_ledger(c: Circuit, t: &[f64]) -> (Simulation, hydrocyl_system::run::Run) {
+    let opts = RunOptions {
+        ledger: true,
+        rtol: 1e-8,
+        ..RunOptions::dp45()
+    };
+    let mut sim = Simulation::of_circuit(c).options(opts);
+    let r = sim.run(t).unwrap();
+    (sim, r)
+}
+
 /// The ledger of rig `v` over 0.3 s of a half-open spool (rtol 1e-9), with
 /// the rod side it was taken on.
 fn half_open_ledger(v: &serde_json::Value) -> (RodSide, hydrocyl_energy::ledger::Ledger) {
@@ -66,13 +78,7 @@ mod closed_forms {
             let orifice = FixedOrifice::new("orifice", "P", "V", Area::new(area), oil());
             let c = charging_circuit(ps, v, b, Box::new(orifice));
             let t: Vec<f64> = (0..=200).map(|k| k as f64 * 5e-3).collect();
-            let opts = RunOptions {
-                ledger: true,
-                rtol: 1e-8,
-                ..RunOptions::dp45()
-            };
-            let mut sim = Simulation::of_circuit(c).options(opts);
-            let r = sim.run(&t).unwrap();
+            let (sim, r) = run_with_ledger(c, &t);
             let c = sim.circuit();
             let pv = *r.channel("pv").unwrap().last().unwrap();
             assert!((pv - ps).abs() < 1e-6 * ps, "not charged: {pv}");
@@ -116,13 +122,7 @@ mod closed_forms {
         ])
         .unwrap();
         let t: Vec<f64> = (0..=100).map(|k| k as f64 * 1e-3).collect();
-        let opts = RunOptions {
-            ledger: true,
-            rtol: 1e-8,
-            ..RunOptions::dp45()
-        };
-        let mut sim = Simulation::of_circuit(c).options(opts);
-        let r = sim.run(&t).unwrap();
+        let (sim, r) = run_with_ledger(c, &t);
         let pv = *r.channel("pv").unwrap().last().unwrap();
         assert!(pv > 0.0 && pv < 0.5 * p0, "not discharged: {pv}");
         let rod = RodSide::of(sim.circuit());

@@ -18,7 +18,7 @@ mod time_axis;
 
 pub use error::DataError;
 pub use read::{foreign_separator, LineCounter};
-pub use time_axis::{beyond_span, MAX_GAP_FACTOR, MAX_SPAN_S};
+pub use time_axis::{beyond_span, GAP_OVER_REST, MAX_GAP_FACTOR, MAX_SPAN_S};
 
 /// A signal of the measured-data format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]

@@ -139,8 +139,9 @@ pub enum DataError {
         span: f64,
     },
     /// An interval of the time axis over [`super::MAX_GAP_FACTOR`] times
-    /// the record's median interval.
-    #[error("{file}: row {row}, column '{column}': time {t:.6e} s is {step:.4e} s after the previous sample, {ratio:.3e} times the record's median interval ({median:.4e} s; at most {max} times): a time stamp typo, or a gap the model would run across on an input nobody measured; correct it or split the record at the gap", ratio = step / median, max = super::MAX_GAP_FACTOR)]
+    /// the record's median interval and over [`super::GAP_OVER_REST`] times
+    /// the rest of its span.
+    #[error("{file}: row {row}, column '{column}': time {t:.6e} s is {step:.4e} s after the previous sample, {ratio:.3e} times the record's median interval ({median:.4e} s) and more than {rest} times the rest of the record together: a time stamp typo, or a gap the model would run across on an input nobody measured; correct it or split the record at the gap", ratio = step / median, rest = super::GAP_OVER_REST)]
     TimeGap {
         /// The file.
         file: String,

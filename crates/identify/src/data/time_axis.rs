@@ -1,9 +1,13 @@
 //! The time axis a record (or a command file) may have: a span of at most
-//! [`MAX_SPAN_S`], and no interval more than [`MAX_GAP_FACTOR`] times the
-//! record's median interval. Both are checked on reading: past them the
-//! time column holds a typo or a wrong unit (`1e308`, a last time stamp of
-//! 1000 s after 12 s), and a model run across it would integrate, for as
-//! long as it takes, an input nobody measured.
+//! [`MAX_SPAN_S`], and no interval that is both more than
+//! [`MAX_GAP_FACTOR`] times the record's median interval and more than
+//! [`GAP_OVER_REST`] times the rest of its span together. Both are checked
+//! on reading: past them the time column holds a typo or a wrong unit
+//! (`1e308`, a last time stamp of 1000 s after 12 s), and a model run across
+//! it would integrate, for as long as it takes, an input nobody measured.
+//! Uneven steps are allowed (the data format's rule): a record logged on
+//! change, with long rests between its moves, is read, its long steps the
+//! `gap` data problem.
 
 use super::DataError;
 
@@ -18,6 +22,11 @@ pub const MAX_SPAN_S: f64 = 1.0e6;
 /// [`crate::data_checks::GAP_FACTOR`] times): the input would be made up
 /// for at least a hundred of the record's own samples.
 pub const MAX_GAP_FACTOR: f64 = 100.0;
+
+/// ... and over this many times the rest of the record's span together
+/// (the span without it): one interval the record is mostly made of, not a
+/// rest between measured moves.
+pub const GAP_OVER_REST: f64 = 10.0;
 
 /// `true` when time `t` lies more than [`MAX_SPAN_S`] after the first
 /// sample `t0` (the one rule of every reader).
@@ -60,7 +69,12 @@ pub(super) fn check(
     if median.is_nan() || median <= 0.0 {
         return Ok(());
     }
-    if let Some(k) = (1..t.len()).find(|&k| t[k] - t[k - 1] > MAX_GAP_FACTOR * median) {
+    let span = t[t.len() - 1] - t0;
+    let absurd = |k: usize| {
+        let step = t[k] - t[k - 1];
+        step > MAX_GAP_FACTOR * median && step > GAP_OVER_REST * (span - step)
+    };
+    if let Some(k) = (1..t.len()).find(|&k| absurd(k)) {
         return Err(DataError::TimeGap {
             file: file.to_string(),
             row: row(k),
@@ -104,14 +118,16 @@ mod tests {
         // 1000 s after 12 s: inside the span, a gap of 988 s
         let e = check("f", "time", &axis(1000.0), |k| k + 3).unwrap_err();
         assert!(matches!(e, DataError::TimeGap { row: 2002, .. }), "{e}");
-        // 99 median intervals: a `gap` data problem at most, not an error
+        // a rest between measured moves, however long against the median
+        // step (a record logged on change): a `gap` data problem at most
         let mut t = axis(11.994);
         for v in &mut t[1000..] {
-            *v += 98.0 * 0.006;
+            *v += 60.0;
         }
         assert!(check("f", "time", &t, |k| k + 2).is_ok());
+        // one interval ten times the rest of the record together: an error
         for v in &mut t[1000..] {
-            *v += 2.0 * 0.006;
+            *v += 70.0;
         }
         assert!(check("f", "time", &t, |k| k + 2).is_err());
     }

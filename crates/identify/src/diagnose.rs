@@ -449,7 +449,9 @@ pub fn nrmse(measured: &[f64], simulated: &[f64]) -> f64 {
 /// a residual of foreign shape is not dressed up as the nearest catalog effect.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Probe {
-    /// Short name: `delay` or `spring` (friction bench); `delay`, `mass`,
+    /// Short name: `delay`, `spring`, `force_gain`, `p1_gain` or `p2_gain`
+    /// (friction bench: a transport delay of the force, a spring, a
+    /// sensor's gain error); `delay`, `mass`,
     /// `coulomb`, `supply_pressure`, `p1_offset` or `p2_offset` (netlist
     /// rigs: a transport delay of the command, a declared parameter other
     /// than declared, a pressure sensor's zero error).
@@ -461,8 +463,9 @@ pub struct Probe {
     /// Its fitted size, SI: delay \[s\], stiffness \[N·m⁻¹\], mass \[kg\],
     /// Coulomb level \[N\] (of the first Coulomb parameter, where the
     /// friction law has one per direction, all scaled by one factor),
-    /// supply pressure \[Pa\], or the offset \[Pa\] the pressure sensor
-    /// reads above the pressure.
+    /// supply pressure \[Pa\], the offset \[Pa\] the pressure sensor
+    /// reads above the pressure, or a sensor's gain error (a fraction:
+    /// 0.03 reads 3 % high).
     pub value: f64,
     /// Share of the residual it explains.
     pub explained_share: f64,

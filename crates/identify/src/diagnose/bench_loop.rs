@@ -1,11 +1,16 @@
 //! The loop on the friction bench: output-error traces of the catalog's
 //! friction effects on imposed motion, LM refits and the out-of-catalog
-//! probes (delay, spring).
+//! probes (delay, spring, sensor gains).
 
 use super::bench_checks::{kept_on_bench, pressure_force_contradiction};
 use super::bench_model::{initial_guess, n_eff, probes, Bench, Part};
 use super::*;
 use crate::accept::{self, FittedParam, Refitted, Scores};
+
+/// A sensor-gain probe stands in for the catalog only where what it leaves
+/// of the force residual is within this factor of the noise floor (NRMSE):
+/// the tolerance the loop's own tests hold an explained record to.
+const GAIN_PROBE_FLOOR: f64 = 1.5;
 
 /// Why an effect the declared rig already has is not traced.
 fn declared_on_why(rig: &FrictionBench, e: EffectId) -> String {
@@ -272,10 +277,22 @@ pub fn diagnose_bench(
         // best first (ties in catalog order)
         eligible.sort_by(|a, b| b.2.explained_share.total_cmp(&a.2.explained_share));
         let top = eligible.first().map(|(_, _, r)| r.explained_share);
+        // A probe that explains more than the best candidate stands in for
+        // it. A sensor's gain error also resembles catalog effects in part
+        // (an offset that grows with the pressure looks like a Coulomb
+        // asymmetry or a pressure term), so it stands in only where it
+        // leaves no more than the noise (GAIN_PROBE_FLOOR × the floor).
         let probe = if rig.steady_state {
             Vec::new()
         } else {
-            probes(&model, &b)
+            let found = probes(&model, &b);
+            let complete =
+                |p: &Probe| rss0 * (1.0 - p.explained_share) <= GAIN_PROBE_FLOOR.powi(2) * noise_ss;
+            found
+                .shapes
+                .into_iter()
+                .chain(found.gains.into_iter().filter(complete))
+                .collect()
         }
         .into_iter()
         .max_by(|a, b| a.explained_share.total_cmp(&b.explained_share));

@@ -1,6 +1,6 @@
 //! The friction bench as the loop fits it: the records' simulated force,
 //! residuals and LM refits ([`Bench`]), a candidate effect's starting
-//! values and the out-of-catalog probes (delay, spring).
+//! values and the out-of-catalog probes (delay, spring, sensor gains).
 
 use super::*;
 use crate::bench::{BenchInputs, BenchRun};
@@ -225,9 +225,10 @@ pub(super) fn initial_guess(
 }
 
 /// Out-of-catalog probes on the current model: a time shift of the measured
-/// force (transport delay, up to ±40 samples) and a force proportional to
-/// the position (a spring the catalog lacks).
-pub(super) fn probes(rig: &FrictionBench, b: &Bench<'_>) -> Vec<Probe> {
+/// force (transport delay, up to ±40 samples), a force proportional to
+/// the position (a spring the catalog lacks) and the sensors' gain errors
+/// ([`gain_probes`]).
+pub(super) fn probes(rig: &FrictionBench, b: &Bench<'_>) -> Probes {
     let sigs = b.sigs;
     let sims = b.simulate_all(rig);
     let rss0: f64 = sigs
@@ -278,5 +279,75 @@ pub(super) fn probes(rig: &FrictionBench, b: &Bench<'_>) -> Vec<Probe> {
         value: k,
         explained_share: num * k / rss0,
     });
+    Probes {
+        shapes: out,
+        gains: gain_probes(rig, sigs, &sims, rss0),
+    }
+}
+
+/// The probes of one round: residual shapes no catalog effect has (delay,
+/// spring) and the sensors' gain errors, which the loop weighs apart.
+pub(super) struct Probes {
+    pub(super) shapes: Vec<Probe>,
+    pub(super) gains: Vec<Probe>,
+}
+
+/// A sensor's gain (calibration) error: the load cell reading `1 + g` times
+/// the force, or a pressure sensor reading `1 + g` times its pressure. The
+/// first leaves a residual proportional to the predicted force; the second
+/// one proportional to that chamber's pressure force `±A p` in the balance
+/// (the model is driven by the pressure as measured): `g/(1 + g)` of it,
+/// of the sign that takes the excess pressure force back out.
+/// Each is a one-parameter least-squares fit on the residual, like the
+/// spring; a chamber without area, or whose pressure is not recorded
+/// (all zero), has no probe.
+fn gain_probes(
+    rig: &FrictionBench,
+    sigs: &[BenchSignals],
+    sims: &[Vec<f64>],
+    rss0: f64,
+) -> Vec<Probe> {
+    // (kind, column, regressor of sample i of record s given the model's force f)
+    type Regressor = fn(&FrictionBench, &BenchSignals, usize, f64) -> f64;
+    let cases: [(&str, &str, Regressor); 3] = [
+        ("force_gain", "load cell (force)", |_, _, _, f| f),
+        ("p1_gain", "p1 sensor", |r, s, i, _| {
+            r.force_sign * r.area1 * s.p1[i]
+        }),
+        ("p2_gain", "p2 sensor", |r, s, i, _| {
+            -r.force_sign * r.area2 * s.p2[i]
+        }),
+    ];
+    let mut out = Vec::new();
+    for (kind, sensor, phi) in cases {
+        let (mut num, mut den) = (0.0, 0.0);
+        for (s, f) in sigs.iter().zip(sims) {
+            for (i, (m, f)) in s.force.iter().zip(f).enumerate() {
+                let x = phi(rig, s, i, *f);
+                num += x * (m - f);
+                den += x * x;
+            }
+        }
+        if den <= 0.0 || !den.is_finite() || !num.is_finite() {
+            continue;
+        }
+        let c = num / den;
+        // the force's own gain is c; a pressure read (1 + g) times too
+        // high leaves c = g/(1 + g) of its force, so g = c/(1 − c)
+        let g = if kind == "force_gain" {
+            c
+        } else {
+            c / (1.0 - c)
+        };
+        out.push(Probe {
+            kind: kind.into(),
+            what: format!(
+                "{sensor} gain error (reads {:+.1} % of its value)",
+                100.0 * g
+            ),
+            value: g,
+            explained_share: num * c / rss0,
+        });
+    }
     out
 }

@@ -148,6 +148,60 @@ fn out_of_catalog_delay_is_unexplained() {
     assert!((p.value - 0.01).abs() < 1.5e-3, "{}", show(&o));
 }
 
+/// The loop on a record without missing effects whose `signal` column
+/// reads `gain` times its value (a sensor's calibration error).
+fn run_with_gain(signal: hydrocyl_identify::data::Signal, gain: f64, seed: u64) -> Outcome {
+    let truth = truth_with(&[]);
+    let mut rec = record(&truth, 8000, 1e-3, Noise::default(), Foreign::None, seed);
+    rec.signals
+        .get_mut(&signal)
+        .expect("the column")
+        .iter_mut()
+        .for_each(|v| *v *= gain);
+    diagnose_bench(
+        &declared_for(&[]),
+        &[rec],
+        &DiagnoseOptions::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap()
+}
+
+/// A sensor's gain error is not a catalog effect: nothing is added (a
+/// constant `external_force` stood in for it before the gain probes), and
+/// the probe names the sensor and its gain.
+fn check_gain(signal: hydrocyl_identify::data::Signal, gain: f64, kind: &str, seed: u64) {
+    let o = run_with_gain(signal, gain, seed);
+    let r = &o.report;
+    assert!(r.effects_added.is_empty(), "{}", show(&o));
+    assert!(r.unexplained_share > 0.9, "{}", show(&o));
+    let p = r
+        .unexplained_resembles
+        .as_ref()
+        .expect("a probe names the shape");
+    assert_eq!(p.kind, kind, "{}", show(&o));
+    assert!(
+        (p.value - (gain - 1.0)).abs() < 0.1 * (gain - 1.0).abs(),
+        "{}",
+        show(&o)
+    );
+}
+
+#[test]
+fn a_load_cell_gain_error_is_unexplained_and_named() {
+    check_gain(
+        hydrocyl_identify::data::Signal::Force,
+        1.03,
+        "force_gain",
+        25,
+    );
+}
+
+#[test]
+fn a_pressure_sensor_gain_error_is_unexplained_and_named() {
+    check_gain(hydrocyl_identify::data::Signal::P2, 1.05, "p2_gain", 26);
+}
+
 #[test]
 fn a_pressure_twice_what_the_force_balance_implies_is_an_error_naming_the_file() {
     // the bench's pressure is its model's input: doubled, the friction the

@@ -451,10 +451,11 @@ pub fn nrmse(measured: &[f64], simulated: &[f64]) -> f64 {
 pub struct Probe {
     /// Short name: `delay`, `spring`, `force_gain`, `p1_gain` or `p2_gain`
     /// (friction bench: a transport delay of the force, a spring, a
-    /// sensor's gain error); `delay`, `mass`,
-    /// `coulomb`, `supply_pressure`, `p1_offset` or `p2_offset` (netlist
-    /// rigs: a transport delay of the command, a declared parameter other
-    /// than declared, a pressure sensor's zero error).
+    /// sensor's gain error); `delay`, `mass`, `coulomb`,
+    /// `supply_pressure`, `p1_offset`, `p2_offset`, `p1_gain`, `p2_gain` or
+    /// `position_gain` (netlist rigs: a transport delay of the command, a
+    /// declared parameter other than declared, a pressure sensor's zero
+    /// error, a sensor's gain error).
     pub kind: String,
     /// What it is, in words (`"time shift of the measured force"`, `"force
     /// proportional to position"`, ``"load mass other than declared

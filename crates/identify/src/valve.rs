@@ -63,7 +63,7 @@ use effects::*;
 pub use effects::{is_on, rig_facts};
 use fit::*;
 pub use model::Model;
-use probes::best_probe;
+use probes::{best_probe, gain_probe};
 use report::{not_applicable_why, traces};
 pub use sim::lag_samples;
 use sim::*;
@@ -617,11 +617,24 @@ pub fn diagnose_rig_traced(
         }
         let Some((id, refit, rep, joint, res)) = accepted else {
             // No single effect: the best candidates in pairs (`pairs.rs`),
-            // which must explain more than a probe that outranked them all.
-            let need = probe_won
+            // which must explain more than a probe that outranked them all,
+            // and more than a sensor's gain error by `--min-share`: two
+            // catalog effects that do no better than one out-of-catalog
+            // parameter are not established (a position read 3 % long
+            // is a flow gain 3 % high beside a stiffer oil). The gain
+            // probe is closed-form, so it is tried here even where the
+            // top candidate left the probes no chance to win.
+            let mut need = probe_won
                 .as_ref()
                 .map_or(opts.min_share, |pr| pr.explained_share);
             resembles = probe_won;
+            if let Some(g) = gain_probe(&pt, &r0, rss0) {
+                if g.explained_share >= opts.min_share && g.explained_share + opts.min_share > need
+                {
+                    need = g.explained_share + opts.min_share;
+                    resembles = Some(g);
+                }
+            }
             if added.len() + 2 > opts.max_effects {
                 break;
             }

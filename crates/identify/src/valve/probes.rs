@@ -14,7 +14,10 @@
 //! * a constant offset on the measured p1 or p2 (a pressure sensor's zero
 //!   error, `p1_offset`, `p2_offset`): the best offset and the sum of
 //!   squares it removes follow in closed form from the channel's weighted
-//!   residual (no simulation).
+//!   residual (no simulation);
+//! * a sensor's gain error on p1, p2 or the position (`p1_gain`,
+//!   `p2_gain`, `position_gain`), in closed form the same way, named only
+//!   where it explains the record down to its noise ([`GAIN_PROBE_FLOOR`]).
 //!
 //! A probe whose best fit sits at the edge of its searched range (a
 //! quarter or four times the value, a delay of 60 ms) says so in its words:
@@ -487,6 +490,87 @@ fn offset_probe(p: &Prepared, r0: &[f64], rss0: f64) -> Option<Probe> {
         .max_by(|a, b| a.explained_share.total_cmp(&b.explained_share))
 }
 
+/// What a gain probe may leave of the weighted residual to stand in for the
+/// catalog, as a factor on the noise (NRMSE over the floor): a sensor's
+/// gain error resembles catalog effects in part (a position read 3 % long
+/// is a flow gain 3 % high with a stiffer oil; a pressure read 5 % high
+/// looks like its zero error where it varies little), so a gain is named
+/// only where it alone explains the record down to its noise.
+const GAIN_PROBE_FLOOR: f64 = 1.5;
+
+/// The sensors' gain (calibration) errors: p1, p2 or the position read
+/// `1 + g` times their value (`p1_gain`, `p2_gain`, `position_gain`). With
+/// `r = (simulated − measured) w` and the measurement `(1 + g)` times the
+/// simulated value, `r = g φ` with `φ = −simulated · w`: `g` and the sum of
+/// squares it removes follow in closed form from the channel's block (the
+/// position's with a free zero, which its initial state holds anyway). The
+/// largest, if it leaves no more than [`GAIN_PROBE_FLOOR`]² times the noise
+/// of a residual that was above it (the weights are one over each channel's
+/// noise, so the noise's weighted sum of squares is the number of compared
+/// samples).
+pub(super) fn gain_probe(p: &Prepared, r0: &[f64], rss0: f64) -> Option<Probe> {
+    let n = p.t.len();
+    let compared: Vec<_> = p
+        .meas
+        .iter()
+        .zip(&p.weights)
+        .filter(|(_, w)| **w > 0.0)
+        .collect();
+    let noise_ss = (n * compared.len()) as f64;
+    if rss0 <= GAIN_PROBE_FLOOR.powi(2) * noise_ss {
+        // nothing above the noise to explain
+        return None;
+    }
+    compared
+        .iter()
+        .enumerate()
+        .filter_map(|(i, ((ch, m), w))| {
+            let (kind, centred) = match ch {
+                Signal::P1 => ("p1_gain", false),
+                Signal::P2 => ("p2_gain", false),
+                Signal::Position => ("position_gain", true),
+                _ => return None,
+            };
+            let block = r0.get(i * n..(i + 1) * n)?;
+            let phi: Vec<f64> = block
+                .iter()
+                .zip(m.iter())
+                .map(|(r, y)| -(y + r / **w) * **w)
+                .collect();
+            let mean = |v: &[f64]| v.iter().sum::<f64>() / n.max(1) as f64;
+            let (mp, mr) = if centred {
+                (mean(&phi), mean(block))
+            } else {
+                (0.0, 0.0)
+            };
+            let (mut num, mut den) = (0.0, 0.0);
+            for (f, r) in phi.iter().zip(block) {
+                num += (f - mp) * (r - mr);
+                den += (f - mp).powi(2);
+            }
+            if den <= 0.0 || !den.is_finite() || !num.is_finite() {
+                return None;
+            }
+            let g = num / den;
+            let removed = num * g + n as f64 * mr * mr;
+            if rss0 - removed > GAIN_PROBE_FLOOR.powi(2) * noise_ss {
+                return None;
+            }
+            Some(Probe {
+                kind: kind.into(),
+                what: format!(
+                    "{} sensor gain error ({} reads {:+.2} % of its value)",
+                    ch.name(),
+                    ch.name(),
+                    100.0 * g
+                ),
+                value: g,
+                explained_share: removed / rss0.max(1e-300),
+            })
+        })
+        .max_by(|a, b| a.explained_share.total_cmp(&b.explained_share))
+}
+
 /// Every out-of-catalog probe on the round model `rig` (weighted residual
 /// `r0` on the whole record, sum of squares `rss0`): the one explaining
 /// the largest share. `need`: the share a probe must explain to outrank
@@ -503,10 +587,15 @@ pub(super) fn best_probe(
         || delay_probe(rig, p, holdout, rss0),
         || scaled_probes(rig, p, holdout, r0, rss0, need),
     );
-    [delay, scaled, offset_probe(p, r0, rss0)]
-        .into_iter()
-        .flatten()
-        .max_by(|a, b| a.explained_share.total_cmp(&b.explained_share))
+    [
+        delay,
+        scaled,
+        offset_probe(p, r0, rss0),
+        gain_probe(p, r0, rss0),
+    ]
+    .into_iter()
+    .flatten()
+    .max_by(|a, b| a.explained_share.total_cmp(&b.explained_share))
 }
 
 #[cfg(test)]

@@ -255,3 +255,49 @@ fn command_delay_is_reported_unexplained() {
         r.human()
     );
 }
+
+/// A record of the declared rig whose `signal` column reads `gain` times its
+/// value (a sensor's calibration error), diagnosed against that rig.
+fn run_with_gain(signal: hydrocyl_identify::data::Signal, gain: f64, seed: u64) -> Report {
+    let truth = ValveRig::leaney_moog();
+    let mut rec = valve_record(&truth, 2000, 1e-3, seed).unwrap();
+    rec.signals
+        .get_mut(&signal)
+        .expect("the column")
+        .iter_mut()
+        .for_each(|v| *v *= gain);
+    diagnose_valve(&truth, &rec, &DiagnoseOptions::default(), &mut |_, _, _| {}).unwrap()
+}
+
+/// A sensor's gain error is not a catalog effect: nothing is added and the
+/// probe names the sensor and its gain (a pressure's was a zero error, a
+/// position's a flow gain beside a stiffer oil before the gain probes).
+fn check_gain(signal: hydrocyl_identify::data::Signal, gain: f64, kind: &str, seed: u64) {
+    let r = run_with_gain(signal, gain, seed);
+    assert!(r.effects_added.is_empty(), "{}", r.human());
+    let p = r
+        .unexplained_resembles
+        .as_ref()
+        .expect("a probe names the shape");
+    assert_eq!(p.kind, kind, "{}", r.human());
+    assert!(
+        (p.value - (gain - 1.0)).abs() < 0.1 * (gain - 1.0).abs(),
+        "{}",
+        r.human()
+    );
+}
+
+#[test]
+fn a_pressure_sensor_gain_error_is_unexplained_and_named() {
+    check_gain(hydrocyl_identify::data::Signal::P2, 1.05, "p2_gain", 41);
+}
+
+#[test]
+fn a_position_sensor_gain_error_is_unexplained_and_named() {
+    check_gain(
+        hydrocyl_identify::data::Signal::Position,
+        1.03,
+        "position_gain",
+        42,
+    );
+}

@@ -3,6 +3,7 @@
 //! report before and after (human table on stdout, JSON with `--report`,
 //! SVG plots with `--plots`). Nothing is written when anything fails.
 
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use hydrocyl_identify::bench::{self, FrictionBench};
@@ -26,15 +27,20 @@ pub struct Args {
     #[arg(long)]
     pub rig: String,
     /// Measured record(s) (CSV); repeat for several records of one rig
-    /// (e.g. one per pressure level), fitted jointly.
+    /// (e.g. one per pressure level), fitted jointly. A record given twice
+    /// (the same file, or the same content under two names) is refused:
+    /// its samples would count twice.
     #[arg(long, required = true, num_args = 1..)]
     pub data: Vec<PathBuf>,
     /// Where to write the JSON report.
     #[arg(long)]
     pub report: Option<PathBuf>,
     /// Folder for SVG plots: per record and channel, measured vs simulated
-    /// with the residuals; for a friction bench with an effect added, also
-    /// the residual vs that effect's regressor.
+    /// with the residuals (`<record>-<channel>.svg`); for a friction bench
+    /// with an effect added, also the residual vs that effect's regressor
+    /// (`<record>-residual.svg`). `<record>` is the file's stem; records
+    /// whose stems are the same (`a/rec.csv`, `b/rec.csv`; case ignored)
+    /// get their position among the --data too (`rec-1`, `rec-2`).
     #[arg(long)]
     pub plots: Option<PathBuf>,
     /// Least share of the residual an effect must explain to be added.
@@ -182,6 +188,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 .collect::<Result<Vec<_>, _>>()?,
         ),
     };
+    // a record given twice would count its samples twice
+    distinct_records(&args.data)?;
     let rig = load_rig(&args.rig)?;
     // every output checked (and its temporary created) before any work
     let mut inputs: Vec<(&str, &Path)> =
@@ -208,6 +216,20 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map(|p| Record::read_mapped(p, &columns))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| CliError::Input(e.to_string()))?;
+    // every plot this run can write, named and checked before the fit
+    let stems = plot_stems(&args.data);
+    if let Some(dir) = &args.plots {
+        for (r, stem) in records.iter().zip(&stems) {
+            for channel in plot_channels(&rig, r) {
+                outputs.check("--plots", &dir.join(plot_name(stem, channel)))?;
+            }
+        }
+    }
+    let stem_of: BTreeMap<&str, &str> = records
+        .iter()
+        .zip(&stems)
+        .map(|(r, s)| (r.source.as_str(), s.as_str()))
+        .collect();
     for (p, r) in args.data.iter().zip(&records) {
         if r.len() < SMALL_SAMPLE && !args.quiet {
             crate::console::note(format_args!(
@@ -281,7 +303,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     // Everything computed: now write every output together.
     let plots = match &args.plots {
-        Some(dir) => render_plots(&traces)?
+        Some(dir) => render_plots(&traces, &stem_of)?
             .into_iter()
             .map(|(name, svg)| (dir.join(name), svg))
             .collect(),
@@ -332,36 +354,143 @@ pub fn run(args: Args) -> Result<(), CliError> {
     Ok(())
 }
 
+/// Refuses a record given twice (exit 2, naming both arguments): the same
+/// file (the same path once resolved through links, or the same file
+/// under two names: a hard link), or two files with the same bytes (a
+/// copy). Fitted jointly, its samples would count twice and every ±
+/// interval would be √2 too narrow. What is not a regular file (a pipe)
+/// is not read here.
+fn distinct_records(paths: &[PathBuf]) -> Result<(), CliError> {
+    let meta: Vec<Option<std::fs::Metadata>> = paths
+        .iter()
+        .map(|p| std::fs::metadata(p).ok().filter(|m| m.is_file()))
+        .collect();
+    let canon: Vec<Option<PathBuf>> = paths.iter().map(|p| p.canonicalize().ok()).collect();
+    let twice = |i: usize, j: usize, what: &str| {
+        CliError::Input(format!(
+            "--data {} and --data {} (arguments {} and {}): {what}; its samples would count twice in the joint fit (every ± interval √2 too narrow): give each record once",
+            paths[i].display(),
+            paths[j].display(),
+            i + 1,
+            j + 1
+        ))
+    };
+    for j in 1..paths.len() {
+        for i in 0..j {
+            let (Some(a), Some(b)) = (&meta[i], &meta[j]) else {
+                continue;
+            };
+            if canon[i].is_some() && canon[i] == canon[j] || same_inode(a, b) {
+                return Err(twice(i, j, "the same file, given twice"));
+            }
+            if a.len() == b.len() {
+                if let (Ok(x), Ok(y)) = (std::fs::read(&paths[i]), std::fs::read(&paths[j])) {
+                    if x == y {
+                        return Err(twice(i, j, "the same content (one record under two names)"));
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether `a` and `b` are one file (device and inode).
+#[cfg(unix)]
+fn same_inode(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    a.dev() == b.dev() && a.ino() == b.ino()
+}
+
+/// Elsewhere the canonical paths and the content decide.
+#[cfg(not(unix))]
+fn same_inode(_: &std::fs::Metadata, _: &std::fs::Metadata) -> bool {
+    false
+}
+
+/// The name each record's plots start with, distinct for distinct records
+/// (ASCII case ignored, for file systems that ignore it): the file's stem
+/// (`record<k>` for one that is not UTF-8); records sharing a stem get
+/// their position `k` (from 1) among the `--data` appended, `<stem>-<k>`,
+/// repeated in the rare case that is still another record's name. A plot
+/// name is `<stem>-<channel>.svg` and no channel holds a `-`, so distinct
+/// stems give distinct plot names.
+fn plot_stems(paths: &[PathBuf]) -> Vec<String> {
+    let base: Vec<String> = paths
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            p.file_stem()
+                .and_then(|s| s.to_str())
+                .map_or_else(|| format!("record{}", k + 1), str::to_string)
+        })
+        .collect();
+    let key = |s: &str| s.to_ascii_lowercase();
+    let shared = |s: &str| base.iter().filter(|b| key(b) == key(s)).count() > 1;
+    let mut taken: BTreeSet<String> = base.iter().filter(|b| !shared(b)).map(|b| key(b)).collect();
+    base.iter()
+        .enumerate()
+        .map(|(k, b)| {
+            if !shared(b) {
+                return b.clone();
+            }
+            let mut name = format!("{b}-{}", k + 1);
+            while !taken.insert(key(&name)) {
+                name = format!("{name}-{}", k + 1);
+            }
+            name
+        })
+        .collect()
+}
+
+/// The channels a record's plots can be of: a friction bench's `friction`
+/// and `residual`; on a circuit rig every signal the record has (those the
+/// model compares are among them).
+fn plot_channels(rig: &Rig, rec: &Record) -> Vec<&'static str> {
+    match rig {
+        Rig::Bench(_) => vec!["friction", "residual"],
+        Rig::Net(..) => hydrocyl_identify::data::Signal::ALL
+            .into_iter()
+            .filter(|&s| s != hydrocyl_identify::data::Signal::Time && rec.get(s).is_some())
+            .map(|s| s.name())
+            .collect(),
+    }
+}
+
+/// The file name of a record's plot of `channel`.
+fn plot_name(stem: &str, channel: &str) -> String {
+    format!("{stem}-{channel}.svg")
+}
+
 /// The SVG files for `traces` as `(file name, text)`: per record and
 /// compared channel `<stem>-<channel>.svg` (measured, before and after
 /// against time, and below it the residuals before and after) and, when an
 /// effect with a regressor was added (friction benches),
-/// `<stem>-residual.svg` (residual before vs that effect's regressor).
-fn render_plots(traces: &[RecordTrace]) -> Result<Vec<(String, String)>, CliError> {
+/// `<stem>-residual.svg` (residual before vs that effect's regressor);
+/// `stem_of` maps a record's source to its stem ([`plot_stems`]).
+fn render_plots(
+    traces: &[RecordTrace],
+    stem_of: &BTreeMap<&str, &str>,
+) -> Result<Vec<(String, String)>, CliError> {
     let mut out = Vec::new();
     for (k, tr) in traces.iter().enumerate() {
-        let stem = record_stem(tr, k);
-        let name = format!("{stem}-{}.svg", tr.channel);
+        let stem = stem_of
+            .get(tr.source.as_str())
+            .map_or_else(|| format!("record{}", k + 1), |s| s.to_string());
+        let name = plot_name(&stem, &tr.channel);
         let mut svg = String::new();
-        plot_series(&mut svg, &stem, tr).map_err(|e| CliError::Input(format!("{name}: {e}")))?;
+        plot_series(&mut svg, &tr.source, tr)
+            .map_err(|e| CliError::Input(format!("{name}: {e}")))?;
         out.push((name, svg));
         if tr.regressor.is_some() {
-            let name = format!("{stem}-residual.svg");
+            let name = plot_name(&stem, "residual");
             let mut svg = String::new();
-            plot_residual(&mut svg, &stem, tr)
+            plot_residual(&mut svg, &tr.source, tr)
                 .map_err(|e| CliError::Input(format!("{name}: {e}")))?;
             out.push((name, svg));
         }
     }
     Ok(out)
-}
-
-/// The record's file stem (`record<k>` if it has none).
-fn record_stem(tr: &RecordTrace, k: usize) -> String {
-    Path::new(&tr.source)
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .map_or_else(|| format!("record{k}"), |s| s.to_string())
 }
 
 fn bounds(series: &[&[f64]]) -> (f64, f64) {
@@ -437,7 +566,7 @@ fn time_panel(
 
 fn plot_series(
     svg: &mut String,
-    stem: &str,
+    title: &str,
     tr: &RecordTrace,
 ) -> Result<(), Box<dyn std::error::Error>> {
     use plotters::prelude::*;
@@ -448,7 +577,7 @@ fn plot_series(
     let scaled = |v: &[f64]| -> Vec<f64> { v.iter().map(|x| x * f).collect() };
     time_panel(
         &upper,
-        &format!("{stem}: {} measured vs simulated", tr.channel),
+        &format!("{title}: {} measured vs simulated", tr.channel),
         &format!("{} [{u}]", tr.channel),
         &tr.t,
         &[
@@ -478,7 +607,7 @@ fn plot_series(
 
 fn plot_residual(
     svg: &mut String,
-    stem: &str,
+    title: &str,
     tr: &RecordTrace,
 ) -> Result<(), Box<dyn std::error::Error>> {
     use plotters::prelude::*;
@@ -497,7 +626,7 @@ fn plot_residual(
     let (ylo, yhi) = bounds(&[&resid]);
     let mut ch = ChartBuilder::on(&root)
         .caption(
-            format!("{stem}: residual before vs {name} regressor"),
+            format!("{title}: residual before vs {name} regressor"),
             ("sans-serif", 15),
         )
         .margin(10)
@@ -523,6 +652,57 @@ fn plot_residual(
 mod tests {
     use super::*;
     use hydrocyl_identify::data::Signal;
+
+    fn stems(paths: &[&str]) -> Vec<String> {
+        let p: Vec<PathBuf> = paths.iter().map(PathBuf::from).collect();
+        plot_stems(&p)
+    }
+
+    /// Distinct stems stay as they are; records sharing a stem (tester
+    /// t38d D15: `a/rec.csv`, `b/rec.csv`) get their position, case
+    /// ignored, and a name so made that is another record's stem is made
+    /// again: no two records share a plot name.
+    #[test]
+    fn records_sharing_a_file_stem_get_distinct_plot_names() {
+        assert_eq!(stems(&["x/a.csv", "y/b.csv"]), ["a", "b"]);
+        assert_eq!(
+            stems(&["coll/a/rec.csv", "coll/b/rec.csv"]),
+            ["rec-1", "rec-2"]
+        );
+        assert_eq!(
+            stems(&["a/Rec.csv", "b/rec.csv", "c.csv"]),
+            ["Rec-1", "rec-2", "c"]
+        );
+        let s = stems(&["a/rec.csv", "b/rec.csv", "rec-1.csv"]);
+        assert_eq!(s, ["rec-1-1", "rec-2", "rec-1"]);
+        let lower: BTreeSet<String> = s.iter().map(|x| x.to_ascii_lowercase()).collect();
+        assert_eq!(lower.len(), s.len());
+    }
+
+    /// The same file under two spellings or through a link, and a copy, are
+    /// refused naming both arguments; two different files pass.
+    #[cfg(unix)]
+    #[test]
+    fn a_record_given_twice_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("a.csv"), "time,force\n0,1\n").unwrap();
+        std::fs::write(d.join("b.csv"), "time,force\n0,2\n").unwrap();
+        std::fs::write(d.join("copy.csv"), "time,force\n0,1\n").unwrap();
+        std::os::unix::fs::symlink(d.join("a.csv"), d.join("link.csv")).unwrap();
+        let e = |names: &[&str]| {
+            let p: Vec<PathBuf> = names.iter().map(|n| d.join(n)).collect();
+            distinct_records(&p).err().map(|e| e.to_string())
+        };
+        assert_eq!(e(&["a.csv", "b.csv"]), None);
+        let m = e(&["b.csv", "a.csv", "link.csv"]).unwrap();
+        assert!(
+            m.contains("link.csv (arguments 2 and 3): the same file"),
+            "{m}"
+        );
+        let m = e(&["a.csv", "copy.csv"]).unwrap();
+        assert!(m.contains("(arguments 1 and 2): the same content"), "{m}");
+    }
 
     /// A cylinder netlist's identification section gives diagnose its column
     /// map; a bad role is refused by its path.

@@ -211,8 +211,9 @@ impl Outputs {
     }
 
     /// Checks that folder `dir` (option `option`) exists or can be created
-    /// (its parent exists), and is not a file, an input or another output
-    /// of this command; the files in it are opened later with
+    /// (its parent exists), takes files (a probe file is created in it, or
+    /// in its parent, and removed), and is not a file, an input or another
+    /// output of this command; the files in it are opened later with
     /// [`Outputs::file`].
     pub fn check_dir(&self, option: &str, dir: &Path) -> Result<(), CliError> {
         let bad = |why: &str| CliError::Input(format!("{option} {}: {why}", dir.display()));
@@ -223,8 +224,12 @@ impl Outputs {
         if self.files.iter().any(|f| canonical(&f.path) == c) {
             return Err(bad("is already another output of this command"));
         }
+        let io = |source| CliError::Io {
+            path: format!("{option} {}", dir.display()),
+            source,
+        };
         if dir.is_dir() {
-            return Ok(());
+            return probe(dir).map_err(io);
         }
         if dir.exists() {
             return Err(bad("is a file, not a folder"));
@@ -233,7 +238,8 @@ impl Outputs {
             Some(p) if !p.as_os_str().is_empty() && !p.is_dir() => {
                 Err(bad("its parent folder does not exist"))
             }
-            _ => Ok(()),
+            Some(p) if !p.as_os_str().is_empty() => probe(p).map_err(io),
+            _ => probe(Path::new(".")).map_err(io),
         }
     }
 
@@ -333,6 +339,21 @@ impl Outputs {
         self.files.clear();
         Ok(())
     }
+}
+
+/// Creates and removes a probe file in folder `dir`: a folder that takes no
+/// file (read-only, or not a real folder such as `/proc/self`) is an error
+/// before any computation, not after it.
+fn probe(dir: &Path) -> std::io::Result<()> {
+    let tmp = dir.join(format!(".hydrocyl-probe.tmp{}", std::process::id()));
+    remove_temporaries_on_signal();
+    register(&tmp);
+    let made = File::create(&tmp);
+    if made.is_ok() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    unregister(&tmp);
+    made.map(drop)
 }
 
 /// Puts file `tmp` in place at `path`: swapped with an existing file

@@ -115,7 +115,7 @@ pub fn diagnose_bench(
     let mut smoother = None;
     for r in records {
         let (s, info) = bench_signals(r, opts.half_window, rig.steady_state)?;
-        if let Some(why) = pressure_force_contradiction(rig, &s) {
+        if let Some(why) = pressure_force_contradiction(rig, &s, &r.units) {
             return Err(DiagnoseError::Unusable {
                 file: r.source.clone(),
                 why,

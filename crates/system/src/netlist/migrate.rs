@@ -139,6 +139,42 @@ mod tests {
         assert!((c.channel("p1").unwrap()[0] - p1).abs() < 1e-6 * p1);
     }
 
+    /// `null` for a number in an older rig kind is refused by its JSON path
+    /// (tester t38d D10: a netlist took it as the default), in each kind;
+    /// a `valve-cylinder` file's initial `p1`/`p2` keep `null` (steady state).
+    #[test]
+    fn null_for_a_number_in_an_older_kind_is_refused_by_its_path() {
+        let valve = serde_json::to_value(ValveRig::leaney_moog()).unwrap();
+        let hybrid = serde_json::to_value(WangHybrid::preset()).unwrap();
+        let bench: Value = serde_json::from_str(include_str!(
+            "../../../../fixtures/legacy/bench-acceleration_friction.rig.json"
+        ))
+        .unwrap();
+        for (old, pointer, path) in [
+            (&valve, "/valve/null_bias_m", "valve.null_bias_m"),
+            (&valve, "/load/mass_kg", "load.mass_kg"),
+            (&hybrid, "/pump_line_volume", "pump_line_volume"),
+            (&bench, "/friction/coulomb", "friction.coulomb"),
+            (
+                &bench,
+                "/friction/effects/viscous/b",
+                "friction.effects.viscous.b",
+            ),
+        ] {
+            let mut v = old.clone();
+            *v.pointer_mut(pointer).unwrap() = Value::Null;
+            let e = migrate(&v).unwrap_err().to_string();
+            assert!(
+                e.contains(&format!("`{path}`")) && e.contains("null"),
+                "{path}: {e}"
+            );
+        }
+        let mut v = valve.clone();
+        v["initial"]["p1"] = Value::Null;
+        v["initial"]["p2"] = Value::Null;
+        assert!(migrate(&v).unwrap().is_some());
+    }
+
     /// A `hybrid-pump` file and its migrated netlist simulate alike.
     #[test]
     fn a_hybrid_pump_file_migrates_to_an_equal_netlist() {

@@ -7,7 +7,8 @@ use serde_json::{Map, Value};
 use std::collections::BTreeMap;
 
 /// Flattens a component's parameter object into dotted names; `null`
-/// leaves are left out (absent).
+/// leaves go to `nulls` (dotted name → JSON path), not to `out`: `null` is
+/// a value only for a parameter that may be absent (see [`read_instance`]).
 /// A parameter given twice, flat (`"orifice.cd"`) and nested (`"orifice":
 /// {"cd": …}`), is refused at the later key: `given` holds how each dotted
 /// name was spelled.
@@ -16,6 +17,7 @@ fn flatten(
     prefix: &str,
     path: &str,
     out: &mut BTreeMap<String, f64>,
+    nulls: &mut BTreeMap<String, String>,
     given: &mut BTreeMap<String, String>,
 ) -> Result<(), NetlistError> {
     for (k, v) in m {
@@ -43,8 +45,10 @@ fn flatten(
                 let x = n.as_f64().unwrap_or(f64::NAN);
                 out.insert(name, x);
             }
-            Value::Null => {}
-            Value::Object(o) => flatten(o, &name, &at, out, given)?,
+            Value::Null => {
+                nulls.insert(name, at);
+            }
+            Value::Object(o) => flatten(o, &name, &at, out, nulls, given)?,
             other => {
                 return err(
                     at,
@@ -98,13 +102,21 @@ pub(super) fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistEr
     };
     // parameters
     let mut given = BTreeMap::new();
+    let mut nulls = BTreeMap::new();
     let rest: Map<String, Value> = obj
         .iter()
         .filter(|(k, _)| !RESERVED.contains(&k.as_str()))
         .map(|(k, v)| (k.clone(), v.clone()))
         .collect();
-    flatten(&rest, "", &path, &mut given, &mut BTreeMap::new())?;
-    for k in given.keys() {
+    flatten(
+        &rest,
+        "",
+        &path,
+        &mut given,
+        &mut nulls,
+        &mut BTreeMap::new(),
+    )?;
+    for k in given.keys().chain(nulls.keys()) {
         if ty.param(k).is_none() {
             return err(
                 format!("{path}.{k}"),
@@ -122,6 +134,22 @@ pub(super) fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistEr
     let mut params = BTreeMap::new();
     for p in ty.params {
         let at = format!("{path}.{}", p.name);
+        // `null` means "absent" only where absent has a meaning of its own
+        // (no end stop, no Stribeck hump); elsewhere it would silently be
+        // the default, so it is refused like any other non-number
+        if nulls.contains_key(p.name) && p.default != Default::Absent {
+            let leave_out = match p.default {
+                Default::Value(d) => format!("leave the key out for the default, {d}"),
+                _ => "it must be given".to_string(),
+            };
+            return err(
+                at,
+                format!(
+                    "a parameter is a number, got null ({} [{}]; {leave_out})",
+                    p.doc, p.unit
+                ),
+            );
+        }
         match (given.get(p.name), p.default) {
             (Some(&x), _) => {
                 if let Err(why) = p.check(x) {
@@ -198,4 +226,60 @@ pub(super) fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistEr
         hint_from: BTreeMap::new(),
         input: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::read_instance;
+    use serde_json::json;
+
+    fn bench_friction(extra: serde_json::Value) -> serde_json::Value {
+        let mut v =
+            json!({ "type": "friction_bench", "coulomb": 20.0, "smoothing_velocity": 1e-3 });
+        for (k, x) in extra.as_object().unwrap() {
+            v[k] = x.clone();
+        }
+        v
+    }
+
+    /// `null` for a parameter with a default would silently be that
+    /// default: it is refused at its JSON path, as a string is.
+    #[test]
+    fn null_for_a_parameter_with_a_default_is_refused_by_its_path() {
+        let e = read_instance("friction", &bench_friction(json!({ "viscous": null }))).unwrap_err();
+        assert_eq!(e.path, "components.friction.viscous");
+        assert!(
+            e.why.starts_with("a parameter is a number, got null")
+                && e.why.contains("leave the key out for the default, 0"),
+            "{}",
+            e.why
+        );
+        let e = read_instance("friction", &bench_friction(json!({ "coulomb": null }))).unwrap_err();
+        assert_eq!(e.path, "components.friction.coulomb");
+        assert!(e.why.contains("it must be given"), "{}", e.why);
+        // a name the type does not have is refused, null or not
+        let e = read_instance("friction", &bench_friction(json!({ "viscos": null }))).unwrap_err();
+        assert_eq!(e.path, "components.friction.viscos");
+        // a wrong type stays refused as before
+        let e =
+            read_instance("friction", &bench_friction(json!({ "viscous": "2.0" }))).unwrap_err();
+        assert_eq!(e.path, "components.friction.viscous");
+    }
+
+    /// Where `null` has a meaning of its own it stays: a parameter that may
+    /// be absent (no Stribeck hump, no end stop) and an initial state
+    /// (computed, or cleared for the cylinder's).
+    #[test]
+    fn null_stays_where_absent_has_a_meaning() {
+        let i = read_instance("friction", &bench_friction(json!({ "stiction": null }))).unwrap();
+        assert_eq!(i.params.get("stiction"), None);
+        assert_eq!(i.params["viscous"], 0.0);
+        let mass = json!({
+            "type": "mass", "mass": 2.0, "stop_min": null, "stop_max": null,
+            "initial": { "position": null, "velocity": null }
+        });
+        let i = read_instance("load", &mass).unwrap();
+        assert_eq!(i.params.get("stop_min"), None);
+        assert_eq!(i.initial["position"], None);
+    }
 }

@@ -19,6 +19,7 @@ use serde::Serialize;
 use crate::data::{Record, Signal};
 use crate::smooth::noise_sigma;
 
+mod balance;
 mod coverage;
 mod unit_errors;
 pub use coverage::{missing_channels, pressure_scale_problems, GAP_FACTOR, SCALE_FACTOR};
@@ -219,7 +220,7 @@ pub fn check_record(rec: &Record, facts: Option<&RigFacts>) -> Vec<DataProblem> 
             }
         }
         if !bad(&out, Signal::P1) && !bad(&out, Signal::P2) {
-            out.extend(balance_problems(rec, f));
+            out.extend(balance::balance_problems(rec, f));
         }
     }
     for p in &mut out {
@@ -404,75 +405,6 @@ fn inward_dwell(y: &[f64], v: f64, r: f64) -> f64 {
     counts.into_iter().max().unwrap_or(0).max(1) as f64
 }
 
-/// Pressure channels that contradict the rig's force balance: with the
-/// piston off its stops, `p1 A1 − m a` must follow `p2 A2` (plus a constant
-/// load and friction, fitted alongside as `c + f tanh(v/5 mm/s) + b v`); a
-/// coefficient on `p2 A2` far from 1 means the two pressures are not in the
-/// same unit (bar under `[psi]` reads 14.5 times too low). Which of the two
-/// is wrong the balance cannot tell, so both are named (and left out).
-fn balance_problems(rec: &Record, f: &RigFacts) -> Vec<DataProblem> {
-    let Some((a1, a2)) = f.areas else {
-        return vec![];
-    };
-    let (Some(p1), Some(p2), Some(x)) = (
-        rec.get(Signal::P1),
-        rec.get(Signal::P2),
-        rec.get(Signal::Position),
-    ) else {
-        return vec![];
-    };
-    let t = &rec.time;
-    let n = t.len();
-    if n < 50 || !(a1 > 0.0 && a2 > 0.0) {
-        return vec![];
-    }
-    let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
-    let k = ((0.025 / dt).round() as usize).clamp(1, n / 4);
-    let mut xtx = nalgebra::Matrix4::<f64>::zeros();
-    let mut xty = nalgebra::Vector4::<f64>::zeros();
-    let mut rows: Vec<(nalgebra::Vector4<f64>, f64)> = Vec::new();
-    for i in k..n - k {
-        if x[i].abs() > 0.45 * f.stroke {
-            continue;
-        }
-        let (hm, hp) = (t[i] - t[i - k], t[i + k] - t[i]);
-        let v = (x[i + k] - x[i - k]) / (hm + hp);
-        let a = 2.0 * ((x[i + k] - x[i]) / hp - (x[i] - x[i - k]) / hm) / (hm + hp);
-        let row = nalgebra::Vector4::new(p2[i] * a2, 1.0, (v / 5e-3).tanh(), v);
-        let y = p1[i] * a1 - f.mass * a;
-        xtx += row * row.transpose();
-        xty += row * y;
-        rows.push((row, y));
-    }
-    let m = rows.len();
-    if m < 50 {
-        return vec![];
-    }
-    let Some(inv) = xtx.try_inverse() else {
-        return vec![];
-    };
-    let beta = inv * xty;
-    let rss: f64 = rows.iter().map(|(r, y)| (y - r.dot(&beta)).powi(2)).sum();
-    let se = (rss / (m - 4) as f64 * inv[(0, 0)]).max(0.0).sqrt();
-    let gain = beta[0];
-    // judged only where the record pins the coefficient down
-    if !(se < 0.1 && gain.is_finite()) || (1.0 / BALANCE_FACTOR..=BALANCE_FACTOR).contains(&gain) {
-        return vec![];
-    }
-    let unit_of = |s: Signal| rec.units.get(&s).map_or("Pa", String::as_str).to_string();
-    let (u1, u2) = (unit_of(Signal::P1), unit_of(Signal::P2));
-    [Signal::P1, Signal::P2]
-        .into_iter()
-        .map(|s| {
-            problem(
-                s,
-                ProblemKind::Units,
-                format!("p1 and p2 do not balance the piston: p1 A1 − m a ≈ {gain:.3} × p2 A2 (± {se:.2}; 1 on this rig, whatever the load and friction): one of the two columns (p1 in {u1}, p2 in {u2}) is in another unit than its header says; both left out"),
-            )
-        })
-        .collect()
-}
-
 /// The command-to-velocity gain of the record against the rig's: the sign
 /// (command up, piston down) and the magnitude (a position logged in the
 /// wrong unit moves the piston 1000 times too little per unit command).
@@ -536,7 +468,7 @@ mod tests {
     use super::*;
     use std::collections::BTreeMap;
 
-    fn rec(cols: &[(Signal, Vec<f64>)]) -> Record {
+    pub(super) fn rec(cols: &[(Signal, Vec<f64>)]) -> Record {
         let n = cols[0].1.len();
         Record {
             source: "test".into(),
@@ -548,7 +480,7 @@ mod tests {
         }
     }
 
-    fn facts() -> RigFacts {
+    pub(super) fn facts() -> RigFacts {
         RigFacts {
             stroke: 0.5,
             supply: 7e6,
@@ -559,7 +491,7 @@ mod tests {
         }
     }
 
-    fn moving(n: usize) -> (Vec<f64>, Vec<f64>) {
+    pub(super) fn moving(n: usize) -> (Vec<f64>, Vec<f64>) {
         // command a sine, position its integral at gain 0.2 m/s
         let u: Vec<f64> = (0..n)
             .map(|i| (i as f64 * 1e-3 * 2.0 * std::f64::consts::PI).sin())
@@ -573,7 +505,7 @@ mod tests {
         (u, x)
     }
 
-    fn pressure(n: usize, mean: f64) -> Vec<f64> {
+    pub(super) fn pressure(n: usize, mean: f64) -> Vec<f64> {
         let e = crate::smooth::gaussian_noise(n, 3);
         (0..n)
             .map(|i| mean + 5e5 * (i as f64 * 3e-3).sin() + 2e4 * e[i])

@@ -22,6 +22,7 @@ use crate::smooth::noise_sigma;
 mod balance;
 mod coverage;
 mod unit_errors;
+mod velocity_sign;
 pub use coverage::{missing_channels, pressure_scale_problems, GAP_FACTOR, SCALE_FACTOR};
 pub use unit_errors::unit_errors;
 
@@ -218,6 +219,9 @@ pub fn check_record(rec: &Record, facts: Option<&RigFacts>) -> Vec<DataProblem> 
             if let Some(p) = gain_problem(rec, f) {
                 out.push(p);
             }
+        }
+        if !bad(&out, Signal::Position) && !bad(&out, Signal::Velocity) {
+            out.extend(velocity_sign::velocity_sign_problem(rec));
         }
         if !bad(&out, Signal::P1) && !bad(&out, Signal::P2) {
             out.extend(balance::balance_problems(rec, f));

@@ -21,9 +21,11 @@ use crate::smooth::noise_sigma;
 
 mod balance;
 mod coverage;
+mod outliers;
 mod unit_errors;
 mod velocity_sign;
 pub use coverage::{missing_channels, pressure_scale_problems, GAP_FACTOR, SCALE_FACTOR};
+pub use outliers::position_outliers;
 pub use unit_errors::unit_errors;
 
 /// What the checks need to know about the rig (SI units).
@@ -164,6 +166,21 @@ fn robust_range(v: &[f64], full: f64) -> f64 {
     }
 }
 
+/// The 0.5th and 99.5th percentiles of `y` (its extremes below 200
+/// samples): the bulk of the channel, without a handful of outliers.
+fn bulk(y: &[f64]) -> (f64, f64) {
+    let mut v = y.to_vec();
+    v.sort_by(f64::total_cmp);
+    let tail = v.len() / 200;
+    match (
+        v.get(tail),
+        v.len().checked_sub(1 + tail).and_then(|k| v.get(k)),
+    ) {
+        (Some(lo), Some(hi)) => (*lo, *hi),
+        _ => (0.0, 0.0),
+    }
+}
+
 /// A value for a message: `0.5200` below 1e6 in magnitude, else `1.0000e305`
 /// (not a 300-digit number).
 fn num(v: f64) -> String {
@@ -267,20 +284,25 @@ fn channel_problem(
     if let Some(f) = facts {
         match s {
             Signal::Position => {
+                // the bulk of the channel (its 0.5th to 99.5th percentiles):
+                // a few samples beyond the stroke are outliers
+                // (`outliers::position_outliers`, an error naming their
+                // rows), not a unit
+                let (blo, bhi) = bulk(y);
                 let allowed = f.stroke + 10.0 * sigma;
-                if r > 1.05 * allowed {
+                if bhi - blo > 1.05 * allowed {
                     return Some(problem(
                         s,
                         ProblemKind::Units,
-                        format!("position spans {} m but the rig's stroke is {:.4} m: check the unit of the position column (mm written as m?) and the rig", num(r), f.stroke),
+                        format!("position spans {} m but the rig's stroke is {:.4} m: check the unit of the position column (mm written as m?) and the rig", num(bhi - blo), f.stroke),
                     ));
                 }
-                let half = 0.5 * f.stroke + 5.0 * sigma + 0.02 * f.stroke;
-                if lo < -half || hi > half {
+                let half = outliers::half_stroke_allowed(f, sigma);
+                if blo < -half || bhi > half {
                     return Some(problem(
                         s,
                         ProblemKind::Units,
-                        format!("position reaches [{}, {}] m, outside the stroke ±{:.4} m: position must be measured from mid-stroke; check the transducer's zero and unit", num(lo), num(hi), 0.5 * f.stroke),
+                        format!("position reaches [{}, {}] m, outside the stroke ±{:.4} m: position must be measured from mid-stroke; check the transducer's zero and unit", num(blo), num(bhi), 0.5 * f.stroke),
                     ));
                 }
             }
@@ -659,9 +681,10 @@ mod tests {
         let (u, mut x) = moving(2000);
         x[500] = 1e305;
         let r = rec(&[(Signal::Command, u.clone()), (Signal::Position, x)]);
-        // the range check calls the position's range a unit problem
-        // (compactly); the outlier is named all the same
+        // the range checks judge the bulk of the channel: no unit problem
+        // (no message holds the 300-digit number); the outlier is named
         let probs = check_record(&r, Some(&facts()));
+        assert_eq!(probs, vec![]);
         assert!(probs.iter().all(|p| p.message.len() < 300), "{probs:?}");
         let e = unit_errors(&r, &facts(), &probs).unwrap_err().to_string();
         assert!(

@@ -40,7 +40,8 @@ use hydrocyl_system::valve_rig::ValveRig;
 use crate::catalog::EffectId;
 use crate::data::{Record, Signal};
 use crate::data_checks::{
-    check_record, missing_channels, pressure_scale_problems, unit_errors, ProblemKind, RigFacts,
+    check_record, missing_channels, position_outliers, pressure_scale_problems, unit_errors,
+    ProblemKind, RigFacts,
 };
 use crate::diagnose::{
     nrmse, Applicable, DiagnoseError, DiagnoseOptions, EffectReport, NotApplicable, Probe,
@@ -197,6 +198,7 @@ pub fn diagnose_rig_traced(
     // Data problems first: each channel named and left out is not fitted.
     let facts = rig_facts(declared);
     let mut data_problems = check_record(rec, Some(&facts));
+    position_outliers(rec, &facts, &data_problems)?;
     unit_errors(rec, &facts, &data_problems)?;
     // the compared channels the record lacks (a position is required)
     let compared: &[Signal] = match rec.get(Signal::Reference) {

@@ -21,10 +21,12 @@ use crate::smooth::noise_sigma;
 
 mod balance;
 mod coverage;
+mod input;
 mod outliers;
 mod unit_errors;
 mod velocity_sign;
 pub use coverage::{missing_channels, pressure_scale_problems, GAP_FACTOR, SCALE_FACTOR};
+pub use input::input_errors;
 pub use outliers::position_outliers;
 pub use unit_errors::unit_errors;
 

@@ -40,8 +40,8 @@ use hydrocyl_system::valve_rig::ValveRig;
 use crate::catalog::EffectId;
 use crate::data::{Record, Signal};
 use crate::data_checks::{
-    check_record, missing_channels, position_outliers, pressure_scale_problems, unit_errors,
-    ProblemKind, RigFacts,
+    check_record, input_errors, missing_channels, position_outliers, pressure_scale_problems,
+    unit_errors, ProblemKind, RigFacts,
 };
 use crate::diagnose::{
     nrmse, Applicable, DiagnoseError, DiagnoseOptions, EffectReport, NotApplicable, Probe,
@@ -200,6 +200,7 @@ pub fn diagnose_rig_traced(
     let mut data_problems = check_record(rec, Some(&facts));
     position_outliers(rec, &facts, &data_problems)?;
     unit_errors(rec, &facts, &data_problems)?;
+    input_errors(rec, &facts)?;
     // the compared channels the record lacks (a position is required)
     let compared: &[Signal] = match rec.get(Signal::Reference) {
         Some(_) => &[Signal::P1, Signal::P2, Signal::Command],

@@ -23,11 +23,13 @@ mod balance;
 mod coverage;
 mod input;
 mod outliers;
+mod travel;
 mod unit_errors;
 mod velocity_sign;
 pub use coverage::{missing_channels, pressure_scale_problems, GAP_FACTOR, SCALE_FACTOR};
 pub use input::input_errors;
 pub use outliers::position_outliers;
+pub use travel::travel_error;
 pub use unit_errors::unit_errors;
 
 /// What the checks need to know about the rig (SI units).

@@ -41,7 +41,7 @@ use crate::catalog::EffectId;
 use crate::data::{Record, Signal};
 use crate::data_checks::{
     check_record, input_errors, missing_channels, position_outliers, pressure_scale_problems,
-    unit_errors, ProblemKind, RigFacts,
+    travel_error, unit_errors, ProblemKind, RigFacts,
 };
 use crate::diagnose::{
     nrmse, Applicable, DiagnoseError, DiagnoseOptions, EffectReport, NotApplicable, Probe,
@@ -267,6 +267,11 @@ pub fn diagnose_rig_traced(
                 .map(|(c, _)| *c)
                 .zip(sims_declared.iter().map(Vec::as_slice))
                 .collect();
+            // the command moves the declared piston as the record's (any
+            // netlist rig, not only the valve circuit's steady gain)
+            if let Some((_, x)) = sim.iter().find(|(s, _)| *s == Signal::Position) {
+                travel_error(rec, x, &facts, &data_problems)?;
+            }
             let scale = pressure_scale_problems(rec, &sim);
             if !scale.is_empty() {
                 data_problems.extend(scale);

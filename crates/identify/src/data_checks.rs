@@ -2,11 +2,20 @@
 //! that is constant, clipped or quantised far coarser than the others; a
 //! unit that contradicts the rig (a position range beyond the stroke,
 //! pressures above the supply or below vacuum, or far below the supply, a
-//! command-to-velocity gain far from the rig's); a sign that contradicts
-//! the rig (command up, piston down); gaps in the time axis. After the
-//! declared model's first run, [`pressure_scale_problems`] compares the
-//! pressures' scale with the model's, and [`missing_channels`] names the
-//! compared channels a record lacks.
+//! command-to-velocity gain far from the rig's, p1 and p2 that do not
+//! balance the piston or look swapped); a sign that contradicts the rig
+//! (command up, piston down) or the record (a velocity against its own
+//! position's derivative); gaps in the time axis. After the declared
+//! model's first run, [`pressure_scale_problems`] compares the pressures'
+//! scale with the model's, and [`missing_channels`] names the compared
+//! channels a record lacks.
+//!
+//! What leaves nothing to diagnose is an error naming the file, row and
+//! column instead: [`position_outliers`] (a handful of position samples
+//! beyond the stroke), [`unit_errors`], [`input_errors`] (a constant
+//! command under a piston moving both ways) and, after the first run,
+//! [`travel_error`] (a command the declared rig does not move the piston
+//! on as the record's).
 //!
 //! The checks read the record and a few facts about the rig ([`RigFacts`]),
 //! not the rig itself, so they do not depend on how a rig is declared. Each

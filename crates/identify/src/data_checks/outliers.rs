@@ -16,7 +16,7 @@ pub(super) fn half_stroke_allowed(f: &RigFacts, sigma: f64) -> f64 {
     0.5 * f.stroke + 5.0 * sigma + 0.02 * f.stroke
 }
 
-/// Position samples beyond the stroke (outside ±[`half_stroke_allowed`])
+/// Position samples beyond the stroke (outside ±(stroke/2 + 5σ + 2 % of it))
 /// while the bulk of the channel, its 0.5th to 99.5th percentiles, stays
 /// within it (the range check of [`super::check_record`] judges the bulk):
 /// an error naming the first such sample's row and the position column,

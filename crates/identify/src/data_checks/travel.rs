@@ -18,7 +18,7 @@ const MOVING_STROKE: f64 = 0.01;
 /// After the declared model's first run on the record's command: the
 /// piston's travel (the range between the 0.5th and 99.5th percentiles of
 /// the position) measured and simulated, as an error naming the command
-/// column when one is more than [`TRAVEL_FACTOR`] times the other. A
+/// column when one is more than 20 times the other. A
 /// valve rig's normalised demand given to a pump rig that takes volts moves
 /// the simulated piston 2.2 mm where the record's moves 81 mm (it was
 /// diagnosed, the residual resembling "a Coulomb level four times

@@ -2,11 +2,20 @@
 //! that is constant, clipped or quantised far coarser than the others; a
 //! unit that contradicts the rig (a position range beyond the stroke,
 //! pressures above the supply or below vacuum, or far below the supply, a
-//! command-to-velocity gain far from the rig's); a sign that contradicts
-//! the rig (command up, piston down); gaps in the time axis. After the
-//! declared model's first run, [`pressure_scale_problems`] compares the
-//! pressures' scale with the model's, and [`missing_channels`] names the
-//! compared channels a record lacks.
+//! command-to-velocity gain far from the rig's, p1 and p2 that do not
+//! balance the piston or look swapped); a sign that contradicts the rig
+//! (command up, piston down) or the record (a velocity against its own
+//! position's derivative); gaps in the time axis. After the declared
+//! model's first run, [`pressure_scale_problems`] compares the pressures'
+//! scale with the model's, and [`missing_channels`] names the compared
+//! channels a record lacks.
+//!
+//! What leaves nothing to diagnose is an error naming the file, row and
+//! column instead: [`position_outliers`] (a handful of position samples
+//! beyond the stroke), [`unit_errors`], [`input_errors`] (a constant
+//! command under a piston moving both ways) and, after the first run,
+//! [`travel_error`] (a command the declared rig does not move the piston
+//! on as the record's).
 //!
 //! The checks read the record and a few facts about the rig ([`RigFacts`]),
 //! not the rig itself, so they do not depend on how a rig is declared. Each
@@ -19,9 +28,17 @@ use serde::Serialize;
 use crate::data::{Record, Signal};
 use crate::smooth::noise_sigma;
 
+mod balance;
 mod coverage;
+mod input;
+mod outliers;
+mod travel;
 mod unit_errors;
+mod velocity_sign;
 pub use coverage::{missing_channels, pressure_scale_problems, GAP_FACTOR, SCALE_FACTOR};
+pub use input::input_errors;
+pub use outliers::position_outliers;
+pub use travel::travel_error;
 pub use unit_errors::unit_errors;
 
 /// What the checks need to know about the rig (SI units).
@@ -162,6 +179,21 @@ fn robust_range(v: &[f64], full: f64) -> f64 {
     }
 }
 
+/// The 0.5th and 99.5th percentiles of `y` (its extremes below 200
+/// samples): the bulk of the channel, without a handful of outliers.
+fn bulk(y: &[f64]) -> (f64, f64) {
+    let mut v = y.to_vec();
+    v.sort_by(f64::total_cmp);
+    let tail = v.len() / 200;
+    match (
+        v.get(tail),
+        v.len().checked_sub(1 + tail).and_then(|k| v.get(k)),
+    ) {
+        (Some(lo), Some(hi)) => (*lo, *hi),
+        _ => (0.0, 0.0),
+    }
+}
+
 /// A value for a message: `0.5200` below 1e6 in magnitude, else `1.0000e305`
 /// (not a 300-digit number).
 fn num(v: f64) -> String {
@@ -218,8 +250,11 @@ pub fn check_record(rec: &Record, facts: Option<&RigFacts>) -> Vec<DataProblem> 
                 out.push(p);
             }
         }
+        if !bad(&out, Signal::Position) && !bad(&out, Signal::Velocity) {
+            out.extend(velocity_sign::velocity_sign_problem(rec));
+        }
         if !bad(&out, Signal::P1) && !bad(&out, Signal::P2) {
-            out.extend(balance_problems(rec, f));
+            out.extend(balance::balance_problems(rec, f));
         }
     }
     for p in &mut out {
@@ -262,20 +297,25 @@ fn channel_problem(
     if let Some(f) = facts {
         match s {
             Signal::Position => {
+                // the bulk of the channel (its 0.5th to 99.5th percentiles):
+                // a few samples beyond the stroke are outliers
+                // (`outliers::position_outliers`, an error naming their
+                // rows), not a unit
+                let (blo, bhi) = bulk(y);
                 let allowed = f.stroke + 10.0 * sigma;
-                if r > 1.05 * allowed {
+                if bhi - blo > 1.05 * allowed {
                     return Some(problem(
                         s,
                         ProblemKind::Units,
-                        format!("position spans {} m but the rig's stroke is {:.4} m: check the unit of the position column (mm written as m?) and the rig", num(r), f.stroke),
+                        format!("position spans {} m but the rig's stroke is {:.4} m: check the unit of the position column (mm written as m?) and the rig", num(bhi - blo), f.stroke),
                     ));
                 }
-                let half = 0.5 * f.stroke + 5.0 * sigma + 0.02 * f.stroke;
-                if lo < -half || hi > half {
+                let half = outliers::half_stroke_allowed(f, sigma);
+                if blo < -half || bhi > half {
                     return Some(problem(
                         s,
                         ProblemKind::Units,
-                        format!("position reaches [{}, {}] m, outside the stroke ±{:.4} m: position must be measured from mid-stroke; check the transducer's zero and unit", num(lo), num(hi), 0.5 * f.stroke),
+                        format!("position reaches [{}, {}] m, outside the stroke ±{:.4} m: position must be measured from mid-stroke; check the transducer's zero and unit", num(blo), num(bhi), 0.5 * f.stroke),
                     ));
                 }
             }
@@ -404,75 +444,6 @@ fn inward_dwell(y: &[f64], v: f64, r: f64) -> f64 {
     counts.into_iter().max().unwrap_or(0).max(1) as f64
 }
 
-/// Pressure channels that contradict the rig's force balance: with the
-/// piston off its stops, `p1 A1 − m a` must follow `p2 A2` (plus a constant
-/// load and friction, fitted alongside as `c + f tanh(v/5 mm/s) + b v`); a
-/// coefficient on `p2 A2` far from 1 means the two pressures are not in the
-/// same unit (bar under `[psi]` reads 14.5 times too low). Which of the two
-/// is wrong the balance cannot tell, so both are named (and left out).
-fn balance_problems(rec: &Record, f: &RigFacts) -> Vec<DataProblem> {
-    let Some((a1, a2)) = f.areas else {
-        return vec![];
-    };
-    let (Some(p1), Some(p2), Some(x)) = (
-        rec.get(Signal::P1),
-        rec.get(Signal::P2),
-        rec.get(Signal::Position),
-    ) else {
-        return vec![];
-    };
-    let t = &rec.time;
-    let n = t.len();
-    if n < 50 || !(a1 > 0.0 && a2 > 0.0) {
-        return vec![];
-    }
-    let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
-    let k = ((0.025 / dt).round() as usize).clamp(1, n / 4);
-    let mut xtx = nalgebra::Matrix4::<f64>::zeros();
-    let mut xty = nalgebra::Vector4::<f64>::zeros();
-    let mut rows: Vec<(nalgebra::Vector4<f64>, f64)> = Vec::new();
-    for i in k..n - k {
-        if x[i].abs() > 0.45 * f.stroke {
-            continue;
-        }
-        let (hm, hp) = (t[i] - t[i - k], t[i + k] - t[i]);
-        let v = (x[i + k] - x[i - k]) / (hm + hp);
-        let a = 2.0 * ((x[i + k] - x[i]) / hp - (x[i] - x[i - k]) / hm) / (hm + hp);
-        let row = nalgebra::Vector4::new(p2[i] * a2, 1.0, (v / 5e-3).tanh(), v);
-        let y = p1[i] * a1 - f.mass * a;
-        xtx += row * row.transpose();
-        xty += row * y;
-        rows.push((row, y));
-    }
-    let m = rows.len();
-    if m < 50 {
-        return vec![];
-    }
-    let Some(inv) = xtx.try_inverse() else {
-        return vec![];
-    };
-    let beta = inv * xty;
-    let rss: f64 = rows.iter().map(|(r, y)| (y - r.dot(&beta)).powi(2)).sum();
-    let se = (rss / (m - 4) as f64 * inv[(0, 0)]).max(0.0).sqrt();
-    let gain = beta[0];
-    // judged only where the record pins the coefficient down
-    if !(se < 0.1 && gain.is_finite()) || (1.0 / BALANCE_FACTOR..=BALANCE_FACTOR).contains(&gain) {
-        return vec![];
-    }
-    let unit_of = |s: Signal| rec.units.get(&s).map_or("Pa", String::as_str).to_string();
-    let (u1, u2) = (unit_of(Signal::P1), unit_of(Signal::P2));
-    [Signal::P1, Signal::P2]
-        .into_iter()
-        .map(|s| {
-            problem(
-                s,
-                ProblemKind::Units,
-                format!("p1 and p2 do not balance the piston: p1 A1 − m a ≈ {gain:.3} × p2 A2 (± {se:.2}; 1 on this rig, whatever the load and friction): one of the two columns (p1 in {u1}, p2 in {u2}) is in another unit than its header says; both left out"),
-            )
-        })
-        .collect()
-}
-
 /// The command-to-velocity gain of the record against the rig's: the sign
 /// (command up, piston down) and the magnitude (a position logged in the
 /// wrong unit moves the piston 1000 times too little per unit command).
@@ -536,7 +507,7 @@ mod tests {
     use super::*;
     use std::collections::BTreeMap;
 
-    fn rec(cols: &[(Signal, Vec<f64>)]) -> Record {
+    pub(super) fn rec(cols: &[(Signal, Vec<f64>)]) -> Record {
         let n = cols[0].1.len();
         Record {
             source: "test".into(),
@@ -548,7 +519,7 @@ mod tests {
         }
     }
 
-    fn facts() -> RigFacts {
+    pub(super) fn facts() -> RigFacts {
         RigFacts {
             stroke: 0.5,
             supply: 7e6,
@@ -559,7 +530,7 @@ mod tests {
         }
     }
 
-    fn moving(n: usize) -> (Vec<f64>, Vec<f64>) {
+    pub(super) fn moving(n: usize) -> (Vec<f64>, Vec<f64>) {
         // command a sine, position its integral at gain 0.2 m/s
         let u: Vec<f64> = (0..n)
             .map(|i| (i as f64 * 1e-3 * 2.0 * std::f64::consts::PI).sin())
@@ -573,7 +544,7 @@ mod tests {
         (u, x)
     }
 
-    fn pressure(n: usize, mean: f64) -> Vec<f64> {
+    pub(super) fn pressure(n: usize, mean: f64) -> Vec<f64> {
         let e = crate::smooth::gaussian_noise(n, 3);
         (0..n)
             .map(|i| mean + 5e5 * (i as f64 * 3e-3).sin() + 2e4 * e[i])
@@ -723,9 +694,10 @@ mod tests {
         let (u, mut x) = moving(2000);
         x[500] = 1e305;
         let r = rec(&[(Signal::Command, u.clone()), (Signal::Position, x)]);
-        // the range check calls the position's range a unit problem
-        // (compactly); the outlier is named all the same
+        // the range checks judge the bulk of the channel: no unit problem
+        // (no message holds the 300-digit number); the outlier is named
         let probs = check_record(&r, Some(&facts()));
+        assert_eq!(probs, vec![]);
         assert!(probs.iter().all(|p| p.message.len() < 300), "{probs:?}");
         let e = unit_errors(&r, &facts(), &probs).unwrap_err().to_string();
         assert!(

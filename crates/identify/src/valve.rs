@@ -40,7 +40,8 @@ use hydrocyl_system::valve_rig::ValveRig;
 use crate::catalog::EffectId;
 use crate::data::{Record, Signal};
 use crate::data_checks::{
-    check_record, missing_channels, pressure_scale_problems, unit_errors, ProblemKind, RigFacts,
+    check_record, input_errors, missing_channels, position_outliers, pressure_scale_problems,
+    travel_error, unit_errors, ProblemKind, RigFacts,
 };
 use crate::diagnose::{
     nrmse, Applicable, DiagnoseError, DiagnoseOptions, EffectReport, NotApplicable, Probe,
@@ -197,7 +198,9 @@ pub fn diagnose_rig_traced(
     // Data problems first: each channel named and left out is not fitted.
     let facts = rig_facts(declared);
     let mut data_problems = check_record(rec, Some(&facts));
+    position_outliers(rec, &facts, &data_problems)?;
     unit_errors(rec, &facts, &data_problems)?;
+    input_errors(rec, &facts)?;
     // the compared channels the record lacks (a position is required)
     let compared: &[Signal] = match rec.get(Signal::Reference) {
         Some(_) => &[Signal::P1, Signal::P2, Signal::Command],
@@ -264,6 +267,11 @@ pub fn diagnose_rig_traced(
                 .map(|(c, _)| *c)
                 .zip(sims_declared.iter().map(Vec::as_slice))
                 .collect();
+            // the command moves the declared piston as the record's (any
+            // netlist rig, not only the valve circuit's steady gain)
+            if let Some((_, x)) = sim.iter().find(|(s, _)| *s == Signal::Position) {
+                travel_error(rec, x, &facts, &data_problems)?;
+            }
             let scale = pressure_scale_problems(rec, &sim);
             if !scale.is_empty() {
                 data_problems.extend(scale);

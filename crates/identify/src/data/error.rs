@@ -190,6 +190,17 @@ pub enum DataError {
         /// What contradicts what, and what to check.
         reason: String,
     },
+    /// The model's input never changes while the piston moves: nothing in
+    /// the record drives the model (a disconnected command channel).
+    #[error("{file}: row 1, column '{column}': {reason}")]
+    ConstantInput {
+        /// The file.
+        file: String,
+        /// The column header.
+        column: String,
+        /// What was seen and what to check.
+        reason: String,
+    },
     /// Too few samples to do anything with.
     #[error("{file}: only {n} samples (at least {min} needed)")]
     TooShort {

@@ -100,7 +100,9 @@ pub enum Method {
     /// Rodas4 while it is, switched by the stiffness the run shows (DP45's
     /// step held by its stability region; the Jacobian's spectral radius
     /// against the Rosenbrock step); Bogacki–Shampine 3(2) where the
-    /// explicit step is held at `Options::h_max` far inside the tolerance.
+    /// explicit step is held at `Options::h_max` far inside the tolerance,
+    /// for the steps it takes within 5 % of the tolerance (its error
+    /// stays of the order of DP45's).
     /// [`Stats::stiff_steps`], [`Stats::switches`],
     /// [`Stats::low_order_steps`] and [`Stats::order_switches`] say what it
     /// chose.

@@ -383,9 +383,15 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
             stats.rejected += 1;
             h = ctrl.rejected(h, err_norm);
             stepper.rejected();
+            last_rejection = Rejection::Error;
+            continue;
+        }
+        if adaptive && stepper.retake(err_norm) {
+            stats.rejected += 1;
             continue;
         }
         singular_retries = 0;
+        last_rejection = Rejection::None;
 
         // Accepted.
         stats.steps += 1;

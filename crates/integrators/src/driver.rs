@@ -11,13 +11,13 @@ pub(crate) use step_size::Controller;
 pub(crate) use stepper::{Attempt, Stepper, Switch};
 
 use crate::api::{
-    Crossing, EventAction, EventRecord, OdeSystem, Options, Solution, SolveError, Stats,
+    Crossing, EventAction, EventRecord, OdeSystem, Options, Solution, SolveError, StateShare, Stats,
 };
 use crate::checks::check_inputs;
 use crate::events::{locate_root, Bracket};
 use crate::pace::Pace;
 use std::borrow::Cow;
-use step_size::{initial_step, split_error_norm, ControlState};
+use step_size::{dominant_states, initial_step, split_error_norm, ControlState};
 
 /// Largest number of consecutive singular-matrix retries before giving up.
 const MAX_SINGULAR_RETRIES: usize = 8;
@@ -60,6 +60,17 @@ struct EventState {
     bracket_mag: Vec<f64>,
     triggered: Vec<bool>,
     x_tmp: Vec<f64>,
+}
+
+/// Why the last step attempt was rejected.
+#[derive(Clone, Copy)]
+enum Rejection {
+    /// It was not (or it was for another reason: a singular matrix).
+    None,
+    /// For its error.
+    Error,
+    /// For a non-finite state, this one.
+    NonFinite(usize),
 }
 
 /// Writes the states at the output times in `(t_from, t_to]` (all of them
@@ -239,6 +250,10 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
     let mut fresh = true; // a fresh step-size estimate is needed
     let mut h = opts.h0.unwrap_or(0.0);
     let mut singular_retries = 0usize;
+    // What the last attempt was rejected for: its error (`err`, `x_new`
+    // hold its estimate) or a non-finite state; what a step that falls
+    // below `h_min` reports.
+    let mut last_rejection = Rejection::None;
     let mut pace = Pace::new(t0);
     // The system's next breakpoint after `bp_from`: while nothing changes
     // the system (no event, no streamed input) it is still the next one
@@ -304,7 +319,17 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
             // A step that does not move t in floating point is as bad as h < h_min.
             if h < opts.h_min || t + h <= t {
                 sol.stats = stats;
-                return Err(SolveError::StepTooSmall { t, h });
+                let dominant = match last_rejection {
+                    Rejection::Error => dominant_states(&*sys, &err, &x, &x_new, &atol, rtol),
+                    Rejection::NonFinite(i) => vec![StateShare {
+                        index: i,
+                        name: sys.state_name(i),
+                        value: x[i],
+                        error: f64::INFINITY,
+                    }],
+                    Rejection::None => Vec::new(),
+                };
+                return Err(SolveError::StepTooSmall { t, h, dominant });
             }
         }
         // Land exactly on t_end; avoid a sliver of a last step.
@@ -354,6 +379,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
             }
             h *= 0.5;
             ctrl.last_rejected = true;
+            last_rejection = Rejection::None;
             continue;
         }
         if let Some(i) = stepper.f_start().iter().position(|v| !v.is_finite()) {
@@ -371,6 +397,7 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
             }
             h = h_try;
             ctrl.last_rejected = true;
+            last_rejection = Rejection::NonFinite(i);
             continue;
         }
         let err_norm = if adaptive {
@@ -383,9 +410,15 @@ pub(crate) fn run_with<S: OdeSystem + ?Sized, St: Stepper, B: Between<S>>(
             stats.rejected += 1;
             h = ctrl.rejected(h, err_norm);
             stepper.rejected();
+            last_rejection = Rejection::Error;
+            continue;
+        }
+        if adaptive && stepper.retake(err_norm) {
+            stats.rejected += 1;
             continue;
         }
         singular_retries = 0;
+        last_rejection = Rejection::None;
 
         // Accepted.
         stats.steps += 1;

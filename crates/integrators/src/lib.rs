@@ -33,7 +33,10 @@
 //!   error ≤ 1e-2 for 3 steps (a drive at rest between command edges), it
 //!   takes Bogacki–Shampine 3(2) (`ode23`'s pair: 3 right-hand sides a step
 //!   instead of 6) until that pair's controller wants a step below `h_max`
-//!   or rejects one, then DP45 again. [`Stats::stiff_steps`],
+//!   or rejects one, then DP45 again; a BS3 step is kept only with a normed
+//!   error ≤ 0.05, one between that and 1 is taken again by DP45 (BS3's
+//!   estimate can be 4× below its step's error: auto's error stays of the
+//!   order of DP45's, see docs/speed.md). [`Stats::stiff_steps`],
 //!   [`Stats::switches`], [`Stats::low_order_steps`] and
 //!   [`Stats::order_switches`] report the choice; a run that never switches
 //!   is the DP45 run exactly;

@@ -9,6 +9,7 @@
 //! | [`VanDerPol`] | 2 | for large `μ` | limit cycle, period ≈ (3 − 2 ln 2) μ for large μ |
 //! | [`Robertson`] | 3 | yes | conservation `x1 + x2 + x3 = 1` |
 //! | [`BouncingBall`] | 2 | no | bounce times in closed form ([`BouncingBall::bounce_times`]) |
+//! | [`OrificeCharge`] | 1 | near its end | `p(t) = ps − (√ps − k t/2)²` until `p = ps` |
 //!
 //! All give analytic Jacobians except [`BouncingBall`] and [`TimeVarying`],
 //! which exercise the finite-difference Jacobian.
@@ -150,6 +151,58 @@ impl OdeSystem for Robertson {
             6e7 * x[1],
             0.0,
         ]);
+        true
+    }
+}
+
+/// A closed volume charged from a supply `ps` through a turbulent orifice,
+/// `dp/dt = k √(ps − p)` with `k = (B/V) Cd a √(2/ρ)` (hydrocyl's `volume`
+/// behind an `orifice`: a physics test's `vol.json`): from `p = 0` at time 0
+/// the solution is the parabola `p(t) = ps − (√ps − k t/2)²` until it
+/// reaches `ps` at `t* = 2√ps / k`, then `ps`. Its third derivative is zero:
+/// the case where Bogacki–Shampine 3(2)'s error estimate (`h³ p‴ / 48` to
+/// leading order) sees nothing of its step's error. Stiff near `t*`
+/// (`∂f/∂p = −k / (2√(ps − p))` grows without bound).
+#[derive(Clone, Copy, Debug)]
+pub struct OrificeCharge {
+    /// Supply pressure `ps` \[Pa\].
+    pub supply: f64,
+    /// Rate constant `k = (B/V) Cd a √(2/ρ)` \[Pa^½/s\].
+    pub k: f64,
+}
+
+impl OrificeCharge {
+    /// That test's circuit: 100 bar through `a = 1e-7 m²`, `Cd = 0.7`,
+    /// `ρ = 870 kg/m³` into `V = 1e-4 m³` of `B = 1 GPa` (`t* ≈ 0.188 s`).
+    pub fn hundred_bar() -> Self {
+        Self {
+            supply: 1e7,
+            k: 1e9 / 1e-4 * 0.7 * 1e-7 * (2.0f64 / 870.0).sqrt(),
+        }
+    }
+
+    /// When the volume reaches the supply pressure from `p = 0` at time 0 \[s\].
+    pub fn t_full(&self) -> f64 {
+        2.0 * self.supply.sqrt() / self.k
+    }
+
+    /// The exact pressure at `t` from `p = 0` at time 0 \[Pa\].
+    pub fn exact(&self, t: f64) -> f64 {
+        let r = (self.supply.sqrt() - 0.5 * self.k * t).max(0.0);
+        self.supply - r * r
+    }
+}
+
+impl OdeSystem for OrificeCharge {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn rhs(&self, _t: f64, x: &[f64], dx: &mut [f64]) {
+        dx[0] = self.k * (self.supply - x[0]).max(0.0).sqrt();
+    }
+    fn jacobian(&self, _t: f64, x: &[f64], jac: &mut [f64]) -> bool {
+        let r = (self.supply - x[0]).max(0.0).sqrt();
+        jac[0] = if r > 0.0 { -0.5 * self.k / r } else { 0.0 };
         true
     }
 }

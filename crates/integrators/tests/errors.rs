@@ -84,7 +84,7 @@ fn blow_up_hits_the_minimum_step() {
         };
         let e = solve(method, &mut BlowUp, 0.0, &[1.0], 2.0, &opts).unwrap_err();
         match e {
-            SolveError::StepTooSmall { t, h } => {
+            SolveError::StepTooSmall { t, h, .. } => {
                 assert!(h < 1e-8, "{method:?}: h = {h}");
                 assert!(t > 0.99 && t < 1.01, "{method:?}: t = {t}");
             }
@@ -166,4 +166,63 @@ fn zero_length_interval_returns_the_initial_state() {
     assert_eq!(sol.t, vec![2.0]);
     assert_eq!(sol.x, vec![3.0]);
     assert_eq!(sol.stats.steps, 0);
+}
+
+/// Three states of which the middle one is stiff: `x0' = −x0`,
+/// `x1' = −λ (x1 − cos t)` with λ = 1e12 s⁻¹, `x2' = x0`. Named
+/// `a.slow`, `b.stiff`, `c.sum` when `named`.
+struct OneStiff {
+    named: bool,
+}
+
+impl OdeSystem for OneStiff {
+    fn dim(&self) -> usize {
+        3
+    }
+    fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
+        dx[0] = -x[0];
+        dx[1] = -1e12 * (x[1] - t.cos());
+        dx[2] = x[0];
+    }
+    fn state_name(&self, i: usize) -> Option<String> {
+        self.named
+            .then(|| ["a.slow", "b.stiff", "c.sum"][i].to_string())
+    }
+}
+
+/// An explicit method on a stiff state needs a step below the stability
+/// limit (≈ 3e-12 s here); with `h_min` above it the solve fails, and the
+/// failure names the state whose error the steps could not control.
+#[test]
+fn a_step_below_the_minimum_names_the_state_that_dominates_the_error() {
+    let opts = Options {
+        h_min: 1e-9,
+        ..Options::default()
+    };
+    for named in [false, true] {
+        let mut sys = OneStiff { named };
+        let e = solve(
+            Method::DormandPrince45,
+            &mut sys,
+            0.0,
+            &[1.0, 1.0, 0.0],
+            1.0,
+            &opts,
+        )
+        .unwrap_err();
+        let SolveError::StepTooSmall { dominant, .. } = &e else {
+            panic!("expected StepTooSmall, got {e:?}");
+        };
+        assert_eq!(dominant.len(), 1, "{dominant:?}");
+        assert_eq!(dominant[0].index, 1);
+        assert!(dominant[0].error > 1.0, "{dominant:?}");
+        let m = e.to_string();
+        assert!(!m.contains('\n'), "{m}");
+        let who = if named { "`b.stiff` = " } else { "state 1 = " };
+        assert!(
+            m.contains(&format!("error estimate is dominated by {who}")),
+            "{m}"
+        );
+        assert!(m.contains("× its tolerance"), "{m}");
+    }
 }

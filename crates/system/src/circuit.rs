@@ -12,6 +12,7 @@ use crate::series::{SeriesGroup, Step};
 mod attachments;
 mod component;
 mod jacobian;
+mod naming;
 pub use component::{Component, PowerTerms, Probe};
 pub use jacobian::Tangents;
 
@@ -95,6 +96,8 @@ pub struct Circuit {
     /// wire index.
     publisher: Vec<Option<usize>>,
     probe_names: Option<Vec<Option<String>>>,
+    /// The states' names in messages ([`Circuit::name_states`]).
+    state_labels: Option<Vec<Option<String>>>,
     /// Units given to probes by [`Circuit::set_probe_unit`]:
     /// `(component, probe, unit)`.
     probe_units: Vec<(String, String, &'static str)>,
@@ -234,6 +237,7 @@ impl Circuit {
             wire_names: net.names,
             publisher,
             probe_names: None,
+            state_labels: None,
             probe_units: Vec::new(),
             attachments,
             analytic,
@@ -679,6 +683,10 @@ impl OdeSystem for Circuit {
     /// flows and powers that no component reads back.
     fn n_quadratures(&self) -> usize {
         self.dim() - self.n_states
+    }
+
+    fn state_name(&self, i: usize) -> Option<String> {
+        self.state_label(i)
     }
 
     fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {

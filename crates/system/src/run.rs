@@ -77,7 +77,9 @@ impl SimError {
     }
 
     /// A solver failure of `circuit` started at `(t0, x0)`, with the state
-    /// it is about named: a non-finite state by its name, a failure at the
+    /// it is about named ([`Circuit::state_label`]; a step that fell below
+    /// the minimum names the states that dominate its error itself,
+    /// [`SolveError::StepTooSmall`]): a non-finite state by its name, a failure at the
     /// start (a step that fell to nothing, a non-finite value at `t0`) by
     /// the state whose rate, relative to its scale, is the largest there —
     /// the one a parameter out of its physical range (a vanishing mass, an
@@ -89,8 +91,8 @@ impl SimError {
         t0: f64,
         x0: &[f64],
     ) -> Self {
-        let names = circuit.state_names();
-        let name = |i: usize| names.get(i).map_or("?", String::as_str);
+        // the netlist's names (`v.pressure`, what `v.initial.pressure` sets)
+        let name = |i: usize| circuit.state_label(i).unwrap_or_else(|| "?".into());
         let at_start = |t: f64| t <= t0 && x0.len() == circuit.n_states();
         let fastest = || {
             let mut dx = vec![0.0; x0.len()];

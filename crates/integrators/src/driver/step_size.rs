@@ -1,7 +1,7 @@
 //! Step-size control: the controller ([`Controller`]) and its state across
 //! steps, the error norm it reads, and the starting step.
 
-use crate::api::{OdeSystem, Stats};
+use crate::api::{OdeSystem, StateShare, Stats};
 
 /// Step-size controller of an adaptive method.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -205,4 +205,44 @@ pub(super) fn initial_step<S: OdeSystem + ?Sized>(
         (0.01 / dmax).powf(1.0 / order)
     };
     (100.0 * h0).min(h1).min(h_max)
+}
+
+/// The states that dominate a rejected step's error estimate `err` (from
+/// `x` towards `x_new`): each state's term of [`error_norm`], the largest
+/// first, those within a tenth of the largest, at most three; NaN terms
+/// count as the largest. Empty when every term is zero.
+pub(crate) fn dominant_states<S: OdeSystem + ?Sized>(
+    sys: &S,
+    err: &[f64],
+    x: &[f64],
+    x_new: &[f64],
+    atol: &[f64],
+    rtol: f64,
+) -> Vec<StateShare> {
+    let term = |i: usize| {
+        let sc = (atol[i] + rtol * x[i].abs().max(x_new[i].abs())).max(f64::MIN_POSITIVE);
+        let r = (err[i] / sc).abs();
+        if r.is_nan() {
+            f64::INFINITY
+        } else {
+            r
+        }
+    };
+    let mut order: Vec<usize> = (0..err.len()).filter(|&i| term(i) > 0.0).collect();
+    order.sort_by(|&a, &b| term(b).total_cmp(&term(a)));
+    let Some(&top) = order.first() else {
+        return Vec::new();
+    };
+    let floor = 0.1 * term(top);
+    order
+        .into_iter()
+        .take_while(|&i| term(i) >= floor)
+        .take(3)
+        .map(|i| StateShare {
+            index: i,
+            name: sys.state_name(i),
+            value: x[i],
+            error: term(i),
+        })
+        .collect()
 }

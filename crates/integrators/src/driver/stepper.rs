@@ -79,6 +79,15 @@ pub(crate) trait Stepper {
 
     /// Told after each step rejected for its error.
     fn rejected(&mut self) {}
+
+    /// Asked of a step within the tolerance (normed error `err ≤ 1`) before
+    /// it is accepted: `true` discards it and has the step taken again, at
+    /// the same size, by the method the stepper switches to (counted as a
+    /// rejected step). The automatic choice's low-order pair keeps only the
+    /// steps far inside the tolerance.
+    fn retake(&mut self, _err: f64) -> bool {
+        false
+    }
 }
 
 /// A change of method decided by a switching stepper ([`Stepper::switch`]).

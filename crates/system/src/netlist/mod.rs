@@ -57,6 +57,7 @@ pub(crate) use catalog::friction_terms_of as catalog_friction_terms;
 pub(crate) use catalog::typed_view_friction_law;
 pub use inputs::{samples_beyond, stroke_warning, InputRating, INPUT_TYPES};
 pub use reader::{read, NetlistError, Schematic};
+use registry::StateSpec;
 use serde_json::{Map, Value};
 
 /// The `kind` of a netlist rig file.
@@ -205,6 +206,18 @@ fn assemble_driven(s: &Schematic, drive: &[(String, Signal)]) -> Result<Circuit,
         .iter()
         .map(|i| (i.name.clone(), i.ty.probes))
         .collect();
+    // a state by the name its netlist gives it (`v.pressure`, what
+    // `v.initial.pressure` sets), where the component's states are the
+    // ones its type declares
+    let states: Vec<(&str, &[StateSpec])> = s
+        .instances
+        .iter()
+        .map(|i| (i.name.as_str(), i.ty.states))
+        .collect();
+    c.name_states(|comp, k, n| {
+        let (_, declared) = states.iter().find(|(name, _)| *name == comp)?;
+        (declared.len() == n).then(|| format!("{comp}.{}", declared[k].name))
+    });
     c.name_probes(|comp, probe| {
         let Some(types) = declared.iter().find(|(n, _)| n == comp).map(|(_, p)| *p) else {
             return Some(probe.to_string());

@@ -626,12 +626,8 @@ pub fn diagnose_rig_traced(
         let Some((id, refit, rep, joint, res)) = accepted else {
             // No single effect: the best candidates in pairs (`pairs.rs`),
             // which must explain more than a probe that outranked them all,
-            // and more than a sensor's gain error by `--min-share`: two
-            // catalog effects that do no better than one out-of-catalog
-            // parameter are not established (a position read 3 % long
-            // is a flow gain 3 % high beside a stiffer oil). The gain
-            // probe is closed-form, so it is tried here even where the
-            // top candidate left the probes no chance to win.
+            // and more than a sensor's gain error (closed-form, so tried
+            // even where no probe ran) by `--min-share` (`gain_probe`).
             let mut need = probe_won
                 .as_ref()
                 .map_or(opts.min_share, |pr| pr.explained_share);

@@ -44,9 +44,9 @@ pub fn input_errors(rec: &Record, f: &RigFacts) -> Result<(), DataError> {
     sorted.sort_by(f64::total_cmp);
     let span = robust_range(&sorted, xhi - xlo);
     let sigma = noise_sigma(&rec.time, x);
-    let least = (MOVING_SIGMAS * sigma).max(MOVING_STROKE * f.stroke);
     let (rise, fall) = excursions(x);
-    if !(span > least && rise > least && fall > least) {
+    let moves = |d| is_motion(d, sigma, f.stroke);
+    if !(moves(span) && moves(rise) && moves(fall)) {
         return Ok(());
     }
     let column = match rec.units.get(&Signal::Command) {
@@ -60,6 +60,13 @@ pub fn input_errors(rec: &Record, f: &RigFacts) -> Result<(), DataError> {
             "the command reads {lo} in every sample while the piston moves over {span:.4} m: nothing in the record drives the model (a disconnected or unlogged command channel?); check the logged command column"
         ),
     })
+}
+
+/// Whether a travel `d` of the piston is motion: more than
+/// [`MOVING_SIGMAS`] noise sigmas `sigma` and [`MOVING_STROKE`] of the
+/// stroke.
+pub(super) fn is_motion(d: f64, sigma: f64, stroke: f64) -> bool {
+    d > MOVING_SIGMAS * sigma && d > MOVING_STROKE * stroke
 }
 
 /// The largest rise (a later sample above an earlier one) and the largest

@@ -10,10 +10,6 @@ use crate::smooth::noise_sigma;
 /// check's factor, [`super::GAIN_FACTOR`]: a wrong supply, a leak or a
 /// friction level the loop can find move the travel by far less).
 const TRAVEL_FACTOR: f64 = super::GAIN_FACTOR;
-/// A travel counts only above this many noise sigmas and this share of
-/// the stroke (as in [`super::input_errors`]).
-const MOVING_SIGMAS: f64 = 20.0;
-const MOVING_STROKE: f64 = 0.01;
 
 /// After the declared model's first run on the record's command: the
 /// piston's travel (the range between the 0.5th and 99.5th percentiles of
@@ -54,7 +50,7 @@ pub fn travel_error(
     };
     let (meas, sim) = (span(x), span(simulated));
     let sigma = noise_sigma(&rec.time, x);
-    let moves = |d: f64| d > MOVING_SIGMAS * sigma && d > MOVING_STROKE * f.stroke;
+    let moves = |d| super::input::is_motion(d, sigma, f.stroke);
     let ratio = if moves(meas) && meas > TRAVEL_FACTOR * sim {
         meas / sim.max(f64::MIN_POSITIVE)
     } else if moves(sim) && sim > TRAVEL_FACTOR * meas {

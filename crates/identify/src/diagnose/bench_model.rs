@@ -264,20 +264,13 @@ pub(super) fn probes(rig: &FrictionBench, b: &Bench<'_>) -> Probes {
         explained_share: 1.0 - best.1 / rss0,
     });
     // Spring: residual ∝ position.
-    let (mut num, mut den) = (0.0, 0.0);
-    for (s, f) in sigs.iter().zip(&sims) {
-        for ((x, m), f) in s.x.iter().zip(&s.force).zip(f) {
-            let phi = rig.force_sign * x;
-            num += phi * (m - f);
-            den += phi * phi;
-        }
-    }
-    let k = if den > 0.0 { num / den } else { 0.0 };
+    let (k, removed) =
+        fit_regressor(sigs, &sims, |s, i, _| rig.force_sign * s.x[i]).unwrap_or((0.0, 0.0));
     out.push(Probe {
         kind: "spring".into(),
         what: "force proportional to position (spring)".into(),
         value: k,
-        explained_share: num * k / rss0,
+        explained_share: removed / rss0,
     });
     Probes {
         shapes: out,
@@ -320,18 +313,9 @@ fn gain_probes(
     ];
     let mut out = Vec::new();
     for (kind, sensor, phi) in cases {
-        let (mut num, mut den) = (0.0, 0.0);
-        for (s, f) in sigs.iter().zip(sims) {
-            for (i, (m, f)) in s.force.iter().zip(f).enumerate() {
-                let x = phi(rig, s, i, *f);
-                num += x * (m - f);
-                den += x * x;
-            }
-        }
-        if den <= 0.0 || !den.is_finite() || !num.is_finite() {
+        let Some((c, removed)) = fit_regressor(sigs, sims, |s, i, f| phi(rig, s, i, f)) else {
             continue;
-        }
-        let c = num / den;
+        };
         // the force's own gain is c; a pressure read (1 + g) times too
         // high leaves c = g/(1 + g) of its force, so g = c/(1 − c)
         let g = if kind == "force_gain" {
@@ -346,8 +330,32 @@ fn gain_probes(
                 100.0 * g
             ),
             value: g,
-            explained_share: num * c / rss0,
+            explained_share: removed / rss0,
         });
     }
     out
+}
+
+/// The least-squares coefficient `c` of a regressor `φ` (of a record's
+/// signals, the sample's index and the model's force there) on the force
+/// residual of every record, and the sum of squares `c φ` removes; `None`
+/// where `φ` is zero everywhere or not finite.
+fn fit_regressor(
+    sigs: &[BenchSignals],
+    sims: &[Vec<f64>],
+    phi: impl Fn(&BenchSignals, usize, f64) -> f64,
+) -> Option<(f64, f64)> {
+    let (mut num, mut den) = (0.0, 0.0);
+    for (s, f) in sigs.iter().zip(sims) {
+        for (i, (m, f)) in s.force.iter().zip(f).enumerate() {
+            let x = phi(s, i, *f);
+            num += x * (m - f);
+            den += x * x;
+        }
+    }
+    if den <= 0.0 || !den.is_finite() || !num.is_finite() {
+        return None;
+    }
+    let c = num / den;
+    Some((c, num * c))
 }

@@ -400,6 +400,7 @@ fn budget_message(rk4_step: f64, span: f64, max: usize) -> String {
 
 /// Runs `hydrocyl simulate`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    crate::heap::keep_freed_memory();
     let rig_err = |e: rig::RigError| CliError::Input(e.to_string());
     if crate::bench_sim::runs_on_motion(&args.rig) {
         if let Some((bench, net)) = crate::bench_sim::load(&args.rig, &args.set)? {

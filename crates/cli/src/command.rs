@@ -182,26 +182,66 @@ fn read_plain(text: &str, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
 /// The time and command columns read by the fast path, put in seconds and
 /// the rig's unit; `None` (the full reader) unless the times increase.
 fn finish_plain(mut cols: Vec<Vec<f64>>, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
-    let mut u = cols.pop()?;
-    let mut t = cols.pop()?;
+    let (t, u) = scaled(&mut cols, c)?;
+    let (t, u) = (std::mem::take(t), std::mem::take(u));
+    increasing(&t).then_some((t, u))
+}
+
+/// The time and command columns `cols` (as the fast path reads them), put
+/// in seconds and the rig's unit.
+fn scaled<'a>(
+    cols: &'a mut [Vec<f64>],
+    c: &Columns,
+) -> Option<(&'a mut Vec<f64>, &'a mut Vec<f64>)> {
+    let [t, u] = cols else { return None };
     if c.time_factor != 1.0 {
         t.iter_mut().for_each(|v| *v *= c.time_factor);
     }
     if c.command_factor != 1.0 {
         u.iter_mut().for_each(|v| *v *= c.command_factor);
     }
-    if t.len() < 2 || t.windows(2).any(|w| w[1] <= w[0]) {
+    Some((t, u))
+}
+
+/// At least two times, each after the one before.
+fn increasing(t: &[f64]) -> bool {
+    t.len() >= 2 && t.windows(2).all(|w| w[1] > w[0])
+}
+
+/// The columns of the two halves of a long body (as the fast path reads
+/// them), scaled ([`scaled`]) and joined straight into the shared storage
+/// a [`Table`] keeps (one copy); `None` (the full reader) unless the times
+/// increase.
+fn join_halves(
+    mut first: Vec<Vec<f64>>,
+    mut second: Vec<Vec<f64>>,
+    c: &Columns,
+) -> Option<(Arc<[f64]>, Arc<[f64]>)> {
+    let (t1, u1) = scaled(&mut first, c)?;
+    let (t2, u2) = scaled(&mut second, c)?;
+    let t: Arc<[f64]> = t1.iter().chain(t2.iter()).copied().collect();
+    if !increasing(&t) {
         return None;
     }
+    let u: Arc<[f64]> = u1.iter().chain(u2.iter()).copied().collect();
     Some((t, u))
 }
 
 /// The bytes of file `path` (an error names it).
 pub fn read_bytes(path: &Path) -> Result<Vec<u8>, CliError> {
-    std::fs::read(path).map_err(|source| CliError::Io {
-        path: path.display().to_string(),
-        source,
-    })
+    read_into(path, Vec::new())
+}
+
+/// The bytes of file `path` appended to `buf` (an error names the file).
+fn read_into(path: &Path, mut buf: Vec<u8>) -> Result<Vec<u8>, CliError> {
+    use std::io::Read as _;
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_to_end(&mut buf))
+        .map(|_| buf)
+        .map_err(|source| CliError::Io {
+            path: path.display().to_string(),
+            source,
+        })
 }
 
 /// A command file read whole, as a run takes it.
@@ -221,7 +261,7 @@ pub struct Table {
 pub fn read_table(path: &Path, bytes: &[u8], unit: CommandUnit) -> Result<Table, CliError> {
     let file = path.display().to_string();
     let (t, u) = parse_command(&file, bytes, unit)?;
-    table_of(&file, t, u, unit)
+    table_of(&file, t.into(), u.into(), unit)
 }
 
 /// The samples `u` (at times `t`) beyond `limit` in magnitude, and the
@@ -231,15 +271,19 @@ pub fn beyond(t: &[f64], u: &[f64], limit: f64) -> (usize, (f64, f64)) {
 }
 
 /// The [`Table`] of file `file`'s samples `(t, u)`.
-fn table_of(file: &str, t: Vec<f64>, u: Vec<f64>, unit: CommandUnit) -> Result<Table, CliError> {
+fn table_of(
+    file: &str,
+    times: Arc<[f64]>,
+    u: Arc<[f64]>,
+    unit: CommandUnit,
+) -> Result<Table, CliError> {
     let (outside, peak) = if unit == CommandUnit::Normalised {
-        beyond(&t, &u, 1.0)
+        beyond(&times, &u, 1.0)
     } else {
         (0, (0.0, f64::NAN))
     };
     // the output times are the table's own (shared, not copied)
-    let times: std::sync::Arc<[f64]> = t.into();
-    let signal = Signal::shared_table(times.clone(), u.into())
+    let signal = Signal::shared_table(times.clone(), u)
         .map_err(|e| CliError::Input(format!("{file}: {e}")))?;
     Ok(Table {
         times,
@@ -279,15 +323,10 @@ fn cut_of(body: &[u8]) -> Option<usize> {
 }
 
 /// The time and command cells of the whole lines `piece` (see
-/// [`Rows::parse`]), in columns with room for `room` more bytes of lines.
-fn parse_piece(
-    csv: &PlainCsv,
-    c: &Columns,
-    piece: &[u8],
-    room: usize,
-) -> Option<(Body, Vec<Vec<f64>>)> {
+/// [`Rows::parse`]), in columns.
+fn parse_piece(csv: &PlainCsv, c: &Columns, piece: &[u8]) -> Option<(Body, Vec<Vec<f64>>)> {
     let rows = Rows::new(csv.width(), &[c.time, c.command])?;
-    let hint = (piece.len() + room) / (8 * csv.width()).max(1) + 1;
+    let hint = piece.len() / (8 * csv.width()).max(1) + 1;
     let mut out = vec![Vec::with_capacity(hint), Vec::with_capacity(hint)];
     let end = rows.parse(piece, &mut out)?;
     Some((end, out))
@@ -315,15 +354,23 @@ pub struct Ahead {
 }
 
 impl Ahead {
-    /// Starts reading `path`.
+    /// Starts reading `path`. Its buffer is allocated here, on the thread
+    /// that later takes the table: freed once the file is parsed, its
+    /// memory serves that thread's next allocations (the output's blocks)
+    /// instead of fresh pages (see [`crate::heap`]).
     pub fn start(path: PathBuf, stream_above: u64) -> Self {
         let (unit, told) = mpsc::channel::<CommandUnit>();
         let (send, bytes) = mpsc::channel::<Arc<Vec<u8>>>();
         let (done, read) = mpsc::channel::<Result<Read, CliError>>();
         let file = path.clone();
+        let len = std::fs::metadata(&path).ok().map(|m| m.len());
+        let buf = match len {
+            Some(n) if n <= stream_above => Vec::with_capacity(n.try_into().unwrap_or(0)),
+            _ => Vec::new(),
+        };
         std::thread::spawn(move || {
             let path = file;
-            let _ = done.send(Self::read(&path, stream_above, &send, &told));
+            let _ = done.send(Self::read(&path, len, stream_above, buf, &send, &told));
         });
         Ahead {
             path,
@@ -333,17 +380,20 @@ impl Ahead {
         }
     }
 
-    /// The reading thread's work.
+    /// The reading thread's work on the file of `len` bytes, read into
+    /// `buf`.
     fn read(
         path: &Path,
+        len: Option<u64>,
         stream_above: u64,
+        buf: Vec<u8>,
         send: &mpsc::Sender<Arc<Vec<u8>>>,
         told: &mpsc::Receiver<CommandUnit>,
     ) -> Result<Read, CliError> {
-        if std::fs::metadata(path).is_ok_and(|m| m.len() > stream_above) {
+        if len.is_some_and(|n| n > stream_above) {
             return Ok(Read::Whole(None));
         }
-        let read = read_bytes(path).map(Arc::new);
+        let read = read_into(path, buf).map(Arc::new);
         if let Ok(b) = &read {
             let _ = send.send(b.clone());
         }
@@ -355,8 +405,7 @@ impl Ahead {
         if let Some((csv, c)) = plain_columns(&path.display().to_string(), &bytes, unit) {
             let body = csv.body().as_bytes();
             if let Some(cut) = cut_of(body) {
-                // with room for the second half, appended to it
-                let first = parse_piece(&csv, &c, &body[..cut], body.len() - cut);
+                let first = parse_piece(&csv, &c, &body[..cut]);
                 return Ok(Read::Half(first));
             }
         }
@@ -378,7 +427,7 @@ impl Ahead {
             let body = csv.body().as_bytes();
             let piece = &body[cut_of(body)?..];
             let blank = piece.iter().all(|&b| b == b'\n' || b == b'\r');
-            Some((parse_piece(&csv, &c, piece, 0), blank, c))
+            Some((parse_piece(&csv, &c, piece), blank, c))
         });
         let read = self
             .read
@@ -392,14 +441,11 @@ impl Ahead {
         // both halves plain (blank lines only at the very end), or the
         // full reader, which names what is wrong
         let joined = second.and_then(|(second, blank, c)| {
-            let ((end, mut cols), (_, rest)) = (first?, second?);
+            let ((end, first), (_, second)) = (first?, second?);
             if end == Body::BlankEnd && !blank {
                 return None;
             }
-            for (a, b) in cols.iter_mut().zip(rest) {
-                a.extend_from_slice(&b);
-            }
-            finish_plain(cols, &c)
+            join_halves(first, second, &c)
         });
         match joined {
             Some((t, u)) => table_of(&file, t, u, unit).map(Some),

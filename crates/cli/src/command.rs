@@ -203,28 +203,39 @@ fn scaled<'a>(
     Some((t, u))
 }
 
-/// At least two times, each after the one before.
+/// At least two times, none at or before the one before.
 fn increasing(t: &[f64]) -> bool {
-    t.len() >= 2 && t.windows(2).all(|w| w[1] > w[0])
+    t.len() >= 2 && !t.windows(2).any(|w| w[1] <= w[0])
 }
 
-/// The columns of the two halves of a long body (as the fast path reads
-/// them), scaled ([`scaled`]) and joined straight into the shared storage
-/// a [`Table`] keeps (one copy); `None` (the full reader) unless the times
-/// increase.
-fn join_halves(
-    mut first: Vec<Vec<f64>>,
-    mut second: Vec<Vec<f64>>,
-    c: &Columns,
-) -> Option<(Arc<[f64]>, Arc<[f64]>)> {
-    let (t1, u1) = scaled(&mut first, c)?;
-    let (t2, u2) = scaled(&mut second, c)?;
-    let t: Arc<[f64]> = t1.iter().chain(t2.iter()).copied().collect();
-    if !increasing(&t) {
-        return None;
+/// Scales the columns of the two halves of a long body (as the fast path
+/// reads them, [`scaled`]); `None` (the full reader) unless the times
+/// increase through both, as [`increasing`] on the two joined.
+fn scaled_halves(first: &mut [Vec<f64>], second: &mut [Vec<f64>], c: &Columns) -> Option<()> {
+    let (t1, _) = scaled(first, c)?;
+    let (t2, _) = scaled(second, c)?;
+    let across = match (t1.last(), t2.first()) {
+        (Some(a), Some(b)) => b > a || b.is_nan() || a.is_nan(),
+        _ => true,
+    };
+    let each = |t: &[f64]| t.len() < 2 || increasing(t);
+    (t1.len() + t2.len() >= 2 && across && each(t1) && each(t2)).then_some(())
+}
+
+/// The time and command columns of two halves ([`scaled_halves`]) joined
+/// straight into the shared storage a [`Table`] keeps (one copy).
+fn joined(first: &[Vec<f64>], second: &[Vec<f64>]) -> (Arc<[f64]>, Arc<[f64]>) {
+    fn part(h: &[Vec<f64>], k: usize) -> &[f64] {
+        h.get(k).map_or(&[], Vec::as_slice)
     }
-    let u: Arc<[f64]> = u1.iter().chain(u2.iter()).copied().collect();
-    Some((t, u))
+    let column = |k: usize| -> Arc<[f64]> {
+        part(first, k)
+            .iter()
+            .chain(part(second, k))
+            .copied()
+            .collect()
+    };
+    (column(0), column(1))
 }
 
 /// The bytes of file `path` (an error names it).
@@ -440,15 +451,22 @@ impl Ahead {
         };
         // both halves plain (blank lines only at the very end), or the
         // full reader, which names what is wrong
-        let joined = second.and_then(|(second, blank, c)| {
-            let ((end, first), (_, second)) = (first?, second?);
+        let halves = second.and_then(|(second, blank, c)| {
+            let ((end, mut first), (_, mut second)) = (first?, second?);
             if end == Body::BlankEnd && !blank {
                 return None;
             }
-            join_halves(first, second, &c)
+            scaled_halves(&mut first, &mut second, &c)?;
+            Some((first, second))
         });
-        match joined {
-            Some((t, u)) => table_of(&file, t, u, unit).map(Some),
+        match halves {
+            Some((first, second)) => {
+                // the file's bytes, done with, are freed first: the table
+                // takes their memory, not fresh pages (see `crate::heap`)
+                drop(bytes);
+                let (t, u) = joined(&first, &second);
+                table_of(&file, t, u, unit).map(Some)
+            }
             None => read_table(&self.path, &bytes, unit).map(Some),
         }
     }

@@ -598,6 +598,43 @@ fn parse_samples(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// A long body's two halves, scaled and joined, are the columns the
+    /// one-piece fast path reads from the whole ([`finish_plain`]), bit for
+    /// bit, or both send the file to the full reader: for any cut, in
+    /// either unit, with times that stop increasing anywhere (at the cut
+    /// too) or are NaN.
+    #[test]
+    fn halves_join_as_the_whole() {
+        let step = prop_oneof![Just(1.0), Just(2.5), Just(0.0), Just(-1.0), Just(f64::NAN)];
+        let rows = prop::collection::vec((step, -2.0..2.0f64), 0..12);
+        let factors = (
+            prop::sample::select(vec![1.0, 1e-3]),
+            prop::sample::select(vec![1.0, 0.01]),
+        );
+        proptest!(|(rows in rows, cut in 0..13usize, (tf, cf) in factors)| {
+            let mut t = Vec::new();
+            let mut at = 0.0;
+            for (s, _) in &rows {
+                at += s;
+                t.push(at);
+            }
+            let u: Vec<f64> = rows.iter().map(|r| r.1).collect();
+            let c = Columns { time: 0, time_factor: tf, command: 1, command_factor: cf };
+            let cut = cut.min(t.len());
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            let whole = finish_plain(vec![t.clone(), u.clone()], &c)
+                .map(|(t, u)| (bits(&t), bits(&u)));
+            let mut first = vec![t[..cut].to_vec(), u[..cut].to_vec()];
+            let mut second = vec![t[cut..].to_vec(), u[cut..].to_vec()];
+            let halves = scaled_halves(&mut first, &mut second, &c).map(|()| {
+                let (t, u) = joined(&first, &second);
+                (bits(&t), bits(&u))
+            });
+            prop_assert_eq!(halves, whole);
+        });
+    }
 
     #[test]
     fn units_and_duplicates() {

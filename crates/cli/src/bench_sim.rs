@@ -176,7 +176,7 @@ fn switched_off_by(net: &serde_json::Value, set: &str) -> Option<String> {
 /// simulated on a command as the preset is, by name, as a file or printed
 /// by `--print-rig`; `diagnose` reads each of them as the same bench.
 pub fn runs_on_motion(spec: &str) -> bool {
-    rig::preset(spec).is_none()
+    !crate::presets::is_preset(spec)
         && rig::load(spec).is_ok_and(|v| {
             bench::is_bench_rig(&v)
                 && v.get("components")

@@ -182,26 +182,77 @@ fn read_plain(text: &str, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
 /// The time and command columns read by the fast path, put in seconds and
 /// the rig's unit; `None` (the full reader) unless the times increase.
 fn finish_plain(mut cols: Vec<Vec<f64>>, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
-    let mut u = cols.pop()?;
-    let mut t = cols.pop()?;
+    let (t, u) = scaled(&mut cols, c)?;
+    let (t, u) = (std::mem::take(t), std::mem::take(u));
+    increasing(&t).then_some((t, u))
+}
+
+/// The time and command columns `cols` (as the fast path reads them), put
+/// in seconds and the rig's unit.
+fn scaled<'a>(
+    cols: &'a mut [Vec<f64>],
+    c: &Columns,
+) -> Option<(&'a mut Vec<f64>, &'a mut Vec<f64>)> {
+    let [t, u] = cols else { return None };
     if c.time_factor != 1.0 {
         t.iter_mut().for_each(|v| *v *= c.time_factor);
     }
     if c.command_factor != 1.0 {
         u.iter_mut().for_each(|v| *v *= c.command_factor);
     }
-    if t.len() < 2 || t.windows(2).any(|w| w[1] <= w[0]) {
-        return None;
-    }
     Some((t, u))
+}
+
+/// At least two times, none at or before the one before.
+fn increasing(t: &[f64]) -> bool {
+    t.len() >= 2 && !t.windows(2).any(|w| w[1] <= w[0])
+}
+
+/// Scales the columns of the two halves of a long body (as the fast path
+/// reads them, [`scaled`]); `None` (the full reader) unless the times
+/// increase through both, as [`increasing`] on the two joined.
+fn scaled_halves(first: &mut [Vec<f64>], second: &mut [Vec<f64>], c: &Columns) -> Option<()> {
+    let (t1, _) = scaled(first, c)?;
+    let (t2, _) = scaled(second, c)?;
+    let across = match (t1.last(), t2.first()) {
+        (Some(a), Some(b)) => b > a || b.is_nan() || a.is_nan(),
+        _ => true,
+    };
+    let each = |t: &[f64]| t.len() < 2 || increasing(t);
+    (t1.len() + t2.len() >= 2 && across && each(t1) && each(t2)).then_some(())
+}
+
+/// The time and command columns of two halves ([`scaled_halves`]) joined
+/// straight into the shared storage a [`Table`] keeps (one copy).
+fn joined(first: &[Vec<f64>], second: &[Vec<f64>]) -> (Arc<[f64]>, Arc<[f64]>) {
+    fn part(h: &[Vec<f64>], k: usize) -> &[f64] {
+        h.get(k).map_or(&[], Vec::as_slice)
+    }
+    let column = |k: usize| -> Arc<[f64]> {
+        part(first, k)
+            .iter()
+            .chain(part(second, k))
+            .copied()
+            .collect()
+    };
+    (column(0), column(1))
 }
 
 /// The bytes of file `path` (an error names it).
 pub fn read_bytes(path: &Path) -> Result<Vec<u8>, CliError> {
-    std::fs::read(path).map_err(|source| CliError::Io {
-        path: path.display().to_string(),
-        source,
-    })
+    read_into(path, Vec::new())
+}
+
+/// The bytes of file `path` appended to `buf` (an error names the file).
+fn read_into(path: &Path, mut buf: Vec<u8>) -> Result<Vec<u8>, CliError> {
+    use std::io::Read as _;
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_to_end(&mut buf))
+        .map(|_| buf)
+        .map_err(|source| CliError::Io {
+            path: path.display().to_string(),
+            source,
+        })
 }
 
 /// A command file read whole, as a run takes it.
@@ -221,7 +272,7 @@ pub struct Table {
 pub fn read_table(path: &Path, bytes: &[u8], unit: CommandUnit) -> Result<Table, CliError> {
     let file = path.display().to_string();
     let (t, u) = parse_command(&file, bytes, unit)?;
-    table_of(&file, t, u, unit)
+    table_of(&file, t.into(), u.into(), unit)
 }
 
 /// The samples `u` (at times `t`) beyond `limit` in magnitude, and the
@@ -231,15 +282,19 @@ pub fn beyond(t: &[f64], u: &[f64], limit: f64) -> (usize, (f64, f64)) {
 }
 
 /// The [`Table`] of file `file`'s samples `(t, u)`.
-fn table_of(file: &str, t: Vec<f64>, u: Vec<f64>, unit: CommandUnit) -> Result<Table, CliError> {
+fn table_of(
+    file: &str,
+    times: Arc<[f64]>,
+    u: Arc<[f64]>,
+    unit: CommandUnit,
+) -> Result<Table, CliError> {
     let (outside, peak) = if unit == CommandUnit::Normalised {
-        beyond(&t, &u, 1.0)
+        beyond(&times, &u, 1.0)
     } else {
         (0, (0.0, f64::NAN))
     };
     // the output times are the table's own (shared, not copied)
-    let times: std::sync::Arc<[f64]> = t.into();
-    let signal = Signal::shared_table(times.clone(), u.into())
+    let signal = Signal::shared_table(times.clone(), u)
         .map_err(|e| CliError::Input(format!("{file}: {e}")))?;
     Ok(Table {
         times,
@@ -279,15 +334,10 @@ fn cut_of(body: &[u8]) -> Option<usize> {
 }
 
 /// The time and command cells of the whole lines `piece` (see
-/// [`Rows::parse`]), in columns with room for `room` more bytes of lines.
-fn parse_piece(
-    csv: &PlainCsv,
-    c: &Columns,
-    piece: &[u8],
-    room: usize,
-) -> Option<(Body, Vec<Vec<f64>>)> {
+/// [`Rows::parse`]), in columns.
+fn parse_piece(csv: &PlainCsv, c: &Columns, piece: &[u8]) -> Option<(Body, Vec<Vec<f64>>)> {
     let rows = Rows::new(csv.width(), &[c.time, c.command])?;
-    let hint = (piece.len() + room) / (8 * csv.width()).max(1) + 1;
+    let hint = piece.len() / (8 * csv.width()).max(1) + 1;
     let mut out = vec![Vec::with_capacity(hint), Vec::with_capacity(hint)];
     let end = rows.parse(piece, &mut out)?;
     Some((end, out))
@@ -315,15 +365,23 @@ pub struct Ahead {
 }
 
 impl Ahead {
-    /// Starts reading `path`.
+    /// Starts reading `path`. Its buffer is allocated here, on the thread
+    /// that later takes the table: freed once the file is parsed, its
+    /// memory serves that thread's next allocations (the output's blocks)
+    /// instead of fresh pages (see [`crate::heap`]).
     pub fn start(path: PathBuf, stream_above: u64) -> Self {
         let (unit, told) = mpsc::channel::<CommandUnit>();
         let (send, bytes) = mpsc::channel::<Arc<Vec<u8>>>();
         let (done, read) = mpsc::channel::<Result<Read, CliError>>();
         let file = path.clone();
+        let len = std::fs::metadata(&path).ok().map(|m| m.len());
+        let buf = match len {
+            Some(n) if n <= stream_above => Vec::with_capacity(n.try_into().unwrap_or(0)),
+            _ => Vec::new(),
+        };
         std::thread::spawn(move || {
             let path = file;
-            let _ = done.send(Self::read(&path, stream_above, &send, &told));
+            let _ = done.send(Self::read(&path, len, stream_above, buf, &send, &told));
         });
         Ahead {
             path,
@@ -333,17 +391,20 @@ impl Ahead {
         }
     }
 
-    /// The reading thread's work.
+    /// The reading thread's work on the file of `len` bytes, read into
+    /// `buf`.
     fn read(
         path: &Path,
+        len: Option<u64>,
         stream_above: u64,
+        buf: Vec<u8>,
         send: &mpsc::Sender<Arc<Vec<u8>>>,
         told: &mpsc::Receiver<CommandUnit>,
     ) -> Result<Read, CliError> {
-        if std::fs::metadata(path).is_ok_and(|m| m.len() > stream_above) {
+        if len.is_some_and(|n| n > stream_above) {
             return Ok(Read::Whole(None));
         }
-        let read = read_bytes(path).map(Arc::new);
+        let read = read_into(path, buf).map(Arc::new);
         if let Ok(b) = &read {
             let _ = send.send(b.clone());
         }
@@ -355,8 +416,7 @@ impl Ahead {
         if let Some((csv, c)) = plain_columns(&path.display().to_string(), &bytes, unit) {
             let body = csv.body().as_bytes();
             if let Some(cut) = cut_of(body) {
-                // with room for the second half, appended to it
-                let first = parse_piece(&csv, &c, &body[..cut], body.len() - cut);
+                let first = parse_piece(&csv, &c, &body[..cut]);
                 return Ok(Read::Half(first));
             }
         }
@@ -378,7 +438,7 @@ impl Ahead {
             let body = csv.body().as_bytes();
             let piece = &body[cut_of(body)?..];
             let blank = piece.iter().all(|&b| b == b'\n' || b == b'\r');
-            Some((parse_piece(&csv, &c, piece, 0), blank, c))
+            Some((parse_piece(&csv, &c, piece), blank, c))
         });
         let read = self
             .read
@@ -391,18 +451,22 @@ impl Ahead {
         };
         // both halves plain (blank lines only at the very end), or the
         // full reader, which names what is wrong
-        let joined = second.and_then(|(second, blank, c)| {
-            let ((end, mut cols), (_, rest)) = (first?, second?);
+        let halves = second.and_then(|(second, blank, c)| {
+            let ((end, mut first), (_, mut second)) = (first?, second?);
             if end == Body::BlankEnd && !blank {
                 return None;
             }
-            for (a, b) in cols.iter_mut().zip(rest) {
-                a.extend_from_slice(&b);
-            }
-            finish_plain(cols, &c)
+            scaled_halves(&mut first, &mut second, &c)?;
+            Some((first, second))
         });
-        match joined {
-            Some((t, u)) => table_of(&file, t, u, unit).map(Some),
+        match halves {
+            Some((first, second)) => {
+                // the file's bytes, done with, are freed first: the table
+                // takes their memory, not fresh pages (see `crate::heap`)
+                drop(bytes);
+                let (t, u) = joined(&first, &second);
+                table_of(&file, t, u, unit).map(Some)
+            }
             None => read_table(&self.path, &bytes, unit).map(Some),
         }
     }
@@ -534,6 +598,43 @@ fn parse_samples(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// A long body's two halves, scaled and joined, are the columns the
+    /// one-piece fast path reads from the whole ([`finish_plain`]), bit for
+    /// bit, or both send the file to the full reader: for any cut, in
+    /// either unit, with times that stop increasing anywhere (at the cut
+    /// too) or are NaN.
+    #[test]
+    fn halves_join_as_the_whole() {
+        let step = prop_oneof![Just(1.0), Just(2.5), Just(0.0), Just(-1.0), Just(f64::NAN)];
+        let rows = prop::collection::vec((step, -2.0..2.0f64), 0..12);
+        let factors = (
+            prop::sample::select(vec![1.0, 1e-3]),
+            prop::sample::select(vec![1.0, 0.01]),
+        );
+        proptest!(|(rows in rows, cut in 0..13usize, (tf, cf) in factors)| {
+            let mut t = Vec::new();
+            let mut at = 0.0;
+            for (s, _) in &rows {
+                at += s;
+                t.push(at);
+            }
+            let u: Vec<f64> = rows.iter().map(|r| r.1).collect();
+            let c = Columns { time: 0, time_factor: tf, command: 1, command_factor: cf };
+            let cut = cut.min(t.len());
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            let whole = finish_plain(vec![t.clone(), u.clone()], &c)
+                .map(|(t, u)| (bits(&t), bits(&u)));
+            let mut first = vec![t[..cut].to_vec(), u[..cut].to_vec()];
+            let mut second = vec![t[cut..].to_vec(), u[cut..].to_vec()];
+            let halves = scaled_halves(&mut first, &mut second, &c).map(|()| {
+                let (t, u) = joined(&first, &second);
+                (bits(&t), bits(&u))
+            });
+            prop_assert_eq!(halves, whole);
+        });
+    }
 
     #[test]
     fn units_and_duplicates() {

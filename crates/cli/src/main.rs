@@ -13,6 +13,7 @@ mod error;
 mod fmu;
 #[cfg(test)]
 mod fuzz;
+mod heap;
 mod ledger;
 mod output;
 mod presets;

@@ -400,6 +400,7 @@ fn budget_message(rk4_step: f64, span: f64, max: usize) -> String {
 
 /// Runs `hydrocyl simulate`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    crate::heap::keep_freed_memory();
     let rig_err = |e: rig::RigError| CliError::Input(e.to_string());
     if crate::bench_sim::runs_on_motion(&args.rig) {
         if let Some((bench, net)) = crate::bench_sim::load(&args.rig, &args.set)? {
@@ -437,7 +438,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     let rig_path = Path::new(&args.rig);
     let mut inputs = vec![("--command", cmd_path.as_path())];
-    if rig::preset(&args.rig).is_none() {
+    if !crate::presets::is_preset(&args.rig) {
         inputs.push(("--rig", rig_path));
     }
     let unit = command_unit(&checked);

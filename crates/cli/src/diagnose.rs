@@ -171,12 +171,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.holdout
         )));
     }
-    let window = match args.window {
-        Some(w) if w < 1 => {
-            return Err(CliError::Input(format!("--window {w}: must be at least 1")))
-        }
-        w => w.map(|w| w as usize),
-    };
+    let window = args
+        .window
+        .map(|w| {
+            hydrocyl_identify::smooth::check_half_window(w)
+                .map_err(|why| CliError::Input(format!("--window {w}: {why}")))
+        })
+        .transpose()?;
     let candidates = match &args.effects {
         None => None,
         Some(ids) => Some(

@@ -170,7 +170,13 @@ fn negative_options_are_refused_by_their_range() {
             ["--holdout", "-0.1"],
             "--holdout -0.1: must be in [0.05, 0.5]",
         ),
-        (["--window", "-3"], "--window -3: must be at least 1"),
+        (["--window", "-3"], "--window -3: must be at least 2"),
+        // a window of 3 samples interpolates the cubic's 4 coefficients:
+        // too narrow to smooth (it was accepted; tester t38d C7)
+        (
+            ["--window", "1"],
+            "--window 1: must be at least 2: the order-3 smoother fits 4 coefficients",
+        ),
     ] {
         let out = bin()
             .args(["diagnose", "--rig", "leaney-moog", "--data"])

@@ -78,6 +78,17 @@ pub enum DataError {
         /// The record's samples.
         samples: usize,
     },
+    /// The smoother half-width asked for is too narrow to smooth: its window
+    /// holds no more samples than the polynomial has coefficients.
+    #[error("{file}: a smoother half-width (window) of {half_window} samples is too narrow for the order-{order} smoother: its {} samples would be interpolated, not smoothed; at least {}", 2 * half_window + 1, (order + 2) / 2)]
+    WindowTooNarrow {
+        /// The record.
+        file: String,
+        /// The half-width asked for.
+        half_window: usize,
+        /// The polynomial degree.
+        order: usize,
+    },
     /// A smoother half-width given for records that are not smoothed.
     #[error("{file}: a steady-state bench's samples are not smoothed (measured velocity, zero acceleration): leave out the smoother half-width (window)")]
     WindowNotUsed {

@@ -675,3 +675,37 @@ fn a_bench_presets_file_and_printout_diagnose_as_its_name() {
         }
     }
 }
+
+/// A record of fewer than 100 samples is warned of in the report's
+/// `warnings`, not only on stderr (a script reading the report never saw
+/// it; tester t38d C6), on the valve rig and on the bench, with `--quiet`.
+#[test]
+fn a_short_record_is_warned_of_in_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    for (rig, data) in [
+        ("leaney-moog".to_string(), "valve-none.csv"),
+        (
+            fixtures().join("bench-none.rig.json").display().to_string(),
+            "bench-none.csv",
+        ),
+    ] {
+        let text = std::fs::read_to_string(fixtures().join(data)).unwrap();
+        let short: String = text.lines().take(61).map(|l| format!("{l}\n")).collect();
+        let path = dir.path().join(data);
+        std::fs::write(&path, short).unwrap();
+        let json = diagnose_json(&[
+            "--rig".as_ref(),
+            rig.as_ref(),
+            "--data".as_ref(),
+            path.as_os_str(),
+        ]);
+        let warnings = json["warnings"].as_array().unwrap();
+        assert!(
+            warnings.iter().any(|w| {
+                let w = w.as_str().unwrap();
+                w.contains(data) && w.contains("60 samples, fewer than 100")
+            }),
+            "{rig}: {warnings:?}"
+        );
+    }
+}

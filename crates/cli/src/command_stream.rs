@@ -47,6 +47,8 @@ pub struct Scan {
 pub struct Chunks {
     file: File,
     rows: Rows,
+    /// The time column's header, as errors name it.
+    time_header: String,
     time_factor: f64,
     command_factor: f64,
     buf: Vec<u8>,
@@ -103,6 +105,7 @@ impl Chunks {
             rows,
             time_factor: c.time_factor,
             command_factor: c.command_factor,
+            time_header: c.time_header,
             buf,
             kept: len - nl - 1,
             eof: false,
@@ -235,7 +238,8 @@ pub fn scan(
             .iter()
             .position(|&tk| hydrocyl_identify::data::beyond_span(s.t0, tk))
         {
-            crate::command::check_span(&path.display().to_string(), s.rows + k + 2, s.t0, t[k])?;
+            let file = path.display().to_string();
+            crate::command::check_span(&file, &c.time_header, s.rows + k + 2, s.t0, t[k])?;
         }
         s.rows += t.len();
         s.t1 = t[t.len() - 1];

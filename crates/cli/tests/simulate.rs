@@ -727,7 +727,7 @@ fn an_existing_output_is_replaced_by_a_good_run_and_kept_by_a_failed_one() {
     std::fs::write(&bad, &text).unwrap();
     std::fs::write(&out, "old content\n").unwrap();
     for (command, extra, needle) in [
-        (&bad, &[][..], "row 3501, column `command`"),
+        (&bad, &[][..], "row 3501, column 'command'"),
         (
             &cmd,
             &["--solver", "rk4", "--rk4-step", "2e-2"][..],
@@ -909,7 +909,7 @@ fn the_input_column_is_in_the_unit_of_its_rig() {
     let err = String::from_utf8_lossy(&st.stderr);
     assert_eq!(st.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("row 1, column `command [%]`") && err.contains("m/s"),
+        err.contains("row 1, column 'command [%]'") && err.contains("m/s"),
         "{err}"
     );
     assert!(!dir.path().join("none.csv").exists());
@@ -952,7 +952,7 @@ fn a_number_that_is_not_finite_is_named() {
     let (code, err) = run(&big, &[]);
     assert_eq!(code, Some(2), "{err}");
     assert!(
-        err.contains("row 2, column `command`: `1e400` is not a finite number"),
+        err.contains("row 2, column 'command': '1e400' is not finite"),
         "{err}"
     );
     for v in ["1e400", "inf", "NaN"] {

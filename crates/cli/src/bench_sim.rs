@@ -245,7 +245,7 @@ pub fn simulate(
         .map_err(|e| CliError::Input(e.to_string()))?;
     let inputs = BenchInputs::of(&s).map_err(CliError::Input)?;
     progress("simulating", 2, STAGES);
-    let run = bench
+    let mut run = bench
         .simulate_channels(&s, &inputs, !measured_force, only)
         .map_err(|e| CliError::Input(format!("{}: {e}", input.display())))?;
     for c in &run.channels {
@@ -260,6 +260,9 @@ pub fn simulate(
         }
     }
     progress("writing", 3, STAGES);
+    for c in &mut run.channels {
+        crate::simulate::flush_to_zero(&mut c.values);
+    }
     let header = crate::simulate::column_headers(&run.channels);
     let names: Vec<&str> = header.iter().map(String::as_str).collect();
     let columns: Vec<&[f64]> = std::iter::once(run.time.as_slice())

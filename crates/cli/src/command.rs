@@ -6,7 +6,7 @@
 //! and column.
 
 use crate::error::CliError;
-use hydrocyl_identify::data::DataError;
+use hydrocyl_identify::data::{scale_decimal, scaled_decimal, DataError};
 use hydrocyl_identify::plaincsv::{Body, PlainCsv, Rows};
 use hydrocyl_system::signal::Signal;
 use std::path::{Path, PathBuf};
@@ -188,12 +188,8 @@ fn read_plain(text: &str, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
 fn finish_plain(mut cols: Vec<Vec<f64>>, c: &Columns) -> Option<(Vec<f64>, Vec<f64>)> {
     let mut u = cols.pop()?;
     let mut t = cols.pop()?;
-    if c.time_factor != 1.0 {
-        t.iter_mut().for_each(|v| *v *= c.time_factor);
-    }
-    if c.command_factor != 1.0 {
-        u.iter_mut().for_each(|v| *v *= c.command_factor);
-    }
+    scale_decimal(&mut t, c.time_factor);
+    scale_decimal(&mut u, c.command_factor);
     if t.len() < 2 || t.windows(2).any(|w| w[1] <= w[0]) {
         return None;
     }
@@ -514,7 +510,7 @@ fn parse_samples(
                 })),
             }
         };
-        let tv = cell(c.time)? * c.time_factor;
+        let tv = scaled_decimal(cell(c.time)?, c.time_factor);
         if let Some(&t0) = t.first() {
             check_span(file, &c.time_header, row, t0, tv)?;
         }
@@ -530,7 +526,7 @@ fn parse_samples(
             }
         }
         t.push(tv);
-        u.push(cell(c.command)? * c.command_factor);
+        u.push(scaled_decimal(cell(c.command)?, c.command_factor));
     }
     if t.len() < 2 {
         return Err(CliError::Input(format!(

@@ -165,14 +165,10 @@ impl Chunks {
             }
             self.buf.copy_within(cut..self.kept, 0);
             self.kept -= cut;
-            if self.time_factor != 1.0 {
-                self.cols[0].iter_mut().for_each(|v| *v *= self.time_factor);
-            }
-            if self.command_factor != 1.0 {
-                self.cols[1]
-                    .iter_mut()
-                    .for_each(|v| *v *= self.command_factor);
-            }
+            // a power-of-ten unit on the decimal: 1.999 ms is 0.001999 s
+            let [t, u] = &mut self.cols;
+            hydrocyl_identify::data::scale_decimal(t, self.time_factor);
+            hydrocyl_identify::data::scale_decimal(u, self.command_factor);
             for &t in &self.cols[0] {
                 if t <= self.prev {
                     return Err(std::io::Error::other("not plain"));

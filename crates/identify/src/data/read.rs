@@ -468,7 +468,10 @@ mod tests {
         let e = parse(&s.replace("10,1", "10,nan")).unwrap_err().to_string();
         assert!(e.contains("row 14,"), "{e}");
         let e = parse(&s.replace("10,1", "10,1,2")).unwrap_err().to_string();
-        assert!(e.contains("row 14, column 3:") && !e.contains("record"), "{e}");
+        assert!(
+            e.contains("row 14, column 3:") && !e.contains("record"),
+            "{e}"
+        );
         let e = parse(&s.replace("19,1", "1e9,1")).unwrap_err().to_string();
         assert!(
             e.contains("row 23, column 'time'") && e.contains("1e6"),

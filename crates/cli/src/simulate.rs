@@ -746,9 +746,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         run.stats.rejected,
         run.stats.rhs_evals,
         if cav > 0 {
+            // the entries are the solver's events, found between the
+            // samples; the samples' lowest pressure need not show the dip
             let lowest = if min_p.is_finite() {
                 format!(
-                    "lowest sampled cylinder chamber pressure {} Pa",
+                    "the output samples need not show it: their lowest cylinder chamber pressure is {} Pa; sample more finely to see the dip",
                     whole_pascals(min_p)
                 )
             } else {
@@ -759,7 +761,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 .iter()
                 .map(|(n, k)| format!("{n} {k}"))
                 .collect();
-            format!("CAVITATION: a cylinder chamber fell below its cavitation pressure, or a line volume below absolute vacuum, {cav} times between the output samples ({lowest}; {})", which.join(", "))
+            format!("CAVITATION: a cylinder chamber fell below its cavitation pressure, or a line volume below absolute vacuum, {cav} times ({}), found by the solver between the output samples ({lowest})", which.join(", "))
         } else {
             "no cavitation".to_string()
         }

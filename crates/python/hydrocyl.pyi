@@ -247,6 +247,7 @@ def diagnose(
 ) -> dict[str, Any]:
     """``hydrocyl diagnose`` on a valve rig and one measured record (CSV
     path or dict of arrays by column name, SI or with unit suffixes); the
-    report as a dict. ``window`` is at least 1. ``effects``: the effect ids
-    the loop may add, a list or one string (split at commas, as the CLI's
+    report as a dict. ``window`` is at least 2 (a narrower one interpolates
+    the order-3 smoother's coefficients). ``effects``: the effect ids the
+    loop may add, a list or one string (split at commas, as the CLI's
     ``--effects``); any other type is a TypeError naming ``effects``."""

@@ -4,7 +4,8 @@
 //! bench's input is not a command but the motion itself. The `--command` file
 //! is a record in the measured-data format (through the rig's column map) with
 //! `time`, `position` or `velocity`, and `p1`/`p2` where the bench has
-//! pressures; the output adds the predicted load-cell `force` and the
+//! pressures (a chamber of area over zero needs its pressure column, as in
+//! `diagnose`: [`FrictionBench::require_inputs`]); the output adds the predicted load-cell `force` and the
 //! friction on the rod: `time, position, velocity, p1, p2, force,
 //! friction_force`, or those of them the rig's `outputs` names, as a
 //! netlist's run is chosen (a name that is none of them is refused before
@@ -231,6 +232,10 @@ pub fn simulate(
             input.display()
         )));
     }
+    // a pressure the rig's areas make an input is needed, not taken as 0 Pa
+    bench
+        .require_inputs(&rec)
+        .map_err(|e| CliError::Input(e.to_string()))?;
     let measured_force = rec.get(Signal::Force).is_some();
     if !measured_force {
         rec.signals.insert(Signal::Force, vec![0.0; rec.len()]);
@@ -240,7 +245,7 @@ pub fn simulate(
         .map_err(|e| CliError::Input(e.to_string()))?;
     let inputs = BenchInputs::of(&s).map_err(CliError::Input)?;
     progress("simulating", 2, STAGES);
-    let run = bench
+    let mut run = bench
         .simulate_channels(&s, &inputs, !measured_force, only)
         .map_err(|e| CliError::Input(format!("{}: {e}", input.display())))?;
     for c in &run.channels {
@@ -255,6 +260,9 @@ pub fn simulate(
         }
     }
     progress("writing", 3, STAGES);
+    for c in &mut run.channels {
+        crate::simulate::flush_to_zero(&mut c.values);
+    }
     let header = crate::simulate::column_headers(&run.channels);
     let names: Vec<&str> = header.iter().map(String::as_str).collect();
     let columns: Vec<&[f64]> = std::iter::once(run.time.as_slice())

@@ -6,6 +6,7 @@
 //! and column.
 
 use crate::error::CliError;
+use hydrocyl_identify::data::{scale_decimal, scaled_decimal, DataError};
 use hydrocyl_identify::plaincsv::{Body, PlainCsv, Rows};
 use hydrocyl_system::signal::Signal;
 use std::path::{Path, PathBuf};
@@ -87,6 +88,8 @@ impl CommandUnit {
 pub struct Columns {
     /// Index of the `time` column.
     pub time: usize,
+    /// Its header cell (`time [ms]`), as errors name the column.
+    pub time_header: String,
     /// Its factor to seconds.
     pub time_factor: f64,
     /// Index of the `command` (or `reference`) column.
@@ -137,14 +140,14 @@ pub fn columns_of<'a>(
                 Some("ms") => 1e-3,
                 Some(u) => {
                     return Err(CliError::Input(format!(
-                        "{file}: row 1, column `{h}`: unknown time unit `{u}` (use s or ms)"
+                        "{file}: row 1, column '{h}': unknown time unit `{u}` (use s or ms)"
                     )))
                 }
             }
         } else {
             unit.factor(u).ok_or_else(|| {
                 CliError::Input(format!(
-                    "{file}: row 1, column `{h}`: unit `{}` does not fit this rig's {} [{}] (use {})",
+                    "{file}: row 1, column '{h}': unit `{}` does not fit this rig's {} [{}] (use {})",
                     u.unwrap_or_default(),
                     unit.column(),
                     unit.symbol(),
@@ -166,6 +169,7 @@ pub fn columns_of<'a>(
     })?;
     Ok(Columns {
         time,
+        time_header: headers[time].to_string(),
         time_factor,
         command,
         command_factor,
@@ -194,12 +198,8 @@ fn scaled<'a>(
     c: &Columns,
 ) -> Option<(&'a mut Vec<f64>, &'a mut Vec<f64>)> {
     let [t, u] = cols else { return None };
-    if c.time_factor != 1.0 {
-        t.iter_mut().for_each(|v| *v *= c.time_factor);
-    }
-    if c.command_factor != 1.0 {
-        u.iter_mut().for_each(|v| *v *= c.command_factor);
-    }
+    scale_decimal(t, c.time_factor);
+    scale_decimal(u, c.command_factor);
     Some((t, u))
 }
 
@@ -457,14 +457,15 @@ impl Ahead {
                 return None;
             }
             scaled_halves(&mut first, &mut second, &c)?;
-            Some((first, second))
+            Some((first, second, c.time_header))
         });
         match halves {
-            Some((first, second)) => {
+            Some((first, second, column)) => {
                 // the file's bytes, done with, are freed first: the table
                 // takes their memory, not fresh pages (see `crate::heap`)
                 drop(bytes);
                 let (t, u) = joined(&first, &second);
+                check_plain_span(&file, &column, &t)?;
                 table_of(&file, t, u, unit).map(Some)
             }
             None => read_table(&self.path, &bytes, unit).map(Some),
@@ -472,45 +473,59 @@ impl Ahead {
     }
 }
 
+// a command file spans at most the record reader's limit (`MAX_SPAN_S`,
+// about 11.6 days), one rule for both
 use hydrocyl_identify::data::beyond_span;
-/// The longest run a command file may span \[s\] (about 11.6 days): the
-/// record reader's limit, one rule for both ([`beyond_span`]).
-pub use hydrocyl_identify::data::MAX_SPAN_S;
 
-/// Refuses sample `t` (at CSV row `row` of `file`) lying more than
-/// [`MAX_SPAN_S`] after the first sample `t0`.
-pub fn check_span(file: &str, row: usize, t0: f64, t: f64) -> Result<(), CliError> {
+/// Refuses sample `t` (at CSV row `row` of `file`, time column header
+/// `column`) lying more than [`MAX_SPAN_S`](hydrocyl_identify::data::MAX_SPAN_S) after the first sample `t0`,
+/// with the record reader's error.
+pub fn check_span(file: &str, column: &str, row: usize, t0: f64, t: f64) -> Result<(), CliError> {
     if beyond_span(t0, t) {
-        return Err(CliError::Input(format!(
-            "{file}: row {row}, column `time`: {t:e} s is {:e} s after the first sample: a run spans at most {MAX_SPAN_S:e} s (about 11.6 days); is the time column in seconds?",
-            t - t0
-        )));
+        return Err(CliError::Input(
+            DataError::SpanTooLong {
+                file: file.to_string(),
+                row,
+                column: column.to_string(),
+                t,
+                span: t - t0,
+            }
+            .to_string(),
+        ));
     }
     Ok(())
 }
 
 /// The command CSV `bytes` of file `file` as `(time [s], command [unit])`;
-/// a span longer than [`MAX_SPAN_S`] is refused.
+/// a span longer than [`MAX_SPAN_S`](hydrocyl_identify::data::MAX_SPAN_S) is refused.
 pub fn parse_command(
     file: &str,
     bytes: &[u8],
     unit: CommandUnit,
 ) -> Result<(Vec<f64>, Vec<f64>), CliError> {
-    let (t, u) = parse_samples(file, bytes, unit)?;
-    // the full reader checked each row at its line; what reaches here from
-    // the fast path has no blank line inside, so sample k is on line k + 2
-    if let Some(k) = t.iter().position(|&tk| beyond_span(t[0], tk)) {
-        check_span(file, k + 2, t[0], t[k])?;
-    }
+    let (t, u, column) = parse_samples(file, bytes, unit)?;
+    check_plain_span(file, &column, &t)?;
     Ok((t, u))
 }
 
-/// [`parse_command`] without the span check.
+/// [`check_span`] on the times `t` of a whole file (time column header
+/// `column`). The full reader checked each row at its line; what reaches
+/// here from the fast path has no blank line inside, so sample k is on
+/// line k + 2.
+fn check_plain_span(file: &str, column: &str, t: &[f64]) -> Result<(), CliError> {
+    match t.iter().position(|&tk| beyond_span(t[0], tk)) {
+        Some(k) => check_span(file, column, k + 2, t[0], t[k]),
+        None => Ok(()),
+    }
+}
+
+/// [`parse_command`] without the span check; also the time column's header.
+/// A bad row is refused with the record reader's errors ([`DataError`]).
 fn parse_samples(
     file: &str,
     bytes: &[u8],
     unit: CommandUnit,
-) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+) -> Result<(Vec<f64>, Vec<f64>, String), CliError> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         CliError::Input(format!(
             "{file}: not UTF-8 text (byte {})",
@@ -525,9 +540,11 @@ fn parse_samples(
         .map_err(|e| CliError::Input(format!("{file}: row 1: {e}")))?
         .clone();
     let c = columns_of(file, headers.iter(), unit)?;
-    if let Some(r) = read_plain(text, &c) {
-        return Ok(r);
+    if let Some((t, u)) = read_plain(text, &c) {
+        return Ok((t, u, c.time_header));
     }
+    let header_list: Vec<&str> = headers.iter().collect();
+    let input = |e: DataError| CliError::Input(e.to_string());
     let (mut t, mut u) = (Vec::new(), Vec::new());
     // a row is the file's line: the CSV reader skips blank lines, which
     // its record count would not see
@@ -540,51 +557,48 @@ fn parse_samples(
         };
         row = at.map_or(row + 1, |p| lines.line_at(p.byte() as usize));
         let rec = rec.map_err(|e| match e.kind() {
-            csv::ErrorKind::UnequalLengths {
-                expected_len, len, ..
-            } => CliError::Input(format!(
-                "{file}: row {row}: {len} cell{}, the header has {expected_len}{}",
-                if *len == 1 { "" } else { "s" },
-                if (*len as usize) <= c.command.max(c.time) {
-                    format!(
-                        " (no `{}` cell, column {})",
-                        headers.get(c.command.max(c.time)).unwrap_or(""),
-                        c.command.max(c.time) + 1
-                    )
-                } else {
-                    String::new()
-                }
-            )),
+            csv::ErrorKind::UnequalLengths { len, .. } => {
+                input(DataError::ragged(file, row, *len as usize, &header_list))
+            }
             _ => CliError::Input(format!("{file}: row {row}: {e}")),
         })?;
         let cell = |i: usize| -> Result<f64, CliError> {
-            let col = headers.get(i).unwrap_or("");
-            let s = rec.get(i).unwrap_or("");
-            let v: f64 = s.parse().map_err(|_| {
-                CliError::Input(format!(
-                    "{file}: row {row}, column `{col}`: `{s}` is not a number"
-                ))
-            })?;
-            if !v.is_finite() {
-                return Err(CliError::Input(format!(
-                    "{file}: row {row}, column `{col}`: `{s}` is not a finite number"
-                )));
+            let column = headers.get(i).unwrap_or("").to_string();
+            let text = rec.get(i).unwrap_or("").to_string();
+            let (file, row) = (file.to_string(), row);
+            match text.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                Ok(_) => Err(input(DataError::NotFinite {
+                    file,
+                    row,
+                    column,
+                    text,
+                })),
+                Err(_) => Err(input(DataError::NotANumber {
+                    file,
+                    row,
+                    column,
+                    text,
+                })),
             }
-            Ok(v)
         };
-        let tv = cell(c.time)? * c.time_factor;
+        let tv = scaled_decimal(cell(c.time)?, c.time_factor);
         if let Some(&t0) = t.first() {
-            check_span(file, row, t0, tv)?;
+            check_span(file, &c.time_header, row, t0, tv)?;
         }
         if let Some(&prev) = t.last() {
             if tv <= prev {
-                return Err(CliError::Input(format!(
-                    "{file}: row {row}, column `time`: {tv} s does not increase (previous {prev} s)"
-                )));
+                return Err(input(DataError::TimeNotIncreasing {
+                    file: file.to_string(),
+                    row,
+                    column: c.time_header.clone(),
+                    t: tv,
+                    prev,
+                }));
             }
         }
         t.push(tv);
-        u.push(cell(c.command)? * c.command_factor);
+        u.push(scaled_decimal(cell(c.command)?, c.command_factor));
     }
     if t.len() < 2 {
         return Err(CliError::Input(format!(
@@ -592,7 +606,7 @@ fn parse_samples(
             t.len()
         )));
     }
-    Ok((t, u))
+    Ok((t, u, c.time_header))
 }
 
 #[cfg(test)]
@@ -673,11 +687,11 @@ mod tests {
         let e = parse_command("f", text.as_bytes(), CommandUnit::Normalised)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("row 8, column `command`"), "{e}");
+        assert!(e.contains("row 8, column 'command'"), "{e}");
         let text = "time,command\n0,0\n\n1,0\n\n2e6,0\n";
         let e = parse_command("f", text.as_bytes(), CommandUnit::Normalised)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("row 6, column `time`"), "{e}");
+        assert!(e.contains("row 6, column 'time'"), "{e}");
     }
 }

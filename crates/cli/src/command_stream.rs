@@ -47,6 +47,8 @@ pub struct Scan {
 pub struct Chunks {
     file: File,
     rows: Rows,
+    /// The time column's header, as errors name it.
+    time_header: String,
     time_factor: f64,
     command_factor: f64,
     buf: Vec<u8>,
@@ -103,6 +105,7 @@ impl Chunks {
             rows,
             time_factor: c.time_factor,
             command_factor: c.command_factor,
+            time_header: c.time_header,
             buf,
             kept: len - nl - 1,
             eof: false,
@@ -162,14 +165,10 @@ impl Chunks {
             }
             self.buf.copy_within(cut..self.kept, 0);
             self.kept -= cut;
-            if self.time_factor != 1.0 {
-                self.cols[0].iter_mut().for_each(|v| *v *= self.time_factor);
-            }
-            if self.command_factor != 1.0 {
-                self.cols[1]
-                    .iter_mut()
-                    .for_each(|v| *v *= self.command_factor);
-            }
+            // a power-of-ten unit on the decimal: 1.999 ms is 0.001999 s
+            let [t, u] = &mut self.cols;
+            hydrocyl_identify::data::scale_decimal(t, self.time_factor);
+            hydrocyl_identify::data::scale_decimal(u, self.command_factor);
             for &t in &self.cols[0] {
                 if t <= self.prev {
                     return Err(std::io::Error::other("not plain"));
@@ -235,7 +234,8 @@ pub fn scan(
             .iter()
             .position(|&tk| hydrocyl_identify::data::beyond_span(s.t0, tk))
         {
-            crate::command::check_span(&path.display().to_string(), s.rows + k + 2, s.t0, t[k])?;
+            let file = path.display().to_string();
+            crate::command::check_span(&file, &c.time_header, s.rows + k + 2, s.t0, t[k])?;
         }
         s.rows += t.len();
         s.t1 = t[t.len() - 1];

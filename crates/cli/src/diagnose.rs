@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_identify::catalog::EffectId;
 use hydrocyl_identify::data::{ColumnMap, Record};
-use hydrocyl_identify::diagnose::{diagnose_bench, DiagnoseOptions, RecordTrace};
+use hydrocyl_identify::diagnose::{
+    diagnose_bench, small_sample_warning, DiagnoseOptions, RecordTrace,
+};
 use hydrocyl_identify::valve::{diagnose_rig_traced, Model};
 use hydrocyl_system::rig::valve_rig_from;
 
@@ -153,10 +155,6 @@ pub fn presets() -> Vec<&'static str> {
         .collect()
 }
 
-/// Fewer samples than this per record: the ± intervals of the report assume
-/// many independent samples, so they are not to be trusted.
-const SMALL_SAMPLE: usize = 100;
-
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<(), CliError> {
     if !(0.0..1.0).contains(&args.min_share) {
@@ -171,12 +169,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.holdout
         )));
     }
-    let window = match args.window {
-        Some(w) if w < 1 => {
-            return Err(CliError::Input(format!("--window {w}: must be at least 1")))
-        }
-        w => w.map(|w| w as usize),
-    };
+    let window = args
+        .window
+        .map(|w| {
+            hydrocyl_identify::smooth::check_half_window(w)
+                .map_err(|why| CliError::Input(format!("--window {w}: {why}")))
+        })
+        .transpose()?;
     let candidates = match &args.effects {
         None => None,
         Some(ids) => Some(
@@ -230,13 +229,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .zip(&stems)
         .map(|(r, s)| (r.source.as_str(), s.as_str()))
         .collect();
-    for (p, r) in args.data.iter().zip(&records) {
-        if r.len() < SMALL_SAMPLE && !args.quiet {
-            crate::console::note(format_args!(
-                "hydrocyl: warning: {}: {} samples, fewer than {SMALL_SAMPLE}: the ± intervals assume many independent samples and are not to be trusted",
-                p.display(),
-                r.len()
-            ));
+    // before the run, as the report's `warnings` carry it after
+    for w in records.iter().filter_map(small_sample_warning) {
+        if !args.quiet {
+            crate::console::note(format_args!("hydrocyl: warning: {w}"));
         }
     }
     let opts = DiagnoseOptions {

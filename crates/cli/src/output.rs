@@ -89,6 +89,8 @@ struct Pending {
     /// Where it is put in place, with its temporary file beside it; `None`
     /// for a stream, written directly.
     place: Option<Place>,
+    /// The open file; `None` for a file before its first write (its
+    /// temporary is created then, [`Place::create`]).
     writer: Option<BufWriter<File>>,
 }
 
@@ -97,6 +99,21 @@ struct Pending {
 struct Place {
     target: PathBuf,
     tmp: PathBuf,
+}
+
+impl Place {
+    /// Creates the temporary (registered for removal on a signal), with
+    /// the permissions of the file it replaces.
+    fn create(&self) -> std::io::Result<BufWriter<File>> {
+        remove_temporaries_on_signal();
+        let f = File::create(&self.tmp)?;
+        register(&self.tmp);
+        if let Ok(m) = std::fs::metadata(&self.target) {
+            let _ = f.set_permissions(m.permissions());
+        }
+        // small: a block of rows larger than this goes straight to the file
+        Ok(BufWriter::with_capacity(1 << 16, f))
+    }
 }
 
 /// Most symbolic links followed to an output's file (Linux's own limit).
@@ -172,40 +189,39 @@ impl Outputs {
         Ok(c)
     }
 
-    /// Opens output `path` (option `option`): checks it, then creates its
-    /// temporary file `.<name>.tmp<pid>` next to the file it names (through
-    /// its symbolic links), so that a missing or read-only folder is
-    /// reported before any computation; a stream is opened for writing.
+    /// Opens output `path` (option `option`): checks it, then creates and
+    /// removes its temporary file `.<name>.tmp<pid>` next to the file it
+    /// names (through its symbolic links), so that a missing or read-only
+    /// folder is reported before any computation; the temporary is created
+    /// again at the first write (a run killed before it, even by SIGKILL,
+    /// leaves none: a `diagnose` report's exists only while it is written).
+    /// A stream is opened for writing.
     pub fn file(&mut self, option: &str, path: &Path) -> Result<OutputId, CliError> {
         self.check(option, path)?;
         let io = |source| CliError::Io {
             path: format!("{option} {}", path.display()),
             source,
         };
-        let (f, place) = if is_stream(path) {
+        let (writer, place) = if is_stream(path) {
             let f = std::fs::OpenOptions::new()
                 .write(true)
                 .open(path)
                 .map_err(io)?;
-            (f, None)
+            (Some(BufWriter::with_capacity(1 << 16, f)), None)
         } else {
             let target = through_links(path).map_err(io)?;
             let name = target.file_name().unwrap_or_default().to_string_lossy();
             let tmp = target.with_file_name(format!(".{name}.tmp{}", std::process::id()));
-            remove_temporaries_on_signal();
-            let f = File::create(&tmp).map_err(io)?;
-            register(&tmp);
-            // the file it replaces keeps its permissions
-            if let Ok(m) = std::fs::metadata(&target) {
-                let _ = f.set_permissions(m.permissions());
-            }
-            (f, Some(Place { target, tmp }))
+            let place = Place { target, tmp };
+            drop(place.create().map_err(io)?);
+            let _ = std::fs::remove_file(&place.tmp);
+            unregister(&place.tmp);
+            (None, Some(place))
         };
         self.files.push(Pending {
             path: path.to_path_buf(),
             place,
-            // small: a block of rows larger than this goes straight to the file
-            writer: Some(BufWriter::with_capacity(1 << 16, f)),
+            writer,
         });
         Ok(OutputId(self.files.len() - 1))
     }
@@ -243,28 +259,43 @@ impl Outputs {
         }
     }
 
+    /// Output `id`'s open file (its temporary created at the first call).
+    fn writer(&mut self, id: OutputId) -> Result<&mut BufWriter<File>, CliError> {
+        let f = &mut self.files[id.0];
+        if f.writer.is_none() {
+            let place = f.place.as_ref().ok_or_else(|| CliError::Io {
+                path: f.path.display().to_string(),
+                source: std::io::Error::other("written after it was closed"),
+            })?;
+            let w = place.create().map_err(|source| CliError::Io {
+                path: f.path.display().to_string(),
+                source,
+            })?;
+            f.writer = Some(w);
+        }
+        f.writer.as_mut().ok_or_else(|| CliError::Io {
+            path: f.path.display().to_string(),
+            source: std::io::Error::other("not open"),
+        })
+    }
+
     /// Appends `bytes` to output `id`.
     pub fn write(&mut self, id: OutputId, bytes: &[u8]) -> Result<(), CliError> {
-        let f = &mut self.files[id.0];
-        let w = f.writer.as_mut().ok_or_else(|| CliError::Io {
-            path: f.path.display().to_string(),
-            source: std::io::Error::other("written after it was closed"),
-        })?;
-        w.write_all(bytes).map_err(|source| CliError::Io {
-            path: f.path.display().to_string(),
-            source,
-        })
+        let path = self.files[id.0].path.display().to_string();
+        self.writer(id)?
+            .write_all(bytes)
+            .map_err(|source| CliError::Io { path, source })
     }
 
     /// Appends `pieces`, one after the other, to output `id` (with as few
     /// system calls and copies as the buffer allows: pieces larger than it
     /// go straight to the file).
     pub fn write_all(&mut self, id: OutputId, pieces: &[Vec<u8>]) -> Result<(), CliError> {
+        self.writer(id)?;
         let f = &mut self.files[id.0];
-        let w = f.writer.as_mut().ok_or_else(|| CliError::Io {
-            path: f.path.display().to_string(),
-            source: std::io::Error::other("written after it was closed"),
-        })?;
+        let Some(w) = f.writer.as_mut() else {
+            return Ok(());
+        };
         let mut slices: Vec<IoSlice<'_>> = pieces.iter().map(|p| IoSlice::new(p)).collect();
         let mut left = &mut slices[..];
         IoSlice::advance_slices(&mut left, 0);
@@ -295,10 +326,15 @@ impl Outputs {
     /// content back, and one renamed in (it did not exist) is removed.
     pub fn commit(mut self, fsync: bool) -> Result<(), CliError> {
         for f in &mut self.files {
-            let Some(w) = f.writer.take() else { continue };
             let io = |source| CliError::Io {
                 path: f.path.display().to_string(),
                 source,
+            };
+            // an output never written is put in place empty
+            let w = match (f.writer.take(), &f.place) {
+                (Some(w), _) => w,
+                (None, Some(p)) => p.create().map_err(io)?,
+                (None, None) => continue,
             };
             let file = w.into_inner().map_err(|e| io(e.into_error()))?;
             // a stream (a pipe, a terminal) has no disk to flush to
@@ -393,5 +429,46 @@ impl Drop for Outputs {
                 unregister(&p.tmp);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The temporaries in folder `dir`.
+    fn temporaries(dir: &Path) -> Vec<String> {
+        std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .filter(|n| n.contains(".tmp"))
+            .collect()
+    }
+
+    /// An output's temporary exists only from its first write to the
+    /// commit: a run killed before it writes (SIGKILL during a `diagnose`
+    /// fit) leaves none behind (tester t38d C1); a bad folder is still
+    /// refused up front; an output never written is put in place empty.
+    #[test]
+    fn the_temporary_exists_only_while_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let mut outputs = Outputs::new(&[]);
+        let report = outputs.file("--report", &d.join("r.json")).unwrap();
+        let _never_written = outputs.file("--out", &d.join("e.csv")).unwrap();
+        assert!(temporaries(d).is_empty(), "{:?}", temporaries(d));
+        outputs.write(report, b"{}").unwrap();
+        assert_eq!(temporaries(d).len(), 1, "{:?}", temporaries(d));
+        outputs.commit(false).unwrap();
+        assert!(temporaries(d).is_empty(), "{:?}", temporaries(d));
+        assert_eq!(std::fs::read(d.join("r.json")).unwrap(), b"{}");
+        assert_eq!(std::fs::read(d.join("e.csv")).unwrap(), b"");
+        let mut outputs = Outputs::new(&[]);
+        let e = outputs
+            .file("--report", &d.join("no-such-folder").join("r.json"))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("--report"), "{e}");
     }
 }

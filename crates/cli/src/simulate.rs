@@ -191,6 +191,19 @@ const BLOCK: usize = 1 << 8;
 /// Samples of the command window of a streamed command file.
 const WINDOW: usize = 1 << 18;
 
+/// Writes `values` of a `simulate` output as zero where they are zero to
+/// double precision: a subnormal (below `f64::MIN_POSITIVE`, 2.2e-308, in
+/// magnitude: a pressure decaying onto the tank's 0 Pa, `-1.3e-316`) and
+/// `-0.0` become `0.0`. A subnormal has lost its precision and is no
+/// physical value; every normal double is written as the solver gave it.
+pub fn flush_to_zero(values: &mut [f64]) {
+    for v in values {
+        if v.is_subnormal() || *v == 0.0 {
+            *v = 0.0;
+        }
+    }
+}
+
 /// The CSV header of a run's `channels`: `time [s]`, then each channel as
 /// `name [unit]` (the in-memory channel names stay bare; the readers take
 /// both forms): every `simulate` output's, a netlist's or a friction
@@ -650,9 +663,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
                         let fill = |b: &mut Block| {
                             b.time.extend_from_slice(&block.time);
                             b.values.reserve(block.channels.len() * block.time.len());
+                            let start = b.values.len();
                             for c in &block.channels {
                                 b.values.extend_from_slice(&c.values);
                             }
+                            flush_to_zero(&mut b.values[start..]);
                         };
                         if w.behind() < args.probes_behind {
                             w.push(fill)
@@ -732,9 +747,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         run.stats.rejected,
         run.stats.rhs_evals,
         if cav > 0 {
+            // the entries are the solver's events, found between the
+            // samples; the samples' lowest pressure need not show the dip
             let lowest = if min_p.is_finite() {
                 format!(
-                    "lowest sampled cylinder chamber pressure {} Pa",
+                    "the output samples need not show it: their lowest cylinder chamber pressure is {} Pa; sample more finely to see the dip",
                     whole_pascals(min_p)
                 )
             } else {
@@ -745,7 +762,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 .iter()
                 .map(|(n, k)| format!("{n} {k}"))
                 .collect();
-            format!("CAVITATION: a cylinder chamber fell below its cavitation pressure, or a line volume below absolute vacuum, {cav} times between the output samples ({lowest}; {})", which.join(", "))
+            format!("CAVITATION: a cylinder chamber fell below its cavitation pressure, or a line volume below absolute vacuum, {cav} times ({}), found by the solver between the output samples ({lowest})", which.join(", "))
         } else {
             "no cavitation".to_string()
         }

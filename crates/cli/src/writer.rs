@@ -91,6 +91,9 @@ impl Maker {
                 let run = &mut self.run;
                 r.read_channels(&block.time, &block.values, run);
                 let deep = crate::simulate::check_solution(run, *solver, *rk4_step)?;
+                for c in &mut run.channels {
+                    crate::simulate::flush_to_zero(&mut c.values);
+                }
                 if seq == 0 {
                     out.extend_from_slice(
                         crate::simulate::column_headers(&run.channels)

@@ -170,7 +170,13 @@ fn negative_options_are_refused_by_their_range() {
             ["--holdout", "-0.1"],
             "--holdout -0.1: must be in [0.05, 0.5]",
         ),
-        (["--window", "-3"], "--window -3: must be at least 1"),
+        (["--window", "-3"], "--window -3: must be at least 2"),
+        // a window of 3 samples interpolates the cubic's 4 coefficients:
+        // too narrow to smooth (it was accepted; tester t38d C7)
+        (
+            ["--window", "1"],
+            "--window 1: must be at least 2: the order-3 smoother fits 4 coefficients",
+        ),
     ] {
         let out = bin()
             .args(["diagnose", "--rig", "leaney-moog", "--data"])
@@ -667,5 +673,39 @@ fn a_bench_presets_file_and_printout_diagnose_as_its_name() {
                 String::from_utf8_lossy(&out.stderr)
             );
         }
+    }
+}
+
+/// A record of fewer than 100 samples is warned of in the report's
+/// `warnings`, not only on stderr (a script reading the report never saw
+/// it; tester t38d C6), on the valve rig and on the bench, with `--quiet`.
+#[test]
+fn a_short_record_is_warned_of_in_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    for (rig, data) in [
+        ("leaney-moog".to_string(), "valve-none.csv"),
+        (
+            fixtures().join("bench-none.rig.json").display().to_string(),
+            "bench-none.csv",
+        ),
+    ] {
+        let text = std::fs::read_to_string(fixtures().join(data)).unwrap();
+        let short: String = text.lines().take(61).map(|l| format!("{l}\n")).collect();
+        let path = dir.path().join(data);
+        std::fs::write(&path, short).unwrap();
+        let json = diagnose_json(&[
+            "--rig".as_ref(),
+            rig.as_ref(),
+            "--data".as_ref(),
+            path.as_os_str(),
+        ]);
+        let warnings = json["warnings"].as_array().unwrap();
+        assert!(
+            warnings.iter().any(|w| {
+                let w = w.as_str().unwrap();
+                w.contains(data) && w.contains("60 samples, fewer than 100")
+            }),
+            "{rig}: {warnings:?}"
+        );
     }
 }

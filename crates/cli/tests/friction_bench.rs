@@ -17,12 +17,13 @@ fn bench_rig() -> PathBuf {
         .join("../../fixtures/measured/bench-acceleration_friction.rig.json")
 }
 
-/// A `time,velocity` record of a slow sine.
+/// A `time,velocity,p2` record of a slow sine at 5 bar (the bench's
+/// chamber 2 has an area: its pressure is an input the record must carry).
 fn velocity_record(dir: &Path) -> PathBuf {
-    let mut s = String::from("time,velocity\n");
+    let mut s = String::from("time,velocity,p2 [bar]\n");
     for k in 0..200 {
         let t = k as f64 * 0.002;
-        s.push_str(&format!("{t},{}\n", 0.05 * (6.0 * t).sin()));
+        s.push_str(&format!("{t},{},5\n", 0.05 * (6.0 * t).sin()));
     }
     let p = dir.join("velv.csv");
     std::fs::write(&p, s).unwrap();

@@ -12,10 +12,12 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+mod decimal;
 mod error;
 mod read;
 mod time_axis;
 
+pub use decimal::{scale_decimal, scaled_decimal};
 pub use error::DataError;
 pub use read::{foreign_separator, LineCounter};
 pub use time_axis::{beyond_span, GAP_OVER_REST, MAX_GAP_FACTOR, MAX_SPAN_S};

@@ -38,6 +38,29 @@ mod bench_loop;
 mod bench_model;
 pub use bench_loop::diagnose_bench;
 
+/// Fewer samples than this in a record: the report's ± intervals assume
+/// many independent samples, so they are not to be trusted.
+pub const SMALL_SAMPLE: usize = 100;
+
+/// The warning for record `rec` when it has fewer than [`SMALL_SAMPLE`]
+/// samples (`None` otherwise): in the report's `warnings`, and what the CLI
+/// prints on stderr before the run.
+pub fn small_sample_warning(rec: &Record) -> Option<String> {
+    (rec.len() < SMALL_SAMPLE).then(|| {
+        format!(
+            "{}: {} samples, fewer than {SMALL_SAMPLE}: the ± intervals assume many independent samples and are not to be trusted",
+            rec.source,
+            rec.len()
+        )
+    })
+}
+
+/// `warnings` after the [`small_sample_warning`]s of `records`.
+pub fn with_small_sample_warnings(warnings: Vec<String>, records: &[&Record]) -> Vec<String> {
+    let small = records.iter().filter_map(|r| small_sample_warning(r));
+    small.chain(warnings).collect()
+}
+
 /// Options of the loop.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DiagnoseOptions {

@@ -240,9 +240,34 @@ fn apply(w: &Weights, y: &[f64]) -> (f64, f64, f64) {
     a
 }
 
+/// The polynomial degree of the smoother `diagnose` differentiates records
+/// with (both rigs, [`smooth_with`] and [`smooth_gcv`]).
+pub const ORDER: usize = 3;
+
+/// The narrowest half-width `h` that smooths with a polynomial of degree
+/// [`ORDER`]: its window of `2 h + 1` samples holds more samples than the
+/// polynomial has coefficients. A narrower one (`h = 1`: 3 samples for a
+/// cubic's 4) interpolates the samples, noise and all.
+pub const MIN_HALF_WINDOW: usize = (ORDER + 2) / 2;
+
+/// Checks a smoother half-width given as an option (`--window`, Python's
+/// `window`): the half-width, or why it is refused (to follow the option's
+/// name and value in a one-line error).
+pub fn check_half_window(w: i64) -> Result<usize, String> {
+    match usize::try_from(w) {
+        Ok(h) if h >= MIN_HALF_WINDOW => Ok(h),
+        _ => Err(format!(
+            "must be at least {MIN_HALF_WINDOW}: the order-{ORDER} smoother fits {} coefficients, and a narrower window ({} samples or fewer) would interpolate the samples, not smooth them",
+            ORDER + 1,
+            2 * MIN_HALF_WINDOW - 1
+        )),
+    }
+}
+
 /// Smooths the samples `y` of record `rec` with a given half-width
 /// (`criterion = "fixed"`): a window of `2 h + 1` samples must fit inside
-/// the record, never clamped silently.
+/// the record, never clamped silently, and hold more samples than the
+/// polynomial of degree `order` has coefficients.
 pub fn smooth_with(
     rec: &crate::data::Record,
     y: &[f64],
@@ -250,7 +275,14 @@ pub fn smooth_with(
     order: usize,
 ) -> Result<Smoothed, crate::data::DataError> {
     let samples = rec.time.len();
-    if half_window == 0 || 2 * half_window + 1 > samples {
+    if 2 * half_window < order + 1 {
+        return Err(crate::data::DataError::WindowTooNarrow {
+            file: rec.source.clone(),
+            half_window,
+            order,
+        });
+    }
+    if 2 * half_window + 1 > samples {
         return Err(crate::data::DataError::WindowTooWide {
             file: rec.source.clone(),
             half_window,

@@ -771,7 +771,7 @@ pub fn diagnose_rig_traced(
             .collect(),
         unexplained_share: rss_after / rss_before.max(1e-300),
         unexplained_resembles: resembles,
-        warnings,
+        warnings: crate::diagnose::with_small_sample_warnings(warnings, &[rec]),
         noise_share: (noise_ss / rss_after.max(1e-300)).min(1.0),
         selection: format!(
             "output-error tracing: add the effect removing the largest share of the noise-weighted output-error SS if share >= {:.0} %, held-out share >= {:.1} % and BIC falls; refit all added parameters on the output error; keep it only if its size's 95 % interval excludes zero and stays in the parameter's valid range, no parameter sits at a bound, no compared channel's NRMSE rises by more than {:.0} % of its noise floor and the held-out part improves; after the last joint refit, drop the least resolved added effect whose interval no longer passes and refit the rest, until all pass; where a round adds no single effect, pairs of its best candidates are traced and refitted together, and a pair is added when both effects pass the same rule; after the forward step, where what is left is more than twice the noise, the best pair from the declared model replaces the added set when it passes the rule, leaves less and its ΔBIC against the set is negative",

@@ -109,9 +109,10 @@ pub fn diagnose<'py>(
     if !(0.05..=0.5).contains(&holdout) {
         return bad(format!("holdout {holdout}: must be in [0.05, 0.5]"));
     }
-    let window = match window {
-        Some(w) if w < 1 => return bad(format!("window {w}: must be at least 1")),
-        w => w.and_then(|w| usize::try_from(w).ok()),
+    let window = match window.map(|w| (w, hydrocyl_identify::smooth::check_half_window(w))) {
+        Some((w, Err(why))) => return bad(format!("window {w}: {why}")),
+        Some((_, Ok(h))) => Some(h),
+        None => None,
     };
     let effects = effects.map(effect_ids).transpose()?;
     let candidates = effects

@@ -85,8 +85,9 @@ def test_diagnose_errors(repo):
         hydrocyl.diagnose(rig, str(repo / "no-such.csv"))
 
 
-@pytest.mark.parametrize("window", [0, -1])
-def test_a_window_below_one_is_a_value_error_naming_it(repo, window):
+@pytest.mark.parametrize("window", [1, 0, -1])
+def test_a_window_below_two_is_a_value_error_naming_it(repo, window):
+    # a half-width of 1 (3 samples) interpolates the order-3 smoother's 4 coefficients
     with pytest.raises(ValueError) as e:
         hydrocyl.diagnose(hydrocyl.Rig.load("leaney-moog"), str(repo / RECORD), window=window)
-    assert str(e.value) == f"window {window}: must be at least 1"
+    assert str(e.value).startswith(f"window {window}: must be at least 2: the order-3 smoother")

@@ -71,15 +71,15 @@ pub fn bench_signals(
     }
     let (x, v, a, info) = if let Some(x) = rec.get(Signal::Position) {
         let s = match half_window {
-            Some(h) => crate::smooth::smooth_with(rec, x, h, 3)?,
-            None => crate::smooth::smooth_gcv(&t, x, 3, 400),
+            Some(h) => crate::smooth::smooth_with(rec, x, h, crate::smooth::ORDER)?,
+            None => crate::smooth::smooth_gcv(&t, x, crate::smooth::ORDER, 400),
         };
         (s.value, s.d1, s.d2, s.info)
     } else {
         let vel = rec.require(Signal::Velocity)?;
         let s = match half_window {
-            Some(h) => crate::smooth::smooth_with(rec, vel, h, 3)?,
-            None => crate::smooth::smooth_gcv(&t, vel, 3, 400),
+            Some(h) => crate::smooth::smooth_with(rec, vel, h, crate::smooth::ORDER)?,
+            None => crate::smooth::smooth_gcv(&t, vel, crate::smooth::ORDER, 400),
         };
         let mut x = vec![0.0; t.len()];
         for i in 1..t.len() {

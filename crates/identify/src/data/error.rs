@@ -26,6 +26,26 @@ pub enum DataError {
         /// What is wrong.
         reason: String,
     },
+    /// A row with more or fewer cells than the header has columns; the
+    /// column is the first without a cell (fewer) or the first cell
+    /// without a column (more). Made by [`DataError::ragged`], for the
+    /// record reader and `simulate`'s command reader alike.
+    #[error("{file}: row {row}, column {column}: {cells} cell{}, the header has {header} ({what})", if *cells == 1 { "" } else { "s" })]
+    Ragged {
+        /// The file.
+        file: String,
+        /// The row (1-based line).
+        row: usize,
+        /// The column: its header in quotes (`'force [N]'`), or its number
+        /// where it is beyond the header.
+        column: String,
+        /// The row's cells.
+        cells: usize,
+        /// The header's columns.
+        header: usize,
+        /// What is missing or extra.
+        what: String,
+    },
     /// A required column is missing.
     #[error("{file}: row 1: missing column '{column}'")]
     MissingColumn {
@@ -78,6 +98,17 @@ pub enum DataError {
         /// The record's samples.
         samples: usize,
     },
+    /// The smoother half-width asked for is too narrow to smooth: its window
+    /// holds no more samples than the polynomial has coefficients.
+    #[error("{file}: a smoother half-width (window) of {half_window} samples is too narrow for the order-{order} smoother: its {} samples would be interpolated, not smoothed; at least {}", 2 * half_window + 1, (order + 2) / 2)]
+    WindowTooNarrow {
+        /// The record.
+        file: String,
+        /// The half-width asked for.
+        half_window: usize,
+        /// The polynomial degree.
+        order: usize,
+    },
     /// A smoother half-width given for records that are not smoothed.
     #[error("{file}: a steady-state bench's samples are not smoothed (measured velocity, zero acceleration): leave out the smoother half-width (window)")]
     WindowNotUsed {
@@ -97,7 +128,7 @@ pub enum DataError {
         text: String,
     },
     /// A cell is NaN or infinite.
-    #[error("{file}: row {row}, column '{column}': value is not finite ({text})")]
+    #[error("{file}: row {row}, column '{column}': '{text}' is not finite")]
     NotFinite {
         /// The file.
         file: String,
@@ -107,6 +138,20 @@ pub enum DataError {
         column: String,
         /// The cell's text.
         text: String,
+    },
+    /// A cell finite as written but not in SI units (`1e308` under `[bar]`).
+    #[error("{file}: row {row}, column '{column}': '{text}' is {value} in SI units: not finite")]
+    NotFiniteInSi {
+        /// The file.
+        file: String,
+        /// The row (1-based line).
+        row: usize,
+        /// The column header.
+        column: String,
+        /// The cell's text.
+        text: String,
+        /// Its value in SI units.
+        value: f64,
     },
     /// Time does not increase strictly.
     #[error(
@@ -125,7 +170,7 @@ pub enum DataError {
         prev: f64,
     },
     /// A time stamp lies more than [`super::MAX_SPAN_S`] after the first.
-    #[error("{file}: row {row}, column '{column}': time {t:.4e} s is {span:.4e} s after the first sample: a record spans at most {max:e} s (about 11.6 days); is the time column in seconds, or this time stamp a typo?", max = super::MAX_SPAN_S)]
+    #[error("{file}: row {row}, column '{column}': time {t:.4e} s is {span:.4e} s after the first sample: a record or command file spans at most {max:e} s (about 11.6 days); is the time column in seconds, or this time stamp a typo?", max = super::MAX_SPAN_S)]
     SpanTooLong {
         /// The file.
         file: String,
@@ -211,4 +256,26 @@ pub enum DataError {
         /// Samples needed.
         min: usize,
     },
+}
+
+impl DataError {
+    /// The [`DataError::Ragged`] error of row `row` of file `file`: `cells`
+    /// cells under the header `headers`.
+    pub fn ragged(file: &str, row: usize, cells: usize, headers: &[&str]) -> DataError {
+        let (column, what) = match headers.get(cells) {
+            Some(h) => (format!("'{h}'"), "no cell for this column".to_string()),
+            None => (
+                (headers.len() + 1).to_string(),
+                "a cell beyond the header's last column".to_string(),
+            ),
+        };
+        DataError::Ragged {
+            file: file.to_string(),
+            row,
+            column,
+            cells,
+            header: headers.len(),
+            what,
+        }
+    }
 }

@@ -206,10 +206,15 @@ impl Record {
                     .map_or(lines.last().map_or(k + 2, |l| l + 1), |p| {
                         counter.line_at(p.byte() as usize)
                     });
-                DataError::Malformed {
-                    file: file.to_string(),
-                    row,
-                    reason: malformed_reason(&e),
+                match e.kind() {
+                    csv::ErrorKind::UnequalLengths { len, .. } => {
+                        DataError::ragged(file, row, *len as usize, &header_list)
+                    }
+                    _ => DataError::Malformed {
+                        file: file.to_string(),
+                        row,
+                        reason: e.to_string(),
+                    },
                 }
             })?;
             let row = rec
@@ -217,11 +222,7 @@ impl Record {
                 .map_or(k + 2, |p| counter.line_at(p.byte() as usize));
             lines.push(row);
             if rec.len() != headers.len() {
-                return Err(DataError::Malformed {
-                    file: file.to_string(),
-                    row,
-                    reason: format!("{} cells, header has {}", rec.len(), headers.len()),
-                });
+                return Err(DataError::ragged(file, row, rec.len(), &header_list));
             }
             for (j, col) in cols.iter().enumerate() {
                 let Some((sig, factor)) = col else { continue };
@@ -243,11 +244,12 @@ impl Record {
                 let v = v * factor;
                 if !v.is_finite() {
                     // finite as written, beyond f64 in SI (1e308 bar)
-                    return Err(DataError::NotFinite {
+                    return Err(DataError::NotFiniteInSi {
                         file: file.to_string(),
                         row,
                         column: headers[j].to_string(),
-                        text: format!("{cell} is {v} in SI units"),
+                        text: cell.to_string(),
+                        value: v,
                     });
                 }
                 if *sig == Signal::Time {
@@ -381,17 +383,6 @@ impl<'a> LineCounter<'a> {
     }
 }
 
-/// What a CSV error says, without the CSV reader's own record and line
-/// numbers (the message names the row once, as the file's line).
-fn malformed_reason(e: &csv::Error) -> String {
-    match e.kind() {
-        csv::ErrorKind::UnequalLengths {
-            expected_len, len, ..
-        } => format!("{len} cells, header has {expected_len}"),
-        _ => e.to_string(),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -477,7 +468,10 @@ mod tests {
         let e = parse(&s.replace("10,1", "10,nan")).unwrap_err().to_string();
         assert!(e.contains("row 14,"), "{e}");
         let e = parse(&s.replace("10,1", "10,1,2")).unwrap_err().to_string();
-        assert!(e.contains("row 14:") && !e.contains("record"), "{e}");
+        assert!(
+            e.contains("row 14, column 3:") && !e.contains("record"),
+            "{e}"
+        );
         let e = parse(&s.replace("19,1", "1e9,1")).unwrap_err().to_string();
         assert!(
             e.contains("row 23, column 'time'") && e.contains("1e6"),

@@ -511,7 +511,7 @@ pub fn diagnose_bench(
         effects_not_applicable: not_applicable,
         unexplained_share: rss_after / rss_before.max(1e-300),
         unexplained_resembles: resembles,
-        warnings: Vec::new(),
+        warnings: super::with_small_sample_warnings(Vec::new(), &records.iter().collect::<Vec<_>>()),
         noise_share: if noise_ss.is_nan() {
             f64::NAN
         } else {

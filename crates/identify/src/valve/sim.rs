@@ -142,8 +142,8 @@ pub(super) fn prepare(
     let command0 = rec.get(Signal::Command).map(|u| u[0]);
     let x = rec.require(Signal::Position)?;
     let s = match half {
-        Some(h) => smooth_with(rec, x, h, 3)?,
-        None => smooth_gcv(&t, x, 3, 400),
+        Some(h) => smooth_with(rec, x, h, crate::smooth::ORDER)?,
+        None => smooth_gcv(&t, x, crate::smooth::ORDER, 400),
     };
     let position_ok = !excluded.contains(&Signal::Position);
     let mut meas = Vec::new();
@@ -190,7 +190,10 @@ pub(super) fn prepare(
     // take the smoothed values at t0 (local cubic fit over the GCV window).
     let p0 = |sig: Signal| {
         (!excluded.contains(&sig))
-            .then(|| rec.get(sig).map(|y| smooth_gcv(&t, y, 3, 100).value[0]))
+            .then(|| {
+                rec.get(sig)
+                    .map(|y| smooth_gcv(&t, y, crate::smooth::ORDER, 100).value[0])
+            })
             .flatten()
     };
     let (p10, p20) = (p0(Signal::P1), p0(Signal::P2));

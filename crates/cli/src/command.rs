@@ -635,7 +635,7 @@ mod tests {
                 t.push(at);
             }
             let u: Vec<f64> = rows.iter().map(|r| r.1).collect();
-            let c = Columns { time: 0, time_factor: tf, command: 1, command_factor: cf };
+            let c = Columns { time: 0, time_header: "time".into(), time_factor: tf, command: 1, command_factor: cf };
             let cut = cut.min(t.len());
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             let whole = finish_plain(vec![t.clone(), u.clone()], &c)

@@ -184,3 +184,40 @@ fn every_entry_of_the_state_vector_is_named() {
         }
     }
 }
+
+/// The hybrid rig's circuit commanded by `signal`, and its initial state.
+fn hybrid(signal: crate::signal::Signal) -> (Circuit, Vec<f64>) {
+    let c = crate::hybrid::WangHybrid::preset()
+        .build(signal)
+        .expect("rig");
+    let x = c.initial_state();
+    (c, x)
+}
+
+#[test]
+fn the_table_is_reused_at_the_same_point_until_forgotten() {
+    use crate::external::ExternalInput;
+    let (input, other) = (ExternalInput::new(), ExternalInput::new());
+    input.set(0.0, 0.5, 0.0);
+    other.set(0.0, -0.5, 0.0);
+    let (c, x) = hybrid(crate::signal::Signal::External(input.clone()));
+    let n = c.dim();
+    let (mut a, mut b, mut fresh) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    c.rhs(0.0, &x, &mut a);
+    // the input changes behind the circuit's back: the same point reads the
+    // table as it was (what `Simulation::step_to` forgets before a step)
+    input.set(0.0, -0.5, 0.0);
+    c.rhs(0.0, &x, &mut b);
+    assert_eq!(a, b);
+    c.forget_evaluation();
+    c.rhs(0.0, &x, &mut b);
+    let (d, _) = hybrid(crate::signal::Signal::External(other));
+    d.rhs(0.0, &x, &mut fresh);
+    assert_ne!(a, b);
+    for (i, (b, f)) in b.iter().zip(&fresh).enumerate() {
+        assert!(
+            (b - f).abs() <= 1e-9 * f.abs().max(1.0),
+            "state {i}: {b} against {f}"
+        );
+    }
+}

@@ -14,8 +14,9 @@
 //! The Jacobian is the model's ([`OdeSystem::jacobian`]) or a column-wise
 //! forward difference with increments `δ_j = sqrt(ε) · max(|x_j|, atol_j/rtol)`
 //! (`atol_j/rtol` is the magnitude below which the error norm treats state j
-//! as absolute, a natural scale for it); `f_t` is always a forward difference
-//! in `t` with `δ_t = sqrt(ε) · max(|t|, h)`. After a rejected step the
+//! as absolute, a natural scale for it); `f_t` is zero where the model says
+//! so ([`OdeSystem::constant_in_time`]), else a forward difference in `t`
+//! with `δ_t = sqrt(ε) · max(|t|, h)`. After a rejected step the
 //! Jacobian is reused and only `E` is refactorised.
 //!
 //! Quadrature states ([`OdeSystem::n_quadratures`], the last `q` states) have
@@ -214,14 +215,18 @@ impl Rodas4 {
         // that evaluation for it (the circuit's tangent pass does)
         stats.jac_evals += 1;
         let analytic = sys.jacobian(t, x, &mut self.jac);
-        // ∂f/∂t by a forward difference.
-        let t_plus = t + sqrt_eps * t.abs().max(h);
-        let dt = t_plus - t;
-        sys.rhs(t_plus, x, &mut self.fy);
-        stats.rhs_evals += 1;
-        self.lin_bad = self.lin_bad.or(first_nonfinite(&self.fy));
-        for i in 0..n {
-            self.ft[i] = (self.fy[i] - self.f0[i]) / dt;
+        if sys.constant_in_time(t) {
+            self.ft.fill(0.0);
+        } else {
+            // ∂f/∂t by a forward difference.
+            let t_plus = t + sqrt_eps * t.abs().max(h);
+            let dt = t_plus - t;
+            sys.rhs(t_plus, x, &mut self.fy);
+            stats.rhs_evals += 1;
+            self.lin_bad = self.lin_bad.or(first_nonfinite(&self.fy));
+            for i in 0..n {
+                self.ft[i] = (self.fy[i] - self.f0[i]) / dt;
+            }
         }
         if !analytic {
             let scale = &self.scale;

@@ -748,6 +748,10 @@ impl OdeSystem for Circuit {
         self.analytic_jacobian(t, x, jac)
     }
 
+    fn constant_in_time(&self, t: f64) -> bool {
+        !self.comps.iter().any(|c| c.reads_time(t))
+    }
+
     fn next_breakpoint(&self, t: f64) -> f64 {
         self.comps
             .iter()

@@ -195,6 +195,42 @@ fn hybrid(signal: crate::signal::Signal) -> (Circuit, Vec<f64>) {
 }
 
 #[test]
+fn a_piecewise_constant_command_leaves_the_circuit_constant_in_time() {
+    use crate::signal::Signal;
+    let square = Signal::Square {
+        amplitude: 0.3,
+        period_s: 5.0,
+        bias: 0.01,
+    };
+    let (c, x) = hybrid(square);
+    let n = c.dim();
+    let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+    // between the square's jumps (0, 2.5 s, ...) the promise holds
+    for t in [0.1, 1.3, 2.4] {
+        assert!(c.constant_in_time(t));
+        c.rhs(t, &x, &mut a);
+        c.rhs(t + 1e-3, &x, &mut b);
+        for (i, (a, b)) in a.iter().zip(&b).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-12 * a.abs().max(1.0),
+                "state {i}: {a} against {b}"
+            );
+        }
+    }
+    let sine = Signal::Sine {
+        amplitude: 0.3,
+        period_s: 5.0,
+        bias: 0.0,
+        phase_rad: 0.0,
+    };
+    let (c, x) = hybrid(sine);
+    assert!(!c.constant_in_time(1.3));
+    c.rhs(1.3, &x, &mut a);
+    c.rhs(1.3 + 1e-3, &x, &mut b);
+    assert_ne!(a, b, "the sine's circuit does change with time");
+}
+
+#[test]
 fn the_table_is_reused_at_the_same_point_until_forgotten() {
     use crate::external::ExternalInput;
     let (input, other) = (ExternalInput::new(), ExternalInput::new());

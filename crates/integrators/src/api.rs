@@ -37,6 +37,16 @@ pub trait OdeSystem {
         false
     }
 
+    /// Whether the right-hand side at `x` stays the same over a short time
+    /// after `t` (`∂f/∂t = 0` there: no input that changes with time, or
+    /// only piecewise-constant ones, whose jumps are events' business).
+    /// The stiff solver then takes `∂f/∂t = 0` instead of differencing `f`
+    /// in `t`, one right-hand side a step less. Return `false` (the
+    /// default) unless the model knows: it is a promise.
+    fn constant_in_time(&self, _t: f64) -> bool {
+        false
+    }
+
     /// How many of the **last** states are quadratures: integrals that no
     /// derivative depends on, not even their own (accumulated energies,
     /// pumped volumes). Their Jacobian columns are zero by construction, so

@@ -14,8 +14,9 @@
 //! The Jacobian is the model's ([`OdeSystem::jacobian`]) or a column-wise
 //! forward difference with increments `δ_j = sqrt(ε) · max(|x_j|, atol_j/rtol)`
 //! (`atol_j/rtol` is the magnitude below which the error norm treats state j
-//! as absolute, a natural scale for it); `f_t` is always a forward difference
-//! in `t` with `δ_t = sqrt(ε) · max(|t|, h)`. After a rejected step the
+//! as absolute, a natural scale for it); `f_t` is zero where the model says
+//! so ([`OdeSystem::constant_in_time`]), else a forward difference in `t`
+//! with `δ_t = sqrt(ε) · max(|t|, h)`. After a rejected step the
 //! Jacobian is reused and only `E` is refactorised.
 //!
 //! Quadrature states ([`OdeSystem::n_quadratures`], the last `q` states) have
@@ -123,6 +124,41 @@ impl BlockSolve<'_> {
     }
 }
 
+/// `out = Σ c_j v_j`, the terms added in their order (a coefficient 1 is
+/// exact): the stages' sums as one loop, not one copy per sum (the step's
+/// code is what the instruction cache has to hold).
+#[inline(never)]
+fn combine(out: &mut [f64], terms: &[(f64, &[f64])]) {
+    let Some((&(c0, v0), rest)) = terms.split_first() else {
+        return;
+    };
+    for (o, &v) in out.iter_mut().zip(v0) {
+        *o = c0 * v;
+    }
+    for &(c, v) in rest {
+        for (o, &v) in out.iter_mut().zip(v) {
+            *o += c * v;
+        }
+    }
+}
+
+/// `k = f + k / h + hd · f_t`: a stage's right-hand side from the sum of
+/// the earlier stages `Σ c_ij k_j` held in `k`.
+#[inline(never)]
+fn stage(k: &mut [f64], f: &[f64], inv_h: f64, hd: f64, ft: &[f64]) {
+    for ((k, &f), &ft) in k.iter_mut().zip(f).zip(ft) {
+        *k = f + inv_h * *k + hd * ft;
+    }
+}
+
+/// `out += v`.
+#[inline(never)]
+fn add(out: &mut [f64], v: &[f64]) {
+    for (o, &v) in out.iter_mut().zip(v) {
+        *o += v;
+    }
+}
+
 /// First index of a non-finite entry.
 fn first_nonfinite(v: &[f64]) -> Option<usize> {
     v.iter().position(|x| !x.is_finite())
@@ -179,14 +215,18 @@ impl Rodas4 {
         // that evaluation for it (the circuit's tangent pass does)
         stats.jac_evals += 1;
         let analytic = sys.jacobian(t, x, &mut self.jac);
-        // ∂f/∂t by a forward difference.
-        let t_plus = t + sqrt_eps * t.abs().max(h);
-        let dt = t_plus - t;
-        sys.rhs(t_plus, x, &mut self.fy);
-        stats.rhs_evals += 1;
-        self.lin_bad = self.lin_bad.or(first_nonfinite(&self.fy));
-        for i in 0..n {
-            self.ft[i] = (self.fy[i] - self.f0[i]) / dt;
+        if sys.constant_in_time(t) {
+            self.ft.fill(0.0);
+        } else {
+            // ∂f/∂t by a forward difference.
+            let t_plus = t + sqrt_eps * t.abs().max(h);
+            let dt = t_plus - t;
+            sys.rhs(t_plus, x, &mut self.fy);
+            stats.rhs_evals += 1;
+            self.lin_bad = self.lin_bad.or(first_nonfinite(&self.fy));
+            for i in 0..n {
+                self.ft[i] = (self.fy[i] - self.f0[i]) / dt;
+            }
         }
         if !analytic {
             let scale = &self.scale;
@@ -269,68 +309,49 @@ impl Stepper for Rodas4 {
         };
         let inv_h = 1.0 / h;
 
-        for i in 0..n {
-            k1[i] = f0[i] + h * D1 * ft[i];
-        }
+        combine(k1, &[(1.0, f0), (h * D1, ft)]);
         solver.solve(k1);
 
-        for i in 0..n {
-            y[i] = x[i] + A21 * k1[i];
-        }
+        combine(y, &[(1.0, x), (A21, k1)]);
         sys.rhs(t + C2 * h, y, fy);
         let mut bad = first_nonfinite(fy);
-        for i in 0..n {
-            k2[i] = fy[i] + C21 * inv_h * k1[i] + h * D2 * ft[i];
-        }
+        combine(k2, &[(C21, k1)]);
+        stage(k2, fy, inv_h, h * D2, ft);
         solver.solve(k2);
 
-        for i in 0..n {
-            y[i] = x[i] + A31 * k1[i] + A32 * k2[i];
-        }
+        combine(y, &[(1.0, x), (A31, k1), (A32, k2)]);
         sys.rhs(t + C3 * h, y, fy);
         bad = bad.or(first_nonfinite(fy));
-        for i in 0..n {
-            k3[i] = fy[i] + inv_h * (C31 * k1[i] + C32 * k2[i]) + h * D3 * ft[i];
-        }
+        combine(k3, &[(C31, k1), (C32, k2)]);
+        stage(k3, fy, inv_h, h * D3, ft);
         solver.solve(k3);
 
-        for i in 0..n {
-            y[i] = x[i] + A41 * k1[i] + A42 * k2[i] + A43 * k3[i];
-        }
+        combine(y, &[(1.0, x), (A41, k1), (A42, k2), (A43, k3)]);
         sys.rhs(t + C4 * h, y, fy);
         bad = bad.or(first_nonfinite(fy));
-        for i in 0..n {
-            k4[i] = fy[i] + inv_h * (C41 * k1[i] + C42 * k2[i] + C43 * k3[i]) + h * D4 * ft[i];
-        }
+        combine(k4, &[(C41, k1), (C42, k2), (C43, k3)]);
+        stage(k4, fy, inv_h, h * D4, ft);
         solver.solve(k4);
 
-        for i in 0..n {
-            y[i] = x[i] + A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i];
-        }
+        combine(y, &[(1.0, x), (A51, k1), (A52, k2), (A53, k3), (A54, k4)]);
         sys.rhs(t + h, y, fy);
         bad = bad.or(first_nonfinite(fy));
-        for i in 0..n {
-            k5[i] = fy[i] + inv_h * (C51 * k1[i] + C52 * k2[i] + C53 * k3[i] + C54 * k4[i]);
-        }
+        combine(k5, &[(C51, k1), (C52, k2), (C53, k3), (C54, k4)]);
+        stage(k5, fy, inv_h, 0.0, ft);
         solver.solve(k5);
 
-        for i in 0..n {
-            y[i] += k5[i];
-        }
+        add(y, k5);
         sys.rhs(t + h, y, fy);
         bad = bad.or(first_nonfinite(fy));
-        for i in 0..n {
-            k6[i] = fy[i]
-                + inv_h * (C61 * k1[i] + C62 * k2[i] + C63 * k3[i] + C64 * k4[i] + C65 * k5[i]);
-        }
+        combine(k6, &[(C61, k1), (C62, k2), (C63, k3), (C64, k4), (C65, k5)]);
+        stage(k6, fy, inv_h, 0.0, ft);
         solver.solve(k6);
         stats.rhs_evals += 5;
         self.bad = self.bad.or(bad);
 
-        for i in 0..n {
-            x_new[i] = y[i] + k6[i];
-            err[i] = k6[i];
-        }
+        x_new.copy_from_slice(y);
+        add(x_new, k6);
+        err.copy_from_slice(k6);
         Attempt::Done
     }
 
@@ -360,12 +381,16 @@ impl Stepper for Rodas4 {
         stats.stiff_steps += 1;
         let [k1, k2, k3, k4, k5, _] = &self.k;
         let [c1, c2, c3, c4] = &mut self.cont;
-        for i in 0..self.n {
-            c1[i] = x[i];
-            c2[i] = x_new[i] - x[i];
-            c3[i] = DD21 * k1[i] + DD22 * k2[i] + DD23 * k3[i] + DD24 * k4[i] + DD25 * k5[i];
-            c4[i] = DD31 * k1[i] + DD32 * k2[i] + DD33 * k3[i] + DD34 * k4[i] + DD35 * k5[i];
-        }
+        c1.copy_from_slice(x);
+        combine(c2, &[(1.0, x_new), (-1.0, x)]);
+        combine(
+            c3,
+            &[(DD21, k1), (DD22, k2), (DD23, k3), (DD24, k4), (DD25, k5)],
+        );
+        combine(
+            c4,
+            &[(DD31, k1), (DD32, k2), (DD33, k3), (DD34, k4), (DD35, k5)],
+        );
         self.jac_valid = false;
     }
 

@@ -2,7 +2,7 @@
 //! method exceeds a step budget.
 
 use hydrocyl_integrators::problems::{Robertson, VanDerPol};
-use hydrocyl_integrators::{solve, Method, Options, SolveError};
+use hydrocyl_integrators::{solve, Method, OdeSystem, Options, SolveError};
 
 #[test]
 fn van_der_pol_mu_1000_rosenbrock_few_steps_dp45_over_budget() {
@@ -211,4 +211,65 @@ fn declared_quadratures_skip_their_jacobian_columns_and_change_nothing_else() {
     );
     // ∫x₁² dt is positive and grows with the limit cycle's |x₁| ≈ 1..2
     assert!(b[3] > 50.0 && b[2].is_finite(), "∫x₁² dt = {}", b[3]);
+}
+
+/// Van der Pol that says it is autonomous ([`OdeSystem::constant_in_time`]).
+struct SaysAutonomous(VanDerPol);
+
+impl OdeSystem for SaysAutonomous {
+    fn dim(&self) -> usize {
+        self.0.dim()
+    }
+    fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
+        self.0.rhs(t, x, dx)
+    }
+    fn jacobian(&self, t: f64, x: &[f64], jac: &mut [f64]) -> bool {
+        self.0.jacobian(t, x, jac)
+    }
+    fn constant_in_time(&self, _t: f64) -> bool {
+        true
+    }
+}
+
+#[test]
+fn an_autonomous_model_saves_the_time_difference_and_nothing_moves() {
+    // f does not depend on t, so the forward difference in t is exactly 0:
+    // taking ∂f/∂t = 0 must give the same solution bit for bit, one
+    // right-hand side a Jacobian cheaper
+    let opts = Options {
+        rtol: 1e-6,
+        atol: vec![1e-6],
+        ..Options::default()
+    };
+    let (x0, t_end) = ([2.0, 0.0], 3000.0);
+    let fd = solve(
+        Method::Rosenbrock,
+        &mut VanDerPol { mu: 1000.0 },
+        0.0,
+        &x0,
+        t_end,
+        &opts,
+    )
+    .unwrap();
+    let zero = solve(
+        Method::Rosenbrock,
+        &mut SaysAutonomous(VanDerPol { mu: 1000.0 }),
+        0.0,
+        &x0,
+        t_end,
+        &opts,
+    )
+    .unwrap();
+    assert_eq!(fd.t, zero.t);
+    assert_eq!(fd.x, zero.x);
+    let (a, b) = (fd.stats, zero.stats);
+    assert_eq!(
+        (a.steps, a.rejected, a.jac_evals),
+        (b.steps, b.rejected, b.jac_evals)
+    );
+    assert_eq!(
+        a.rhs_evals - b.rhs_evals,
+        a.jac_evals,
+        "{a:?} against {b:?}"
+    );
 }

@@ -579,6 +579,14 @@ impl Circuit {
         self.filled.borrow_mut().valid = false;
     }
 
+    /// Forgets where the wire table was last evaluated, so that the next
+    /// evaluation at any point fills it afresh: an input from outside the
+    /// circuit (an [`ExternalInput`](crate::external::ExternalInput)) may
+    /// have changed since, at the same time and state.
+    pub(crate) fn forget_evaluation(&self) {
+        self.filled.borrow_mut().valid = false;
+    }
+
     /// Whether the wire table holds the evaluation at exactly `(t, x)` with
     /// the components' modes as they are now (the stiff solver asks for the
     /// Jacobian right after `f(t, x)`; its tangent pass reuses that table).
@@ -690,7 +698,12 @@ impl OdeSystem for Circuit {
     }
 
     fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
-        self.fill(t, x);
+        // the table may already hold (t, x): the switching functions at the
+        // end of an accepted step evaluated it, and the stiff solver's next
+        // step starts with f there
+        if !self.filled_at(t, x) {
+            self.fill(t, x);
+        }
         let w = self.wires.borrow();
         for (c, o) in self.comps.iter().zip(self.offsets.windows(2)) {
             let r = o[0]..o[1];
@@ -733,6 +746,10 @@ impl OdeSystem for Circuit {
     /// one and the ledger is off; finite differences otherwise.
     fn jacobian(&self, t: f64, x: &[f64], jac: &mut [f64]) -> bool {
         self.analytic_jacobian(t, x, jac)
+    }
+
+    fn constant_in_time(&self, t: f64) -> bool {
+        !self.comps.iter().any(|c| c.reads_time(t))
     }
 
     fn next_breakpoint(&self, t: f64) -> f64 {

@@ -59,6 +59,9 @@ impl Component for LaggedPressureSensor {
     fn name(&self) -> &str {
         &self.name
     }
+    fn reads_time(&self, _t: f64) -> bool {
+        false
+    }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         if !(self.time_constant.is_finite() && self.time_constant > 0.0) {
             return Err(BuildError::Component {

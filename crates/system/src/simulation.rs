@@ -424,6 +424,8 @@ impl Simulation {
         }
         let opts = self.options.solver_options(&self.circuit, vec![t, t_end]);
         let method = self.options.solver;
+        // the host may have set the inputs anew since the last step ended
+        self.circuit.forget_evaluation();
         let sol = solve(method.method(), &mut self.circuit, t, x, t_end, &opts)
             .map_err(|source| SimError::solve(method.name(), source, &self.circuit, t, x))?;
         match (sol.t.last(), sol.last()) {

@@ -169,6 +169,15 @@ pub trait Component {
         None
     }
 
+    /// Whether what it publishes, evaluates or derives at `t` changes with
+    /// the time itself over a short span after `t` (at fixed states and
+    /// wires): a source of a time-varying signal. `true` (the default)
+    /// unless it knows; a circuit whose components all say `false` has
+    /// `∂f/∂t = 0` there ([`OdeSystem::constant_in_time`](hydrocyl_integrators::OdeSystem::constant_in_time)).
+    fn reads_time(&self, _t: f64) -> bool {
+        true
+    }
+
     /// Time derivatives of its states (all accumulators are complete here).
     fn derivatives(&self, _t: f64, _x: &[f64], _w: &Wires, _dx: &mut [f64]) {}
 

@@ -184,3 +184,76 @@ fn every_entry_of_the_state_vector_is_named() {
         }
     }
 }
+
+/// The hybrid rig's circuit commanded by `signal`, and its initial state.
+fn hybrid(signal: crate::signal::Signal) -> (Circuit, Vec<f64>) {
+    let c = crate::hybrid::WangHybrid::preset()
+        .build(signal)
+        .expect("rig");
+    let x = c.initial_state();
+    (c, x)
+}
+
+#[test]
+fn a_piecewise_constant_command_leaves_the_circuit_constant_in_time() {
+    use crate::signal::Signal;
+    let square = Signal::Square {
+        amplitude: 0.3,
+        period_s: 5.0,
+        bias: 0.01,
+    };
+    let (c, x) = hybrid(square);
+    let n = c.dim();
+    let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+    // between the square's jumps (0, 2.5 s, ...) the promise holds
+    for t in [0.1, 1.3, 2.4] {
+        assert!(c.constant_in_time(t));
+        c.rhs(t, &x, &mut a);
+        c.rhs(t + 1e-3, &x, &mut b);
+        for (i, (a, b)) in a.iter().zip(&b).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-12 * a.abs().max(1.0),
+                "state {i}: {a} against {b}"
+            );
+        }
+    }
+    let sine = Signal::Sine {
+        amplitude: 0.3,
+        period_s: 5.0,
+        bias: 0.0,
+        phase_rad: 0.0,
+    };
+    let (c, x) = hybrid(sine);
+    assert!(!c.constant_in_time(1.3));
+    c.rhs(1.3, &x, &mut a);
+    c.rhs(1.3 + 1e-3, &x, &mut b);
+    assert_ne!(a, b, "the sine's circuit does change with time");
+}
+
+#[test]
+fn the_table_is_reused_at_the_same_point_until_forgotten() {
+    use crate::external::ExternalInput;
+    let (input, other) = (ExternalInput::new(), ExternalInput::new());
+    input.set(0.0, 0.5, 0.0);
+    other.set(0.0, -0.5, 0.0);
+    let (c, x) = hybrid(crate::signal::Signal::External(input.clone()));
+    let n = c.dim();
+    let (mut a, mut b, mut fresh) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    c.rhs(0.0, &x, &mut a);
+    // the input changes behind the circuit's back: the same point reads the
+    // table as it was (what `Simulation::step_to` forgets before a step)
+    input.set(0.0, -0.5, 0.0);
+    c.rhs(0.0, &x, &mut b);
+    assert_eq!(a, b);
+    c.forget_evaluation();
+    c.rhs(0.0, &x, &mut b);
+    let (d, _) = hybrid(crate::signal::Signal::External(other));
+    d.rhs(0.0, &x, &mut fresh);
+    assert_ne!(a, b);
+    for (i, (b, f)) in b.iter().zip(&fresh).enumerate() {
+        assert!(
+            (b - f).abs() <= 1e-9 * f.abs().max(1.0),
+            "state {i}: {b} against {f}"
+        );
+    }
+}

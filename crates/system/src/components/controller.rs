@@ -107,6 +107,9 @@ impl Component for PositionController {
     fn name(&self) -> &str {
         &self.name
     }
+    fn reads_time(&self, _t: f64) -> bool {
+        false
+    }
     fn has_tangents(&self) -> bool {
         true
     }

@@ -178,6 +178,9 @@ impl Component for FourWayValve {
     fn name(&self) -> &str {
         &self.name
     }
+    fn reads_time(&self, _t: f64) -> bool {
+        false
+    }
     fn has_tangents(&self) -> bool {
         true
     }

@@ -93,6 +93,9 @@ impl Component for Friction {
     fn name(&self) -> &str {
         &self.name
     }
+    fn reads_time(&self, _t: f64) -> bool {
+        false
+    }
     fn has_tangents(&self) -> bool {
         // the friction Jacobian has one internal state at most
         self.model.n_states() <= 1

@@ -136,6 +136,9 @@ impl Component for GeneralisedCylinder {
     fn name(&self) -> &str {
         &self.name
     }
+    fn reads_time(&self, _t: f64) -> bool {
+        false
+    }
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError> {
         let err = |m: String| BuildError::Component {
             component: self.name.clone(),

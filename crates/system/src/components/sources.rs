@@ -37,6 +37,9 @@ impl Component for PressureSource {
     fn name(&self) -> &str {
         &self.name
     }
+    fn reads_time(&self, _t: f64) -> bool {
+        false
+    }
     fn has_tangents(&self) -> bool {
         true
     }
@@ -151,6 +154,13 @@ impl Component for CommandInput {
     }
     fn publish(&self, t: f64, _x: &[f64], w: &mut Wires) {
         w.set(self.out, self.signal.value_hinted(t, &self.hint));
+    }
+    fn reads_time(&self, _t: f64) -> bool {
+        // piecewise constant: no slope between the jumps
+        !matches!(
+            self.signal,
+            Signal::Constant { .. } | Signal::Step { .. } | Signal::Square { .. }
+        )
     }
     fn next_breakpoint(&self, t: f64) -> f64 {
         if let Signal::Streamed(table) = &self.signal {

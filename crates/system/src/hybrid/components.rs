@@ -68,6 +68,9 @@ impl Component for PumpComponent {
     fn name(&self) -> &str {
         &self.name
     }
+    fn reads_time(&self, _t: f64) -> bool {
+        false
+    }
     fn has_tangents(&self) -> bool {
         true
     }
@@ -207,6 +210,9 @@ impl Component for ReliefComponent {
     fn name(&self) -> &str {
         &self.name
     }
+    fn reads_time(&self, _t: f64) -> bool {
+        false
+    }
     fn has_tangents(&self) -> bool {
         true
     }
@@ -330,6 +336,9 @@ impl Component for CheckComponent {
     fn name(&self) -> &str {
         &self.name
     }
+    fn reads_time(&self, _t: f64) -> bool {
+        false
+    }
     fn has_tangents(&self) -> bool {
         true
     }
@@ -446,6 +455,9 @@ impl NeedleComponent {
 impl Component for NeedleComponent {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn reads_time(&self, _t: f64) -> bool {
+        false
     }
     fn has_tangents(&self) -> bool {
         true

@@ -80,6 +80,9 @@ impl Component for BenchFriction {
     fn name(&self) -> &str {
         &self.name
     }
+    fn reads_time(&self, _t: f64) -> bool {
+        false
+    }
     fn has_tangents(&self) -> bool {
         true
     }
@@ -229,6 +232,9 @@ pub struct SignalPressureSource {
 impl Component for SignalPressureSource {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn reads_time(&self, _t: f64) -> bool {
+        false
     }
     fn has_tangents(&self) -> bool {
         true

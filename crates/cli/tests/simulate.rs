@@ -1,12 +1,10 @@
 //! `hydrocyl simulate` end to end: output format, sampling, overrides,
 //! solvers, and one-line errors with no output file.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn hydrocyl() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_hydrocyl"))
-}
+use common::{hydrocyl, simulate_ok};
+use std::path::{Path, PathBuf};
 
 fn write_command(dir: &Path, name: &str, rows: &[(f64, f64)]) -> PathBuf {
     let mut s = String::from("time,command,comment\n");
@@ -16,25 +14,6 @@ fn write_command(dir: &Path, name: &str, rows: &[(f64, f64)]) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, s).unwrap();
     p
-}
-
-/// `hydrocyl simulate --rig <rig>` on `cmd` into `out` with `extra`
-/// arguments, which must succeed.
-fn simulate_ok(rig: &str, cmd: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
-    let st = hydrocyl()
-        .args(["simulate", "--rig", rig, "--command"])
-        .arg(cmd)
-        .arg("--out")
-        .arg(out)
-        .args(extra)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{extra:?}: {}",
-        String::from_utf8_lossy(&st.stderr)
-    );
-    st
 }
 
 /// `hydrocyl simulate --rig leaney-moog` on `cmd` into `out`, which must

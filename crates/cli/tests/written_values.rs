@@ -2,26 +2,9 @@
 //! converted on the decimal (the times and commands written back are the
 //! numbers given, in SI), and no subnormal or `-0.0` (tester t38d C3).
 
-use std::path::Path;
-use std::process::Command;
+mod common;
 
-/// `hydrocyl simulate --rig leaney-moog` on `cmd` into `out` with `extra`
-/// arguments, which must succeed.
-fn simulate_ok(cmd: &Path, out: &Path, extra: &[&str]) {
-    let st = Command::new(env!("CARGO_BIN_EXE_hydrocyl"))
-        .args(["simulate", "--rig", "leaney-moog", "--quiet", "--command"])
-        .arg(cmd)
-        .arg("--out")
-        .arg(out)
-        .args(extra)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{extra:?}: {}",
-        String::from_utf8_lossy(&st.stderr)
-    );
-}
+use common::simulate_ok;
 
 /// A command file in [ms] and [%] is converted on the decimal: the output's
 /// `time [s]` and `command [-]` are the numbers written, in SI (`1.999` ms
@@ -45,7 +28,7 @@ fn millisecond_and_percent_commands_are_written_as_the_decimals_given() {
     std::fs::write(&cmd, s).unwrap();
     for extra in [&[][..], &["--stream-above", "100"][..]] {
         let out = dir.path().join("out.csv");
-        simulate_ok(&cmd, &out, extra);
+        simulate_ok("leaney-moog", &cmd, &out, &[&["--quiet"], extra].concat());
         let text = std::fs::read_to_string(&out).unwrap();
         for (line, (t, u)) in text.lines().skip(1).zip(&want) {
             let mut cells = line.split(',');
@@ -73,7 +56,7 @@ fn no_subnormal_or_negative_zero_is_written() {
         .collect();
     std::fs::write(&cmd, format!("time,command\n{rows}")).unwrap();
     let out = dir.path().join("out.csv");
-    simulate_ok(&cmd, &out, &[]);
+    simulate_ok("leaney-moog", &cmd, &out, &["--quiet"]);
     let text = std::fs::read_to_string(&out).unwrap();
     let mut zeros = 0;
     for line in text.lines().skip(1) {

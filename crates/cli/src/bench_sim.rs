@@ -35,7 +35,7 @@ pub fn load(
     spec: &str,
     sets: &[String],
 ) -> Result<Option<(FrictionBench, serde_json::Value)>, CliError> {
-    if rig::preset(spec).is_some() {
+    if rig::is_preset(spec) {
         return Ok(None);
     }
     // read as every rig file is (a byte-order mark, an older kind)
@@ -177,7 +177,7 @@ fn switched_off_by(net: &serde_json::Value, set: &str) -> Option<String> {
 /// simulated on a command as the preset is, by name, as a file or printed
 /// by `--print-rig`; `diagnose` reads each of them as the same bench.
 pub fn runs_on_motion(spec: &str) -> bool {
-    !crate::presets::is_preset(spec)
+    !rig::is_preset(spec)
         && rig::load(spec).is_ok_and(|v| {
             bench::is_bench_rig(&v)
                 && v.get("components")

@@ -65,14 +65,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map_err(|e| input(&crate::rigfile::at_line_or_set(e, &rig_arg, &args.set)))?;
     let library = find_library(args.library.as_deref()).map_err(|e| input(&e))?;
     // the FMU must not be written over an input: the rig file or the library
-    let rig_file = (rig::preset(&rig_arg).is_none()).then(|| PathBuf::from(&rig_arg));
+    let rig_file = (!rig::is_preset(&rig_arg)).then(|| PathBuf::from(&rig_arg));
     let mut inputs: Vec<(&str, &Path)> = vec![("--library", library.as_path())];
     if let Some(f) = &rig_file {
         inputs.push(("--rig", f.as_path()));
     }
     let mut outputs = Outputs::new(&inputs);
     let file = outputs.file("--out", &out)?;
-    let name = if rig::preset(&rig_arg).is_some() {
+    let name = if rig::is_preset(&rig_arg) {
         rig_arg.clone()
     } else {
         Path::new(&rig_arg)

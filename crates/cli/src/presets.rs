@@ -54,13 +54,6 @@ pub fn all(short: bool) -> Vec<(&'static str, String, String)> {
         .collect()
 }
 
-/// Whether `--rig` value `spec` names a preset (by its name alone: building
-/// the preset's JSON to ask, as `rig::preset(spec).is_some()` does, costs
-/// each start of `simulate`).
-pub fn is_preset(spec: &str) -> bool {
-    rig::PRESETS.iter().any(|p| p.name == spec)
-}
-
 /// The preset names, comma-separated (for `--rig`'s help).
 pub fn names() -> String {
     // names only: reading every preset here would cost each start-up

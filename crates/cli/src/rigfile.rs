@@ -37,7 +37,7 @@ pub fn at_line_or_set(e: RigError, source: &str, sets: &[String]) -> RigError {
     });
     // a preset has no lines: its message names the path as `--set` takes
     // it, as Python's `Rig.set` words it
-    let (Some(set), false) = (set, crate::presets::is_preset(source)) else {
+    let (Some(set), false) = (set, rig::is_preset(source)) else {
         return rig::at_line(e, source);
     };
     let by = format!("(set by --set {set} on {source})");

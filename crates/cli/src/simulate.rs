@@ -451,7 +451,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     let rig_path = Path::new(&args.rig);
     let mut inputs = vec![("--command", cmd_path.as_path())];
-    if !crate::presets::is_preset(&args.rig) {
+    if !rig::is_preset(&args.rig) {
         inputs.push(("--rig", rig_path));
     }
     let unit = command_unit(&checked);

@@ -194,6 +194,12 @@ pub fn valve_rig_from(v: &Value) -> Result<ValveRig, RigError> {
 /// loading one fails with a note naming the netlists that replace it.
 const RETIRED_VARIANT_KIND: &str = "hybrid-variant";
 
+/// Whether `name` names a preset: by its name alone ([`preset`] builds
+/// the preset's JSON, which costs each start of a command that only asks).
+pub fn is_preset(name: &str) -> bool {
+    PRESETS.iter().any(|p| p.name == name)
+}
+
 /// The JSON of preset `name`, if there is one.
 pub fn preset(name: &str) -> Option<Value> {
     PRESETS.iter().find(|p| p.name == name).map(|p| (p.json)())

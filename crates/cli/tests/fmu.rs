@@ -2,12 +2,10 @@
 //! one-line errors, exit code 2, no file written. (Exports with the library, checked by
 //! FMPy, are in `crates/fmu/tests/python`, run by `crates/fmu/tests/run_fmpy_tests.sh`.)
 
-use std::path::Path;
-use std::process::Command;
+mod common;
 
-fn hydrocyl() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_hydrocyl"))
-}
+use common::hydrocyl;
+use std::path::Path;
 
 /// `hydrocyl fmu --rig leaney-moog [extra] --out <out>` with `library` as
 /// `--library` (or none), checked to fail with exit code 2 and no file;

@@ -5,12 +5,11 @@
 //! a netlist run's (units in the header, shortest round-trip values), and
 //! what the bench cannot take is refused in one line, nothing written.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn hydrocyl() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_hydrocyl"))
-}
+use common::hydrocyl;
+use std::path::{Path, PathBuf};
+use std::process::Output;
 
 fn bench_rig() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -3,12 +3,11 @@
 //! errors, `--set`'s blame, the benches' columns, help text and
 //! `--print-rig`'s combinations.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn hydrocyl() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_hydrocyl"))
-}
+use common::hydrocyl;
+use std::path::{Path, PathBuf};
+use std::process::Output;
 
 /// A fresh scratch folder for one test.
 fn scratch(name: &str) -> PathBuf {

@@ -21,7 +21,7 @@ const CSV_ROUNDS: usize = 60;
 /// falls on every variant alike instead of on one block of one variant's
 /// runs. The fastest of a variant is its least disturbed run; the ratios
 /// are taken between fastests, the medians printed beside them.
-fn interleaved_ns<const N: usize>(
+pub(crate) fn interleaved_ns<const N: usize>(
     rounds: usize,
     mut fs: [&mut dyn FnMut() -> usize; N],
 ) -> [Timing; N] {
@@ -49,20 +49,20 @@ fn interleaved_ns<const N: usize>(
 /// One variant's time per call (or, scaled, per row) \[ns\]: its fastest
 /// (least disturbed) run and its median run.
 #[derive(Clone, Copy)]
-struct Timing {
+pub(crate) struct Timing {
     min: f64,
     median: f64,
 }
 
 impl Timing {
-    fn per(self, n: f64) -> Timing {
+    pub(crate) fn per(self, n: f64) -> Timing {
         Timing {
             min: self.min / n,
             median: self.median / n,
         }
     }
     /// "`old`/`self` x (median `...`x)": how many times faster than `old`.
-    fn speedup(self, old: Timing) -> String {
+    pub(crate) fn speedup(self, old: Timing) -> String {
         format!(
             "{:.1}x (medians {:.1}x)",
             old.min / self.min,
@@ -70,7 +70,7 @@ impl Timing {
         )
     }
     /// "fastest ns (median ns)"
-    fn show(self) -> String {
+    pub(crate) fn show(self) -> String {
         format!("{:.0} ns/row (median {:.0})", self.min, self.median)
     }
 }

@@ -577,8 +577,9 @@ fn whole_process(keep: Option<&Path>) -> Result<(), String> {
 /// could not run. `keep`: see [`whole_process`].
 pub fn run(wanted: &dyn Fn(&str) -> bool, keep: Option<&Path>) -> bool {
     let mut ok = true;
-    let sections: [(&str, crate::bench::Section); 4] = [
+    let sections: [(&str, crate::bench::Section); 5] = [
         ("csv", crate::bench_csv::csv_per_row),
+        ("csv record", crate::bench_record::record_per_row),
         ("cost per step", cost_per_step),
         ("work-precision", work_precision),
         ("hybrid solver choice", hybrid_solver_choice),

@@ -14,6 +14,7 @@
 
 mod bench;
 mod bench_csv;
+mod bench_record;
 mod bench_solve;
 mod commands;
 mod energy;

@@ -13,7 +13,7 @@
 
 use crate::api::{OdeSystem, Stats};
 use crate::driver::{Attempt, Stepper};
-use crate::rk4::cubic_hermite;
+use crate::hermite::Hermite;
 
 const A32: f64 = 3.0 / 4.0;
 const B1: f64 = 2.0 / 9.0;
@@ -32,12 +32,8 @@ pub(crate) struct BogackiShampine {
     y: Vec<f64>,
     /// `k[0]` holds `f(t, x)` for the next attempt (FSAL).
     k1_valid: bool,
-    /// Hermite data of the last accepted step: x, f(x), x_new, f(x_new), h.
-    hx0: Vec<f64>,
-    hf0: Vec<f64>,
-    hx1: Vec<f64>,
-    hf1: Vec<f64>,
-    hh: f64,
+    /// The last accepted step, for the dense output.
+    last: Hermite,
 }
 
 impl BogackiShampine {
@@ -46,11 +42,7 @@ impl BogackiShampine {
             k: std::array::from_fn(|_| vec![0.0; n]),
             y: vec![0.0; n],
             k1_valid: false,
-            hx0: vec![0.0; n],
-            hf0: vec![0.0; n],
-            hx1: vec![0.0; n],
-            hf1: vec![0.0; n],
-            hh: 0.0,
+            last: Hermite::new(n),
         }
     }
 
@@ -123,21 +115,13 @@ impl Stepper for BogackiShampine {
         x_new: &[f64],
         _stats: &mut Stats,
     ) {
-        self.hx0.copy_from_slice(x);
-        self.hf0.copy_from_slice(&self.k[0]);
-        self.hx1.copy_from_slice(x_new);
-        self.hf1.copy_from_slice(&self.k[3]);
-        self.hh = h;
+        self.last.keep_step(x, &self.k[0], x_new, h);
+        self.last.f1.copy_from_slice(&self.k[3]);
         // FSAL: f(t + h, x_new) is the first stage of the next step.
         self.k.swap(0, 3);
     }
 
     fn dense(&self, theta: f64, out: &mut [f64]) {
-        cubic_hermite(
-            theta,
-            self.hh,
-            [&self.hx0, &self.hf0, &self.hx1, &self.hf1],
-            out,
-        );
+        self.last.dense(theta, out);
     }
 }

@@ -168,6 +168,7 @@ mod driver;
 pub mod events;
 pub mod expo;
 mod fdjac;
+mod hermite;
 pub mod linalg;
 mod pace;
 pub mod problems;

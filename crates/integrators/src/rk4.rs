@@ -5,18 +5,15 @@
 
 use crate::api::{OdeSystem, Stats};
 use crate::driver::{Attempt, Stepper};
+use crate::hermite::Hermite;
 
 /// RK4 stepper; `k[0]` carries `f(t, x)` from the end of the previous step.
 pub(crate) struct Rk4 {
     k: [Vec<f64>; 4],
     y: Vec<f64>,
     k1_valid: bool,
-    /// Hermite data of the last accepted step: x, f(x), x_new, f(x_new), h.
-    hx0: Vec<f64>,
-    hf0: Vec<f64>,
-    hx1: Vec<f64>,
-    hf1: Vec<f64>,
-    hh: f64,
+    /// The last accepted step, for the dense output.
+    last: Hermite,
 }
 
 impl Rk4 {
@@ -25,11 +22,7 @@ impl Rk4 {
             k: std::array::from_fn(|_| vec![0.0; n]),
             y: vec![0.0; n],
             k1_valid: false,
-            hx0: vec![0.0; n],
-            hf0: vec![0.0; n],
-            hx1: vec![0.0; n],
-            hf1: vec![0.0; n],
-            hh: 0.0,
+            last: Hermite::new(n),
         }
     }
 }
@@ -94,39 +87,14 @@ impl Stepper for Rk4 {
         x_new: &[f64],
         stats: &mut Stats,
     ) {
-        self.hx0.copy_from_slice(x);
-        self.hf0.copy_from_slice(&self.k[0]);
-        self.hx1.copy_from_slice(x_new);
-        sys.rhs(t + h, x_new, &mut self.hf1);
+        self.last.keep_step(x, &self.k[0], x_new, h);
+        sys.rhs(t + h, x_new, &mut self.last.f1);
         stats.rhs_evals += 1;
-        self.hh = h;
         // f(t + h, x_new) is the first stage of the next step.
-        self.k[0].copy_from_slice(&self.hf1);
+        self.k[0].copy_from_slice(&self.last.f1);
     }
 
     fn dense(&self, theta: f64, out: &mut [f64]) {
-        cubic_hermite(
-            theta,
-            self.hh,
-            [&self.hx0, &self.hf0, &self.hx1, &self.hf1],
-            out,
-        );
-    }
-}
-
-/// The cubic Hermite interpolant at `θ ∈ [0, 1]` of a step of size `h` from
-/// its end values and end derivatives `[x0, f0, x1, f1]` (third order).
-pub(crate) fn cubic_hermite(theta: f64, h: f64, [x0, f0, x1, f1]: [&[f64]; 4], out: &mut [f64]) {
-    let s = theta;
-    let s2 = s * s;
-    let s3 = s2 * s;
-    let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
-    let h10 = s3 - 2.0 * s2 + s;
-    let h01 = -2.0 * s3 + 3.0 * s2;
-    let h11 = s3 - s2;
-    let n = out.len();
-    let (x0, f0, x1, f1) = (&x0[..n], &f0[..n], &x1[..n], &f1[..n]);
-    for i in 0..n {
-        out[i] = h00 * x0[i] + h10 * h * f0[i] + h01 * x1[i] + h11 * h * f1[i];
+        self.last.dense(theta, out);
     }
 }

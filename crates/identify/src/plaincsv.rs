@@ -371,24 +371,24 @@ fn word(b: &[u8], i: usize) -> u64 {
 }
 
 /// Where the number ends if the cell at `pos` repeats the text of the cell
-/// above (`above`): the same bytes, then a byte no
-/// number goes on with (so the parser would stop there too, with the same
-/// value). `None` when it does not, or when that is not quickly seen.
+/// above (`above`): the same bytes, then a byte no number goes on with (so
+/// the parser would stop there too, with the same value). `None` when it
+/// does not, or when that is not quickly seen.
 #[inline(always)]
 fn repeat(b: &[u8], pos: usize, above: &Above) -> Option<usize> {
-    let (a, n) = (above.start, above.len);
-    // the words read stay inside `b` (`a < pos`, n <= MAX_CELL)
-    if n == 0 || pos + MAX_CELL >= b.len() {
-        return None;
-    }
+    // both texts as arrays of a known length, and n <= MAX_CELL: the words
+    // read need no bounds checks (7 ns/row of the 10-column table's 180)
+    let n = above.len.min(MAX_CELL);
+    let here: &[u8; MAX_CELL + 1] = b.get(pos..pos + MAX_CELL + 1)?.try_into().ok()?;
+    let there: &[u8; MAX_CELL + 1] = b[above.start..].get(..MAX_CELL + 1)?.try_into().ok()?;
     let same = if n <= 8 {
-        (word(b, a) ^ word(b, pos)) & (u64::MAX >> (64 - 8 * n)) == 0
+        n > 0 && (word(there, 0) ^ word(here, 0)) & (u64::MAX >> (64 - 8 * n)) == 0
     } else {
-        word(b, a) == word(b, pos)
-            && word(b, a + n - 8) == word(b, pos + n - 8)
-            && (n <= 16 || word(b, a + 8) == word(b, pos + 8))
+        word(there, 0) == word(here, 0)
+            && word(there, n - 8) == word(here, n - 8)
+            && (n <= 16 || word(there, 8) == word(here, 8))
     };
-    let next = b[pos + n];
+    let next = here[n];
     (same && (next == b',' || next == b'\n' || next == b'\r' || blank(next))).then_some(pos + n)
 }
 

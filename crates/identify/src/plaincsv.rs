@@ -25,17 +25,17 @@
 //! split into blocks of whole rows, one per core
 //! ([`PlainCsv::columns`], [`write_columns_in_parts`] with [`write_parts`]).
 
-use rayon::prelude::*;
-
 /// Wanted cells each thread of [`PlainCsv::columns`] has at least: ~0.3–0.5
 /// ms of parsing (9–16 ns a cell), well above what a second thread costs.
 /// Measured on the 2-core machine (`cargo xtask bench --only csv`, and single
 /// reads in fresh processes): the 10-column table (10 000 rows, 100 000
-/// cells) reads in ~150 ns/row on one thread and 80–90 on two; the 1 kHz
-/// command file (10 000 rows of 2 cells, half of them repeats, so cheap per
-/// cell) in 17 ns/row on one and 12 on two once rayon's threads run, but a
-/// single read in a fresh process takes 260 µs on one thread and 390–500 µs
-/// on two (the threads' start): it stays on one.
+/// cells) reads in ~140 ns/row on one thread and 76–90 on two when the
+/// second core is free, and once (a fresh process) in 1.8 ms on one and
+/// 1.4–1.6 ms on two, rayon's threads started; the 1 kHz command file
+/// (10 000 rows of 2 cells, half of them repeats, so cheap per cell) in 15
+/// ns/row on one and 12 on two once rayon's threads run, but once in 220 µs
+/// on one thread and 340–500 µs on two (the threads' start): it stays on
+/// one.
 const PARALLEL_CELLS: usize = 1 << 15;
 
 /// Cells each part of a parallel write has at least ([`write_parts`]):
@@ -149,22 +149,25 @@ impl<'a> PlainCsv<'a> {
         }
         cuts.push(body.len());
         let pieces: Vec<&[u8]> = cuts.windows(2).map(|w| &body[w[0]..w[1]]).collect();
-        // on rayon's threads, started once, not per call: measured on the
-        // 2-core machine, the 10-column table read in 86 ns/row this way, in
-        // 137 on threads started for the call (std::thread::scope) and in
-        // 121 with the first piece on the calling thread and the others on
-        // rayon's (its wait for them costs); inside a rayon task the pieces
-        // are shared out among the threads already there
-        let parts: Vec<Option<(Body, Vec<Vec<f64>>)>> = pieces
-            .par_iter()
-            .with_max_len(1)
-            .enumerate()
-            .map(|(i, &p)| {
-                // the first piece's columns take the others' rows after
-                // their own: room for all of them from the start
-                read(p, rows_in(if i == 0 { body.len() } else { p.len() }))
-            })
-            .collect();
+        // the first piece on this thread, the others on rayon's threads,
+        // started once, not per call. Measured by the bench, the 10-column
+        // read on 2 threads, fastest (median) of 60 rounds in four runs each,
+        // interleaved, load 2.4-2.8: 76-142 (85-150) ns/row this way, 92-145
+        // (101-183) on threads started for the call (std::thread::scope),
+        // 83-91 (151-171) with every piece on rayon's threads (par_iter: this
+        // thread sleeps, and two of rayon's must wake). Inside a rayon task
+        // the pieces are shared out among the threads already there.
+        let mut rest: Vec<Option<(Body, Vec<Vec<f64>>)>> =
+            pieces[1..].iter().map(|_| None).collect();
+        let first = rayon::in_place_scope(|s| {
+            for (part, &p) in rest.iter_mut().zip(&pieces[1..]) {
+                s.spawn(move |_| *part = read(p, rows_in(p.len())));
+            }
+            // the first piece's columns take the others' rows after their
+            // own: room for all of them from the start
+            read(pieces[0], rows_in(body.len()))
+        });
+        let parts = std::iter::once(first).chain(rest);
         let mut parts = pieces.iter().zip(parts);
         let (_, first) = parts.next()?;
         let (end, mut out) = first?;

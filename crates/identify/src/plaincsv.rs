@@ -31,10 +31,10 @@
 /// reads in fresh processes): the 10-column table (10 000 rows, 100 000
 /// cells) reads in ~140 ns/row on one thread and 76–90 on two when the
 /// second core is free, and once (a fresh process) in 1.8 ms on one and
-/// 1.4–1.6 ms on two, rayon's threads started; the 1 kHz command file
+/// 1.3–1.5 ms on two, rayon's threads started; the 1 kHz command file
 /// (10 000 rows of 2 cells, half of them repeats, so cheap per cell) in 15
 /// ns/row on one and 12 on two once rayon's threads run, but once in 220 µs
-/// on one thread and 340–500 µs on two (the threads' start): it stays on
+/// on one thread and 320–460 µs on two (the threads' start): it stays on
 /// one.
 const PARALLEL_CELLS: usize = 1 << 15;
 

@@ -207,7 +207,7 @@ fn cells_of(text: &str) -> Vec<Vec<&[u8]>> {
 /// alone on the same cells: no splitting, no columns, no copying).
 fn read_per_row(text: &str, wanted: &[usize]) -> Result<(usize, [Timing; 4]), String> {
     let threads = PlainCsv::new(text)
-        .map(|p| p.threads())
+        .map(|p| p.threads(wanted))
         .ok_or("not plain CSV")?;
     let lines = cells_of(text);
     let rows = lines.len() as f64;

@@ -25,16 +25,28 @@
 //! split into blocks of whole rows, one per core
 //! ([`PlainCsv::columns`], [`write_columns_in_parts`] with [`write_parts`]).
 
-/// Bodies at least this long are read on every core ([`PlainCsv::columns`]):
-/// below it, starting and joining a thread (10–40 µs measured on the
-/// 2-core machine under load) and joining the pieces cost too much of what
-/// they save (128 KiB is ~750 rows of 10 full-precision columns, ~160 µs of
-/// parsing on one thread).
-const PARALLEL_BYTES: usize = 1 << 17;
+/// Wanted cells each thread of [`PlainCsv::columns`] has at least: ~0.3–0.5
+/// ms of parsing (9–16 ns a cell), well above what a second thread costs.
+/// Measured on the 2-core machine (`cargo xtask bench --only csv`, and single
+/// reads in fresh processes): the 10-column table (10 000 rows, 100 000
+/// cells) reads in ~140 ns/row on one thread and 76–90 on two when the
+/// second core is free, and once (a fresh process) in 1.8 ms on one and
+/// 1.3–1.5 ms on two, rayon's threads started; the 1 kHz command file
+/// (10 000 rows of 2 cells, half of them repeats, so cheap per cell) in 15
+/// ns/row on one and 12 on two once rayon's threads run, but once in 220 µs
+/// on one thread and 320–460 µs on two (the threads' start): it stays on
+/// one.
+const PARALLEL_CELLS: usize = 1 << 15;
 
 /// Cells each part of a parallel write has at least ([`write_parts`]):
 /// 8192 cells are ~160 µs of formatting, several times a thread's start.
 const WRITE_PART_CELLS: usize = 1 << 13;
+
+/// The cores there are to use (at most 8), asked of the system once.
+fn cores() -> usize {
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get().min(8)))
+}
 
 /// A CSV text without quoting, split into its header and its data lines.
 #[derive(Clone, Debug)]
@@ -91,16 +103,22 @@ impl<'a> PlainCsv<'a> {
     /// core ([`PlainCsv::threads`]), and the pieces' columns joined: the
     /// values are the same.
     pub fn columns(&self, wanted: &[usize]) -> Option<Vec<Vec<f64>>> {
-        self.columns_on(wanted, self.threads())
+        self.columns_on(wanted, self.threads(wanted))
     }
 
-    /// The threads [`PlainCsv::columns`] reads with: one per core (at most
-    /// 8) for a body of at least 128 KiB, else one.
-    pub fn threads(&self) -> usize {
-        if self.body.len() < PARALLEL_BYTES {
-            1
-        } else {
-            std::thread::available_parallelism().map_or(1, |n| n.get().min(8))
+    /// The threads [`PlainCsv::columns`] reads the columns `wanted` with:
+    /// one per core (at most 8), as long as each has at least 32 768 wanted
+    /// cells (rows estimated from the first line's length), else one. The
+    /// work is counted in cells, not bytes: a cell costs about the same
+    /// however long its line, and a narrow file's cells are few for its
+    /// bytes.
+    pub fn threads(&self, wanted: &[usize]) -> usize {
+        let line = memchr::memchr(b'\n', self.body.as_bytes()).map_or(self.body.len(), |i| i + 1);
+        let cells = (self.body.len() / line.max(1)).saturating_mul(wanted.len());
+        match cells / PARALLEL_CELLS {
+            // one: the cores are not asked (that reads cgroup files, 30 µs)
+            0 | 1 => 1,
+            n => n.min(cores()),
         }
     }
 
@@ -131,19 +149,30 @@ impl<'a> PlainCsv<'a> {
         }
         cuts.push(body.len());
         let pieces: Vec<&[u8]> = cuts.windows(2).map(|w| &body[w[0]..w[1]]).collect();
-        let parts: Vec<Option<(Body, Vec<Vec<f64>>)>> = std::thread::scope(|s| {
-            let handles: Vec<_> = pieces[1..]
-                .iter()
-                .map(|&p| s.spawn(move || read(p, rows_in(p.len()))))
-                .collect();
-            // the first piece's columns take the others' rows after its own
-            std::iter::once(read(pieces[0], rows_in(body.len())))
-                .chain(handles.into_iter().map(|h| h.join().ok().flatten()))
-                .collect()
+        // the first piece on this thread, the others on rayon's threads,
+        // started once, not per call. Measured by the bench, the 10-column
+        // read on 2 threads, fastest (median) of 60 rounds in four runs each,
+        // interleaved, load 2.4-2.8: 76-142 (85-150) ns/row this way, 92-145
+        // (101-183) on threads started for the call (std::thread::scope),
+        // 83-91 (151-171) with every piece on rayon's threads (par_iter: this
+        // thread sleeps, and two of rayon's must wake). Inside a rayon task
+        // the pieces are shared out among the threads already there.
+        let mut rest: Vec<Option<(Body, Vec<Vec<f64>>)>> =
+            pieces[1..].iter().map(|_| None).collect();
+        let first = rayon::in_place_scope(|s| {
+            for (part, &p) in rest.iter_mut().zip(&pieces[1..]) {
+                s.spawn(move |_| *part = read(p, rows_in(p.len())));
+            }
+            // the first piece's columns take the others' rows after their
+            // own: room for all of them from the start
+            read(pieces[0], rows_in(body.len()))
         });
-        let mut out: Vec<Vec<f64>> = wanted.iter().map(|_| Vec::new()).collect();
-        let mut blank_end = false;
-        for (piece, part) in pieces.iter().zip(parts) {
+        let parts = std::iter::once(first).chain(rest);
+        let mut parts = pieces.iter().zip(parts);
+        let (_, first) = parts.next()?;
+        let (end, mut out) = first?;
+        let mut blank_end = end == Body::BlankEnd;
+        for (piece, part) in parts {
             // after blank lines only blank lines may follow (as in `parse`)
             if blank_end && !blank_tail(piece) {
                 return None;
@@ -151,11 +180,7 @@ impl<'a> PlainCsv<'a> {
             let (end, cols) = part?;
             blank_end |= end == Body::BlankEnd;
             for (o, c) in out.iter_mut().zip(cols) {
-                if o.is_empty() {
-                    *o = c;
-                } else {
-                    o.extend_from_slice(&c);
-                }
+                o.extend_from_slice(&c);
             }
         }
         Some(out)
@@ -217,12 +242,21 @@ impl Rows {
     /// without being parsed again.
     pub fn parse(&self, b: &[u8], out: &mut [Vec<f64>]) -> Option<Body> {
         let len = b.len();
-        // per column, the text of the cell above (start, length; length 0:
-        // none to compare with) and its value
-        let mut above: Vec<(usize, usize, f64)> = vec![(0, 0, 0.0); self.width];
+        // per column, the text of the cell above and its value
+        let mut above: Vec<Above> = vec![Above::default(); self.width];
+        // the values of a block of rows, column after column: one store per
+        // cell, and one copy per column and block into `out`
+        let mut block: Vec<f64> = vec![0.0; BLOCK_ROWS * out.len()];
+        let mut r = 0;
+        let flush = |block: &[f64], r: usize, out: &mut [Vec<f64>]| {
+            for (o, c) in out.iter_mut().zip(block.chunks_exact(BLOCK_ROWS)) {
+                o.extend_from_slice(&c[..r]);
+            }
+        };
         let mut pos = 0;
         while pos < len {
             if b[pos] == b'\n' || b[pos] == b'\r' {
+                flush(&block, r, out);
                 // the full reader skips blank lines, which shifts its row
                 // numbers away from the line numbers: only a blank end is plain
                 return blank_tail(&b[pos..]).then_some(Body::BlankEnd);
@@ -232,16 +266,25 @@ impl Rows {
                     skip_cell(b, pos)?
                 } else {
                     let (v, end) = match repeat(b, pos, a) {
-                        Some(end) => (a.2, end),
+                        Some(end) => (a.value, end),
                         None => {
                             let (v, start, n) = number_at(b, pos)?;
                             // texts longer than any shortest round trip
                             // (24 bytes) are not compared
-                            *a = (start, if n <= MAX_CELL { n } else { 0 }, v);
+                            *a = Above {
+                                start,
+                                len: if n <= MAX_CELL { n } else { 0 },
+                                value: v,
+                            };
                             (v, start + n)
                         }
                     };
-                    out[k].push(v);
+                    block[k * BLOCK_ROWS + r] = v;
+                    // mostly the separator follows the number at once
+                    if b.get(end) == Some(&sep) {
+                        pos = end + 1;
+                        continue;
+                    }
                     cell_end(b, end)?
                 };
                 // a cell ends at a comma, the last at the line's end
@@ -250,9 +293,31 @@ impl Rows {
                 }
                 pos = end + 1;
             }
+            r += 1;
+            if r == BLOCK_ROWS {
+                flush(&block, r, out);
+                r = 0;
+            }
         }
+        flush(&block, r, out);
         Some(Body::Rows)
     }
+}
+
+/// Rows whose values [`Rows::parse`] gathers before appending them to the
+/// output columns: a store per cell instead of a push (a length and a
+/// capacity read and a length written), one copy per column and block;
+/// with the separator checked where the number ends, 158 ns/row against 166
+/// for the 10-column table on one thread.
+const BLOCK_ROWS: usize = 64;
+
+/// The cell above one being read: where its text starts, its length (0:
+/// none to compare with) and its value.
+#[derive(Clone, Copy, Debug, Default)]
+struct Above {
+    start: usize,
+    len: usize,
+    value: f64,
 }
 
 /// Whether `b` is nothing but line ends (`\n`, `\r\n`).
@@ -309,24 +374,24 @@ fn word(b: &[u8], i: usize) -> u64 {
 }
 
 /// Where the number ends if the cell at `pos` repeats the text of the cell
-/// above, `(start, n, _)` in `above`: the same `n` bytes, then a byte no
-/// number goes on with (so the parser would stop there too, with the same
-/// value). `None` when it does not, or when that is not quickly seen.
+/// above (`above`): the same bytes, then a byte no number goes on with (so
+/// the parser would stop there too, with the same value). `None` when it
+/// does not, or when that is not quickly seen.
 #[inline(always)]
-fn repeat(b: &[u8], pos: usize, above: &(usize, usize, f64)) -> Option<usize> {
-    let (a, n, _) = *above;
-    // the words read stay inside `b` (`a < pos`, n <= MAX_CELL)
-    if n == 0 || pos + MAX_CELL >= b.len() {
-        return None;
-    }
+fn repeat(b: &[u8], pos: usize, above: &Above) -> Option<usize> {
+    // both texts as arrays of a known length, and n <= MAX_CELL: the words
+    // read need no bounds checks (7 ns/row of the 10-column table's 180)
+    let n = above.len.min(MAX_CELL);
+    let here: &[u8; MAX_CELL + 1] = b.get(pos..pos + MAX_CELL + 1)?.try_into().ok()?;
+    let there: &[u8; MAX_CELL + 1] = b[above.start..].get(..MAX_CELL + 1)?.try_into().ok()?;
     let same = if n <= 8 {
-        (word(b, a) ^ word(b, pos)) & (u64::MAX >> (64 - 8 * n)) == 0
+        n > 0 && (word(there, 0) ^ word(here, 0)) & (u64::MAX >> (64 - 8 * n)) == 0
     } else {
-        word(b, a) == word(b, pos)
-            && word(b, a + n - 8) == word(b, pos + n - 8)
-            && (n <= 16 || word(b, a + 8) == word(b, pos + 8))
+        word(there, 0) == word(here, 0)
+            && word(there, n - 8) == word(here, n - 8)
+            && (n <= 16 || word(there, 8) == word(here, 8))
     };
-    let next = b[pos + n];
+    let next = here[n];
     (same && (next == b',' || next == b'\n' || next == b'\r' || blank(next))).then_some(pos + n)
 }
 
@@ -336,7 +401,7 @@ fn repeat(b: &[u8], pos: usize, above: &(usize, usize, f64)) -> Option<usize> {
 /// does and refuses the rest), where its text starts and its length (what
 /// follows is for [`cell_end`] to judge); `None` when there is no such
 /// number or it is not finite.
-#[inline]
+#[inline(always)]
 fn number_at(b: &[u8], start: usize) -> Option<(f64, usize, usize)> {
     let mut i = start;
     while i < b.len() && blank(b[i]) {
@@ -488,7 +553,7 @@ pub fn write_columns(names: &[&str], columns: &[&[f64]]) -> Vec<u8> {
 /// `width` columns: one per core (at most 8), as long as each part has at
 /// least 8192 cells.
 pub fn write_parts(rows: usize, width: usize) -> usize {
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
+    let cores = cores();
     (rows.saturating_mul(width) / WRITE_PART_CELLS).clamp(1, cores)
 }
 
@@ -671,14 +736,15 @@ mod tests {
         );
     }
 
-    /// A body long enough to be read in pieces reads as it does whole:
-    /// every value, the blank end, and blank lines inside refused wherever
-    /// the cut falls.
+    /// A body long enough to be read in pieces reads as it does whole, on
+    /// any number of threads: every value, the blank end, and blank lines
+    /// inside refused wherever the cut falls.
     #[test]
     fn pieces_read_as_the_whole() {
         let mut text = String::from("time,u,x\n");
         let mut k = 0u64;
-        while text.len() < 3 * PARALLEL_BYTES {
+        // two wanted cells a row: enough for two threads
+        while k < (PARALLEL_CELLS + 1000) as u64 {
             text.push_str(&format!("{},{},{}\n", k as f64 * 1e-3, (k as f64).sin(), k));
             k += 1;
         }
@@ -692,21 +758,42 @@ mod tests {
         assert_eq!(p.columns(&[1, 0]).unwrap(), whole);
         assert_eq!(whole[1].len() as u64, k);
         let ended = format!("{text}\n\r\n\n");
-        assert_eq!(
-            PlainCsv::new(&ended).unwrap().columns(&[1, 0]).unwrap(),
-            whole
-        );
+        let ended = PlainCsv::new(&ended).unwrap();
+        for threads in 1..=4 {
+            assert_eq!(p.columns_on(&[1, 0], threads).unwrap(), whole);
+            assert_eq!(ended.columns_on(&[1, 0], threads).unwrap(), whole);
+        }
         for at in [0.1, 0.45, 0.5, 0.55, 0.9] {
             let mut i = (text.len() as f64 * at) as usize;
             while text.as_bytes()[i] != b'\n' {
                 i += 1;
             }
             let holed = format!("{}\n{}", &text[..=i], &text[i + 1..]);
-            assert!(
-                PlainCsv::new(&holed).unwrap().columns(&[0]).is_none(),
-                "blank line at {at}"
-            );
+            for threads in 1..=3 {
+                assert!(
+                    PlainCsv::new(&holed)
+                        .unwrap()
+                        .columns_on(&[0], threads)
+                        .is_none(),
+                    "blank line at {at}, {threads} threads"
+                );
+            }
         }
+    }
+
+    /// The threads go by wanted cells: a long narrow file stays on one, a
+    /// table as long with ten columns goes on every core (up to two here).
+    #[test]
+    fn threads_go_by_wanted_cells() {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get().min(2));
+        let narrow = format!("t,u\n{}", "0.001,0.13641301660791483\n".repeat(10_000));
+        assert_eq!(PlainCsv::new(&narrow).unwrap().threads(&[0, 1]), 1);
+        let row = ["0.5"; 10].join(",") + "\n";
+        let wide = format!("{}\n{}", ["c"; 10].join(","), row.repeat(10_000));
+        let p = PlainCsv::new(&wide).unwrap();
+        let all: Vec<usize> = (0..10).collect();
+        assert_eq!(p.threads(&all).min(2), cores);
+        assert_eq!(p.threads(&[0, 1]), 1, "two columns of the same rows");
     }
 
     proptest! {

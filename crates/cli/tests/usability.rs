@@ -251,6 +251,54 @@ fn a_bad_value_from_set_names_the_set_not_a_line_of_the_rig_file() {
     assert!(e.contains("(line ") && !e.contains("--set"), "{e}");
 }
 
+/// An initial state a `--set` gave and a component refuses when it is built
+/// (a spool position beyond its stroke, a mass's own position beyond its
+/// end stops) is named at its path and blamed on the `--set`, as a
+/// parameter's range error is: they were named at `components.<name>` with
+/// the line of the file, which held the value the `--set` replaced.
+#[test]
+fn a_bad_initial_state_from_set_names_its_path_and_the_set() {
+    let d = scratch("set-blame-initial");
+    let cmd = command_file(&d, 11, 1e-3);
+    let rig = d.join("lm.json");
+    let p = hydrocyl()
+        .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
+        .output()
+        .unwrap();
+    assert!(p.status.success());
+    std::fs::write(&rig, &p.stdout).unwrap();
+    let out = d.join("o.csv");
+    for (sets, path) in [
+        (
+            &["spool.initial.position=0.001"][..],
+            "components.spool.initial.position",
+        ),
+        (
+            &[
+                "load.initial.position=0.3",
+                "cylinder.initial.position=null",
+            ],
+            "components.load.initial.position",
+        ),
+    ] {
+        let mut args = vec![
+            "--rig",
+            rig.to_str().unwrap(),
+            "--command",
+            cmd.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        let e = simulate_fails(&args, &out);
+        assert!(e.contains(&format!("rig `{path}`")), "{e}");
+        assert!(e.contains(&format!("(set by --set {} on ", sets[0])), "{e}");
+        assert!(!e.contains("(line "), "{e}");
+    }
+}
+
 #[test]
 fn a_friction_bench_writes_its_command_column_like_every_rig() {
     let d = scratch("bench-command");
@@ -360,3 +408,4 @@ fn print_rig_refuses_the_output_options_it_would_not_write() {
         .unwrap();
     assert!(o.status.success() && String::from_utf8_lossy(&o.stdout).contains("50"));
 }
+

@@ -709,3 +709,44 @@ fn a_short_record_is_warned_of_in_the_report() {
         );
     }
 }
+
+/// A user's circuit whose netlist lists no `outputs` (every probe named
+/// `component.probe`, as `docs/netlist.md` allows) has no `position`, `p1`,
+/// `p2` for the record to be compared with: one line naming `outputs` and
+/// the outputs to add, exit 2, no report. It failed in the declared run
+/// ("rig: declared model does not simulate: … channel `position`: the
+/// circuit has no such output"), naming no JSON path and no remedy.
+#[test]
+fn a_netlist_without_the_compared_outputs_is_named_at_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = bin()
+        .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
+        .output()
+        .unwrap();
+    assert!(p.status.success());
+    let mut v: serde_json::Value = serde_json::from_slice(&p.stdout).unwrap();
+    v.as_object_mut().unwrap().remove("outputs");
+    let rig = dir.path().join("no-outputs.json");
+    std::fs::write(&rig, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    let report = dir.path().join("report.json");
+    let out = bin()
+        .args(["diagnose", "--rig"])
+        .arg(&rig)
+        .arg("--data")
+        .arg(fixtures().join("valve-none.csv"))
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_one_line_error(
+        (out.status.code(), err, report.exists()),
+        &[
+            "`outputs`",
+            "\"position\": \"load.position\"",
+            "\"velocity\": \"load.velocity\"",
+            "\"p1\": \"cylinder.p1\"",
+            "\"p2\": \"cylinder.p2\"",
+        ],
+    );
+}

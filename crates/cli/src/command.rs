@@ -526,12 +526,12 @@ fn parse_samples(
     bytes: &[u8],
     unit: CommandUnit,
 ) -> Result<(Vec<f64>, Vec<f64>, String), CliError> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        CliError::Input(format!(
-            "{file}: not UTF-8 text (byte {})",
-            e.valid_up_to() + 1
-        ))
-    })?;
+    // bytes that are not UTF-8 (a logger's `°C` in Windows-1252 in a
+    // column the run does not read) are kept as U+FFFD: a column the run
+    // reads is then refused at its row and column, as the record reader
+    // (`diagnose`) does, and any other is ignored
+    let text = String::from_utf8_lossy(bytes);
+    let text: &str = &text;
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_reader(text.as_bytes());

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::hydrocyl;
+use common::{hydrocyl, simulate_ok};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -409,3 +409,41 @@ fn print_rig_refuses_the_output_options_it_would_not_write() {
     assert!(o.status.success() && String::from_utf8_lossy(&o.stdout).contains("50"));
 }
 
+/// A command file with a column the run does not read written in
+/// Windows-1252 by a logger (`Öl [°C]`) runs as the same file without it;
+/// a `command` cell with such a byte is refused at its row and column. The
+/// file was refused whole, at a byte offset ("not UTF-8 text (byte 27)").
+#[test]
+fn bytes_that_are_not_utf8_are_named_only_where_the_run_reads_them() {
+    let d = scratch("latin1");
+    let mut plain = String::from("time [s],command\n");
+    let mut s = b"time [s],command,\xd6l [\xb0C]\r\n".to_vec();
+    for k in 0..21 {
+        let t = k as f64 * 1e-3;
+        plain.push_str(&format!("{t},0.2\n"));
+        s.extend(format!("{t},0.2,41.5\r\n").bytes());
+    }
+    let (a, b) = (d.join("plain.csv"), d.join("latin1.csv"));
+    std::fs::write(&a, plain).unwrap();
+    std::fs::write(&b, &s).unwrap();
+    let (oa, ob) = (d.join("a.csv"), d.join("b.csv"));
+    simulate_ok("leaney-moog", &a, &oa, &[]);
+    simulate_ok("leaney-moog", &b, &ob, &[]);
+    assert_eq!(std::fs::read(&oa).unwrap(), std::fs::read(&ob).unwrap());
+    let at = s.windows(5).position(|w| w == b"0.2,4").unwrap();
+    s[at + 1] = 0xb7;
+    std::fs::write(&b, &s).unwrap();
+    let out = d.join("c.csv");
+    let e = simulate_fails(
+        &[
+            "--rig",
+            "leaney-moog",
+            "--command",
+            b.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &out,
+    );
+    assert!(e.contains("row 2, column 'command'"), "{e}");
+}

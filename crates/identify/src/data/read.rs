@@ -136,10 +136,16 @@ impl Record {
     /// Reads a CSV file whose columns are found through `map`.
     pub fn read_mapped(path: &Path, map: &ColumnMap) -> Result<Record, DataError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| DataError::Io {
+        let bytes = std::fs::read(path).map_err(|e| DataError::Io {
             file: file.clone(),
             reason: e.to_string(),
         })?;
+        // bytes that are not UTF-8 (a logger's `°C` in Windows-1252 in a
+        // column that is not a signal) are kept as U+FFFD: such a column is
+        // kept and ignored, and a signal's cell or header with one is
+        // refused at its row and column (it used to refuse the whole file
+        // with no row: "stream did not contain valid UTF-8")
+        let text = String::from_utf8_lossy(&bytes);
         Self::parse(&file, &text, map)
     }
 
@@ -540,5 +546,32 @@ mod tests {
                 && e.contains("identify.columns.position"),
             "{e}"
         );
+    }
+
+    /// A column that is not a signal, written in Windows-1252 by a logger
+    /// (`Öl [°C]`), is kept and ignored, as the format promises of columns
+    /// that are not signals; a signal's cell with such a byte is refused at
+    /// its row and column. The file was refused whole, with no row ("cannot
+    /// read: stream did not contain valid UTF-8").
+    #[test]
+    fn bytes_that_are_not_utf8_are_named_only_where_a_signal_has_them() {
+        let dir = std::env::temp_dir().join(format!("hydrocyl-latin1-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut s = b"time [s],command,\xd6l [\xb0C]\r\n".to_vec();
+        for i in 0..10 {
+            s.extend(format!("{},0.1,41.5\r\n", i as f64 * 1e-3).bytes());
+        }
+        let ok = dir.join("ok.csv");
+        std::fs::write(&ok, &s).unwrap();
+        let r = Record::read(&ok).unwrap();
+        assert_eq!(r.time.len(), 10);
+        assert_eq!(r.ignored.len(), 1, "{:?}", r.ignored);
+        let at = s.windows(5).position(|w| w == b"0.1,4").unwrap();
+        s[at + 2] = 0xb0;
+        let bad = dir.join("bad.csv");
+        std::fs::write(&bad, &s).unwrap();
+        let e = Record::read(&bad).unwrap_err().to_string();
+        std::fs::remove_dir_all(&dir).ok();
+        assert!(e.contains("row 2, column 'command'"), "{e}");
     }
 }

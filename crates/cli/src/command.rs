@@ -555,6 +555,15 @@ fn parse_samples(
             Ok(r) => r.position(),
             Err(e) => e.position(),
         };
+        // a line of spaces or tabs is blank (skipped, as an empty one is),
+        // as the record reader (`diagnose`) has it
+        if let (Err(e), Some(p)) = (&rec, at) {
+            if matches!(e.kind(), csv::ErrorKind::UnequalLengths { len: 1, .. })
+                && lines.is_blank_at(p.byte() as usize)
+            {
+                continue;
+            }
+        }
         row = at.map_or(row + 1, |p| lines.line_at(p.byte() as usize));
         let rec = rec.map_err(|e| match e.kind() {
             csv::ErrorKind::UnequalLengths { len, .. } => {

@@ -447,3 +447,31 @@ fn bytes_that_are_not_utf8_are_named_only_where_the_run_reads_them() {
     );
     assert!(e.contains("row 2, column 'command'"), "{e}");
 }
+
+/// A line of spaces or tabs in a command file (a logger's padded blank
+/// line, between rows or at the end) is blank: the run is the one without
+/// it. It was refused as a row of one cell ("1 cell, the header has 2").
+#[test]
+fn a_line_of_spaces_in_a_command_file_is_blank() {
+    let d = scratch("blank-spaces");
+    let (mut plain, mut padded) = (
+        String::from("time,command\n"),
+        String::from("time,command\r\n"),
+    );
+    for k in 0..21 {
+        let row = format!("{},0.2", k as f64 * 1e-3);
+        plain.push_str(&format!("{row}\n"));
+        padded.push_str(&format!("{row}\r\n"));
+        if k == 7 {
+            padded.push_str(" \t \r\n");
+        }
+    }
+    padded.push_str("  \r\n\t\r\n");
+    let (a, b) = (d.join("plain.csv"), d.join("padded.csv"));
+    std::fs::write(&a, plain).unwrap();
+    std::fs::write(&b, padded).unwrap();
+    let (oa, ob) = (d.join("a.csv"), d.join("b.csv"));
+    simulate_ok("leaney-moog", &a, &oa, &[]);
+    simulate_ok("leaney-moog", &b, &ob, &[]);
+    assert_eq!(std::fs::read(&oa).unwrap(), std::fs::read(&ob).unwrap());
+}

@@ -206,6 +206,16 @@ impl Record {
         let mut lines = Vec::new();
         let mut counter = LineCounter::new(text);
         for (k, rec) in rdr.records().enumerate() {
+            // a line of spaces or tabs is blank (skipped, as an empty one)
+            if let Err(e) = &rec {
+                if let (csv::ErrorKind::UnequalLengths { len: 1, .. }, Some(p)) =
+                    (e.kind(), e.position())
+                {
+                    if counter.is_blank_at(p.byte() as usize) {
+                        continue;
+                    }
+                }
+            }
             let rec = rec.map_err(|e| {
                 let row = e
                     .position()
@@ -368,6 +378,20 @@ impl<'a> LineCounter<'a> {
             byte: 0,
             line: 1,
         }
+    }
+
+    /// Whether the record the CSV reader starts at byte offset `byte` is a
+    /// line of nothing but spaces and tabs (a logger's padded blank line):
+    /// blank, skipped as an empty line is, not a row of one empty cell.
+    pub fn is_blank_at(&self, byte: usize) -> bool {
+        let mut at = byte.min(self.text.len());
+        while at < self.text.len() && matches!(self.text[at], b'\n' | b'\r') {
+            at += 1;
+        }
+        self.text[at..]
+            .iter()
+            .take_while(|&&b| b != b'\n')
+            .all(|&b| matches!(b, b' ' | b'\t' | b'\r'))
     }
 
     /// The line of the record starting at byte offset `byte` (not before
@@ -573,5 +597,27 @@ mod tests {
         let e = Record::read(&bad).unwrap_err().to_string();
         std::fs::remove_dir_all(&dir).ok();
         assert!(e.contains("row 2, column 'command'"), "{e}");
+    }
+
+    /// A line of spaces or tabs (a logger's padded blank line, at the end
+    /// or between rows) is blank: skipped as an empty line is, and counted
+    /// in the rows of later errors. It was refused as a row of one cell
+    /// ("row 5, column 'command': 1 cell, the header has 2").
+    #[test]
+    fn a_line_of_spaces_is_blank() {
+        let map = ColumnMap::default();
+        let mut s = String::from("time [s],command\n");
+        for i in 0..10 {
+            s.push_str(&format!("{},0.1\n", i));
+            if i == 3 {
+                s.push_str("  \t \r\n");
+            }
+        }
+        s.push_str(" \n\t\r\n");
+        let r = Record::parse("x.csv", &s, &map).unwrap();
+        assert_eq!(r.time.len(), 10);
+        let bad = s.replacen("5,0.1", "5,x", 1);
+        let e = Record::parse("x.csv", &bad, &map).unwrap_err().to_string();
+        assert!(e.contains("row 8, column 'command'"), "{e}");
     }
 }

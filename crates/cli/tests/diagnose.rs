@@ -750,3 +750,109 @@ fn a_netlist_without_the_compared_outputs_is_named_at_outputs() {
         ],
     );
 }
+
+/// A record of the example pump-controlled closed circuit (no four-way
+/// valve, no supply: `fixtures/rigs/examples/pump-closed-circuit.json`)
+/// with Ce1 = 2e-12 m³/(s·Pa) planted, written by `simulate` with a
+/// deterministic noise of ±20 µm and ±20 kPa; `keep_pressures` false drops
+/// the p1/p2 columns. Returns the record's path.
+fn pump_record(dir: &Path, keep_pressures: bool) -> PathBuf {
+    let rig = fixtures().join("../rigs/examples/pump-closed-circuit.json");
+    let cmd = dir.join("cmd.csv");
+    let u = |t: f64| {
+        1.5 * (2.0 * std::f64::consts::PI * 0.8 * t).sin()
+            + 0.5 * (2.0 * std::f64::consts::PI * 2.1 * t).sin()
+    };
+    let mut s = String::from("time,command\n");
+    for k in 0..=2000 {
+        let t = k as f64 * 1e-3;
+        s.push_str(&format!("{t},{}\n", u(t)));
+    }
+    std::fs::write(&cmd, s).unwrap();
+    let sim = dir.join("sim.csv");
+    let o = bin()
+        .args(["simulate", "--rig"])
+        .arg(&rig)
+        .arg("--command")
+        .arg(&cmd)
+        .arg("--out")
+        .arg(&sim)
+        .args(["--rtol", "1e-8", "--quiet"])
+        .args(["--set", "cylinder.external_leakage_1=2e-12"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&sim).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| head.iter().position(|h| h.starts_with(n)).unwrap();
+    let (x, p1, p2) = (col("position "), col("p1 "), col("p2 "));
+    // a fixed pseudo-random noise, uniform in ±1 (sd 0.577)
+    let mut seed = 12345u64;
+    let mut noise = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    };
+    let mut rec = String::from(if keep_pressures {
+        "time [s],command,position [mm],p1 [bar],p2 [bar]\n"
+    } else {
+        "time [s],command,position [mm]\n"
+    });
+    for l in lines {
+        let c: Vec<f64> = l.split(',').map(|v| v.parse().unwrap()).collect();
+        let row = format!(
+            "{},{},{:.4}",
+            c[0],
+            u(c[0]),
+            (c[x] + 3.5e-5 * noise()) * 1e3
+        );
+        rec.push_str(&row);
+        if keep_pressures {
+            let (a, b) = (c[p1] + 3.5e4 * noise(), c[p2] + 3.5e4 * noise());
+            rec.push_str(&format!(",{:.4},{:.4}", a / 1e5, b / 1e5));
+        }
+        rec.push('\n');
+    }
+    let path = dir.join(if keep_pressures {
+        "pump.csv"
+    } else {
+        "pump-np.csv"
+    });
+    std::fs::write(&path, rec).unwrap();
+    path
+}
+
+/// `diagnose` on a pump-controlled closed circuit (a user's circuit with no
+/// four-way valve and no supply). Its pressures were left out as a unit
+/// error ("p1 reaches 6.9e5 Pa, above the supply 0 Pa") — a circuit that
+/// holds no pressure above tank has no supply to be above — and with no
+/// measured pressure to start from, the declared model did not simulate:
+/// the initial p1/p2 its file declares were cleared for a steady state at
+/// rest the circuit does not have ("declared model does not simulate: …
+/// no four-way valve feeds this cylinder's chambers"). Now the pressures are
+/// compared and the planted leak is found; without pressure columns the
+/// run starts from the file's pressures.
+#[test]
+fn a_pump_circuit_without_a_supply_is_diagnosed() {
+    let dir = tempfile::tempdir().unwrap();
+    let rig = fixtures().join("../rigs/examples/pump-closed-circuit.json");
+    for keep in [false] {
+        let data = pump_record(dir.path(), keep);
+        let json = diagnose_json(&[
+            "--rig".as_ref(),
+            rig.as_os_str(),
+            "--data".as_ref(),
+            data.as_os_str(),
+        ]);
+        let problems = json["data_problems"].as_array().unwrap();
+        assert!(
+            problems.iter().all(|p| p["kind"] != "units"),
+            "{problems:?}"
+        );
+        if keep {
+            assert_eq!(json["effects_added"][0]["id"], "external_leakage", "{json}");
+        }
+    }
+}

@@ -838,7 +838,7 @@ fn pump_record(dir: &Path, keep_pressures: bool) -> PathBuf {
 fn a_pump_circuit_without_a_supply_is_diagnosed() {
     let dir = tempfile::tempdir().unwrap();
     let rig = fixtures().join("../rigs/examples/pump-closed-circuit.json");
-    for keep in [false] {
+    for keep in [true, false] {
         let data = pump_record(dir.path(), keep);
         let json = diagnose_json(&[
             "--rig".as_ref(),

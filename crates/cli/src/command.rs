@@ -140,7 +140,7 @@ pub fn columns_of<'a>(
                 Some("ms") => 1e-3,
                 Some(u) => {
                     return Err(CliError::Input(format!(
-                        "{file}: row 1, column '{h}': unknown time unit `{u}` (use s or ms)"
+                        "{file}: row 1, column '{h}': unknown unit '{u}' (accepted: s, ms)"
                     )))
                 }
             }
@@ -158,13 +158,13 @@ pub fn columns_of<'a>(
         *found = Some((i, f));
     }
     let (time, time_factor) =
-        time.ok_or_else(|| CliError::Input(format!("{file}: row 1: no `time` column")))?;
+        time.ok_or_else(|| CliError::Input(format!("{file}: row 1: missing column 'time'")))?;
     let (command, command_factor) = command.ok_or_else(|| {
         CliError::Input(match unit {
             CommandUnit::Reference => format!(
-                "{file}: row 1: no `reference` column (a closed-loop rig is driven by its position set-point)"
+                "{file}: row 1: missing column 'reference' (a closed-loop rig is driven by its position set-point)"
             ),
-            _ => format!("{file}: row 1: no `command` column"),
+            _ => format!("{file}: row 1: missing column 'command'"),
         })
     })?;
     Ok(Columns {

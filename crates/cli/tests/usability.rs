@@ -475,3 +475,46 @@ fn a_line_of_spaces_in_a_command_file_is_blank() {
     simulate_ok("leaney-moog", &b, &ob, &[]);
     assert_eq!(std::fs::read(&oa).unwrap(), std::fs::read(&ob).unwrap());
 }
+
+/// The command reader (`simulate`) and the record reader (`diagnose`) say
+/// the same fault the same way (README): a missing `time` or `command`
+/// column and an unknown time unit. `simulate` said "no `time` column" and
+/// "unknown time unit `min` (use s or ms)" where `diagnose` said "missing
+/// column 'time'" and "unknown unit 'min' (accepted: s, ms)".
+#[test]
+fn both_readers_word_a_missing_column_and_a_time_unit_alike() {
+    let d = scratch("same-words");
+    let rows: String = (0..150)
+        .map(|k| format!("{},0.1,0.0,21.0,42.0\n", k as f64 * 1e-3))
+        .collect();
+    for header in [
+        "Time [s],command,position [mm],p1 [bar],p2 [bar]",
+        "time [s],cmd,position [mm],p1 [bar],p2 [bar]",
+        "time [min],command,position [mm],p1 [bar],p2 [bar]",
+    ] {
+        let f = d.join("rec.csv");
+        std::fs::write(&f, format!("{header}\n{rows}")).unwrap();
+        let f = f.to_str().unwrap();
+        let out = d.join("o.csv");
+        let s = simulate_fails(
+            &[
+                "--rig",
+                "leaney-moog",
+                "--command",
+                f,
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &out,
+        );
+        let report = d.join("r.json");
+        let o = hydrocyl()
+            .args(["diagnose", "--rig", "leaney-moog", "--data", f, "--report"])
+            .arg(&report)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2));
+        assert!(!report.exists());
+        assert_eq!(s, stderr(&o), "{header}");
+    }
+}

@@ -856,3 +856,68 @@ fn a_pump_circuit_without_a_supply_is_diagnosed() {
         }
     }
 }
+
+/// A record whose command is logged in per cent (`command [%]`, as
+/// `simulate` takes a command file) diagnoses as the same record in `-`:
+/// the record reader refused it ("unknown unit '%' (accepted: -, V)").
+#[test]
+fn a_command_in_per_cent_is_read_as_simulate_reads_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = std::fs::read_to_string(fixtures().join("valve-internal_leakage.csv")).unwrap();
+    let mut lines = src.lines();
+    let head = lines.next().unwrap();
+    assert!(head.starts_with("time [s],command,"), "{head}");
+    let mut pc = head.replacen(",command,", ",command [%],", 1) + "\n";
+    for l in lines {
+        let mut c: Vec<String> = l.split(',').map(str::to_string).collect();
+        // the same digits, the decimal point two places on
+        let v: f64 = c[1].parse().unwrap();
+        c[1] = format!("{:.4}", v * 100.0);
+        assert_eq!(
+            format!("{:.6}", c[1].parse::<f64>().unwrap() / 100.0),
+            l.split(',').nth(1).unwrap()
+        );
+        pc.push_str(&c.join(","));
+        pc.push('\n');
+    }
+    let data = dir.path().join("pc.csv");
+    std::fs::write(&data, pc).unwrap();
+    let a = diagnose_json(&[
+        "--rig".as_ref(),
+        "leaney-moog".as_ref(),
+        "--data".as_ref(),
+        fixtures().join("valve-internal_leakage.csv").as_os_str(),
+    ]);
+    let b = diagnose_json(&[
+        "--rig".as_ref(),
+        "leaney-moog".as_ref(),
+        "--data".as_ref(),
+        data.as_os_str(),
+    ]);
+    // the same record but for the last bit of a command (0.01 × in
+    // binary): the same effect, within the integration's noise
+    let ids = |j: &serde_json::Value| -> Vec<String> {
+        j["effects_added"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e["id"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(ids(&a), ["internal_leakage"]);
+    assert_eq!(ids(&a), ids(&b));
+    let cl = |j: &serde_json::Value| j["effects_added"][0]["params"]["Cl"].as_f64().unwrap();
+    assert!(
+        (cl(&a) / cl(&b) - 1.0).abs() < 1e-4,
+        "{} {}",
+        cl(&a),
+        cl(&b)
+    );
+    for ch in ["position", "p1", "p2"] {
+        let (x, y) = (
+            a["nrmse_after"][ch].as_f64().unwrap(),
+            b["nrmse_after"][ch].as_f64().unwrap(),
+        );
+        assert!((x / y - 1.0).abs() < 1e-3, "{ch}: {x} {y}");
+    }
+}

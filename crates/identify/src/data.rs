@@ -91,6 +91,10 @@ impl Signal {
             (Signal::Time, "s") => 1.0,
             (Signal::Time, "ms") => 1e-3,
             (Signal::Command, "-" | "V" | "1") => 1.0,
+            // as `simulate` reads a command file: a spool demand in per
+            // cent, a drive voltage in millivolts
+            (Signal::Command, "%") => 1e-2,
+            (Signal::Command, "mV") => 1e-3,
             (Signal::Position | Signal::Reference, "m") => 1.0,
             (Signal::Position | Signal::Reference, "mm") => 1e-3,
             (Signal::Velocity, "m/s") => 1.0,
@@ -117,7 +121,7 @@ impl Signal {
     pub fn accepted_units(self) -> &'static str {
         match self {
             Signal::Time => "s, ms",
-            Signal::Command => "-, V",
+            Signal::Command => "-, %, V, mV",
             Signal::Position | Signal::Reference => "m, mm",
             Signal::Velocity => "m/s, mm/s, cm/s",
             Signal::P1 | Signal::P2 | Signal::Ps => "Pa, bar, kPa, MPa, psi",

@@ -921,3 +921,31 @@ fn a_command_in_per_cent_is_read_as_simulate_reads_it() {
         assert!((x / y - 1.0).abs() < 1e-3, "{ch}: {x} {y}");
     }
 }
+
+/// A short record (fewer than 100 samples: warned of) that the rig refuses
+/// (a closed-loop record's `reference` on an open-loop rig) gets its one
+/// error line alone: the warning was printed first, before the record was
+/// checked against the rig, making the error two lines.
+#[test]
+fn a_short_record_refused_by_the_rig_is_one_error_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = String::from("time [s],reference [mm],command,position [mm],p1 [bar],p2 [bar]\n");
+    for k in 0..30 {
+        s.push_str(&format!("{},1.0,0.01,0.0,21.0,42.0\n", k as f64 * 1e-3));
+    }
+    let data = dir.path().join("short.csv");
+    std::fs::write(&data, s).unwrap();
+    let report = dir.path().join("r.json");
+    let out = bin()
+        .args(["diagnose", "--rig", "leaney-moog", "--data"])
+        .arg(&data)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_one_line_error(
+        (out.status.code(), err, report.exists()),
+        &["short.csv", "has no controller"],
+    );
+}

@@ -518,3 +518,30 @@ fn both_readers_word_a_missing_column_and_a_time_unit_alike() {
         assert_eq!(s, stderr(&o), "{header}");
     }
 }
+
+/// A `--set` path copied from an error about a rig file, which names the
+/// JSON path (`components.load.mass`), is refused with the path `--set`
+/// takes: it said only "no component `components`".
+#[test]
+fn a_set_with_the_json_path_names_the_parameter_path() {
+    let d = scratch("set-json-path");
+    let cmd = command_file(&d, 11, 1e-3);
+    let out = d.join("o.csv");
+    let e = simulate_fails(
+        &[
+            "--rig",
+            "leaney-moog",
+            "--command",
+            cmd.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            "components.load.mass=50",
+        ],
+        &out,
+    );
+    assert!(
+        e.contains("without the JSON path's `components.`: `load.mass`"),
+        "{e}"
+    );
+}

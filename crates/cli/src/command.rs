@@ -157,14 +157,21 @@ pub fn columns_of<'a>(
         };
         *found = Some((i, f));
     }
-    let (time, time_factor) =
-        time.ok_or_else(|| CliError::Input(format!("{file}: row 1: missing column 'time'")))?;
+    let (time, time_factor) = time.ok_or_else(|| {
+        CliError::Input(format!(
+            "{file}: row 1: missing column 'time'{}",
+            hydrocyl_identify::data::unread_header_hint(&headers, "time")
+        ))
+    })?;
     let (command, command_factor) = command.ok_or_else(|| {
         CliError::Input(match unit {
             CommandUnit::Reference => format!(
                 "{file}: row 1: missing column 'reference' (a closed-loop rig is driven by its position set-point)"
             ),
-            _ => format!("{file}: row 1: missing column 'command'"),
+            _ => format!(
+                "{file}: row 1: missing column 'command'{}",
+                hydrocyl_identify::data::unread_header_hint(&headers, "command")
+            ),
         })
     })?;
     Ok(Columns {

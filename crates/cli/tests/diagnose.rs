@@ -949,3 +949,74 @@ fn a_short_record_refused_by_the_rig_is_one_error_line() {
         &["short.csv", "has no controller"],
     );
 }
+
+/// A header that names a signal but is not read as it — the unit in
+/// parentheses, `p1 (bar)`, or the name in capitals, `Time [s]` — is named
+/// where the signal is missing, with the header that would be read. The
+/// record's pressures were dropped as "the record has no p1 column" (a
+/// data problem; the diagnosis went on without them) and a time column as
+/// "missing column 'time'", with nothing pointing at the header.
+#[test]
+fn a_signal_header_not_read_as_it_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = std::fs::read_to_string(fixtures().join("valve-internal_leakage.csv")).unwrap();
+    let (head, body) = src.split_once('\n').unwrap();
+    assert_eq!(head, "time [s],command,position [mm],p1 [bar],p2 [bar]");
+    let data = dir.path().join("paren.csv");
+    std::fs::write(
+        &data,
+        format!("time [s],command,position [mm],p1 (bar),p2 [bar]\n{body}"),
+    )
+    .unwrap();
+    let json = diagnose_json(&[
+        "--rig".as_ref(),
+        "leaney-moog".as_ref(),
+        "--data".as_ref(),
+        data.as_os_str(),
+    ]);
+    let p1 = json["data_problems"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["channel"] == "p1")
+        .unwrap()["message"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    assert!(
+        p1.contains("the header 'p1 (bar)' is not read as p1") && p1.contains("`p1 [bar]`"),
+        "{p1}"
+    );
+    std::fs::write(
+        &data,
+        format!("Time [s],command,position [mm],p1 [bar],p2 [bar]\n{body}"),
+    )
+    .unwrap();
+    let r = run_bad_rig("leaney-moog", &data);
+    assert_one_line_error(
+        r,
+        &[
+            "row 1: missing column 'time' (the header 'Time [s]' is not read as time",
+            "`time [s]`",
+        ],
+    );
+}
+
+/// Runs diagnose with `rig` on `data`; (exit code, stderr, whether a
+/// report file appeared).
+fn run_bad_rig(rig: &str, data: &Path) -> (Option<i32>, String, bool) {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("report.json");
+    let out = bin()
+        .args(["diagnose", "--rig", rig, "--data"])
+        .arg(data)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+        report.exists(),
+    )
+}

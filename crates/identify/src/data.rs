@@ -19,7 +19,7 @@ mod time_axis;
 
 pub use decimal::{scale_decimal, scaled_decimal};
 pub use error::DataError;
-pub use read::{foreign_separator, LineCounter};
+pub use read::{foreign_separator, unread_header_hint, LineCounter};
 pub use time_axis::{beyond_span, GAP_OVER_REST, MAX_GAP_FACTOR, MAX_SPAN_S};
 
 /// A signal of the measured-data format.
@@ -199,6 +199,7 @@ impl Record {
         self.get(signal).ok_or_else(|| DataError::MissingColumn {
             file: self.source.clone(),
             column: signal.name().to_string(),
+            hint: read::unread_header_hint(&self.ignored, signal.name()),
         })
     }
 

@@ -187,6 +187,11 @@ impl Record {
             None => {
                 return Err(DataError::MissingColumn {
                     file: file.to_string(),
+                    hint: if map.0.contains_key(&Signal::Time) {
+                        String::new()
+                    } else {
+                        unread_header_hint(&header_list, "time")
+                    },
                     column: map
                         .0
                         .get(&Signal::Time)
@@ -359,6 +364,35 @@ impl Record {
             lines: Vec::new(),
         })
     }
+}
+
+/// Where `signal` is missing from a file with headers `headers`: a
+/// header that names it but is not read as it — its unit in parentheses
+/// (`p1 (bar)`) or its name in capitals (`Time [s]`) — as the hint that
+/// ends the error or data problem, `(the header 'p1 (bar)' is not read as
+/// p1: ... `p1 [bar]`)`; empty where there is none.
+pub fn unread_header_hint<S: AsRef<str>>(headers: &[S], signal: &str) -> String {
+    headers
+        .iter()
+        .map(|h| h.as_ref().trim())
+        .find_map(|h| {
+            let cut = h.find(['[', '(']).unwrap_or(h.len());
+            let name = h[..cut].trim();
+            if !name.eq_ignore_ascii_case(signal) {
+                return None;
+            }
+            let unit = h[cut..]
+                .trim_matches(|c: char| matches!(c, '[' | ']' | '(' | ')') || c.is_whitespace());
+            let right = if unit.is_empty() {
+                signal.to_string()
+            } else {
+                format!("{signal} [{unit}]")
+            };
+            Some(format!(
+                " (the header '{h}' is not read as {signal}: a signal's name is lower case and its unit in brackets, `{right}`)"
+            ))
+        })
+        .unwrap_or_default()
 }
 
 /// The file line (1-based, blank lines counted) of byte offsets of a text,

@@ -140,7 +140,7 @@ pub fn columns_of<'a>(
                 Some("ms") => 1e-3,
                 Some(u) => {
                     return Err(CliError::Input(format!(
-                        "{file}: row 1, column '{h}': unknown time unit `{u}` (use s or ms)"
+                        "{file}: row 1, column '{h}': unknown unit '{u}' (accepted: s, ms)"
                     )))
                 }
             }
@@ -157,14 +157,21 @@ pub fn columns_of<'a>(
         };
         *found = Some((i, f));
     }
-    let (time, time_factor) =
-        time.ok_or_else(|| CliError::Input(format!("{file}: row 1: no `time` column")))?;
+    let (time, time_factor) = time.ok_or_else(|| {
+        CliError::Input(format!(
+            "{file}: row 1: missing column 'time'{}",
+            hydrocyl_identify::data::unread_header_hint(&headers, "time")
+        ))
+    })?;
     let (command, command_factor) = command.ok_or_else(|| {
         CliError::Input(match unit {
             CommandUnit::Reference => format!(
-                "{file}: row 1: no `reference` column (a closed-loop rig is driven by its position set-point)"
+                "{file}: row 1: missing column 'reference' (a closed-loop rig is driven by its position set-point)"
             ),
-            _ => format!("{file}: row 1: no `command` column"),
+            _ => format!(
+                "{file}: row 1: missing column 'command'{}",
+                hydrocyl_identify::data::unread_header_hint(&headers, "command")
+            ),
         })
     })?;
     Ok(Columns {
@@ -526,12 +533,12 @@ fn parse_samples(
     bytes: &[u8],
     unit: CommandUnit,
 ) -> Result<(Vec<f64>, Vec<f64>, String), CliError> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        CliError::Input(format!(
-            "{file}: not UTF-8 text (byte {})",
-            e.valid_up_to() + 1
-        ))
-    })?;
+    // bytes that are not UTF-8 (a logger's `°C` in Windows-1252 in a
+    // column the run does not read) are kept as U+FFFD: a column the run
+    // reads is then refused at its row and column, as the record reader
+    // (`diagnose`) does, and any other is ignored
+    let text = String::from_utf8_lossy(bytes);
+    let text: &str = &text;
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_reader(text.as_bytes());
@@ -555,6 +562,15 @@ fn parse_samples(
             Ok(r) => r.position(),
             Err(e) => e.position(),
         };
+        // a line of spaces or tabs is blank (skipped, as an empty one is),
+        // as the record reader (`diagnose`) has it
+        if let (Err(e), Some(p)) = (&rec, at) {
+            if matches!(e.kind(), csv::ErrorKind::UnequalLengths { len: 1, .. })
+                && lines.is_blank_at(p.byte() as usize)
+            {
+                continue;
+            }
+        }
         row = at.map_or(row + 1, |p| lines.line_at(p.byte() as usize));
         let rec = rec.map_err(|e| match e.kind() {
             csv::ErrorKind::UnequalLengths { len, .. } => {

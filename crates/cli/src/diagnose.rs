@@ -229,12 +229,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .zip(&stems)
         .map(|(r, s)| (r.source.as_str(), s.as_str()))
         .collect();
-    // before the run, as the report's `warnings` carry it after
-    for w in records.iter().filter_map(small_sample_warning) {
-        if !args.quiet {
-            crate::console::note(format_args!("hydrocyl: warning: {w}"));
+    // as the run starts (the report's `warnings` carry it after): at its
+    // first progress, after the record has been checked against the rig,
+    // so that a record refused there gets its one error line alone (a
+    // short record with no `command` column was a warning, then the error)
+    let warnings: Vec<String> = records.iter().filter_map(small_sample_warning).collect();
+    let warned = std::cell::Cell::new(args.quiet);
+    let warn = || {
+        if !warned.replace(true) {
+            for w in &warnings {
+                crate::console::note(format_args!("hydrocyl: warning: {w}"));
+            }
         }
-    }
+    };
     let opts = DiagnoseOptions {
         min_share: args.min_share,
         holdout: args.holdout,
@@ -244,6 +251,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     let mut bar = Progress::new("diagnose", 1, args.progress, args.quiet);
     let mut progress = |stage: &str, done: usize, total: usize| {
+        warn();
         bar.set(stage, done as u64, total as u64);
     };
     let (report, traces) = match &rig {
@@ -264,6 +272,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             (o.report, o.traces)
         }
     };
+    warn();
     bar.finish();
     if let Some(wanted) = &args.effects {
         // an effect asked for that the loop neither added nor tried

@@ -709,3 +709,314 @@ fn a_short_record_is_warned_of_in_the_report() {
         );
     }
 }
+
+/// A user's circuit whose netlist lists no `outputs` (every probe named
+/// `component.probe`, as `docs/netlist.md` allows) has no `position`, `p1`,
+/// `p2` for the record to be compared with: one line naming `outputs` and
+/// the outputs to add, exit 2, no report. It failed in the declared run
+/// ("rig: declared model does not simulate: … channel `position`: the
+/// circuit has no such output"), naming no JSON path and no remedy.
+#[test]
+fn a_netlist_without_the_compared_outputs_is_named_at_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = bin()
+        .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
+        .output()
+        .unwrap();
+    assert!(p.status.success());
+    let mut v: serde_json::Value = serde_json::from_slice(&p.stdout).unwrap();
+    v.as_object_mut().unwrap().remove("outputs");
+    let rig = dir.path().join("no-outputs.json");
+    std::fs::write(&rig, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    let report = dir.path().join("report.json");
+    let out = bin()
+        .args(["diagnose", "--rig"])
+        .arg(&rig)
+        .arg("--data")
+        .arg(fixtures().join("valve-none.csv"))
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_one_line_error(
+        (out.status.code(), err, report.exists()),
+        &[
+            "`outputs`",
+            "\"position\": \"load.position\"",
+            "\"velocity\": \"load.velocity\"",
+            "\"p1\": \"cylinder.p1\"",
+            "\"p2\": \"cylinder.p2\"",
+        ],
+    );
+}
+
+/// A record of the example pump-controlled closed circuit (no four-way
+/// valve, no supply: `fixtures/rigs/examples/pump-closed-circuit.json`)
+/// with Ce1 = 2e-12 m³/(s·Pa) planted, written by `simulate` with a
+/// deterministic noise of ±20 µm and ±20 kPa; `keep_pressures` false drops
+/// the p1/p2 columns. Returns the record's path.
+fn pump_record(dir: &Path, keep_pressures: bool) -> PathBuf {
+    let rig = fixtures().join("../rigs/examples/pump-closed-circuit.json");
+    let cmd = dir.join("cmd.csv");
+    let u = |t: f64| {
+        1.5 * (2.0 * std::f64::consts::PI * 0.8 * t).sin()
+            + 0.5 * (2.0 * std::f64::consts::PI * 2.1 * t).sin()
+    };
+    let mut s = String::from("time,command\n");
+    for k in 0..=2000 {
+        let t = k as f64 * 1e-3;
+        s.push_str(&format!("{t},{}\n", u(t)));
+    }
+    std::fs::write(&cmd, s).unwrap();
+    let sim = dir.join("sim.csv");
+    let o = bin()
+        .args(["simulate", "--rig"])
+        .arg(&rig)
+        .arg("--command")
+        .arg(&cmd)
+        .arg("--out")
+        .arg(&sim)
+        .args(["--rtol", "1e-8", "--quiet"])
+        .args(["--set", "cylinder.external_leakage_1=2e-12"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&sim).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| head.iter().position(|h| h.starts_with(n)).unwrap();
+    let (x, p1, p2) = (col("position "), col("p1 "), col("p2 "));
+    // a fixed pseudo-random noise, uniform in ±1 (sd 0.577)
+    let mut seed = 12345u64;
+    let mut noise = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    };
+    let mut rec = String::from(if keep_pressures {
+        "time [s],command,position [mm],p1 [bar],p2 [bar]\n"
+    } else {
+        "time [s],command,position [mm]\n"
+    });
+    for l in lines {
+        let c: Vec<f64> = l.split(',').map(|v| v.parse().unwrap()).collect();
+        let row = format!(
+            "{},{},{:.4}",
+            c[0],
+            u(c[0]),
+            (c[x] + 3.5e-5 * noise()) * 1e3
+        );
+        rec.push_str(&row);
+        if keep_pressures {
+            let (a, b) = (c[p1] + 3.5e4 * noise(), c[p2] + 3.5e4 * noise());
+            rec.push_str(&format!(",{:.4},{:.4}", a / 1e5, b / 1e5));
+        }
+        rec.push('\n');
+    }
+    let path = dir.join(if keep_pressures {
+        "pump.csv"
+    } else {
+        "pump-np.csv"
+    });
+    std::fs::write(&path, rec).unwrap();
+    path
+}
+
+/// `diagnose` on a pump-controlled closed circuit (a user's circuit with no
+/// four-way valve and no supply). Its pressures were left out as a unit
+/// error ("p1 reaches 6.9e5 Pa, above the supply 0 Pa") — a circuit that
+/// holds no pressure above tank has no supply to be above — and with no
+/// measured pressure to start from, the declared model did not simulate:
+/// the initial p1/p2 its file declares were cleared for a steady state at
+/// rest the circuit does not have ("declared model does not simulate: …
+/// no four-way valve feeds this cylinder's chambers"). Now the pressures are
+/// compared and the planted leak is found; without pressure columns the
+/// run starts from the file's pressures.
+#[test]
+fn a_pump_circuit_without_a_supply_is_diagnosed() {
+    let dir = tempfile::tempdir().unwrap();
+    let rig = fixtures().join("../rigs/examples/pump-closed-circuit.json");
+    for keep in [true, false] {
+        let data = pump_record(dir.path(), keep);
+        let json = diagnose_json(&[
+            "--rig".as_ref(),
+            rig.as_os_str(),
+            "--data".as_ref(),
+            data.as_os_str(),
+        ]);
+        let problems = json["data_problems"].as_array().unwrap();
+        assert!(
+            problems.iter().all(|p| p["kind"] != "units"),
+            "{problems:?}"
+        );
+        if keep {
+            assert_eq!(json["effects_added"][0]["id"], "external_leakage", "{json}");
+        }
+    }
+}
+
+/// A record whose command is logged in per cent (`command [%]`, as
+/// `simulate` takes a command file) diagnoses as the same record in `-`:
+/// the record reader refused it ("unknown unit '%' (accepted: -, V)").
+#[test]
+fn a_command_in_per_cent_is_read_as_simulate_reads_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = std::fs::read_to_string(fixtures().join("valve-internal_leakage.csv")).unwrap();
+    let mut lines = src.lines();
+    let head = lines.next().unwrap();
+    assert!(head.starts_with("time [s],command,"), "{head}");
+    let mut pc = head.replacen(",command,", ",command [%],", 1) + "\n";
+    for l in lines {
+        let mut c: Vec<String> = l.split(',').map(str::to_string).collect();
+        // the same digits, the decimal point two places on
+        let v: f64 = c[1].parse().unwrap();
+        c[1] = format!("{:.4}", v * 100.0);
+        assert_eq!(
+            format!("{:.6}", c[1].parse::<f64>().unwrap() / 100.0),
+            l.split(',').nth(1).unwrap()
+        );
+        pc.push_str(&c.join(","));
+        pc.push('\n');
+    }
+    let data = dir.path().join("pc.csv");
+    std::fs::write(&data, pc).unwrap();
+    let a = diagnose_json(&[
+        "--rig".as_ref(),
+        "leaney-moog".as_ref(),
+        "--data".as_ref(),
+        fixtures().join("valve-internal_leakage.csv").as_os_str(),
+    ]);
+    let b = diagnose_json(&[
+        "--rig".as_ref(),
+        "leaney-moog".as_ref(),
+        "--data".as_ref(),
+        data.as_os_str(),
+    ]);
+    // the same record but for the last bit of a command (0.01 × in
+    // binary): the same effect, within the integration's noise
+    let ids = |j: &serde_json::Value| -> Vec<String> {
+        j["effects_added"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e["id"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(ids(&a), ["internal_leakage"]);
+    assert_eq!(ids(&a), ids(&b));
+    let cl = |j: &serde_json::Value| j["effects_added"][0]["params"]["Cl"].as_f64().unwrap();
+    assert!(
+        (cl(&a) / cl(&b) - 1.0).abs() < 1e-4,
+        "{} {}",
+        cl(&a),
+        cl(&b)
+    );
+    for ch in ["position", "p1", "p2"] {
+        let (x, y) = (
+            a["nrmse_after"][ch].as_f64().unwrap(),
+            b["nrmse_after"][ch].as_f64().unwrap(),
+        );
+        assert!((x / y - 1.0).abs() < 1e-3, "{ch}: {x} {y}");
+    }
+}
+
+/// A short record (fewer than 100 samples: warned of) that the rig refuses
+/// (a closed-loop record's `reference` on an open-loop rig) gets its one
+/// error line alone: the warning was printed first, before the record was
+/// checked against the rig, making the error two lines.
+#[test]
+fn a_short_record_refused_by_the_rig_is_one_error_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = String::from("time [s],reference [mm],command,position [mm],p1 [bar],p2 [bar]\n");
+    for k in 0..30 {
+        s.push_str(&format!("{},1.0,0.01,0.0,21.0,42.0\n", k as f64 * 1e-3));
+    }
+    let data = dir.path().join("short.csv");
+    std::fs::write(&data, s).unwrap();
+    let report = dir.path().join("r.json");
+    let out = bin()
+        .args(["diagnose", "--rig", "leaney-moog", "--data"])
+        .arg(&data)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_one_line_error(
+        (out.status.code(), err, report.exists()),
+        &["short.csv", "has no controller"],
+    );
+}
+
+/// A header that names a signal but is not read as it — the unit in
+/// parentheses, `p1 (bar)`, or the name in capitals, `Time [s]` — is named
+/// where the signal is missing, with the header that would be read. The
+/// record's pressures were dropped as "the record has no p1 column" (a
+/// data problem; the diagnosis went on without them) and a time column as
+/// "missing column 'time'", with nothing pointing at the header.
+#[test]
+fn a_signal_header_not_read_as_it_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = std::fs::read_to_string(fixtures().join("valve-internal_leakage.csv")).unwrap();
+    let (head, body) = src.split_once('\n').unwrap();
+    assert_eq!(head, "time [s],command,position [mm],p1 [bar],p2 [bar]");
+    let data = dir.path().join("paren.csv");
+    std::fs::write(
+        &data,
+        format!("time [s],command,position [mm],p1 (bar),p2 [bar]\n{body}"),
+    )
+    .unwrap();
+    let json = diagnose_json(&[
+        "--rig".as_ref(),
+        "leaney-moog".as_ref(),
+        "--data".as_ref(),
+        data.as_os_str(),
+    ]);
+    let p1 = json["data_problems"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["channel"] == "p1")
+        .unwrap()["message"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    assert!(
+        p1.contains("the header 'p1 (bar)' is not read as p1") && p1.contains("`p1 [bar]`"),
+        "{p1}"
+    );
+    std::fs::write(
+        &data,
+        format!("Time [s],command,position [mm],p1 [bar],p2 [bar]\n{body}"),
+    )
+    .unwrap();
+    let r = run_bad_rig("leaney-moog", &data);
+    assert_one_line_error(
+        r,
+        &[
+            "row 1: missing column 'time' (the header 'Time [s]' is not read as time",
+            "`time [s]`",
+        ],
+    );
+}
+
+/// Runs diagnose with `rig` on `data`; (exit code, stderr, whether a
+/// report file appeared).
+fn run_bad_rig(rig: &str, data: &Path) -> (Option<i32>, String, bool) {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("report.json");
+    let out = bin()
+        .args(["diagnose", "--rig", rig, "--data"])
+        .arg(data)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+        report.exists(),
+    )
+}

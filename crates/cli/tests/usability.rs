@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::hydrocyl;
+use common::{hydrocyl, simulate_ok};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -251,6 +251,54 @@ fn a_bad_value_from_set_names_the_set_not_a_line_of_the_rig_file() {
     assert!(e.contains("(line ") && !e.contains("--set"), "{e}");
 }
 
+/// An initial state a `--set` gave and a component refuses when it is built
+/// (a spool position beyond its stroke, a mass's own position beyond its
+/// end stops) is named at its path and blamed on the `--set`, as a
+/// parameter's range error is: they were named at `components.<name>` with
+/// the line of the file, which held the value the `--set` replaced.
+#[test]
+fn a_bad_initial_state_from_set_names_its_path_and_the_set() {
+    let d = scratch("set-blame-initial");
+    let cmd = command_file(&d, 11, 1e-3);
+    let rig = d.join("lm.json");
+    let p = hydrocyl()
+        .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
+        .output()
+        .unwrap();
+    assert!(p.status.success());
+    std::fs::write(&rig, &p.stdout).unwrap();
+    let out = d.join("o.csv");
+    for (sets, path) in [
+        (
+            &["spool.initial.position=0.001"][..],
+            "components.spool.initial.position",
+        ),
+        (
+            &[
+                "load.initial.position=0.3",
+                "cylinder.initial.position=null",
+            ],
+            "components.load.initial.position",
+        ),
+    ] {
+        let mut args = vec![
+            "--rig",
+            rig.to_str().unwrap(),
+            "--command",
+            cmd.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        let e = simulate_fails(&args, &out);
+        assert!(e.contains(&format!("rig `{path}`")), "{e}");
+        assert!(e.contains(&format!("(set by --set {} on ", sets[0])), "{e}");
+        assert!(!e.contains("(line "), "{e}");
+    }
+}
+
 #[test]
 fn a_friction_bench_writes_its_command_column_like_every_rig() {
     let d = scratch("bench-command");
@@ -359,4 +407,141 @@ fn print_rig_refuses_the_output_options_it_would_not_write() {
         .output()
         .unwrap();
     assert!(o.status.success() && String::from_utf8_lossy(&o.stdout).contains("50"));
+}
+
+/// A command file with a column the run does not read written in
+/// Windows-1252 by a logger (`Öl [°C]`) runs as the same file without it;
+/// a `command` cell with such a byte is refused at its row and column. The
+/// file was refused whole, at a byte offset ("not UTF-8 text (byte 27)").
+#[test]
+fn bytes_that_are_not_utf8_are_named_only_where_the_run_reads_them() {
+    let d = scratch("latin1");
+    let mut plain = String::from("time [s],command\n");
+    let mut s = b"time [s],command,\xd6l [\xb0C]\r\n".to_vec();
+    for k in 0..21 {
+        let t = k as f64 * 1e-3;
+        plain.push_str(&format!("{t},0.2\n"));
+        s.extend(format!("{t},0.2,41.5\r\n").bytes());
+    }
+    let (a, b) = (d.join("plain.csv"), d.join("latin1.csv"));
+    std::fs::write(&a, plain).unwrap();
+    std::fs::write(&b, &s).unwrap();
+    let (oa, ob) = (d.join("a.csv"), d.join("b.csv"));
+    simulate_ok("leaney-moog", &a, &oa, &[]);
+    simulate_ok("leaney-moog", &b, &ob, &[]);
+    assert_eq!(std::fs::read(&oa).unwrap(), std::fs::read(&ob).unwrap());
+    let at = s.windows(5).position(|w| w == b"0.2,4").unwrap();
+    s[at + 1] = 0xb7;
+    std::fs::write(&b, &s).unwrap();
+    let out = d.join("c.csv");
+    let e = simulate_fails(
+        &[
+            "--rig",
+            "leaney-moog",
+            "--command",
+            b.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &out,
+    );
+    assert!(e.contains("row 2, column 'command'"), "{e}");
+}
+
+/// A line of spaces or tabs in a command file (a logger's padded blank
+/// line, between rows or at the end) is blank: the run is the one without
+/// it. It was refused as a row of one cell ("1 cell, the header has 2").
+#[test]
+fn a_line_of_spaces_in_a_command_file_is_blank() {
+    let d = scratch("blank-spaces");
+    let (mut plain, mut padded) = (
+        String::from("time,command\n"),
+        String::from("time,command\r\n"),
+    );
+    for k in 0..21 {
+        let row = format!("{},0.2", k as f64 * 1e-3);
+        plain.push_str(&format!("{row}\n"));
+        padded.push_str(&format!("{row}\r\n"));
+        if k == 7 {
+            padded.push_str(" \t \r\n");
+        }
+    }
+    padded.push_str("  \r\n\t\r\n");
+    let (a, b) = (d.join("plain.csv"), d.join("padded.csv"));
+    std::fs::write(&a, plain).unwrap();
+    std::fs::write(&b, padded).unwrap();
+    let (oa, ob) = (d.join("a.csv"), d.join("b.csv"));
+    simulate_ok("leaney-moog", &a, &oa, &[]);
+    simulate_ok("leaney-moog", &b, &ob, &[]);
+    assert_eq!(std::fs::read(&oa).unwrap(), std::fs::read(&ob).unwrap());
+}
+
+/// The command reader (`simulate`) and the record reader (`diagnose`) say
+/// the same fault the same way (README): a missing `time` or `command`
+/// column and an unknown time unit. `simulate` said "no `time` column" and
+/// "unknown time unit `min` (use s or ms)" where `diagnose` said "missing
+/// column 'time'" and "unknown unit 'min' (accepted: s, ms)".
+#[test]
+fn both_readers_word_a_missing_column_and_a_time_unit_alike() {
+    let d = scratch("same-words");
+    let rows: String = (0..150)
+        .map(|k| format!("{},0.1,0.0,21.0,42.0\n", k as f64 * 1e-3))
+        .collect();
+    for header in [
+        "Time [s],command,position [mm],p1 [bar],p2 [bar]",
+        "time [s],cmd,position [mm],p1 [bar],p2 [bar]",
+        "time [min],command,position [mm],p1 [bar],p2 [bar]",
+    ] {
+        let f = d.join("rec.csv");
+        std::fs::write(&f, format!("{header}\n{rows}")).unwrap();
+        let f = f.to_str().unwrap();
+        let out = d.join("o.csv");
+        let s = simulate_fails(
+            &[
+                "--rig",
+                "leaney-moog",
+                "--command",
+                f,
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &out,
+        );
+        let report = d.join("r.json");
+        let o = hydrocyl()
+            .args(["diagnose", "--rig", "leaney-moog", "--data", f, "--report"])
+            .arg(&report)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2));
+        assert!(!report.exists());
+        assert_eq!(s, stderr(&o), "{header}");
+    }
+}
+
+/// A `--set` path copied from an error about a rig file, which names the
+/// JSON path (`components.load.mass`), is refused with the path `--set`
+/// takes: it said only "no component `components`".
+#[test]
+fn a_set_with_the_json_path_names_the_parameter_path() {
+    let d = scratch("set-json-path");
+    let cmd = command_file(&d, 11, 1e-3);
+    let out = d.join("o.csv");
+    let e = simulate_fails(
+        &[
+            "--rig",
+            "leaney-moog",
+            "--command",
+            cmd.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            "components.load.mass=50",
+        ],
+        &out,
+    );
+    assert!(
+        e.contains("without the JSON path's `components.`: `load.mass`"),
+        "{e}"
+    );
 }

@@ -19,7 +19,7 @@ mod time_axis;
 
 pub use decimal::{scale_decimal, scaled_decimal};
 pub use error::DataError;
-pub use read::{foreign_separator, LineCounter};
+pub use read::{foreign_separator, unread_header_hint, LineCounter};
 pub use time_axis::{beyond_span, GAP_OVER_REST, MAX_GAP_FACTOR, MAX_SPAN_S};
 
 /// A signal of the measured-data format.
@@ -91,6 +91,10 @@ impl Signal {
             (Signal::Time, "s") => 1.0,
             (Signal::Time, "ms") => 1e-3,
             (Signal::Command, "-" | "V" | "1") => 1.0,
+            // as `simulate` reads a command file: a spool demand in per
+            // cent, a drive voltage in millivolts
+            (Signal::Command, "%") => 1e-2,
+            (Signal::Command, "mV") => 1e-3,
             (Signal::Position | Signal::Reference, "m") => 1.0,
             (Signal::Position | Signal::Reference, "mm") => 1e-3,
             (Signal::Velocity, "m/s") => 1.0,
@@ -117,7 +121,7 @@ impl Signal {
     pub fn accepted_units(self) -> &'static str {
         match self {
             Signal::Time => "s, ms",
-            Signal::Command => "-, V",
+            Signal::Command => "-, %, V, mV",
             Signal::Position | Signal::Reference => "m, mm",
             Signal::Velocity => "m/s, mm/s, cm/s",
             Signal::P1 | Signal::P2 | Signal::Ps => "Pa, bar, kPa, MPa, psi",
@@ -195,6 +199,7 @@ impl Record {
         self.get(signal).ok_or_else(|| DataError::MissingColumn {
             file: self.source.clone(),
             column: signal.name().to_string(),
+            hint: read::unread_header_hint(&self.ignored, signal.name()),
         })
     }
 

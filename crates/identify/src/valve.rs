@@ -195,6 +195,40 @@ pub fn diagnose_rig_traced(
         }
         _ => {}
     }
+    // The record's channels are compared with the circuit's outputs of
+    // their names: a netlist without them (no `outputs`, so that every
+    // probe is named `component.probe`) is named here, with the outputs to
+    // add (it failed in the declared run, "channel `position`: the circuit
+    // has no such output", naming no JSON path)
+    let mut wanted = vec!["position", "velocity"];
+    wanted.extend(
+        [
+            (Signal::P1, "p1"),
+            (Signal::P2, "p2"),
+            (Signal::Reference, "command"),
+        ]
+        .into_iter()
+        .filter(|(s, _)| rec.get(*s).is_some())
+        .map(|(_, n)| n),
+    );
+    let missing = declared.missing_outputs(&wanted);
+    if !missing.is_empty() {
+        return Err(DiagnoseError::Rig(format!(
+            "`outputs`: the record's {} compared with the circuit's outputs of those names, which rig `{}` lacks: name them, `\"outputs\": {{{}}}` (docs/netlist.md, the identification section)",
+            missing
+                .iter()
+                .map(|(n, _)| format!("`{n}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+                + if missing.len() == 1 { " is" } else { " are" },
+            declared.roles.name,
+            missing
+                .iter()
+                .map(|(n, p)| format!("\"{n}\": \"{p}\""))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
     // Data problems first: each channel named and left out is not fitted.
     let facts = rig_facts(declared);
     let mut data_problems = check_record(rec, Some(&facts));

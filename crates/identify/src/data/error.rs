@@ -47,12 +47,15 @@ pub enum DataError {
         what: String,
     },
     /// A required column is missing.
-    #[error("{file}: row 1: missing column '{column}'")]
+    #[error("{file}: row 1: missing column '{column}'{hint}")]
     MissingColumn {
         /// The file.
         file: String,
         /// The missing column's name.
         column: String,
+        /// A header that names it but is not read as it, as a remark
+        /// ([`super::unread_header_hint`]); empty where there is none.
+        hint: String,
     },
     /// A column the rig's column map names is not in the file.
     #[error("{file}: row 1: missing column '{column}' (the rig's column map, `identify.columns.{signal}`; the file's headers: {headers})")]

@@ -136,10 +136,16 @@ impl Record {
     /// Reads a CSV file whose columns are found through `map`.
     pub fn read_mapped(path: &Path, map: &ColumnMap) -> Result<Record, DataError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| DataError::Io {
+        let bytes = std::fs::read(path).map_err(|e| DataError::Io {
             file: file.clone(),
             reason: e.to_string(),
         })?;
+        // bytes that are not UTF-8 (a logger's `°C` in Windows-1252 in a
+        // column that is not a signal) are kept as U+FFFD: such a column is
+        // kept and ignored, and a signal's cell or header with one is
+        // refused at its row and column (it used to refuse the whole file
+        // with no row: "stream did not contain valid UTF-8")
+        let text = String::from_utf8_lossy(&bytes);
         Self::parse(&file, &text, map)
     }
 
@@ -181,6 +187,11 @@ impl Record {
             None => {
                 return Err(DataError::MissingColumn {
                     file: file.to_string(),
+                    hint: if map.0.contains_key(&Signal::Time) {
+                        String::new()
+                    } else {
+                        unread_header_hint(&header_list, "time")
+                    },
                     column: map
                         .0
                         .get(&Signal::Time)
@@ -200,6 +211,16 @@ impl Record {
         let mut lines = Vec::new();
         let mut counter = LineCounter::new(text);
         for (k, rec) in rdr.records().enumerate() {
+            // a line of spaces or tabs is blank (skipped, as an empty one)
+            if let Err(e) = &rec {
+                if let (csv::ErrorKind::UnequalLengths { len: 1, .. }, Some(p)) =
+                    (e.kind(), e.position())
+                {
+                    if counter.is_blank_at(p.byte() as usize) {
+                        continue;
+                    }
+                }
+            }
             let rec = rec.map_err(|e| {
                 let row = e
                     .position()
@@ -345,6 +366,35 @@ impl Record {
     }
 }
 
+/// Where `signal` is missing from a file with headers `headers`: a
+/// header that names it but is not read as it — its unit in parentheses
+/// (`p1 (bar)`) or its name in capitals (`Time [s]`) — as the hint that
+/// ends the error or data problem, `(the header 'p1 (bar)' is not read as
+/// p1: ... `p1 [bar]`)`; empty where there is none.
+pub fn unread_header_hint<S: AsRef<str>>(headers: &[S], signal: &str) -> String {
+    headers
+        .iter()
+        .map(|h| h.as_ref().trim())
+        .find_map(|h| {
+            let cut = h.find(['[', '(']).unwrap_or(h.len());
+            let name = h[..cut].trim();
+            if !name.eq_ignore_ascii_case(signal) {
+                return None;
+            }
+            let unit = h[cut..]
+                .trim_matches(|c: char| matches!(c, '[' | ']' | '(' | ')') || c.is_whitespace());
+            let right = if unit.is_empty() {
+                signal.to_string()
+            } else {
+                format!("{signal} [{unit}]")
+            };
+            Some(format!(
+                " (the header '{h}' is not read as {signal}: a signal's name is lower case and its unit in brackets, `{right}`)"
+            ))
+        })
+        .unwrap_or_default()
+}
+
 /// The file line (1-based, blank lines counted) of byte offsets of a text,
 /// asked in increasing order: the CSV reader's own line count skips the
 /// blank lines it skips. Shared by every CSV reader of hydrocyl.
@@ -362,6 +412,20 @@ impl<'a> LineCounter<'a> {
             byte: 0,
             line: 1,
         }
+    }
+
+    /// Whether the record the CSV reader starts at byte offset `byte` is a
+    /// line of nothing but spaces and tabs (a logger's padded blank line):
+    /// blank, skipped as an empty line is, not a row of one empty cell.
+    pub fn is_blank_at(&self, byte: usize) -> bool {
+        let mut at = byte.min(self.text.len());
+        while at < self.text.len() && matches!(self.text[at], b'\n' | b'\r') {
+            at += 1;
+        }
+        self.text[at..]
+            .iter()
+            .take_while(|&&b| b != b'\n')
+            .all(|&b| matches!(b, b' ' | b'\t' | b'\r'))
     }
 
     /// The line of the record starting at byte offset `byte` (not before
@@ -540,5 +604,54 @@ mod tests {
                 && e.contains("identify.columns.position"),
             "{e}"
         );
+    }
+
+    /// A column that is not a signal, written in Windows-1252 by a logger
+    /// (`Öl [°C]`), is kept and ignored, as the format promises of columns
+    /// that are not signals; a signal's cell with such a byte is refused at
+    /// its row and column. The file was refused whole, with no row ("cannot
+    /// read: stream did not contain valid UTF-8").
+    #[test]
+    fn bytes_that_are_not_utf8_are_named_only_where_a_signal_has_them() {
+        let dir = std::env::temp_dir().join(format!("hydrocyl-latin1-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut s = b"time [s],command,\xd6l [\xb0C]\r\n".to_vec();
+        for i in 0..10 {
+            s.extend(format!("{},0.1,41.5\r\n", i as f64 * 1e-3).bytes());
+        }
+        let ok = dir.join("ok.csv");
+        std::fs::write(&ok, &s).unwrap();
+        let r = Record::read(&ok).unwrap();
+        assert_eq!(r.time.len(), 10);
+        assert_eq!(r.ignored.len(), 1, "{:?}", r.ignored);
+        let at = s.windows(5).position(|w| w == b"0.1,4").unwrap();
+        s[at + 2] = 0xb0;
+        let bad = dir.join("bad.csv");
+        std::fs::write(&bad, &s).unwrap();
+        let e = Record::read(&bad).unwrap_err().to_string();
+        std::fs::remove_dir_all(&dir).ok();
+        assert!(e.contains("row 2, column 'command'"), "{e}");
+    }
+
+    /// A line of spaces or tabs (a logger's padded blank line, at the end
+    /// or between rows) is blank: skipped as an empty line is, and counted
+    /// in the rows of later errors. It was refused as a row of one cell
+    /// ("row 5, column 'command': 1 cell, the header has 2").
+    #[test]
+    fn a_line_of_spaces_is_blank() {
+        let map = ColumnMap::default();
+        let mut s = String::from("time [s],command\n");
+        for i in 0..10 {
+            s.push_str(&format!("{},0.1\n", i));
+            if i == 3 {
+                s.push_str("  \t \r\n");
+            }
+        }
+        s.push_str(" \n\t\r\n");
+        let r = Record::parse("x.csv", &s, &map).unwrap();
+        assert_eq!(r.time.len(), 10);
+        let bad = s.replacen("5,0.1", "5,x", 1);
+        let e = Record::parse("x.csv", &bad, &map).unwrap_err().to_string();
+        assert!(e.contains("row 8, column 'command'"), "{e}");
     }
 }

@@ -84,7 +84,7 @@ pub fn missing_channels(rec: &Record, compared: &[Signal]) -> Vec<DataProblem> {
             problem(
                 s,
                 ProblemKind::Missing,
-                format!("the record has no {name} column: {name} is not compared (the model's {name} is simulated, but nothing checks it and no effect is judged on it)"),
+                format!("the record has no {name} column{}: {name} is not compared (the model's {name} is simulated, but nothing checks it and no effect is judged on it)", crate::data::unread_header_hint(&rec.ignored, name)),
             )
         })
         .collect();

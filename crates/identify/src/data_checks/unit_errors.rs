@@ -18,12 +18,12 @@ pub fn unit_errors(rec: &Record, f: &RigFacts, problems: &[DataProblem]) -> Resu
         None => s.name().to_string(),
     };
     if let (Some(want), Some(got)) = (f.command_unit, rec.units.get(&Signal::Command)) {
-        let norm = |u: &str| {
-            if u == "1" {
-                "-".to_string()
-            } else {
-                u.to_string()
-            }
+        // the unit's kind (per cent is a normalised demand, millivolts a
+        // voltage: the reader has scaled them)
+        let norm = |u: &str| match u {
+            "1" | "%" => "-".to_string(),
+            "mV" => "V".to_string(),
+            _ => u.to_string(),
         };
         if norm(got) != norm(want) {
             let what = |u: &str| match u {

@@ -340,6 +340,34 @@ impl Model {
         write(&mut self.net, comp, param, x);
     }
 
+    /// The channels of `names` (the record's compared channels: `position`,
+    /// `velocity`, `p1`, `p2`, `command`) the circuit has no output for,
+    /// with the probe that would give each (`position` → `<mass>.position`):
+    /// a netlist whose `outputs` leave them out (or that lists none, so
+    /// that every probe is named `component.probe`) cannot be compared.
+    pub fn missing_outputs(&self, names: &[&str]) -> Vec<(String, String)> {
+        let Ok(c) = rig::circuit(
+            &self.net,
+            hydrocyl_system::signal::Signal::Constant { value: 0.0 },
+        ) else {
+            return Vec::new();
+        };
+        let have: Vec<String> = c.probes().into_iter().map(|p| p.name).collect();
+        let r = &self.roles;
+        names
+            .iter()
+            .filter(|n| !have.iter().any(|h| h == *n))
+            .map(|&n| {
+                let owner = match n {
+                    "position" | "velocity" => r.load.as_str(),
+                    "command" => r.controller.as_deref().unwrap_or("command"),
+                    _ => r.cylinder.as_str(),
+                };
+                (n.to_string(), format!("{owner}.{n}"))
+            })
+            .collect()
+    }
+
     /// The cylinder's stroke \[m\].
     pub fn stroke(&self) -> f64 {
         self.param(&self.roles.cylinder, "stroke")

@@ -285,8 +285,28 @@ pub(super) fn with_initial(rig: &Model, p: &Prepared) -> Model {
     }
     if r.roles.cylinder_type == "cylinder" {
         let c = r.roles.cylinder.clone();
-        r.set_param(&c, "initial.p1", p.p10.map_or(Value::Null, Value::from));
-        r.set_param(&c, "initial.p2", p.p20.map_or(Value::Null, Value::from));
+        let declared = [r.param(&c, "initial.p1"), r.param(&c, "initial.p2")];
+        let measured = [p.p10, p.p20];
+        for (k, m) in ["initial.p1", "initial.p2"].into_iter().zip(measured) {
+            r.set_param(&c, k, m.map_or(Value::Null, Value::from));
+        }
+        // Where the record gives no pressure (none measured, or left out as
+        // a data problem), the rig's steady state at rest starts it; a rig
+        // that has none (no four-way valve feeds the chambers: a pump's
+        // closed circuit) starts from the pressures its file declares. They
+        // were cleared, and the declared model did not simulate ("not
+        // given, and no four-way valve feeds this cylinder's chambers").
+        if measured.iter().any(Option::is_none) && rig::check(&r.net).is_err() {
+            for ((k, m), d) in ["initial.p1", "initial.p2"]
+                .into_iter()
+                .zip(measured)
+                .zip(declared)
+            {
+                if let (None, Some(d)) = (m, d) {
+                    r.set_param(&c, k, Value::from(d));
+                }
+            }
+        }
     }
     r
 }

@@ -351,8 +351,15 @@ pub fn set(v: &mut Value, path: &str, value: Value) -> Result<(), RigError> {
                     format!("; this bench has no cylinder: its drive `{d}` carries the moving mass and the rod's position, `{d}.mass`, `{d}.initial.position`")
                 }
             });
+            // the JSON path an error names (`components.load.mass`) copied:
+            // the parameter's path is the part after `components.`
+            let json_path = if comp == "components" {
+                format!("; the parameter is named without the JSON path's `components.`: `{rest}`")
+            } else {
+                String::new()
+            };
             unknown(format!(
-                " (no component `{comp}`; components: {}{bench})",
+                " (no component `{comp}`; components: {}{bench}{json_path})",
                 names.join(", ")
             ))
         })?;

@@ -24,12 +24,19 @@ fn controller(i: &Instance) -> Result<Box<dyn Component>, String> {
         ));
     }
     let integral = i.initial("integral").unwrap_or(0.0);
+    // named at its own path, so that a `--set` that gave it is blamed
+    // rather than the file's line
+    let at = format!("components.{}.initial.integral", i.name);
     if !integral.is_finite() {
-        return Err(format!("initial.integral = {integral} must be finite"));
+        return Err(crate::netlist::registry::error_at(
+            &at,
+            &format!("initial.integral = {integral} must be finite"),
+        ));
     }
     if integral != 0.0 && (law.integral_time <= 0.0 || law.integral_time.is_nan()) {
-        return Err(format!(
-            "initial.integral = {integral} needs a PI controller (integral_time > 0)"
+        return Err(crate::netlist::registry::error_at(
+            &at,
+            &format!("initial.integral = {integral} needs a PI controller (integral_time > 0)"),
         ));
     }
     built(

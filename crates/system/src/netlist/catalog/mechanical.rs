@@ -319,7 +319,13 @@ pub const TYPES: &[ComponentType] = &[
                     // named where it was given: on the cylinder at the rod
                     return Err(match (i.initial("position"), i.hint_path("rod", "initial.position")) {
                         (None, Some(path)) => crate::netlist::registry::error_at(&path, &why),
-                        _ => why,
+                        // given here: named at its own path (a `--set`
+                        // that gave it is then blamed, not the file's line)
+                        (Some(_), _) => crate::netlist::registry::error_at(
+                            &format!("components.{}.initial.position", i.name),
+                            &why,
+                        ),
+                        (None, None) => why,
                     });
                 }
             }

@@ -125,8 +125,14 @@ fn spool(i: &Instance, dynamics: SpoolDynamics) -> Result<Box<dyn Component>, St
     s.validate().map_err(|e| e.to_string())?;
     let x0 = i.initial("position").unwrap_or(0.0);
     if x0.abs() > i.get("stroke") {
-        return Err(format!(
-            "initial.position = {x0} m is outside the spool stroke"
+        // named at its own path, so that a `--set` that gave it is blamed
+        // rather than the file's line
+        return Err(super::super::registry::error_at(
+            &format!("components.{}.initial.position", i.name),
+            &format!(
+                "{x0} m is outside the spool stroke [-{s}, {s}] m",
+                s = i.get("stroke")
+            ),
         ));
     }
     built(ServoSpool::new(

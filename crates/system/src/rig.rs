@@ -631,6 +631,24 @@ pub fn each_path_once(sets: &[String]) -> Result<(), RigError> {
     Ok(())
 }
 
+/// An override's value: its JSON, else a number as a shell user writes it
+/// and JSON does not (`+50`, `.5`, `5.`), else the text as a string.
+fn set_value(text: &str) -> Value {
+    if let Ok(v) = serde_json::from_str(text) {
+        return v;
+    }
+    if let Ok(x) = text.parse::<f64>() {
+        // `+50` keeps its integer form; `.5` and `5.` become 0.5 and 5.0
+        if let Ok(v @ Value::Number(_)) = serde_json::from_str(text.trim_start_matches('+')) {
+            return v;
+        }
+        if let Some(n) = serde_json::Number::from_f64(x) {
+            return Value::Number(n);
+        }
+    }
+    Value::String(text.to_string())
+}
+
 /// Applies one `path=value` override (`cylinder.area_1_m2=1.2e-3`,
 /// `initial.p1=3e6`, `valve.dynamics.order="second"`; on a netlist
 /// `<component>.<parameter>`, see [`crate::netlist::set`]). The path must exist in
@@ -652,8 +670,7 @@ pub fn apply_set(rig: &mut Value, assignment: &str) -> Result<(), RigError> {
             why: format!("`{}` is not a finite number", text.trim()),
         });
     }
-    let new: Value = serde_json::from_str(text.trim())
-        .unwrap_or_else(|_| Value::String(text.trim().to_string()));
+    let new = set_value(text.trim());
     if rig.get("kind").and_then(Value::as_str) == Some(crate::netlist::KIND) {
         return crate::netlist::set(rig, path, new);
     }

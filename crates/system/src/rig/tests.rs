@@ -148,6 +148,22 @@ fn parameters_are_set_paths_with_units() {
         .any(|p| p.path == "initial.p1" && p.value.is_none()));
 }
 
+/// A number as a shell user writes it but JSON does not (`+50`, `.5`,
+/// `5.`) is a number, not the string `"+50"` a number cannot be replaced
+/// with ("a parameter is a number, got `"+50"`").
+#[test]
+fn a_set_number_may_be_written_with_a_plus_or_a_bare_point() {
+    for (text, want) in [("+50", 50.0), (".5", 0.5), ("5.", 5.0), ("+2.5e1", 25.0)] {
+        let mut v = preset("leaney-moog").unwrap();
+        apply_set(&mut v, &format!("load.mass={text}")).unwrap();
+        let ps = parameters(&v);
+        let mass = ps.iter().find(|p| p.path == "load.mass").unwrap();
+        assert_eq!(mass.value, Some(want), "{text}");
+    }
+    let mut v = preset("leaney-moog").unwrap();
+    assert!(apply_set(&mut v, "load.mass=+fifty").is_err());
+}
+
 #[test]
 fn circuit_of_a_preset_has_its_initial_state() {
     for p in PRESETS {

@@ -148,8 +148,19 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
             format!("must be a string, got {}", kind_of(d)),
         );
     }
-    let Some(Value::Object(comps)) = root.get("components") else {
-        return err("components", "missing: an object of named components");
+    let comps = match root.get("components") {
+        Some(Value::Object(comps)) => comps,
+        None => return err("components", "missing: an object of named components"),
+        // present but not an object (`[]`, a list of components): say so
+        Some(other) => {
+            return err(
+                "components",
+                format!(
+                    "must be an object of named components (`{{\"valve\": {{\"type\": ...}}, ...}}`), got {}",
+                    kind_of(other)
+                ),
+            )
+        }
     };
     if comps.is_empty() {
         return err(

@@ -320,12 +320,10 @@ fn plain_columns<'a>(
 ) -> Option<(PlainCsv<'a>, Columns)> {
     let text = std::str::from_utf8(bytes).ok()?;
     let csv = PlainCsv::new(text)?;
-    // the header as the full reader reads it
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
-    let headers = rdr.headers().ok()?.clone();
-    let c = columns_of(file, headers.iter(), unit).ok()?;
+    // the header cells split and trimmed as the full reader reads a header
+    // without quotes (which a plain one is): building that reader (its
+    // state machine) cost more than reading a short command file
+    let c = columns_of(file, csv.headers(), unit).ok()?;
     Some((csv, c))
 }
 

@@ -369,8 +369,8 @@ impl Record {
 /// Where `signal` is missing from a file with headers `headers`: a
 /// header that names it but is not read as it — its unit in parentheses
 /// (`p1 (bar)`) or its name in capitals (`Time [s]`) — as the hint that
-/// ends the error or data problem, `(the header 'p1 (bar)' is not read as
-/// p1: ... `p1 [bar]`)`; empty where there is none.
+/// ends the error or data problem — ``(the header 'p1 (bar)' is not read
+/// as p1: ... `p1 [bar]`)`` — empty where there is none.
 pub fn unread_header_hint<S: AsRef<str>>(headers: &[S], signal: &str) -> String {
     headers
         .iter()

@@ -113,6 +113,11 @@ pub fn columns_of<'a>(
     unit: CommandUnit,
 ) -> Result<Columns, CliError> {
     let headers: Vec<&str> = headers.collect();
+    // an empty file, or a first line of nothing but commas and blanks: as
+    // the record reader (`diagnose`) words it
+    if headers.iter().all(|h| h.trim().is_empty()) {
+        return Err(CliError::Input(format!("{file}: row 1: empty header")));
+    }
     if let Some(why) = hydrocyl_identify::data::foreign_separator(&headers) {
         return Err(CliError::Input(format!(
             "{file}: row 1: {why} (`time,command`)"
@@ -128,8 +133,9 @@ pub fn columns_of<'a>(
             _ => continue,
         };
         if let Some((j, _)) = found {
+            // as the record reader (`diagnose`) words it
             return Err(CliError::Input(format!(
-                "{file}: row 1: two `{name}` columns ({} and {}); keep one",
+                "{file}: row 1, column '{h}': a second `{name}` column (columns {} and {}); keep one",
                 *j + 1,
                 i + 1
             )));
@@ -690,7 +696,10 @@ mod tests {
         )
         .unwrap_err()
         .to_string();
-        assert!(e.contains("two `command` columns (2 and 3)"), "{e}");
+        assert!(
+            e.contains("a second `command` column (columns 2 and 3); keep one"),
+            "{e}"
+        );
     }
 
     /// A row is the file's line after blank lines too (the `nan` on line 8

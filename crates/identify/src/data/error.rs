@@ -82,7 +82,7 @@ pub enum DataError {
         accepted: String,
     },
     /// The same signal appears twice.
-    #[error("{file}: row 1, column '{column}': signal '{signal}' appears twice")]
+    #[error("{file}: row 1, column '{column}': a second `{signal}` column (columns {first} and {second}); keep one")]
     DuplicateSignal {
         /// The file.
         file: String,
@@ -90,6 +90,10 @@ pub enum DataError {
         column: String,
         /// The signal.
         signal: String,
+        /// The first column holding it (1-based).
+        first: usize,
+        /// The second (1-based).
+        second: usize,
     },
     /// The smoother half-width asked for is wider than the record allows.
     #[error("{file}: a smoother half-width (window) of {half_window} samples does not fit its {samples} samples: at most {max}", max = samples.saturating_sub(1) / 2)]

@@ -93,11 +93,13 @@ fn map_columns(file: &str, headers: &[&str], map: &ColumnMap) -> Result<Columns,
                         accepted: sig.accepted_units().to_string(),
                     })?,
                 };
-                if seen.insert(sig, j).is_some() {
+                if let Some(first) = seen.insert(sig, j) {
                     return Err(DataError::DuplicateSignal {
                         file: file.to_string(),
                         column: h.to_string(),
                         signal: sig.name().to_string(),
+                        first: first + 1,
+                        second: j + 1,
                     });
                 }
                 cols[j] = Some((sig, factor));

@@ -652,9 +652,10 @@ fn set_value(text: &str) -> Value {
 /// Applies one `path=value` override (`cylinder.area_1_m2=1.2e-3`,
 /// `initial.p1=3e6`, `valve.dynamics.order="second"`; on a netlist
 /// `<component>.<parameter>`, see [`crate::netlist::set`]). The path must exist in
-/// the rig (a `null` entry such as `initial.p1` exists); the value is parsed
-/// as JSON, else taken as a string; a number may only replace a number (or a
-/// `null`), a string a string.
+/// the rig (a `null` entry such as `initial.p1` exists); the value is read
+/// as `set_value` reads it (JSON, else a number as a shell user writes it, else a
+/// string); a number may only replace a number (or a `null`), a string a
+/// string.
 pub fn apply_set(rig: &mut Value, assignment: &str) -> Result<(), RigError> {
     let (path, text) = assignment
         .split_once('=')

@@ -11,9 +11,11 @@ use crate::series::{SeriesGroup, Step};
 
 mod attachments;
 mod component;
+mod dependencies;
 mod jacobian;
 mod naming;
 pub use component::{Component, PowerTerms, Probe};
+pub(crate) use dependencies::Partial;
 pub use jacobian::Tangents;
 
 pub use crate::binding::{Causality, Netlist};
@@ -103,6 +105,8 @@ pub struct Circuit {
     probe_units: Vec<(String, String, &'static str)>,
     /// The nodes each component is attached to.
     attachments: attachments::Attachments,
+    /// What each component reads and who writes each wire.
+    dependencies: dependencies::Dependencies,
     /// Every component has tangents and the analytic Jacobian is wanted.
     analytic: bool,
     tangents: RefCell<Tangents>,
@@ -188,6 +192,7 @@ impl Circuit {
         let (order, groups) = crate::series::evaluation_order(&net)?;
         let n = comps.len();
         let attachments = attachments::Attachments::of(&net, n);
+        let dependencies = dependencies::Dependencies::of(&net, n);
         // components that read complete accumulators go last, in order
         let (mut order, last): (Vec<Step>, Vec<Step>) = order
             .into_iter()
@@ -240,6 +245,7 @@ impl Circuit {
             state_labels: None,
             probe_units: Vec::new(),
             attachments,
+            dependencies,
             analytic,
             tangents: RefCell::new(Tangents::default()),
             filled: RefCell::new(FillKey::default()),
@@ -506,30 +512,6 @@ impl Circuit {
         self.publisher.get(w.0).copied().flatten()
     }
 
-    /// Copies `wires` at `(t, x)` into `out` with only the components
-    /// `publishers` publishing, the circuit not evaluated: the values
-    /// [`Circuit::read_wires`] reads, for wires that are each set by one of
-    /// `publishers` ([`Circuit::publisher_of`]) — a stored effort depends
-    /// on its owner's state and the time alone.
-    pub fn read_published(
-        &self,
-        t: f64,
-        x: &[f64],
-        publishers: &[usize],
-        wires: &[AnyWire],
-        out: &mut [f64],
-    ) {
-        // the table is no evaluation at any point now
-        self.filled.borrow_mut().valid = false;
-        let mut w = self.wires.borrow_mut();
-        for &i in publishers {
-            self.comps[i].publish(t, &x[self.offsets[i]..self.offsets[i + 1]], &mut w);
-        }
-        for (o, wire) in out.iter_mut().zip(wires) {
-            *o = w.get(*wire);
-        }
-    }
-
     /// Name of a wire (`hyd:<node>:p`, `mech:<node>:v`, `sig:<name>`, ...).
     pub fn wire_name(&self, w: impl Into<AnyWire>) -> &str {
         let w = w.into();
@@ -614,10 +596,21 @@ impl Circuit {
         for (c, o) in self.comps.iter().zip(self.offsets.windows(2)) {
             c.publish(t, &x[o[0]..o[1]], &mut w);
         }
+        self.evaluate_steps(&self.order, t, x, &mut w);
+        if !self.settlers.is_empty() {
+            self.settle(t, x, &mut w);
+        }
+    }
+
+    /// Runs `steps` on the published wires (the accumulators zeroed):
+    /// every step for [`Circuit::fill`], or those some wires depend on
+    /// ([`Circuit::partial_for`]).
+    #[inline]
+    fn evaluate_steps(&self, steps: &[Step], t: f64, x: &[f64], w: &mut Wires) {
         let xs = |i: usize| &x[self.offsets[i]..self.offsets[i + 1]];
-        for step in &self.order {
+        for step in steps {
             match *step {
-                Step::Evaluate(i) => self.comps[i].evaluate(t, xs(i), &mut w),
+                Step::Evaluate(i) => self.comps[i].evaluate(t, xs(i), w),
                 Step::Solve(g) => {
                     let g = &self.groups[g];
                     let eval = |w: &mut Wires| {
@@ -637,12 +630,9 @@ impl Circuit {
                         ]),
                         _ => None,
                     };
-                    g.solve(t, &mut w, &mut self.scratch.borrow_mut(), eval, slope, laws);
+                    g.solve(t, w, &mut self.scratch.borrow_mut(), eval, slope, laws);
                 }
             }
-        }
-        if !self.settlers.is_empty() {
-            self.settle(t, x, &mut w);
         }
     }
 

@@ -222,10 +222,18 @@ impl Component for FourWayValve {
     fn power(&self, _t: f64, _x: &[f64], w: &Wires, _dx: &[f64], p: &mut PowerTerms) {
         p.dissipated = self.flows(w).0.dissipated;
     }
+    /// The supply pressure the edges see: without a supply resistance, the
+    /// supply port's own pressure (the same value, read without evaluating
+    /// the valve), else the drooped one `evaluate` solves for.
     fn probes(&self) -> Vec<Probe> {
+        let ps = if self.supply_resistance == 0.0 {
+            self.p.pressure
+        } else {
+            self.ps
+        };
         self.supply_probe
             .iter()
-            .map(|n| Probe::of(n.clone(), self.ps))
+            .map(|n| Probe::of(n.clone(), ps))
             .collect()
     }
 }

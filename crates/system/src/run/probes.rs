@@ -4,7 +4,7 @@
 //! [`Simulation::run_streaming_states`](crate::simulation::Simulation::run_streaming_states)).
 
 use super::{initial, Channel, Run, RunOptions, SimError, ORDER};
-use crate::circuit::{AnyWire, Circuit, CircuitMemory, Probe};
+use crate::circuit::{AnyWire, Circuit, CircuitMemory, Partial, Probe};
 
 /// The probes of a circuit as a run's channels, in the measured-data order
 /// (command, position, velocity, p1, p2, then the others in component
@@ -21,10 +21,21 @@ pub struct ProbeSet {
     /// the reads go on from their own last solutions, not the solve's,
     /// so that they read the same whenever they are made (`None`: none yet).
     memory: Option<CircuitMemory>,
-    /// The components whose `publish` sets every probed wire, when each is
-    /// a stored effort: the probes are then read without evaluating the
-    /// circuit ([`Circuit::read_published`]).
-    publishers: Option<Vec<usize>>,
+    /// How the probed wires are set at each output point.
+    reading: Reading,
+}
+
+/// How a [`ProbeSet`] sets its wires at an output point: with as little of
+/// the circuit's evaluation as they depend on (the values are those of a
+/// full evaluation, bit for bit).
+#[derive(Clone, Debug)]
+enum Reading {
+    /// The components and steps the probed wires depend on publish and run
+    /// ([`Circuit::partial_for`], [`Circuit::read_partial`]): only the
+    /// publishers when every probe is a stored effort.
+    Partial(Partial),
+    /// The whole circuit is evaluated ([`Circuit::read_wires`]).
+    Full,
 }
 
 impl ProbeSet {
@@ -66,15 +77,10 @@ impl ProbeSet {
     }
 
     fn of_probes(circuit: &Circuit, probes: Vec<Probe>) -> Self {
-        let publishers = probes
-            .iter()
-            .map(|p| circuit.publisher_of(p.wire))
-            .collect::<Option<Vec<usize>>>()
-            .map(|mut v| {
-                v.sort_unstable();
-                v.dedup();
-                v
-            });
+        let wires: Vec<AnyWire> = probes.iter().map(|p| p.wire).collect();
+        let reading = circuit
+            .partial_for(&wires)
+            .map_or(Reading::Full, Reading::Partial);
         let mut order: Vec<usize> = (0..probes.len()).collect();
         // stable: probes outside ORDER keep their component order
         order.sort_by_key(|&i| {
@@ -84,7 +90,7 @@ impl ProbeSet {
                 .unwrap_or(ORDER.len())
         });
         Self {
-            wires: probes.iter().map(|p| p.wire).collect(),
+            wires,
             names: order
                 .iter()
                 .map(|&i| {
@@ -98,7 +104,7 @@ impl ProbeSet {
             order,
             row: vec![0.0; probes.len()],
             memory: None,
-            publishers,
+            reading,
         }
     }
 
@@ -150,9 +156,13 @@ impl ProbeSet {
         c.restore_memory(reading);
         for (k, &tk) in t.iter().enumerate() {
             let xk = &x[k * dim..(k + 1) * dim];
-            match &self.publishers {
-                Some(p) => c.read_published(tk, xk, p, &self.wires, &mut self.row),
-                None => c.read_wires(tk, xk, &self.wires, &mut self.row),
+            match &self.reading {
+                Reading::Partial(p) => {
+                    c.read_partial(p, tk, xk, &self.wires, &mut self.row);
+                    #[cfg(debug_assertions)]
+                    self.check_against_full(c, tk, xk);
+                }
+                Reading::Full => c.read_wires(tk, xk, &self.wires, &mut self.row),
             }
             for (ch, &i) in out.iter_mut().zip(&self.order) {
                 ch.values.push(self.row[i]);
@@ -160,6 +170,25 @@ impl ProbeSet {
         }
         self.memory = Some(c.memory());
         c.restore_memory(solving);
+    }
+
+    /// Debug builds: the row just read from what the probes depend on is
+    /// the row a full evaluation gives, bit for bit (a component that
+    /// reads a wire it did not bind would break it); the circuit's memory
+    /// is left as the partial read left it.
+    #[cfg(debug_assertions)]
+    fn check_against_full(&self, c: &Circuit, t: f64, x: &[f64]) {
+        let kept = c.memory();
+        let mut full = vec![0.0; self.wires.len()];
+        c.read_wires(t, x, &self.wires, &mut full);
+        c.restore_memory(kept);
+        for ((a, b), &w) in self.row.iter().zip(&full).zip(&self.wires) {
+            debug_assert!(
+                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                "probe wire `{}` at t = {t}: {a} from the steps it depends on, {b} from the whole circuit",
+                c.wire_name(w)
+            );
+        }
     }
 }
 

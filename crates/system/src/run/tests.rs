@@ -232,6 +232,60 @@ fn stored_channels_read_alone_are_the_full_runs_on_every_preset() {
 }
 
 #[test]
+fn each_channel_read_from_what_it_depends_on_is_the_full_runs_on_every_preset() {
+    // Every preset: each channel read alone (its wire set by what it depends
+    // on, `Circuit::partial_for`, not by the whole circuit)
+    // equals the full run's, bit for bit; debug builds also compare every
+    // such row with a full evaluation as it is read.
+    let (t, u) = square(0.3);
+    let table = Signal::table(t.clone(), u).unwrap();
+    let opts = RunOptions::default();
+    for preset in rig::PRESETS {
+        let value = (preset.json)();
+        let mut c = rig::circuit(&value, table.clone()).unwrap();
+        let x0 = c.initial_state();
+        let whole = run(&mut c, &x0, &t, &opts).unwrap();
+        for probe in c.probes() {
+            let alone = RunOptions {
+                only_channels: Some(vec![probe.name.clone()]),
+                ..opts.clone()
+            };
+            let mut c = rig::circuit(&value, table.clone()).unwrap();
+            let part = run(&mut c, &x0, &t, &alone).unwrap();
+            assert_eq!(
+                Some(part.channels[0].values.as_slice()),
+                whole.channel(&probe.name),
+                "{}: {}",
+                preset.name,
+                probe.name
+            );
+        }
+    }
+    // the valve rig's channels (the friction force and the load pressure
+    // among them): the friction and the cylinder are evaluated, not the
+    // valve's orifices (its supply pressure, undrooped, is the supply's)
+    let c = rig::circuit(&rig::load("leaney-moog").unwrap(), table).unwrap();
+    let wires: Vec<_> = c.probes().into_iter().map(|p| p.wire).collect();
+    let names: Vec<&str> = c.components().map(|k| k.name()).collect();
+    let evaluated: Vec<&str> = c
+        .partial_for(&wires)
+        .expect("less than the whole evaluation")
+        .steps()
+        .iter()
+        .map(|s| match *s {
+            crate::series::Step::Evaluate(i) => names[i],
+            crate::series::Step::Solve(_) => "an algebraic node",
+        })
+        .collect();
+    assert!(
+        evaluated.contains(&"friction")
+            && evaluated.contains(&"cylinder")
+            && !evaluated.contains(&"valve"),
+        "{evaluated:?}"
+    );
+}
+
+#[test]
 fn min_chamber_pressure_reads_every_cylinders_chambers_and_nothing_else() {
     let channel = |probe: &str, values: Vec<f64>| Channel {
         name: format!("column of {probe}"),

@@ -2,8 +2,9 @@
 //! machine in the same run, so the numbers mean something on any machine.
 //! (Absolute times are printed too, for the record.) The criterion benches in
 //! each crate (`cargo bench -p <crate>`) are the detailed measurements; this
-//! task is the quick overview. It runs in the profile `cargo xtask` is built
-//! with (dev, `opt-level = 2`, dependencies at 3): both sides of every ratio
+//! task is the quick overview. It times the release build, the one users
+//! run ([`in_release`]: `cargo xtask bench` builds it and runs itself again
+//! in it; `--dev` times the dev build instead): both sides of every ratio
 //! are built the same way.
 
 use hydrocyl_ports::{Area, Density, Pressure};

@@ -85,7 +85,11 @@ pub trait Component {
     fn name(&self) -> &str;
 
     /// Declares the nodes and signals this component reads and owns, and
-    /// stores the returned wire handles.
+    /// stores the returned wire handles. What [`evaluate`](Component::evaluate)
+    /// reads must be declared here: reading a run's probes evaluates only
+    /// the components the probed wires depend on by these declarations
+    /// (`Circuit::partial_for`; debug builds
+    /// compare every such read with a full evaluation).
     fn bind(&mut self, net: &mut Netlist) -> Result<(), BuildError>;
 
     /// Number of states this component owns.

@@ -179,26 +179,38 @@ fn probes_read_on_a_second_circuit_are_the_runs() {
     assert!(ProbeReader::new(c, &x0, t[0], &opts).is_err());
 }
 
+/// Runs every preset on the 0.3 s square wave with the default options and
+/// calls `f(preset name, rig, command, times, initial state, circuit, run)`
+/// on each; returns the command.
+fn on_every_preset(
+    mut f: impl FnMut(&str, &serde_json::Value, &Signal, &[f64], &[f64], &Circuit, &Run),
+) -> Signal {
+    let (t, u) = square(0.3);
+    let table = Signal::table(t.clone(), u).unwrap();
+    for preset in rig::PRESETS {
+        let value = (preset.json)();
+        let mut c = rig::circuit(&value, table.clone()).unwrap();
+        let x0 = c.initial_state();
+        let whole = run(&mut c, &x0, &t, &RunOptions::default()).unwrap();
+        f(preset.name, &value, &table, &t, &x0, &c, &whole);
+    }
+    table
+}
+
 #[test]
 fn stored_channels_read_alone_are_the_full_runs_on_every_preset() {
     // Every preset: the channels whose wires a component publishes from its
     // state, read alone (without evaluating the circuit), equal the full
     // run's, bit for bit; the valve rig's compared channels are such.
-    let (t, u) = square(0.3);
-    let table = Signal::table(t.clone(), u).unwrap();
     let opts = RunOptions::default();
-    for preset in rig::PRESETS {
-        let value = (preset.json)();
-        let mut c = rig::circuit(&value, table.clone()).unwrap();
-        let x0 = c.initial_state();
-        let whole = run(&mut c, &x0, &t, &opts).unwrap();
+    let table = on_every_preset(|preset, value, table, t, x0, c, whole| {
         let stored: Vec<String> = c
             .probes()
             .into_iter()
             .filter(|p| c.publisher_of(p.wire).is_some())
             .map(|p| p.name)
             .collect();
-        if preset.name == "leaney-moog" {
+        if preset == "leaney-moog" {
             for n in ["position", "velocity", "p1", "p2"] {
                 assert!(stored.iter().any(|s| s == n), "{n} is not stored");
             }
@@ -207,19 +219,19 @@ fn stored_channels_read_alone_are_the_full_runs_on_every_preset() {
             only_channels: Some(stored.clone()),
             ..opts.clone()
         };
-        let mut c = rig::circuit(&value, table.clone()).unwrap();
-        let part = run(&mut c, &x0, &t, &alone).unwrap();
-        assert_eq!(part.channels.len(), stored.len(), "{}", preset.name);
+        let mut c = rig::circuit(value, table.clone()).unwrap();
+        let part = run(&mut c, x0, t, &alone).unwrap();
+        assert_eq!(part.channels.len(), stored.len(), "{preset}");
         for ch in &part.channels {
             assert_eq!(
                 Some(&ch.values),
                 whole.channel(&ch.name).map(|v| v.to_vec()).as_ref(),
-                "{}: {}",
-                preset.name,
+                "{preset}: {}",
                 ch.name
             );
         }
-    }
+    });
+    let (t, _) = square(0.3);
     let value = rig::load("leaney-moog").unwrap();
     let mut c = rig::circuit(&value, table).unwrap();
     let x0 = c.initial_state();
@@ -237,30 +249,22 @@ fn each_channel_read_from_what_it_depends_on_is_the_full_runs_on_every_preset() 
     // on, `Circuit::partial_for`, not by the whole circuit)
     // equals the full run's, bit for bit; debug builds also compare every
     // such row with a full evaluation as it is read.
-    let (t, u) = square(0.3);
-    let table = Signal::table(t.clone(), u).unwrap();
-    let opts = RunOptions::default();
-    for preset in rig::PRESETS {
-        let value = (preset.json)();
-        let mut c = rig::circuit(&value, table.clone()).unwrap();
-        let x0 = c.initial_state();
-        let whole = run(&mut c, &x0, &t, &opts).unwrap();
+    let table = on_every_preset(|preset, value, table, t, x0, c, whole| {
         for probe in c.probes() {
             let alone = RunOptions {
                 only_channels: Some(vec![probe.name.clone()]),
-                ..opts.clone()
+                ..RunOptions::default()
             };
-            let mut c = rig::circuit(&value, table.clone()).unwrap();
-            let part = run(&mut c, &x0, &t, &alone).unwrap();
+            let mut c = rig::circuit(value, table.clone()).unwrap();
+            let part = run(&mut c, x0, t, &alone).unwrap();
             assert_eq!(
                 Some(part.channels[0].values.as_slice()),
                 whole.channel(&probe.name),
-                "{}: {}",
-                preset.name,
+                "{preset}: {}",
                 probe.name
             );
         }
-    }
+    });
     // the valve rig's channels (the friction force and the load pressure
     // among them): the friction and the cylinder are evaluated, not the
     // valve's orifices (its supply pressure, undrooped, is the supply's)

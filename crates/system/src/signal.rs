@@ -226,7 +226,19 @@ impl Signal {
                         why: "no samples".into(),
                     });
                 }
-                for (i, (t, v)) in time_s.iter().zip(value.iter()).enumerate() {
+                // the first bad row, found by a scan without branches to
+                // mispredict (the tables are long, a bad row is rare), then
+                // the rows up to it checked one by one for the message
+                let finite = |x: &[f64]| x.iter().position(|v| !v.is_finite());
+                let rising = time_s.windows(2).position(|w| w[1] <= w[0]).map(|i| i + 1);
+                let Some(bad) = [finite(time_s), finite(value), rising]
+                    .into_iter()
+                    .flatten()
+                    .min()
+                else {
+                    return Ok(());
+                };
+                for (i, (t, v)) in time_s.iter().zip(value.iter()).enumerate().take(bad + 1) {
                     if !t.is_finite() || !v.is_finite() {
                         return Err(SignalError::Table {
                             row: i,
@@ -560,6 +572,35 @@ mod tests {
             let hint = Cell::new(h);
             let expect = 3.0 * t.clamp(ts[0], ts[10]) - 2.0;
             prop_assert!((s.value_hinted(t, &hint) - expect).abs() < 1e-12);
+        }
+
+        /// A table's first bad sample (a time or value not finite, a time
+        /// not after the one before) is the row its error names, however
+        /// many bad samples follow.
+        #[test]
+        fn table_error_names_the_first_bad_sample(
+            n in 2usize..40,
+            bad in proptest::collection::vec((0usize..40, 0u8..4), 0..4),
+        ) {
+            let mut t: Vec<f64> = (0..n).map(|i| i as f64).collect();
+            let mut u = vec![0.5; n];
+            for &(i, kind) in &bad {
+                let i = i % n;
+                match kind {
+                    0 => t[i] = f64::NAN,
+                    1 => u[i] = f64::INFINITY,
+                    2 if i > 0 => t[i] = t[i - 1],
+                    _ => u[i] = f64::NAN,
+                }
+            }
+            let first = (0..n).find(|&i| {
+                !t[i].is_finite() || !u[i].is_finite() || (i > 0 && t[i] <= t[i - 1])
+            });
+            match (Signal::table(t, u), first) {
+                (Ok(_), None) => {}
+                (Err(SignalError::Table { row, .. }), Some(i)) => prop_assert_eq!(row, i),
+                (r, f) => prop_assert!(false, "{:?} against first bad row {:?}", r.err(), f),
+            }
         }
 
         /// The search from the last interval finds the interval a binary

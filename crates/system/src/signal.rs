@@ -226,19 +226,18 @@ impl Signal {
                         why: "no samples".into(),
                     });
                 }
-                // the first bad row, found by a scan without branches to
-                // mispredict (the tables are long, a bad row is rare), then
-                // the rows up to it checked one by one for the message
-                let finite = |x: &[f64]| x.iter().position(|v| !v.is_finite());
-                let rising = time_s.windows(2).position(|w| w[1] <= w[0]).map(|i| i + 1);
-                let Some(bad) = [finite(time_s), finite(value), rising]
-                    .into_iter()
-                    .flatten()
-                    .min()
-                else {
+                // a table is checked whole at every assembly: first in one
+                // pass without a branch per sample, then, only when it
+                // fails, row by row for the first bad one
+                let finite = |x: &[f64]| x.iter().fold(true, |ok, v| ok & v.is_finite());
+                let rising = time_s[1..]
+                    .iter()
+                    .zip(time_s.iter())
+                    .fold(true, |ok, (b, a)| ok & (b > a));
+                if finite(time_s) && finite(value) && rising {
                     return Ok(());
-                };
-                for (i, (t, v)) in time_s.iter().zip(value.iter()).enumerate().take(bad + 1) {
+                }
+                for (i, (t, v)) in time_s.iter().zip(value.iter()).enumerate() {
                     if !t.is_finite() || !v.is_finite() {
                         return Err(SignalError::Table {
                             row: i,

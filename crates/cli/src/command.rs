@@ -10,6 +10,7 @@ use hydrocyl_identify::data::{scale_decimal, scaled_decimal, DataError};
 use hydrocyl_identify::plaincsv::{Body, PlainCsv, Rows};
 use hydrocyl_system::signal::Signal;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc};
 
 /// Plain bodies of at least this many bytes are parsed in two halves by
@@ -344,33 +345,85 @@ fn cut_of(body: &[u8]) -> Option<usize> {
     Some(mid + at + 1).filter(|&cut| cut < body.len())
 }
 
-/// The time and command cells of the whole lines `piece` (see
-/// [`Rows::parse`]), in columns.
-fn parse_piece(csv: &PlainCsv, c: &Columns, piece: &[u8]) -> Option<(Body, Vec<Vec<f64>>)> {
-    let rows = Rows::new(csv.width(), &[c.time, c.command])?;
+/// The plain text of command CSV `bytes` and the second half of its body
+/// (after [`cut_of`]); `None` when it is not plain or not long enough to
+/// halve.
+fn second_half(bytes: &[u8]) -> Option<(PlainCsv<'_>, &[u8])> {
+    let csv = PlainCsv::new(std::str::from_utf8(bytes).ok()?)?;
+    let body = csv.body().as_bytes();
+    let piece = &body[cut_of(body)?..];
+    Some((csv, piece))
+}
+
+/// The cells of columns `[time, command]` (indices) of the whole lines
+/// `piece` (see [`Rows::parse`]), in columns.
+fn parse_piece(csv: &PlainCsv, cols: [usize; 2], piece: &[u8]) -> Option<(Body, Vec<Vec<f64>>)> {
+    let rows = Rows::new(csv.width(), &cols)?;
     let hint = piece.len() / (8 * csv.width()).max(1) + 1;
     let mut out = vec![Vec::with_capacity(hint), Vec::with_capacity(hint)];
     let end = rows.parse(piece, &mut out)?;
     Some((end, out))
 }
 
+/// A piece of a plain body parsed ([`parse_piece`]; `None`: not plain).
+type Piece = Option<(Body, Vec<Vec<f64>>)>;
+
 /// What the reading thread of [`Ahead`] hands back.
 enum Read {
     /// The table read whole (`None`: a file to stream).
     Whole(Option<Table>),
-    /// The first half of a long plain body (the caller reads the second).
-    Half(Option<(Body, Vec<Vec<f64>>)>),
+    /// The halves of a long plain body: the first, and the second when this
+    /// thread parsed it too (else the caller reads it).
+    Half(Piece, Option<Piece>),
+}
+
+/// The halves of a long plain body parsed before the rig's unit is known,
+/// on the columns its header suggests: `time`, and `command` (else
+/// `reference`). Used when the unit's columns are these.
+struct Early {
+    /// The indices of the time and input columns parsed.
+    columns: [usize; 2],
+    first: Piece,
+    /// `None` when the caller took the second half first.
+    second: Option<Piece>,
+}
+
+impl Early {
+    /// Parses the halves of `bytes` (a plain body long enough to halve;
+    /// else `None`); the second only when `second_taken` was not yet set
+    /// (by the caller, which then parses it), and sets it.
+    fn parse(bytes: &[u8], second_taken: &AtomicBool) -> Option<Self> {
+        let csv = PlainCsv::new(std::str::from_utf8(bytes).ok()?)?;
+        let names: Vec<&str> = csv.headers().map(|h| name_unit(h).0).collect();
+        let at = |name: &str| names.iter().position(|n| *n == name);
+        let columns = [at("time")?, at("command").or_else(|| at("reference"))?];
+        let body = csv.body().as_bytes();
+        let cut = cut_of(body)?;
+        let first = parse_piece(&csv, columns, &body[..cut]);
+        let second = (!second_taken.swap(true, Ordering::AcqRel))
+            .then(|| parse_piece(&csv, columns, &body[cut..]));
+        Some(Early {
+            columns,
+            first,
+            second,
+        })
+    }
 }
 
 /// A command file read ahead: a thread reads it while the rig is read and
-/// checked, and parses it once told the rig's unit ([`Ahead::table`]); a
-/// long plain body is parsed in halves, the second by the thread that
-/// waits for the table. A file longer than `stream_above` bytes is left to
+/// checked. A long plain body is parsed at once, in halves, on the columns
+/// its header suggests ([`Early`]): the thread parses the first, and the
+/// second unless the thread that waits for the table ([`Ahead::table`])
+/// comes for it first. Once told the rig's unit, a body parsed on other
+/// columns than the unit's (or a short or not plain one) is parsed (or
+/// read whole) again. A file longer than `stream_above` bytes is left to
 /// the streamed reader (`None`).
 pub struct Ahead {
     path: PathBuf,
     unit: mpsc::Sender<CommandUnit>,
     bytes: mpsc::Receiver<Arc<Vec<u8>>>,
+    /// Set by whichever thread parses a long body's second half first.
+    second_taken: Arc<AtomicBool>,
     /// The thread's result, sent as its last act (its exit is not waited for).
     read: mpsc::Receiver<Result<Read, CliError>>,
 }
@@ -390,28 +443,40 @@ impl Ahead {
             Some(n) if n <= stream_above => Vec::with_capacity(n.try_into().unwrap_or(0)),
             _ => Vec::new(),
         };
+        let second_taken = Arc::new(AtomicBool::new(false));
+        let taken = second_taken.clone();
         std::thread::spawn(move || {
             let path = file;
-            let _ = done.send(Self::read(&path, len, stream_above, buf, &send, &told));
+            let _ = done.send(Self::read(
+                &path,
+                len,
+                stream_above,
+                buf,
+                (&send, &told),
+                &taken,
+            ));
         });
         Ahead {
             path,
             unit,
             bytes,
+            second_taken,
             read,
         }
     }
 
     /// The reading thread's work on the file of `len` bytes, read into
-    /// `buf`.
+    /// `buf`: the bytes go out on `channels.0` as soon as they are in, the
+    /// rig's unit comes in on `channels.1`.
     fn read(
         path: &Path,
         len: Option<u64>,
         stream_above: u64,
         buf: Vec<u8>,
-        send: &mpsc::Sender<Arc<Vec<u8>>>,
-        told: &mpsc::Receiver<CommandUnit>,
+        channels: (&mpsc::Sender<Arc<Vec<u8>>>, &mpsc::Receiver<CommandUnit>),
+        second_taken: &AtomicBool,
     ) -> Result<Read, CliError> {
+        let (send, told) = channels;
         if len.is_some_and(|n| n > stream_above) {
             return Ok(Read::Whole(None));
         }
@@ -419,6 +484,10 @@ impl Ahead {
         if let Ok(b) = &read {
             let _ = send.send(b.clone());
         }
+        let early = read
+            .as_ref()
+            .ok()
+            .and_then(|b| Early::parse(b, second_taken));
         // the run stopped before it needed the command: nothing to say
         let Ok(unit) = told.recv() else {
             return Ok(Read::Whole(None));
@@ -427,8 +496,13 @@ impl Ahead {
         if let Some((csv, c)) = plain_columns(&path.display().to_string(), &bytes, unit) {
             let body = csv.body().as_bytes();
             if let Some(cut) = cut_of(body) {
-                let first = parse_piece(&csv, &c, &body[..cut]);
-                return Ok(Read::Half(first));
+                let columns = [c.time, c.command];
+                return Ok(match early.filter(|e| e.columns == columns) {
+                    Some(e) => Read::Half(e.first, e.second),
+                    // parsed on other columns: the second half, if this
+                    // thread took it, is parsed again by the caller
+                    None => Read::Half(parse_piece(&csv, columns, &body[..cut]), None),
+                });
             }
         }
         read_table(path, &bytes, unit).map(|t| Read::Whole(Some(t)))
@@ -440,29 +514,48 @@ impl Ahead {
     }
 
     /// The table in `unit` (after [`Ahead::parse`]), `None` for a file to
-    /// stream; the second half of a long body is parsed here meanwhile.
+    /// stream; the second half of a long body is parsed here meanwhile,
+    /// unless the reading thread has taken it (then after it, if that
+    /// thread parsed it on other columns than the unit's).
     pub fn table(self, unit: CommandUnit) -> Result<Option<Table>, CliError> {
         let file = self.path.display().to_string();
         let bytes = self.bytes.recv().ok();
-        let second = bytes.as_ref().and_then(|b| {
-            let (csv, c) = plain_columns(&file, b, unit)?;
-            let body = csv.body().as_bytes();
-            let piece = &body[cut_of(body)?..];
-            let blank = piece.iter().all(|&b| b == b'\n' || b == b'\r');
-            Some((parse_piece(&csv, &c, piece), blank, c))
-        });
+        let columns = bytes
+            .as_ref()
+            .and_then(|b| plain_columns(&file, b, unit).map(|(_, c)| c));
+        let parse_second = |b: &[u8], c: &Columns| -> Option<Piece> {
+            let (csv, piece) = second_half(b)?;
+            Some(parse_piece(&csv, [c.time, c.command], piece))
+        };
+        // the second half here, unless the reading thread took it first
+        let mut second = match (&bytes, &columns) {
+            (Some(b), Some(c)) if !self.second_taken.swap(true, Ordering::AcqRel) => {
+                parse_second(b, c)
+            }
+            _ => None,
+        };
         let read = self
             .read
             .recv()
             .map_err(|_| CliError::Input("the command file's reader failed".into()))??;
         let (first, bytes) = match (read, bytes) {
             (Read::Whole(t), _) => return Ok(t),
-            (Read::Half(first), Some(bytes)) => (first, bytes),
-            (Read::Half(_), None) => return Err(CliError::Input(format!("{file}: not read"))),
+            (Read::Half(first, early), Some(bytes)) => {
+                // the thread's second half (on the unit's columns), or, if
+                // it took it and parsed it on others, the second half now
+                second = second.or(early);
+                if second.is_none() {
+                    second = columns.as_ref().and_then(|c| parse_second(&bytes, c));
+                }
+                (first, bytes)
+            }
+            (Read::Half(..), None) => return Err(CliError::Input(format!("{file}: not read"))),
         };
+        let blank = second_half(&bytes)
+            .is_some_and(|(_, piece)| piece.iter().all(|&b| b == b'\n' || b == b'\r'));
         // both halves plain (blank lines only at the very end), or the
         // full reader, which names what is wrong
-        let halves = second.and_then(|(second, blank, c)| {
+        let halves = second.zip(columns).and_then(|(second, c)| {
             let ((end, mut first), (_, mut second)) = (first?, second?);
             if end == Body::BlankEnd && !blank {
                 return None;

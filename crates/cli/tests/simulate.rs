@@ -787,6 +787,62 @@ fn a_long_command_file_read_in_halves_is_the_same_samples() {
     }
 }
 
+/// A long command file's halves are parsed before the rig is read, on the
+/// columns its header suggests (`time`, and `command`, else `reference`);
+/// a rig whose input is another column gets that column, as from a file
+/// holding it alone: a closed-loop rig's `reference` beside a `command`,
+/// in either order.
+#[test]
+fn a_long_command_file_parsed_early_reads_the_rigs_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows = square(6000, 1e-3);
+    let file = |name: &str, header: &str, row: &dyn Fn(f64, f64) -> String| {
+        let mut s = format!("{header}\n");
+        for (t, u) in &rows {
+            s.push_str(&row(*t, *u));
+        }
+        let p = dir.path().join(name);
+        std::fs::write(&p, s).unwrap();
+        p
+    };
+    // a set-point of a few millimetres; a `command` of nonsense beside it
+    let alone = file("alone.csv", "time,reference [mm]", &|t, u| {
+        format!("{t},{}\n", 20.0 * u)
+    });
+    let after = file("after.csv", "time,command,reference [mm]", &|t, u| {
+        format!("{t},{},{}\n", 7.0 - u, 20.0 * u)
+    });
+    let before = file("before.csv", "reference [mm],time,command", &|t, u| {
+        format!("{},{t},{}\n", 20.0 * u, 7.0 - u)
+    });
+    let out = dir.path().join("out.csv");
+    let rig = "leaney-moog-closed-loop";
+    simulate_ok(rig, &alone, &out, &["--quiet"]);
+    let expected = std::fs::read_to_string(&out).unwrap();
+    for cmd in [&after, &before] {
+        simulate_ok(rig, cmd, &out, &["--quiet"]);
+        assert!(
+            std::fs::read_to_string(&out).unwrap() == expected,
+            "{}: the rows differ",
+            cmd.display()
+        );
+    }
+    // and a valve rig reads the `command` of the same files
+    let command = file("command.csv", "time,command", &|t, u| {
+        format!("{t},{}\n", 7.0 - u)
+    });
+    simulate_ok("leaney-moog", &command, &out, &["--quiet"]);
+    let expected = std::fs::read_to_string(&out).unwrap();
+    for cmd in [&after, &before] {
+        simulate_ok("leaney-moog", cmd, &out, &["--quiet"]);
+        assert!(
+            std::fs::read_to_string(&out).unwrap() == expected,
+            "{}: the rows differ",
+            cmd.display()
+        );
+    }
+}
+
 /// An output path that is a symbolic link is written through it, as a
 /// shell's `>` does: the file it points to gets the run, the link stays a
 /// link (also one that points to a file not there yet); a stream

@@ -480,18 +480,22 @@ impl Ahead {
         if len.is_some_and(|n| n > stream_above) {
             return Ok(Read::Whole(None));
         }
+        crate::progress::mark("command: reading");
         let read = read_into(path, buf).map(Arc::new);
         if let Ok(b) = &read {
             let _ = send.send(b.clone());
         }
+        crate::progress::mark("command: read");
         let early = read
             .as_ref()
             .ok()
             .and_then(|b| Early::parse(b, second_taken));
+        crate::progress::mark("command: parsed early");
         // the run stopped before it needed the command: nothing to say
         let Ok(unit) = told.recv() else {
             return Ok(Read::Whole(None));
         };
+        crate::progress::mark("command: unit told");
         let bytes = read?;
         if let Some((csv, c)) = plain_columns(&path.display().to_string(), &bytes, unit) {
             let body = csv.body().as_bytes();

@@ -11,6 +11,7 @@ use crate::error::CliError;
 use crate::output::{OutputId, Outputs};
 use hydrocyl_system::run::{DeepCavitation, ProbeReader, Run, Solver};
 use std::collections::{BTreeMap, VecDeque};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 
 /// The writer thread writes the text it holds once it is this many bytes
@@ -177,16 +178,49 @@ struct Shared {
     rows: std::sync::OnceLock<Rows>,
     work: Mutex<Work>,
     /// Signalled when a block is queued or taken, or the work closes or stops.
-    work_cv: Condvar,
+    work_cv: Cv,
     sink: Mutex<Sink>,
     /// Signalled when a piece is ready or a thread fails.
-    sink_cv: Condvar,
+    sink_cv: Cv,
 }
 
 /// A lock that survives a panicking holder (whose error is then reported
 /// by the join).
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// A condition variable that counts its waiters, so that a notification
+/// nobody waits for is skipped: std's `notify_all` makes a system call
+/// every time (three per block, ~120 a 10 s run, most with no one
+/// waiting). A waiter is counted while it holds the state's lock, before
+/// it sleeps; a notifier changes the state under that lock and reads the
+/// count after: it sees every waiter that could have missed the change.
+#[derive(Default)]
+struct Cv {
+    cv: Condvar,
+    waiters: AtomicUsize,
+}
+
+impl Cv {
+    /// Sleeps until notified (or spuriously woken), the lock of `g`
+    /// released meanwhile.
+    fn wait<'a, T>(&self, g: MutexGuard<'a, T>) -> MutexGuard<'a, T> {
+        self.waiters.fetch_add(1, Ordering::SeqCst);
+        let g = self
+            .cv
+            .wait(g)
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        self.waiters.fetch_sub(1, Ordering::SeqCst);
+        g
+    }
+
+    /// Wakes every waiter, if there is one.
+    fn notify_all(&self) {
+        if self.waiters.load(Ordering::SeqCst) > 0 {
+            self.cv.notify_all();
+        }
+    }
 }
 
 impl Shared {
@@ -220,10 +254,7 @@ impl Shared {
             if w.closed || !wait {
                 return None;
             }
-            w = self
-                .work_cv
-                .wait(w)
-                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            w = self.work_cv.wait(w);
         }
     }
 
@@ -277,14 +308,14 @@ impl Writer {
         let shared = Arc::new(Shared {
             rows: std::sync::OnceLock::new(),
             work: Mutex::new(Work::default()),
-            work_cv: Condvar::new(),
+            work_cv: Cv::default(),
             sink: Mutex::new(Sink {
                 ready: BTreeMap::new(),
                 error: None,
                 lows: Lows::default(),
                 free: Vec::new(),
             }),
-            sink_cv: Condvar::new(),
+            sink_cv: Cv::default(),
         });
         let sh = shared.clone();
         let (send, written) = std::sync::mpsc::channel::<Written>();
@@ -318,10 +349,7 @@ impl Writer {
                     }
                     let mut s = lock(&sh.sink);
                     while next < total && s.error.is_none() && !s.ready.contains_key(&next) {
-                        s = sh
-                            .sink_cv
-                            .wait(s)
-                            .unwrap_or_else(std::sync::PoisonError::into_inner);
+                        s = sh.sink_cv.wait(s);
                     }
                     if s.error.is_some() {
                         break;
@@ -391,11 +419,7 @@ impl Writer {
         let block = self.block(fill);
         let mut w = lock(&self.shared.work);
         while w.queue.len() >= QUEUE && !w.stopped {
-            w = self
-                .shared
-                .work_cv
-                .wait(w)
-                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            w = self.shared.work_cv.wait(w);
         }
         if w.stopped {
             return Err(CliError::Input("the output writer stopped".into()));

@@ -114,6 +114,7 @@ impl Sets {
 /// its warnings (naming the run).
 struct Row {
     names: Vec<String>,
+    units: Vec<String>,
     values: Vec<Vec<f64>>,
     stats: [f64; 4],
     warnings: Vec<RunWarning>,
@@ -156,15 +157,18 @@ fn one(
         e => ctx(e),
     })?;
     let mut names = Vec::new();
+    let mut units = Vec::new();
     let mut values = Vec::new();
     for c in channels {
         if keep.is_none_or(|k| k.contains(&c.name)) {
             names.push(c.name);
+            units.push(c.unit.to_string());
             values.push(c.values);
         }
     }
     Ok(Row {
         names,
+        units,
         values,
         stats: [
             stats.steps as f64,
@@ -338,7 +342,7 @@ fn stack(
             .unwrap_or_else(|| Failure::Input("no runs".into()))
             .into_pyerr(py));
     };
-    let names = first.names.clone();
+    let (names, units) = (first.names.clone(), first.units.clone());
     if let Some(k) = keep {
         if let Some(missing) = k.iter().find(|c| !names.contains(c)) {
             return Err(no_channel(missing, &first.names));
@@ -401,7 +405,11 @@ fn stack(
     }
     Ok(PyBatch {
         time: array(py, t)?,
-        channels: Named { names, values },
+        channels: Named {
+            names,
+            units,
+            values,
+        },
         params,
         stats,
         ok: frozen(PyArray1::from_vec(py, ok))?,
@@ -418,10 +426,18 @@ impl PyBatch {
         self.time.clone_ref(py)
     }
 
-    /// Channel names (units as in `Run.units`).
+    /// Channel names (their units: `units`).
     #[getter]
     fn names(&self) -> Vec<String> {
         self.channels.names.clone()
+    }
+
+    /// `{channel: SI unit}` of the channels kept, as `Run.units` (the CLI
+    /// header's: `Pa` gauge, `-` dimensionless, `command` in `V` on a
+    /// pump rig).
+    #[getter]
+    fn units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        self.channels.units_dict(py)
     }
 
     /// `{channel: (N, len(time)) array}`; row i is parameter set i.
@@ -496,7 +512,7 @@ impl PyBatch {
     }
 
     /// Pickles as its state ([`PyBatch::_from_state`]): the arrays (numpy
-    /// pickles them bit for bit), names, parameter sets, statistics,
+    /// pickles them bit for bit), names, units, parameter sets, statistics,
     /// errors and interval.
     fn __reduce__<'py>(
         &self,
@@ -544,9 +560,8 @@ impl PyBatch {
                 Ok(a)
             })
             .collect::<PyResult<Vec<_>>>()?;
-        if values.len() != names.len() {
-            return Err(bad_state("names and values differ in number"));
-        }
+        let units: Vec<String> = item("units")?.extract()?;
+        let channels = Named::from_state(names, units, values).map_err(bad_state)?;
         let pairs = |k: &str| -> PyResult<Vec<(String, Py<PyArray1<f64>>)>> {
             item(k)?
                 .try_iter()?
@@ -562,7 +577,7 @@ impl PyBatch {
         }
         Ok(Self {
             time,
-            channels: Named { names, values },
+            channels,
             params: pairs("params")?,
             stats: pairs("stats")?,
             ok,

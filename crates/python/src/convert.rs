@@ -333,10 +333,14 @@ pub fn py_to_json(x: &Bound<'_, PyAny>) -> Option<Value> {
     None
 }
 
-/// Named arrays (the channels of a run or a batch), in order.
+/// Named arrays (the channels of a run or a batch), in order, with their
+/// units.
 pub struct Named<T> {
     /// Names, in order.
     pub names: Vec<String>,
+    /// One unit per name: the CLI header's (`m`, `Pa`, `-`; `V` for a
+    /// pump rig's `command`).
+    pub units: Vec<String>,
     /// One array per name (read-only: [`frozen`]).
     pub values: Vec<Py<T>>,
 }
@@ -360,20 +364,48 @@ impl<T: pyo3::PyTypeInfo> Named<T> {
             .ok_or_else(|| no_channel(name, &self.names))
     }
 
+    /// `{name: unit}`, in order.
+    pub fn units_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (n, u) in self.names.iter().zip(&self.units) {
+            d.set_item(n, u)?;
+        }
+        Ok(d)
+    }
+
     /// Whether there is an array named `name`.
     pub fn contains(&self, name: &str) -> bool {
         self.names.iter().any(|n| n == name)
     }
 
-    /// Puts the names (`"names"`) and the arrays in order (`"values"`)
-    /// into a pickled state `d`.
+    /// Puts the names (`"names"`), units (`"units"`) and the arrays in
+    /// order (`"values"`) into a pickled state `d`.
     pub fn pickle_into(&self, d: &Bound<'_, PyDict>) -> PyResult<()> {
         let py = d.py();
         d.set_item("names", &self.names)?;
+        d.set_item("units", &self.units)?;
         d.set_item(
             "values",
             PyList::new(py, self.values.iter().map(|v| v.clone_ref(py)))?,
         )
+    }
+
+    /// Named arrays from a pickled state's `names`, `units` and `values`
+    /// ([`Named::pickle_into`]); `Err` with what is wrong when their
+    /// numbers differ.
+    pub fn from_state(
+        names: Vec<String>,
+        units: Vec<String>,
+        values: Vec<Py<T>>,
+    ) -> Result<Self, &'static str> {
+        if values.len() != names.len() || units.len() != names.len() {
+            return Err("names, values and units differ in number");
+        }
+        Ok(Self {
+            names,
+            units,
+            values,
+        })
     }
 }
 

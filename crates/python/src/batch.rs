@@ -3,7 +3,9 @@
 //! `(N, len(t))` arrays in parameter-set order, so they do not depend on
 //! the number of threads (each run is sequential and deterministic).
 
-use crate::convert::{array, count_arg, frozen, names_arg, no_channel, vector_arg, Named};
+use crate::convert::{
+    array, count_arg, frozen, key_arg, names_arg, no_channel, number_args, vector_arg, Named,
+};
 use crate::errors::{interruptible, stopped, Failure, Outcome, RunWarning, Stop};
 use crate::rig::Rig;
 use crate::run::state_array;
@@ -217,9 +219,9 @@ pub fn simulate_batch(
     u: &Bound<'_, PyAny>,
     params: &Bound<'_, PyDict>,
     solver: &str,
-    rtol: f64,
-    rk4_step: f64,
-    h_max: Option<f64>,
+    #[pyo3(from_py_with = number_args::rtol)] rtol: f64,
+    #[pyo3(from_py_with = number_args::rk4_step)] rk4_step: f64,
+    #[pyo3(from_py_with = number_args::h_max)] h_max: Option<f64>,
     channels: Option<&Bound<'_, PyAny>>,
     threads: Option<&Bound<'_, PyAny>>,
     on_error: &str,
@@ -242,7 +244,7 @@ pub fn simulate_batch(
         n: 0,
     };
     for (k, v) in params.iter() {
-        let path: String = k.extract()?;
+        let path = key_arg("params", "parameter path", &k)?;
         let col = vector_arg(&format!("params[{path:?}]"), &v)?;
         if sets.paths.is_empty() {
             sets.n = col.len();

@@ -200,6 +200,18 @@ pub fn real_array(name: &str, expected: &str, x: &Bound<'_, PyAny>) -> PyResult<
     Ok(readable::<f64, IxDyn>(a.as_any())?.to_owned_array())
 }
 
+/// An array of shape `dims` in messages: `a 2-D array of shape (2, 401)`.
+fn array_of_shape(dims: &[usize]) -> String {
+    format!(
+        "a {}-D array of shape ({})",
+        dims.len(),
+        dims.iter()
+            .map(usize::to_string)
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
+}
+
 /// The 1-D float array given as argument `name` (any array-like of real
 /// numbers, [`real_array`]), copied; anything else is a one-line error
 /// naming the argument, the shape expected and what was given (`t: expected
@@ -213,19 +225,105 @@ pub fn vector_arg(name: &str, x: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
         match a.shape() {
             [_] => return Ok(a.iter().copied().collect()),
             [] => "a scalar (a 0-D array)".to_string(),
-            dims => format!(
-                "a {}-D array of shape ({})",
-                dims.len(),
-                dims.iter()
-                    .map(usize::to_string)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
+            dims => array_of_shape(dims),
         }
     };
     Err(PyValueError::new_err(format!(
         "{name}: expected {EXPECTED}, got {got}"
     )))
+}
+
+/// One real number given as argument `name`: an int or a float (a numpy
+/// scalar or a 0-D array too), read by [`real_array`], so that anything
+/// else is refused with the argument named, as an array argument's is: a
+/// complex or a bool is a TypeError saying so, and so is a string or an
+/// array of another shape (`rtol: expected a number, got a str ('1e-6')`,
+/// `gamma: expected a number, got a 1-D array of shape (2)`), where PyO3
+/// would say only `must be real number, not str`.
+pub fn number_arg(name: &str, x: &Bound<'_, PyAny>) -> PyResult<f64> {
+    const EXPECTED: &str = "a number";
+    let got = if x.is_instance_of::<PyString>() {
+        format!("a str ({})", x.repr()?)
+    } else if x.is_none() {
+        "None".to_string()
+    } else {
+        let a = real_array(name, EXPECTED, x).map_err(|e| {
+            // a value that is not numbers at all is a wrong type here
+            if e.is_instance_of::<PyValueError>(x.py()) {
+                PyTypeError::new_err(e.value(x.py()).to_string())
+            } else {
+                e
+            }
+        })?;
+        match a.shape() {
+            [] => return Ok(a.iter().copied().next().unwrap_or(f64::NAN)),
+            dims => array_of_shape(dims),
+        }
+    };
+    Err(PyTypeError::new_err(format!(
+        "{name}: expected {EXPECTED}, got {got}"
+    )))
+}
+
+/// Extractors of the number arguments for `#[pyo3(from_py_with = ...)]`,
+/// one per argument name: each reads its argument with [`number_arg`]
+/// (an `Option` one takes None as None). PyO3 keeps the signature's
+/// default for an argument not given.
+pub mod number_args {
+    use super::number_arg;
+    use pyo3::prelude::*;
+
+    macro_rules! extractors {
+        ($($(#[$doc:meta])* $f:ident: $name:literal;)*) => {$(
+            $(#[$doc])*
+            pub fn $f(x: &Bound<'_, PyAny>) -> PyResult<f64> {
+                number_arg($name, x)
+            }
+        )*};
+    }
+
+    extractors! {
+        /// `gamma` (`xfactor`).
+        gamma: "gamma";
+        /// `rtol` (`simulate`, `simulate_batch`).
+        rtol: "rtol";
+        /// `rk4_step` (`simulate`, `simulate_batch`).
+        rk4_step: "rk4_step";
+        /// `min_share` (`diagnose`).
+        min_share: "min_share";
+        /// `holdout` (`diagnose`).
+        holdout: "holdout";
+    }
+
+    /// `h_max` (`simulate`, `simulate_batch`): None is the default bound.
+    pub fn h_max(x: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+        if x.is_none() {
+            return Ok(None);
+        }
+        number_arg("h_max", x).map(Some)
+    }
+}
+
+/// A dict key given in argument `name` that is to be `what` (`parameter
+/// path`, `column name`): a str, else a TypeError naming the argument and
+/// the key (`params: a key is a parameter path (a str), got 1 (an int)`),
+/// not PyO3's bare `'int' object is not an instance of 'str'`.
+pub fn key_arg(name: &str, what: &str, k: &Bound<'_, PyAny>) -> PyResult<String> {
+    match k.cast::<PyString>() {
+        Ok(s) => Ok(s.to_string()),
+        Err(_) => {
+            let t = k.get_type().name()?.to_string();
+            let article = if t.starts_with(['a', 'e', 'i', 'o', 'u']) {
+                "an"
+            } else {
+                "a"
+            };
+            Err(PyTypeError::new_err(format!(
+                "{name}: a key is a {what} (a str), got {} ({article} {t})",
+                k.repr()?
+            )))
+        }
+    }
 }
 
 /// A count given as argument `name` (at least 1), or `None`; below 1 is a

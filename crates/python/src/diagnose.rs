@@ -2,7 +2,7 @@
 //! record (crate `hydrocyl-identify`): residuals, the missing effects,
 //! refits, before/after; the report as a dict (the CLI's `--report` JSON).
 
-use crate::convert::{json_to_py, vector_arg};
+use crate::convert::{json_to_py, key_arg, number_args, vector_arg};
 use crate::errors::{detached, Failure};
 use crate::rig::Rig;
 use hydrocyl_identify::catalog::EffectId;
@@ -28,7 +28,7 @@ fn read_record(obj: &Bound<'_, PyAny>) -> PyResult<Record> {
         let mut cols = Vec::new();
         let mut header = Vec::new();
         for (k, v) in d.iter() {
-            header.push(k.extract::<String>()?);
+            header.push(key_arg("record", "column name", &k)?);
             cols.push(vector_arg(&format!("{DICT_RECORD}: column {k}"), &v)?);
         }
         let csv_err = |e: csv::Error| PyValueError::new_err(format!("{DICT_RECORD}: {e}"));
@@ -97,8 +97,8 @@ pub fn diagnose<'py>(
     py: Python<'py>,
     rig: &Rig,
     record: &Bound<'py, PyAny>,
-    min_share: f64,
-    holdout: f64,
+    #[pyo3(from_py_with = number_args::min_share)] min_share: f64,
+    #[pyo3(from_py_with = number_args::holdout)] holdout: f64,
     window: Option<i64>,
     effects: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {

@@ -2,7 +2,7 @@
 //! it, edited by the same parameter paths as `--set`, checked after every
 //! edit, and simulated on a sampled command.
 
-use crate::convert::{json_to_py, set_text, vector_arg};
+use crate::convert::{json_to_py, key_arg, number_args, set_text, vector_arg};
 use crate::errors::interruptible;
 use crate::run::PyRun;
 use crate::sim;
@@ -255,7 +255,7 @@ impl Rig {
     fn update(&self, values: &Bound<'_, PyDict>) -> PyResult<()> {
         let mut assignments = Vec::with_capacity(values.len());
         for (k, x) in values.iter() {
-            let path: String = k.extract()?;
+            let path = key_arg("values", "parameter path", &k)?;
             assignments.push(format!("{path}={}", set_text(&x)?));
         }
         self.edit(&assignments)
@@ -378,9 +378,9 @@ impl Rig {
         t: &Bound<'_, PyAny>,
         u: &Bound<'_, PyAny>,
         solver: &str,
-        rtol: f64,
-        rk4_step: f64,
-        h_max: Option<f64>,
+        #[pyo3(from_py_with = number_args::rtol)] rtol: f64,
+        #[pyo3(from_py_with = number_args::rk4_step)] rk4_step: f64,
+        #[pyo3(from_py_with = number_args::h_max)] h_max: Option<f64>,
         ledger: bool,
     ) -> PyResult<PyRun> {
         let (t, u) = (vector_arg("t", t)?, vector_arg("u", u)?);

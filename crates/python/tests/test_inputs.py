@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import hydrocyl
-from conftest import unaligned
+from conftest import REPO, unaligned
 
 
 def big_endian(a):
@@ -198,3 +198,61 @@ def test_strings_are_a_value_error_naming_the_argument(rig, command):
     t, _ = command
     with pytest.raises(ValueError, match=r"^u: expected a 1-D array of numbers, got a ndarray of <U3 \(not numbers\)$"):
         rig.simulate(t, np.full(t.size, "0.5"))
+
+
+def number_arguments(rig, command):
+    """(argument name, call with that argument set to x) for every argument
+    that is one real number."""
+    t, u = command
+    rec = str(REPO / "fixtures/measured/valve-none.csv")
+    batch = lambda **kw: hydrocyl.simulate_batch(rig, t, u, {"load.mass": [50.0]}, **kw)  # noqa: E731
+    return [
+        ("gamma", lambda x: hydrocyl.xfactor(x, [0.0])),
+        ("rtol", lambda x: rig.simulate(t, u, rtol=x)),
+        ("rk4_step", lambda x: rig.simulate(t, u, solver="rk4", rk4_step=x)),
+        ("h_max", lambda x: rig.simulate(t, u, h_max=x)),
+        ("rtol", lambda x: batch(rtol=x)),
+        ("rk4_step", lambda x: batch(solver="rk4", rk4_step=x)),
+        ("h_max", lambda x: batch(h_max=x)),
+        ("min_share", lambda x: hydrocyl.diagnose(rig, rec, min_share=x)),
+        ("holdout", lambda x: hydrocyl.diagnose(rig, rec, holdout=x)),
+    ]
+
+
+@pytest.mark.parametrize(
+    "bad, why",
+    [
+        ("1e-6", r"expected a number, got a str \('1e-6'\)"),
+        (np.array([1e-6, 1e-5]), r"expected a number, got a 1-D array of shape \(2\)"),
+        (1 + 0j, r"complex numbers are not accepted"),
+        (True, r"booleans are not accepted as numbers"),
+    ],
+)
+def test_an_argument_that_is_not_one_number_is_a_type_error_naming_it(rig, command, bad, why):
+    """A number argument given as a str, an array, a complex or a bool is a
+    TypeError that names the argument, as an array argument's is (not
+    PyO3's bare `must be real number, not str`)."""
+    for name, call in number_arguments(rig, command):
+        with pytest.raises(TypeError, match=rf"^{re.escape(name)}: {why}"):
+            call(bad)
+
+
+def test_a_number_argument_takes_ints_and_numpy_scalars(rig, command, reference):
+    t, u = command
+    same_run(rig.simulate(t, u, rtol=np.float64(1e-6), h_max=np.float64(0.01)), reference)
+    same_run(rig.simulate(t, u, h_max=np.array(0.01)), reference)
+    assert hydrocyl.xfactor(2, [0.0]) == hydrocyl.xfactor(np.int64(2), [0.0]) == hydrocyl.xfactor(2.0, [0.0])
+
+
+@pytest.mark.parametrize(
+    "call, name, what",
+    [
+        (lambda rig, t, u: hydrocyl.simulate_batch(rig, t, u, {1: [50.0]}), "params", "parameter path"),
+        (lambda rig, t, u: rig.update({("load", "mass"): 50.0}), "values", "parameter path"),
+        (lambda rig, t, u: hydrocyl.diagnose(rig, {"time": t, 2: u}), "record", "column name"),
+    ],
+)
+def test_a_key_that_is_not_a_str_is_a_type_error_naming_the_argument(rig, command, call, name, what):
+    t, u = command
+    with pytest.raises(TypeError, match=rf"^{name}: a key is a {what} \(a str\), got .* \(an? (int|tuple)\)$"):
+        call(rig, t, u)

@@ -53,6 +53,42 @@ pub fn foreign_separator(headers: &[&str]) -> Option<String> {
     ))
 }
 
+/// Why a file's bytes are not UTF-8 text that a CSV reader can read, when
+/// they are text in a wide encoding: UTF-16 or UTF-32, told by its
+/// byte-order mark, or UTF-16 without one, told by a NUL byte beside each
+/// character of the first line (a spreadsheet's "Unicode text" export).
+/// Read as UTF-8 such a file's header would be `t\0i\0m\0e\0`, which no
+/// column matches ("missing column 'time'"). Every CSV reader of hydrocyl
+/// (records, command files) gives this message for row 1.
+pub fn foreign_encoding(bytes: &[u8]) -> Option<String> {
+    let (encoding, mark) = match bytes {
+        [0xFF, 0xFE, 0, 0, ..] => ("UTF-32", Some("FF FE 00 00")),
+        [0, 0, 0xFE, 0xFF, ..] => ("UTF-32", Some("00 00 FE FF")),
+        [0xFF, 0xFE, ..] => ("UTF-16", Some("FF FE")),
+        [0xFE, 0xFF, ..] => ("UTF-16", Some("FE FF")),
+        _ => {
+            // UTF-16 without a mark: ASCII characters each with a NUL byte
+            // before (big-endian) or after (little-endian) it
+            let line = bytes.split(|&b| b == b'\n').next().unwrap_or(bytes);
+            let head = &line[..line.len().min(64) & !1];
+            let ascii = |b: u8| b != 0 && b.is_ascii();
+            let le = head.chunks(2).all(|c| ascii(c[0]) && c[1] == 0);
+            let be = head.chunks(2).all(|c| c[0] == 0 && ascii(c[1]));
+            if head.len() < 4 || !(le || be) {
+                return None;
+            }
+            ("UTF-16", None)
+        }
+    };
+    let mark = mark.map_or_else(
+        || "no byte-order mark, a NUL byte beside each character".to_string(),
+        |m| format!("byte-order mark {m}"),
+    );
+    Some(format!(
+        "the file is {encoding} text ({mark}); hydrocyl reads UTF-8 (or ASCII) text: save it as UTF-8 CSV"
+    ))
+}
+
 /// Finds the signals among `headers` (trimmed), directly or through `map`.
 fn map_columns(file: &str, headers: &[&str], map: &ColumnMap) -> Result<Columns, DataError> {
     if let Some(reason) = foreign_separator(headers) {
@@ -142,6 +178,13 @@ impl Record {
             file: file.clone(),
             reason: e.to_string(),
         })?;
+        if let Some(reason) = foreign_encoding(&bytes) {
+            return Err(DataError::Malformed {
+                file,
+                row: 1,
+                reason,
+            });
+        }
         // bytes that are not UTF-8 (a logger's `°C` in Windows-1252 in a
         // column that is not a signal) are kept as U+FFFD: such a column is
         // kept and ignored, and a signal's cell or header with one is
@@ -485,6 +528,51 @@ mod tests {
                 "{e}"
             );
         }
+    }
+
+    #[test]
+    fn a_utf16_or_utf32_file_is_named_as_such() {
+        let text = "time,command,position\n0,0,0\n1,0,0\n";
+        let utf16le: Vec<u8> = text.encode_utf16().flat_map(u16::to_le_bytes).collect();
+        let utf16be: Vec<u8> = text.encode_utf16().flat_map(u16::to_be_bytes).collect();
+        let utf32le: Vec<u8> = text
+            .chars()
+            .flat_map(|c| (c as u32).to_le_bytes())
+            .collect();
+        let with_mark = |mark: &[u8], b: &[u8]| [mark, b].concat();
+        let dir = std::env::temp_dir().join(format!("hydrocyl-utf16-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (bytes, words) in [
+            (
+                with_mark(&[0xFF, 0xFE], &utf16le),
+                "UTF-16 text (byte-order mark FF FE)",
+            ),
+            (
+                with_mark(&[0xFE, 0xFF], &utf16be),
+                "UTF-16 text (byte-order mark FE FF)",
+            ),
+            (utf16le.clone(), "UTF-16 text (no byte-order mark"),
+            (utf16be, "UTF-16 text (no byte-order mark"),
+            (
+                with_mark(&[0xFF, 0xFE, 0, 0], &utf32le),
+                "UTF-32 text (byte-order mark FF FE 00 00)",
+            ),
+        ] {
+            let p = dir.join("rec.csv");
+            std::fs::write(&p, &bytes).unwrap();
+            let e = Record::read(&p).unwrap_err().to_string();
+            assert!(
+                e.starts_with(&format!("{}: row 1: the file is {words}", p.display()))
+                    && e.contains("save it as UTF-8 CSV")
+                    && !e.contains('\n'),
+                "{e}"
+            );
+        }
+        // UTF-8 text, with its mark or not, and a one-character line are not
+        for ok in [text.as_bytes(), "\u{feff}time\n".as_bytes(), b"t\n0\n"] {
+            assert_eq!(foreign_encoding(ok), None);
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

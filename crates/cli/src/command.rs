@@ -166,7 +166,7 @@ pub fn columns_of<'a>(
     let (time, time_factor) = time.ok_or_else(|| {
         CliError::Input(format!(
             "{file}: row 1: missing column 'time'{}",
-            hydrocyl_identify::data::unread_header_hint(&headers, "time")
+            hydrocyl_identify::data::missing_time_hint(&headers)
         ))
     })?;
     let (command, command_factor) = command.ok_or_else(|| {

@@ -235,7 +235,7 @@ impl Record {
                     hint: if map.0.contains_key(&Signal::Time) {
                         String::new()
                     } else {
-                        unread_header_hint(&header_list, "time")
+                        missing_time_hint(&header_list)
                     },
                     column: map
                         .0
@@ -440,6 +440,34 @@ pub fn unread_header_hint<S: AsRef<str>>(headers: &[S], signal: &str) -> String 
         .unwrap_or_default()
 }
 
+/// Where `time` is missing from a file whose row 1 is `headers`: the hint
+/// of [`unread_header_hint`]; or, where row 1 is not a header at all but a
+/// line above it — a comment (`# ...`, `% ...`, `// ...`) or a
+/// spreadsheet's separator line (`sep=,`) — `(row 1, 'sep=', is not a
+/// header: the header must be the file's first line; delete the line(s)
+/// above it)`; empty where there is neither. Both CSV readers (records,
+/// command files) end their "missing column 'time'" with it.
+pub fn missing_time_hint<S: AsRef<str>>(headers: &[S]) -> String {
+    let hint = unread_header_hint(headers, "time");
+    if !hint.is_empty() {
+        return hint;
+    }
+    let Some(first) = headers.first().map(|h| h.as_ref().trim()) else {
+        return hint;
+    };
+    let first = first.trim_start_matches('\u{feff}');
+    let above = ["#", "%", "//"].iter().any(|p| first.starts_with(p))
+        || first
+            .get(..4)
+            .is_some_and(|p| p.eq_ignore_ascii_case("sep="));
+    if !above {
+        return hint;
+    }
+    format!(
+        " (row 1, '{first}', is not a header: the header must be the file's first line; delete the line(s) above it)"
+    )
+}
+
 /// The file line (1-based, blank lines counted) of byte offsets of a text,
 /// asked in increasing order: the CSV reader's own line count skips the
 /// blank lines it skips. Shared by every CSV reader of hydrocyl.
@@ -573,6 +601,27 @@ mod tests {
             assert_eq!(foreign_encoding(ok), None);
         }
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_line_above_the_header_is_named_as_not_the_header() {
+        let body = "time,position\n0,0\n1,0\n2,0\n3,0\n4,0\n5,0\n6,0\n7,0\n";
+        for (line, cell) in [
+            ("sep=,", "sep="),
+            ("SEP=,", "SEP="),
+            ("# rig 3, 2024-05-01", "# rig 3"),
+            ("% logged", "% logged"),
+            ("\u{feff}// export", "// export"),
+        ] {
+            let e = parse(&format!("{line}\n{body}")).unwrap_err().to_string();
+            assert_eq!(
+                e,
+                format!("t.csv: row 1: missing column 'time' (row 1, '{cell}', is not a header: the header must be the file's first line; delete the line(s) above it)")
+            );
+        }
+        // a header without time that is a header gets no such hint
+        let e = parse("position,p1\n0,0\n").unwrap_err().to_string();
+        assert_eq!(e, "t.csv: row 1: missing column 'time'");
     }
 
     #[test]

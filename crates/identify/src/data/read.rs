@@ -625,6 +625,27 @@ mod tests {
     }
 
     #[test]
+    fn a_decimal_comma_is_named_with_the_number_meant() {
+        let ok = "time,position\n0,0\n1,0\n2,0\n3,0\n4,0\n5,0\n6,0\n7,0\n";
+        for (cell, meant) in [("0,5", "0.5"), ("-1,25e-3", "-1.25e-3"), (" 12,0 ", "12.0")] {
+            let e = parse(&ok.replace("3,0", &format!("3,\"{cell}\"")))
+                .unwrap_err()
+                .to_string();
+            assert_eq!(
+                e,
+                format!("t.csv: row 5, column 'position': '{}' is not a number (a decimal comma: hydrocyl reads a decimal point, `{meant}`)", cell.trim())
+            );
+        }
+        // text that is no number with a decimal comma gets no hint
+        for cell in ["1,2,3", "a,5", "5,", ",5", "abc"] {
+            let e = parse(&ok.replace("3,0", &format!("3,\"{cell}\"")))
+                .unwrap_err()
+                .to_string();
+            assert!(e.ends_with("is not a number"), "{e}");
+        }
+    }
+
+    #[test]
     fn errors_name_row_and_column() {
         let ok = "time,position\n0,0\n1,0\n2,0\n3,0\n4,0\n5,0\n6,0\n7,0\n";
         assert!(parse(ok).is_ok());

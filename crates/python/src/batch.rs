@@ -4,7 +4,7 @@
 //! the number of threads (each run is sequential and deterministic).
 
 use crate::convert::{
-    array, count_arg, frozen, key_arg, names_arg, no_channel, number_args, vector_arg, Named,
+    args, array, count_arg, frozen, key_arg, names_arg, no_channel, vector_arg, Named,
 };
 use crate::errors::{interruptible, stopped, Failure, Outcome, RunWarning, Stop};
 use crate::rig::Rig;
@@ -219,9 +219,9 @@ pub fn simulate_batch(
     u: &Bound<'_, PyAny>,
     params: &Bound<'_, PyDict>,
     solver: &str,
-    #[pyo3(from_py_with = number_args::rtol)] rtol: f64,
-    #[pyo3(from_py_with = number_args::rk4_step)] rk4_step: f64,
-    #[pyo3(from_py_with = number_args::h_max)] h_max: Option<f64>,
+    #[pyo3(from_py_with = args::rtol)] rtol: f64,
+    #[pyo3(from_py_with = args::rk4_step)] rk4_step: f64,
+    #[pyo3(from_py_with = args::h_max)] h_max: Option<f64>,
     channels: Option<&Bound<'_, PyAny>>,
     threads: Option<&Bound<'_, PyAny>>,
     on_error: &str,

@@ -265,34 +265,109 @@ pub fn number_arg(name: &str, x: &Bound<'_, PyAny>) -> PyResult<f64> {
     )))
 }
 
-/// Extractors of the number arguments for `#[pyo3(from_py_with = ...)]`,
-/// one per argument name: each reads its argument with [`number_arg`]
-/// (an `Option` one takes None as None). PyO3 keeps the signature's
-/// default for an argument not given.
-pub mod number_args {
-    use super::number_arg;
+/// What a value is, for the messages of the argument readers: its repr
+/// and its type, `1 (an int)`, `'yes' (a str)`, or `None`.
+fn given(x: &Bound<'_, PyAny>) -> PyResult<String> {
+    if x.is_none() {
+        return Ok("None".into());
+    }
+    let t = x.get_type().name()?.to_string();
+    let article = if t.starts_with(['a', 'e', 'i', 'o', 'u']) {
+        "an"
+    } else {
+        "a"
+    };
+    Ok(format!("{} ({article} {t})", x.repr()?))
+}
+
+/// A str given as argument `name`; anything else is a TypeError naming
+/// the argument (`solver: expected a str, got None`), not PyO3's bare
+/// `'None' is not an instance of 'str'`.
+pub fn text_arg(name: &str, x: &Bound<'_, PyAny>) -> PyResult<String> {
+    match x.cast::<PyString>() {
+        Ok(s) => Ok(s.to_string()),
+        Err(_) => Err(PyTypeError::new_err(format!(
+            "{name}: expected a str, got {}",
+            given(x)?
+        ))),
+    }
+}
+
+/// A bool (Python's or numpy's) given as argument `name`; anything else,
+/// an int included, is a TypeError naming the argument (`ledger: expected
+/// True or False, got 1 (an int)`).
+pub fn flag_arg(name: &str, x: &Bound<'_, PyAny>) -> PyResult<bool> {
+    let np_bool = x.py().import("numpy")?.getattr("bool_")?;
+    if x.is_instance_of::<PyBool>() || x.is_instance(&np_bool)? {
+        return x.is_truthy();
+    }
+    Err(PyTypeError::new_err(format!(
+        "{name}: expected True or False, got {}",
+        given(x)?
+    )))
+}
+
+/// An int (Python's or numpy's, not a bool) given as argument `name`, or
+/// None; anything else is a TypeError naming the argument and what the
+/// int counts (`window: expected an int (samples) or None, got 3.5 (a
+/// float)`).
+pub fn int_arg(name: &str, counts: &str, x: &Bound<'_, PyAny>) -> PyResult<Option<i64>> {
+    if x.is_none() {
+        return Ok(None);
+    }
+    let np_int = x.py().import("numpy")?.getattr("integer")?;
+    let is_int =
+        (x.is_instance_of::<PyInt>() && !x.is_instance_of::<PyBool>()) || x.is_instance(&np_int)?;
+    let bad = || -> PyResult<PyErr> {
+        Ok(PyTypeError::new_err(format!(
+            "{name}: expected an int ({counts}) or None, got {}",
+            given(x)?
+        )))
+    };
+    if !is_int {
+        return Err(bad()?);
+    }
+    x.extract::<i64>().map(Some).or_else(|_| Err(bad()?))
+}
+
+/// Extractors of the arguments for `#[pyo3(from_py_with = ...)]`, one per
+/// argument name: each reads its argument with [`number_arg`],
+/// [`text_arg`], [`flag_arg`] or [`int_arg`] under its name, so that a
+/// value of another type is a TypeError naming it (PyO3 0.30 only adds a
+/// note to the traceback). PyO3 keeps the signature's default for an
+/// argument not given.
+pub mod args {
+    use super::{flag_arg, int_arg, number_arg, text_arg};
     use pyo3::prelude::*;
 
     macro_rules! extractors {
-        ($($(#[$doc:meta])* $f:ident: $name:literal;)*) => {$(
+        ($($(#[$doc:meta])* $f:ident: $t:ty = $read:ident($($arg:expr),*);)*) => {$(
             $(#[$doc])*
-            pub fn $f(x: &Bound<'_, PyAny>) -> PyResult<f64> {
-                number_arg($name, x)
+            pub fn $f(x: &Bound<'_, PyAny>) -> PyResult<$t> {
+                $read($($arg,)* x)
             }
         )*};
     }
 
     extractors! {
         /// `gamma` (`xfactor`).
-        gamma: "gamma";
+        gamma: f64 = number_arg("gamma");
         /// `rtol` (`simulate`, `simulate_batch`).
-        rtol: "rtol";
+        rtol: f64 = number_arg("rtol");
         /// `rk4_step` (`simulate`, `simulate_batch`).
-        rk4_step: "rk4_step";
+        rk4_step: f64 = number_arg("rk4_step");
         /// `min_share` (`diagnose`).
-        min_share: "min_share";
+        min_share: f64 = number_arg("min_share");
         /// `holdout` (`diagnose`).
-        holdout: "holdout";
+        holdout: f64 = number_arg("holdout");
+        /// `path` (`Rig.set`, `Rig.get`).
+        path: String = text_arg("path");
+        /// `text` (`Rig.from_json`).
+        text: String = text_arg("text");
+        /// `ledger` (`simulate`).
+        ledger: bool = flag_arg("ledger");
+        /// `window` (`diagnose`): None is the smoother's own choice.
+        window: Option<i64> = int_arg("window", "samples");
     }
 
     /// `h_max` (`simulate`, `simulate_batch`): None is the default bound.
@@ -311,18 +386,10 @@ pub mod number_args {
 pub fn key_arg(name: &str, what: &str, k: &Bound<'_, PyAny>) -> PyResult<String> {
     match k.cast::<PyString>() {
         Ok(s) => Ok(s.to_string()),
-        Err(_) => {
-            let t = k.get_type().name()?.to_string();
-            let article = if t.starts_with(['a', 'e', 'i', 'o', 'u']) {
-                "an"
-            } else {
-                "a"
-            };
-            Err(PyTypeError::new_err(format!(
-                "{name}: a key is a {what} (a str), got {} ({article} {t})",
-                k.repr()?
-            )))
-        }
+        Err(_) => Err(PyTypeError::new_err(format!(
+            "{name}: a key is a {what} (a str), got {}",
+            given(k)?
+        ))),
     }
 }
 

@@ -2,7 +2,7 @@
 //! record (crate `hydrocyl-identify`): residuals, the missing effects,
 //! refits, before/after; the report as a dict (the CLI's `--report` JSON).
 
-use crate::convert::{json_to_py, key_arg, number_args, vector_arg};
+use crate::convert::{args, json_to_py, key_arg, vector_arg};
 use crate::errors::{detached, Failure};
 use crate::rig::Rig;
 use hydrocyl_identify::catalog::EffectId;
@@ -97,9 +97,9 @@ pub fn diagnose<'py>(
     py: Python<'py>,
     rig: &Rig,
     record: &Bound<'py, PyAny>,
-    #[pyo3(from_py_with = number_args::min_share)] min_share: f64,
-    #[pyo3(from_py_with = number_args::holdout)] holdout: f64,
-    window: Option<i64>,
+    #[pyo3(from_py_with = args::min_share)] min_share: f64,
+    #[pyo3(from_py_with = args::holdout)] holdout: f64,
+    #[pyo3(from_py_with = args::window)] window: Option<i64>,
     effects: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let bad = |m: String| Err(PyValueError::new_err(m));

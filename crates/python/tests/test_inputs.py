@@ -256,3 +256,33 @@ def test_a_key_that_is_not_a_str_is_a_type_error_naming_the_argument(rig, comman
     t, u = command
     with pytest.raises(TypeError, match=rf"^{name}: a key is a {what} \(a str\), got .* \(an? (int|tuple)\)$"):
         call(rig, t, u)
+
+
+@pytest.mark.parametrize(
+    "name, call, why",
+    [
+        ("ledger", lambda rig, t, u: rig.simulate(t, u, ledger=1), r"expected True or False, got 1 \(an int\)"),
+        ("ledger", lambda rig, t, u: rig.simulate(t, u, ledger="yes"), r"expected True or False, got 'yes' \(a str\)"),
+        ("window", lambda rig, t, u: hydrocyl.diagnose(rig, "rec.csv", window=3.5), r"expected an int \(samples\) or None, got 3\.5 \(a float\)"),
+        ("window", lambda rig, t, u: hydrocyl.diagnose(rig, "rec.csv", window=True), r"expected an int \(samples\) or None, got True \(a bool\)"),
+        ("path", lambda rig, t, u: rig.set(5, 1.0), r"expected a str, got 5 \(an int\)"),
+        ("path", lambda rig, t, u: rig.get(None), r"expected a str, got None"),
+        ("text", lambda rig, t, u: hydrocyl.Rig.from_json(b"{}"), r"expected a str, got b'\{\}' \(a bytes\)"),
+    ],
+)
+def test_an_argument_of_another_type_is_a_type_error_naming_it(rig, command, name, call, why):
+    """A str, bool or int argument of another type is a TypeError naming
+    the argument, not PyO3's bare `'None' is not an instance of 'str'`
+    (`solver` and `on_error`, whose defaults are str literals in the
+    signature, are not among them)."""
+    t, u = command
+    with pytest.raises(TypeError, match=rf"^{name}: {why}") as e:
+        call(rig, t, u)
+    # the message is one line (PyO3 adds a note, shown in tracebacks only)
+    assert "\n" not in str(e.value)
+
+
+def test_an_int_window_may_be_a_numpy_int(rig):
+    rec = str(REPO / "fixtures/measured/valve-none.csv")
+    with pytest.raises(ValueError, match=r"^window 1: must be at least 2"):
+        hydrocyl.diagnose(rig, rec, window=np.int64(1))

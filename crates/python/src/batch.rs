@@ -4,7 +4,7 @@
 //! the number of threads (each run is sequential and deterministic).
 
 use crate::convert::{
-    args, array, count_arg, frozen, key_arg, names_arg, no_channel, vector_arg, Named,
+    args, array, count_arg, frozen, key_arg, mapping_arg, names_arg, no_channel, vector_arg, Named,
 };
 use crate::errors::{interruptible, stopped, Failure, Outcome, RunWarning, Stop};
 use crate::rig::Rig;
@@ -217,7 +217,7 @@ pub fn simulate_batch(
     rig: &Rig,
     t: &Bound<'_, PyAny>,
     u: &Bound<'_, PyAny>,
-    params: &Bound<'_, PyDict>,
+    params: &Bound<'_, PyAny>,
     solver: &str,
     #[pyo3(from_py_with = args::rtol)] rtol: f64,
     #[pyo3(from_py_with = args::rk4_step)] rk4_step: f64,
@@ -243,6 +243,7 @@ pub fn simulate_batch(
         columns: Vec::new(),
         n: 0,
     };
+    let params = mapping_arg("params", "{path: values}", params)?;
     for (k, v) in params.iter() {
         let path = key_arg("params", "parameter path", &k)?;
         let col = vector_arg(&format!("params[{path:?}]"), &v)?;

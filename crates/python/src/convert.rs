@@ -379,6 +379,36 @@ pub mod args {
     }
 }
 
+/// A mapping given as argument `name` (`what` its keys and values map,
+/// for the message): a dict as it is, or any other object with `keys()`
+/// and `[]` — a `collections.abc.Mapping`, a `mappingproxy`, a pandas
+/// DataFrame (its columns) — as `dict(x)`, the dict of its items.
+/// `None` when `x` is none of these; [`mapping_arg`] makes that an error.
+pub fn as_mapping<'py>(x: &Bound<'py, PyAny>) -> PyResult<Option<Bound<'py, PyDict>>> {
+    if let Ok(d) = x.cast::<PyDict>() {
+        return Ok(Some(d.clone()));
+    }
+    if x.is_instance_of::<PyString>() || !x.hasattr("keys")? {
+        return Ok(None);
+    }
+    let d = x.py().get_type::<PyDict>().call1((x,))?;
+    Ok(Some(d.cast_into::<PyDict>()?))
+}
+
+/// [`as_mapping`], where anything else is a TypeError naming the argument
+/// (`params: expected a dict of {path: values}, got [('load.mass', ...)]
+/// (a list)`).
+pub fn mapping_arg<'py>(
+    name: &str,
+    what: &str,
+    x: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
+    as_mapping(x)?.ok_or_else(|| match given(x) {
+        Ok(g) => PyTypeError::new_err(format!("{name}: expected a dict of {what}, got {g}")),
+        Err(e) => e,
+    })
+}
+
 /// A dict key given in argument `name` that is to be `what` (`parameter
 /// path`, `column name`): a str, else a TypeError naming the argument and
 /// the key (`params: a key is a parameter path (a str), got 1 (an int)`),

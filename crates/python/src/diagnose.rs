@@ -2,7 +2,7 @@
 //! record (crate `hydrocyl-identify`): residuals, the missing effects,
 //! refits, before/after; the report as a dict (the CLI's `--report` JSON).
 
-use crate::convert::{args, json_to_py, key_arg, vector_arg};
+use crate::convert::{args, as_mapping, json_to_py, key_arg, vector_arg};
 use crate::errors::{detached, Failure};
 use crate::rig::Rig;
 use hydrocyl_identify::catalog::EffectId;
@@ -12,7 +12,6 @@ use hydrocyl_identify::valve::diagnose_valve;
 use hydrocyl_system::rig::valve_rig_from;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 /// Name of a record given as a dict, in messages (its CSV rows: row 2 is
 /// element 0).
@@ -23,7 +22,7 @@ const DICT_RECORD: &str = "record (dict; row 2 = element 0)";
 /// `command`, `position`, `p1 [bar]`, ...), checked by the same rules.
 fn read_record(obj: &Bound<'_, PyAny>) -> PyResult<Record> {
     let input = |e: hydrocyl_identify::data::DataError| PyValueError::new_err(e.to_string());
-    if let Ok(d) = obj.cast::<PyDict>() {
+    if let Some(d) = as_mapping(obj)? {
         let mut w = csv::Writer::from_writer(Vec::new());
         let mut cols = Vec::new();
         let mut header = Vec::new();

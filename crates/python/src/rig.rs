@@ -2,7 +2,7 @@
 //! it, edited by the same parameter paths as `--set`, checked after every
 //! edit, and simulated on a sampled command.
 
-use crate::convert::{args, json_to_py, key_arg, set_text, vector_arg};
+use crate::convert::{args, json_to_py, key_arg, mapping_arg, set_text, vector_arg};
 use crate::errors::interruptible;
 use crate::run::PyRun;
 use crate::sim;
@@ -257,7 +257,8 @@ impl Rig {
     /// order, then checks the rig once (for changes that are only
     /// consistent together). On error the rig is unchanged.
     /// `rig.update(rig.parameters())` changes no value (a default it writes out stays the default).
-    fn update(&self, values: &Bound<'_, PyDict>) -> PyResult<()> {
+    fn update(&self, values: &Bound<'_, PyAny>) -> PyResult<()> {
+        let values = mapping_arg("values", "{path: value}", values)?;
         let mut assignments = Vec::with_capacity(values.len());
         for (k, x) in values.iter() {
             let path = key_arg("values", "parameter path", &k)?;

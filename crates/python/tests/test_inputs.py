@@ -286,3 +286,65 @@ def test_an_int_window_may_be_a_numpy_int(rig):
     rec = str(REPO / "fixtures/measured/valve-none.csv")
     with pytest.raises(ValueError, match=r"^window 1: must be at least 2"):
         hydrocyl.diagnose(rig, rec, window=np.int64(1))
+
+
+class TableLike:
+    """A table that is not a dict but has `keys()` and `[]` (as a pandas
+    DataFrame: `dict(table)` is its columns)."""
+
+    def __init__(self, columns):
+        self._columns = dict(columns)
+
+    def keys(self):
+        return list(self._columns)
+
+    def __getitem__(self, k):
+        return self._columns[k]
+
+
+def test_a_mapping_that_is_not_a_dict_is_read_as_its_items(rig, command, reference):
+    """`params`, `rig.update`'s values and a `diagnose` record are typed
+    Mapping: a mappingproxy, a collections.abc.Mapping or a DataFrame-like
+    table (keys() and []) is read as the dict of its items, not refused as
+    `'mappingproxy' object is not an instance of 'dict'`."""
+    import collections.abc
+    import types
+
+    class Frozen(collections.abc.Mapping):
+        def __init__(self, d):
+            self._d = dict(d)
+
+        def __getitem__(self, k):
+            return self._d[k]
+
+        def __iter__(self):
+            return iter(self._d)
+
+        def __len__(self):
+            return len(self._d)
+
+    t, u = command
+    sets = {"load.mass": np.array([40.0, 60.0])}
+    want = hydrocyl.simulate_batch(rig, t, u, sets)
+    for wrap in (types.MappingProxyType, Frozen, TableLike):
+        got = hydrocyl.simulate_batch(rig, t, u, wrap(sets))
+        np.testing.assert_array_equal(got["position"], want["position"])
+        one = rig.copy()
+        one.update(wrap({"load.mass": 40.0}))
+        assert one.get("load.mass") == 40.0
+    # a record read as the dict of its columns (not refused as no path)
+    with pytest.raises(ValueError, match=r"^record \(dict; row 2 = element 0\): only 3 samples"):
+        hydrocyl.diagnose(rig, TableLike({"time": t[:3], "command": u[:3], "position": u[:3]}))
+
+
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda rig, t, u: hydrocyl.simulate_batch(rig, t, u, [("load.mass", [50.0])]), "params"),
+        (lambda rig, t, u: rig.update([("load.mass", 50.0)]), "values"),
+    ],
+)
+def test_a_list_of_pairs_for_a_mapping_is_a_type_error_naming_it(rig, command, call, name):
+    t, u = command
+    with pytest.raises(TypeError, match=rf"^{name}: expected a dict of .*, got \[\('load.mass'"):
+        call(rig, t, u)

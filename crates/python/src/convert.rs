@@ -40,16 +40,22 @@ pub fn json_to_py<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>
     })
 }
 
-/// A Python value as the text after `=` of a CLI `--set path=value`, so that
-/// `Rig.set` parses it exactly as the CLI does: `True` → `true`, `None` →
-/// `null`, an int as itself, a float at full precision (`nan` stays `NaN`
-/// and is refused like `--set x=NaN`), a string as given.
-pub fn set_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
+/// A Python value for the parameter `path` as the text after `=` of a CLI
+/// `--set path=value`, so that `Rig.set` parses it exactly as the CLI
+/// does: `True` (or numpy's `True`) → `true`, `None` → `null`, an int as
+/// itself, a float at full precision (`nan` stays `NaN` and is refused
+/// like `--set x=NaN`), a string as given; a numpy number or 0-D array as
+/// its number ([`number_arg`]). A complex number (Python's or numpy's) is
+/// refused, not read as its real part, and so is anything else, each a
+/// TypeError naming the parameter (``rig `load.mass`: (3+1j) is complex;
+/// a parameter is a real number``).
+pub fn set_text(path: &str, v: &Bound<'_, PyAny>) -> PyResult<String> {
     if v.is_none() {
         return Ok("null".into());
     }
-    if let Ok(b) = v.cast::<PyBool>() {
-        return Ok(if b.is_true() { "true" } else { "false" }.into());
+    let np = v.py().import("numpy")?;
+    if v.is_instance_of::<PyBool>() || v.is_instance(&np.getattr("bool_")?)? {
+        return Ok(if v.is_truthy()? { "true" } else { "false" }.into());
     }
     if v.is_instance_of::<PyInt>() {
         return Ok(v.str()?.to_string());
@@ -57,13 +63,32 @@ pub fn set_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
     if let Ok(s) = v.cast::<PyString>() {
         return Ok(s.to_string());
     }
-    if let Ok(x) = v.extract::<f64>() {
-        return Ok(format!("{x:?}"));
+    let name = format!("rig `{path}`");
+    let complex_array = v
+        .cast::<PyUntypedArray>()
+        .is_ok_and(|a| a.dtype().kind() == b'c');
+    if complex_array
+        || v.is_instance_of::<PyComplex>()
+        || v.is_instance(&np.getattr("complexfloating")?)?
+    {
+        return Err(PyTypeError::new_err(format!(
+            "{name}: {} is complex; a parameter is a real number",
+            v.repr()?
+        )));
     }
-    Err(PyTypeError::new_err(format!(
-        "a rig parameter is a number, a string, a bool or None, not {}",
-        v.get_type().name()?
-    )))
+    let x = if v.cast::<PyUntypedArray>().is_ok() || v.is_instance(&np.getattr("number")?)? {
+        number_arg(&name, v)?
+    } else {
+        v.extract::<f64>().map_err(|_| -> PyErr {
+            match v.get_type().name() {
+                Ok(t) => PyTypeError::new_err(format!(
+                    "{name}: a parameter is a number, a string, a bool or None, not {t}"
+                )),
+                Err(e) => e,
+            }
+        })?
+    };
+    Ok(format!("{x:?}"))
 }
 
 /// The one reader of numpy arrays: `x` as an array of element type `T`

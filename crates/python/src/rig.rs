@@ -250,7 +250,7 @@ impl Rig {
         #[pyo3(from_py_with = args::path)] path: String,
         value: &Bound<'_, PyAny>,
     ) -> PyResult<()> {
-        self.edit(&[format!("{path}={}", set_text(value)?)])
+        self.edit(&[format!("{path}={}", set_text(&path, value)?)])
     }
 
     /// Sets several parameters (`{path: value}`, None for `null`), in
@@ -262,7 +262,7 @@ impl Rig {
         let mut assignments = Vec::with_capacity(values.len());
         for (k, x) in values.iter() {
             let path = key_arg("values", "parameter path", &k)?;
-            assignments.push(format!("{path}={}", set_text(&x)?));
+            assignments.push(format!("{path}={}", set_text(&path, &x)?));
         }
         self.edit(&assignments)
     }

@@ -27,16 +27,20 @@ fn read_record(obj: &Bound<'_, PyAny>) -> PyResult<Record> {
         let mut cols = Vec::new();
         let mut header = Vec::new();
         for (k, v) in d.iter() {
-            header.push(key_arg("record", "column name", &k)?);
-            cols.push(vector_arg(&format!("{DICT_RECORD}: column {k}"), &v)?);
+            let name = key_arg("record", "column name", &k)?;
+            cols.push(vector_arg(&format!("{DICT_RECORD}: column '{name}'"), &v)?);
+            header.push(name);
         }
         let csv_err = |e: csv::Error| PyValueError::new_err(format!("{DICT_RECORD}: {e}"));
         w.write_record(&header).map_err(csv_err)?;
-        let n = cols.iter().map(Vec::len).max().unwrap_or(0);
+        // the columns' headers in quotes, as the CSV readers name them
+        let longest = (0..cols.len()).max_by_key(|&j| (cols[j].len(), usize::MAX - j));
+        let n = longest.map_or(0, |j| cols[j].len());
         if let Some((h, c)) = header.iter().zip(&cols).find(|(_, c)| c.len() != n) {
             return Err(PyValueError::new_err(format!(
-                "{DICT_RECORD}: column `{h}` has {} values, another {n}",
-                c.len()
+                "{DICT_RECORD}: column '{h}' has {} values, column '{}' {n}",
+                c.len(),
+                header[longest.unwrap_or(0)]
             )));
         }
         for i in 0..n {

@@ -187,6 +187,10 @@ class BatchRun:
     @property
     def names(self) -> list[str]: ...
     @property
+    def units(self) -> dict[str, str]:
+        """``{channel: SI unit}`` of the channels kept, as ``Run.units``
+        (``command`` in V on a pump rig)."""
+    @property
     def channels(self) -> dict[str, npt.NDArray[np.float64]]: ...
     @property
     def params(self) -> dict[str, npt.NDArray[np.float64]]: ...

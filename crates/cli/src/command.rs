@@ -167,7 +167,7 @@ pub fn columns_of<'a>(
     let (time, time_factor) = time.ok_or_else(|| {
         CliError::Input(format!(
             "{file}: row 1: missing column 'time'{}",
-            hydrocyl_identify::data::unread_header_hint(&headers, "time")
+            hydrocyl_identify::data::missing_time_hint(&headers)
         ))
     })?;
     let (command, command_factor) = command.ok_or_else(|| {
@@ -634,6 +634,10 @@ fn parse_samples(
     bytes: &[u8],
     unit: CommandUnit,
 ) -> Result<(Vec<f64>, Vec<f64>, String), CliError> {
+    // UTF-16 or UTF-32 text is named so, as the record reader names it
+    if let Some(why) = hydrocyl_identify::data::foreign_encoding(bytes) {
+        return Err(CliError::Input(format!("{file}: row 1: {why}")));
+    }
     // bytes that are not UTF-8 (a logger's `°C` in Windows-1252 in a
     // column the run does not read) are kept as U+FFFD: a column the run
     // reads is then refused at its row and column, as the record reader

@@ -31,8 +31,9 @@ pub struct Args {
     /// The FMU file to write.
     #[arg(long, required = true, conflicts_with = "list_presets")]
     out: Option<PathBuf>,
-    /// Override a rig parameter by its JSON path before export (repeatable);
-    /// it becomes the parameter's start value.
+    /// Override a rig parameter by its path before export, e.g. `--set
+    /// load.mass=50` (repeatable; `hydrocyl simulate --print-rig` lists
+    /// every path); it becomes the parameter's start value.
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
     /// The slave library (`libhydrocyl_fmu.so`) of this build; default:

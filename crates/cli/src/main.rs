@@ -69,7 +69,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
 }
 
 /// The command line's definition, `--rig`'s help listing every preset
-/// (`diagnose`: those it takes, [`diagnose::presets`]).
+/// (`simulate`, `fmu`; `diagnose`: those it takes, [`diagnose::presets`]).
 fn definition() -> clap::Command {
     let names = presets::names();
     let rig_help = |sub: clap::Command| {
@@ -88,6 +88,7 @@ fn definition() -> clap::Command {
     };
     Cli::command()
         .mut_subcommand("simulate", rig_help)
+        .mut_subcommand("fmu", rig_help)
         .mut_subcommand("diagnose", move |sub| {
             sub.mut_arg("rig", move |a| {
                 a.help(format!(

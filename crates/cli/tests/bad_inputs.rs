@@ -276,3 +276,73 @@ fn a_signal_during_the_run_leaves_no_file() {
         assert_eq!(left, vec!["cmd.csv".to_string()], "{sig}");
     }
 }
+
+/// A CSV saved as UTF-16 (a spreadsheet's "Unicode text"; with a
+/// byte-order mark or without) or UTF-32 is named so by both readers, row
+/// 1, exit code 2, nothing written: read as UTF-8 its header had no
+/// `time` ("missing column 'time'", though the column is there).
+#[test]
+fn a_utf16_file_is_named_so_by_both_readers() {
+    let dir = std::env::temp_dir().join(format!("hydrocyl-utf16-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut cmd = String::from("time,command,position\n");
+    for k in 0..50 {
+        cmd.push_str(&format!(
+            "{},{},0\n",
+            k as f64 * 0.01,
+            if k < 25 { 0.1 } else { -0.1 }
+        ));
+    }
+    let le: Vec<u8> = cmd.encode_utf16().flat_map(u16::to_le_bytes).collect();
+    let be: Vec<u8> = cmd.encode_utf16().flat_map(u16::to_be_bytes).collect();
+    for (bytes, words) in [
+        (
+            [&[0xFF, 0xFE][..], &le].concat(),
+            "the file is UTF-16 text (byte-order mark FF FE)",
+        ),
+        (
+            [&[0xFE, 0xFF][..], &be].concat(),
+            "the file is UTF-16 text (byte-order mark FE FF)",
+        ),
+        (le.clone(), "the file is UTF-16 text (no byte-order mark"),
+    ] {
+        let csv = dir.join("rec.csv");
+        std::fs::write(&csv, &bytes).unwrap();
+        for args in [
+            &[
+                "simulate",
+                "--rig",
+                "leaney-moog",
+                "--command",
+                "rec.csv",
+                "--out",
+                "out.csv",
+            ][..],
+            &[
+                "diagnose",
+                "--rig",
+                "leaney-moog",
+                "--data",
+                "rec.csv",
+                "--report",
+                "out.csv",
+            ][..],
+        ] {
+            let o = Command::new(env!("CARGO_BIN_EXE_hydrocyl"))
+                .args(args)
+                .current_dir(&dir)
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+            assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+            assert!(
+                err.starts_with(&format!("hydrocyl: error: rec.csv: row 1: {words}"))
+                    && err.contains("save it as UTF-8 CSV"),
+                "{args:?}: {err}"
+            );
+            assert!(!dir.join("out.csv").exists(), "{args:?}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

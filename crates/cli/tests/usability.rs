@@ -370,6 +370,29 @@ fn help_shows_what_is_required_and_which_rigs_work() {
     }
 }
 
+/// `fmu --help` says `--rig` and `--set` as `simulate --help` does: every
+/// preset by name (it said `leaney-moog, ...`), and `--set` by the path
+/// `--set` takes, `load.mass` (it said "by its JSON path", which is
+/// refused: `components.load.mass`).
+#[test]
+fn fmu_help_names_the_presets_and_the_set_paths_as_simulate_does() {
+    let (fmu, simulate) = (help("fmu"), help("simulate"));
+    let line = |text: &str, opt: &str| {
+        text.lines()
+            .find(|l| l.trim_start().starts_with(opt))
+            .unwrap_or_else(|| panic!("no {opt} in {text}"))
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    assert_eq!(line(&fmu, "--rig"), line(&simulate, "--rig"));
+    let set = line(&fmu, "--set");
+    assert!(
+        !set.contains("JSON path") && set.contains("`--set load.mass=50`"),
+        "{set}"
+    );
+}
+
 #[test]
 fn print_rig_refuses_the_output_options_it_would_not_write() {
     let d = scratch("print-rig");

@@ -19,7 +19,9 @@ mod time_axis;
 
 pub use decimal::{scale_decimal, scaled_decimal};
 pub use error::DataError;
-pub use read::{foreign_separator, unread_header_hint, LineCounter};
+pub use read::{
+    foreign_encoding, foreign_separator, missing_time_hint, unread_header_hint, LineCounter,
+};
 pub use time_axis::{beyond_span, GAP_OVER_REST, MAX_GAP_FACTOR, MAX_SPAN_S};
 
 /// A signal of the measured-data format.

@@ -3,7 +3,9 @@
 //! `(N, len(t))` arrays in parameter-set order, so they do not depend on
 //! the number of threads (each run is sequential and deterministic).
 
-use crate::convert::{array, count_arg, frozen, names_arg, no_channel, vector_arg, Named};
+use crate::convert::{
+    args, array, count_arg, frozen, key_arg, mapping_arg, names_arg, no_channel, vector_arg, Named,
+};
 use crate::errors::{interruptible, stopped, Failure, Outcome, RunWarning, Stop};
 use crate::rig::Rig;
 use crate::run::state_array;
@@ -114,6 +116,7 @@ impl Sets {
 /// its warnings (naming the run).
 struct Row {
     names: Vec<String>,
+    units: Vec<String>,
     values: Vec<Vec<f64>>,
     stats: [f64; 4],
     warnings: Vec<RunWarning>,
@@ -156,15 +159,18 @@ fn one(
         e => ctx(e),
     })?;
     let mut names = Vec::new();
+    let mut units = Vec::new();
     let mut values = Vec::new();
     for c in channels {
         if keep.is_none_or(|k| k.contains(&c.name)) {
             names.push(c.name);
+            units.push(c.unit.to_string());
             values.push(c.values);
         }
     }
     Ok(Row {
         names,
+        units,
         values,
         stats: [
             stats.steps as f64,
@@ -211,11 +217,11 @@ pub fn simulate_batch(
     rig: &Rig,
     t: &Bound<'_, PyAny>,
     u: &Bound<'_, PyAny>,
-    params: &Bound<'_, PyDict>,
+    params: &Bound<'_, PyAny>,
     solver: &str,
-    rtol: f64,
-    rk4_step: f64,
-    h_max: Option<f64>,
+    #[pyo3(from_py_with = args::rtol)] rtol: f64,
+    #[pyo3(from_py_with = args::rk4_step)] rk4_step: f64,
+    #[pyo3(from_py_with = args::h_max)] h_max: Option<f64>,
     channels: Option<&Bound<'_, PyAny>>,
     threads: Option<&Bound<'_, PyAny>>,
     on_error: &str,
@@ -237,8 +243,9 @@ pub fn simulate_batch(
         columns: Vec::new(),
         n: 0,
     };
+    let params = mapping_arg("params", "{path: values}", params)?;
     for (k, v) in params.iter() {
-        let path: String = k.extract()?;
+        let path = key_arg("params", "parameter path", &k)?;
         let col = vector_arg(&format!("params[{path:?}]"), &v)?;
         if sets.paths.is_empty() {
             sets.n = col.len();
@@ -338,7 +345,7 @@ fn stack(
             .unwrap_or_else(|| Failure::Input("no runs".into()))
             .into_pyerr(py));
     };
-    let names = first.names.clone();
+    let (names, units) = (first.names.clone(), first.units.clone());
     if let Some(k) = keep {
         if let Some(missing) = k.iter().find(|c| !names.contains(c)) {
             return Err(no_channel(missing, &first.names));
@@ -401,7 +408,11 @@ fn stack(
     }
     Ok(PyBatch {
         time: array(py, t)?,
-        channels: Named { names, values },
+        channels: Named {
+            names,
+            units,
+            values,
+        },
         params,
         stats,
         ok: frozen(PyArray1::from_vec(py, ok))?,
@@ -418,10 +429,18 @@ impl PyBatch {
         self.time.clone_ref(py)
     }
 
-    /// Channel names (units as in `Run.units`).
+    /// Channel names (their units: `units`).
     #[getter]
     fn names(&self) -> Vec<String> {
         self.channels.names.clone()
+    }
+
+    /// `{channel: SI unit}` of the channels kept, as `Run.units` (the CLI
+    /// header's: `Pa` gauge, `-` dimensionless, `command` in `V` on a
+    /// pump rig).
+    #[getter]
+    fn units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        self.channels.units_dict(py)
     }
 
     /// `{channel: (N, len(time)) array}`; row i is parameter set i.
@@ -496,7 +515,7 @@ impl PyBatch {
     }
 
     /// Pickles as its state ([`PyBatch::_from_state`]): the arrays (numpy
-    /// pickles them bit for bit), names, parameter sets, statistics,
+    /// pickles them bit for bit), names, units, parameter sets, statistics,
     /// errors and interval.
     fn __reduce__<'py>(
         &self,
@@ -544,9 +563,8 @@ impl PyBatch {
                 Ok(a)
             })
             .collect::<PyResult<Vec<_>>>()?;
-        if values.len() != names.len() {
-            return Err(bad_state("names and values differ in number"));
-        }
+        let units: Vec<String> = item("units")?.extract()?;
+        let channels = Named::from_state(names, units, values).map_err(bad_state)?;
         let pairs = |k: &str| -> PyResult<Vec<(String, Py<PyArray1<f64>>)>> {
             item(k)?
                 .try_iter()?
@@ -562,7 +580,7 @@ impl PyBatch {
         }
         Ok(Self {
             time,
-            channels: Named { names, values },
+            channels,
             params: pairs("params")?,
             stats: pairs("stats")?,
             ok,

@@ -40,16 +40,22 @@ pub fn json_to_py<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>
     })
 }
 
-/// A Python value as the text after `=` of a CLI `--set path=value`, so that
-/// `Rig.set` parses it exactly as the CLI does: `True` → `true`, `None` →
-/// `null`, an int as itself, a float at full precision (`nan` stays `NaN`
-/// and is refused like `--set x=NaN`), a string as given.
-pub fn set_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
+/// A Python value for the parameter `path` as the text after `=` of a CLI
+/// `--set path=value`, so that `Rig.set` parses it exactly as the CLI
+/// does: `True` (or numpy's `True`) → `true`, `None` → `null`, an int as
+/// itself, a float at full precision (`nan` stays `NaN` and is refused
+/// like `--set x=NaN`), a string as given; a numpy number or 0-D array as
+/// its number ([`number_arg`]). A complex number (Python's or numpy's) is
+/// refused, not read as its real part, and so is anything else, each a
+/// TypeError naming the parameter (``rig `load.mass`: (3+1j) is complex;
+/// a parameter is a real number``).
+pub fn set_text(path: &str, v: &Bound<'_, PyAny>) -> PyResult<String> {
     if v.is_none() {
         return Ok("null".into());
     }
-    if let Ok(b) = v.cast::<PyBool>() {
-        return Ok(if b.is_true() { "true" } else { "false" }.into());
+    let np = v.py().import("numpy")?;
+    if v.is_instance_of::<PyBool>() || v.is_instance(&np.getattr("bool_")?)? {
+        return Ok(if v.is_truthy()? { "true" } else { "false" }.into());
     }
     if v.is_instance_of::<PyInt>() {
         return Ok(v.str()?.to_string());
@@ -57,13 +63,32 @@ pub fn set_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
     if let Ok(s) = v.cast::<PyString>() {
         return Ok(s.to_string());
     }
-    if let Ok(x) = v.extract::<f64>() {
-        return Ok(format!("{x:?}"));
+    let name = format!("rig `{path}`");
+    let complex_array = v
+        .cast::<PyUntypedArray>()
+        .is_ok_and(|a| a.dtype().kind() == b'c');
+    if complex_array
+        || v.is_instance_of::<PyComplex>()
+        || v.is_instance(&np.getattr("complexfloating")?)?
+    {
+        return Err(PyTypeError::new_err(format!(
+            "{name}: {} is complex; a parameter is a real number",
+            v.repr()?
+        )));
     }
-    Err(PyTypeError::new_err(format!(
-        "a rig parameter is a number, a string, a bool or None, not {}",
-        v.get_type().name()?
-    )))
+    let x = if v.cast::<PyUntypedArray>().is_ok() || v.is_instance(&np.getattr("number")?)? {
+        number_arg(&name, v)?
+    } else {
+        v.extract::<f64>().map_err(|_| -> PyErr {
+            match v.get_type().name() {
+                Ok(t) => PyTypeError::new_err(format!(
+                    "{name}: a parameter is a number, a string, a bool or None, not {t}"
+                )),
+                Err(e) => e,
+            }
+        })?
+    };
+    Ok(format!("{x:?}"))
 }
 
 /// The one reader of numpy arrays: `x` as an array of element type `T`
@@ -200,6 +225,18 @@ pub fn real_array(name: &str, expected: &str, x: &Bound<'_, PyAny>) -> PyResult<
     Ok(readable::<f64, IxDyn>(a.as_any())?.to_owned_array())
 }
 
+/// An array of shape `dims` in messages: `a 2-D array of shape (2, 401)`.
+fn array_of_shape(dims: &[usize]) -> String {
+    format!(
+        "a {}-D array of shape ({})",
+        dims.len(),
+        dims.iter()
+            .map(usize::to_string)
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
+}
+
 /// The 1-D float array given as argument `name` (any array-like of real
 /// numbers, [`real_array`]), copied; anything else is a one-line error
 /// naming the argument, the shape expected and what was given (`t: expected
@@ -213,19 +250,202 @@ pub fn vector_arg(name: &str, x: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
         match a.shape() {
             [_] => return Ok(a.iter().copied().collect()),
             [] => "a scalar (a 0-D array)".to_string(),
-            dims => format!(
-                "a {}-D array of shape ({})",
-                dims.len(),
-                dims.iter()
-                    .map(usize::to_string)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
+            dims => array_of_shape(dims),
         }
     };
     Err(PyValueError::new_err(format!(
         "{name}: expected {EXPECTED}, got {got}"
     )))
+}
+
+/// One real number given as argument `name`: an int or a float (a numpy
+/// scalar or a 0-D array too), read by [`real_array`], so that anything
+/// else is refused with the argument named, as an array argument's is: a
+/// complex or a bool is a TypeError saying so, and so is a string or an
+/// array of another shape (`rtol: expected a number, got a str ('1e-6')`,
+/// `gamma: expected a number, got a 1-D array of shape (2)`), where PyO3
+/// would say only `must be real number, not str`.
+pub fn number_arg(name: &str, x: &Bound<'_, PyAny>) -> PyResult<f64> {
+    const EXPECTED: &str = "a number";
+    let got = if x.is_instance_of::<PyString>() {
+        format!("a str ({})", x.repr()?)
+    } else if x.is_none() {
+        "None".to_string()
+    } else {
+        let a = real_array(name, EXPECTED, x).map_err(|e| {
+            // a value that is not numbers at all is a wrong type here
+            if e.is_instance_of::<PyValueError>(x.py()) {
+                PyTypeError::new_err(e.value(x.py()).to_string())
+            } else {
+                e
+            }
+        })?;
+        match a.shape() {
+            [] => return Ok(a.iter().copied().next().unwrap_or(f64::NAN)),
+            dims => array_of_shape(dims),
+        }
+    };
+    Err(PyTypeError::new_err(format!(
+        "{name}: expected {EXPECTED}, got {got}"
+    )))
+}
+
+/// What a value is, for the messages of the argument readers: its repr
+/// and its type, `1 (an int)`, `'yes' (a str)`, or `None`.
+fn given(x: &Bound<'_, PyAny>) -> PyResult<String> {
+    if x.is_none() {
+        return Ok("None".into());
+    }
+    let t = x.get_type().name()?.to_string();
+    let article = if t.starts_with(['a', 'e', 'i', 'o', 'u']) {
+        "an"
+    } else {
+        "a"
+    };
+    Ok(format!("{} ({article} {t})", x.repr()?))
+}
+
+/// A str given as argument `name`; anything else is a TypeError naming
+/// the argument (`solver: expected a str, got None`), not PyO3's bare
+/// `'None' is not an instance of 'str'`.
+pub fn text_arg(name: &str, x: &Bound<'_, PyAny>) -> PyResult<String> {
+    match x.cast::<PyString>() {
+        Ok(s) => Ok(s.to_string()),
+        Err(_) => Err(PyTypeError::new_err(format!(
+            "{name}: expected a str, got {}",
+            given(x)?
+        ))),
+    }
+}
+
+/// A bool (Python's or numpy's) given as argument `name`; anything else,
+/// an int included, is a TypeError naming the argument (`ledger: expected
+/// True or False, got 1 (an int)`).
+pub fn flag_arg(name: &str, x: &Bound<'_, PyAny>) -> PyResult<bool> {
+    let np_bool = x.py().import("numpy")?.getattr("bool_")?;
+    if x.is_instance_of::<PyBool>() || x.is_instance(&np_bool)? {
+        return x.is_truthy();
+    }
+    Err(PyTypeError::new_err(format!(
+        "{name}: expected True or False, got {}",
+        given(x)?
+    )))
+}
+
+/// An int (Python's or numpy's, not a bool) given as argument `name`, or
+/// None; anything else is a TypeError naming the argument and what the
+/// int counts (`window: expected an int (samples) or None, got 3.5 (a
+/// float)`).
+pub fn int_arg(name: &str, counts: &str, x: &Bound<'_, PyAny>) -> PyResult<Option<i64>> {
+    if x.is_none() {
+        return Ok(None);
+    }
+    let np_int = x.py().import("numpy")?.getattr("integer")?;
+    let is_int =
+        (x.is_instance_of::<PyInt>() && !x.is_instance_of::<PyBool>()) || x.is_instance(&np_int)?;
+    let bad = || -> PyResult<PyErr> {
+        Ok(PyTypeError::new_err(format!(
+            "{name}: expected an int ({counts}) or None, got {}",
+            given(x)?
+        )))
+    };
+    if !is_int {
+        return Err(bad()?);
+    }
+    x.extract::<i64>().map(Some).or_else(|_| Err(bad()?))
+}
+
+/// Extractors of the arguments for `#[pyo3(from_py_with = ...)]`, one per
+/// argument name: each reads its argument with [`number_arg`],
+/// [`text_arg`], [`flag_arg`] or [`int_arg`] under its name, so that a
+/// value of another type is a TypeError naming it (PyO3 0.30 only adds a
+/// note to the traceback). PyO3 keeps the signature's default for an
+/// argument not given.
+pub mod args {
+    use super::{flag_arg, int_arg, number_arg, text_arg};
+    use pyo3::prelude::*;
+
+    macro_rules! extractors {
+        ($($(#[$doc:meta])* $f:ident: $t:ty = $read:ident($($arg:expr),*);)*) => {$(
+            $(#[$doc])*
+            pub fn $f(x: &Bound<'_, PyAny>) -> PyResult<$t> {
+                $read($($arg,)* x)
+            }
+        )*};
+    }
+
+    extractors! {
+        /// `gamma` (`xfactor`).
+        gamma: f64 = number_arg("gamma");
+        /// `rtol` (`simulate`, `simulate_batch`).
+        rtol: f64 = number_arg("rtol");
+        /// `rk4_step` (`simulate`, `simulate_batch`).
+        rk4_step: f64 = number_arg("rk4_step");
+        /// `min_share` (`diagnose`).
+        min_share: f64 = number_arg("min_share");
+        /// `holdout` (`diagnose`).
+        holdout: f64 = number_arg("holdout");
+        /// `path` (`Rig.set`, `Rig.get`).
+        path: String = text_arg("path");
+        /// `text` (`Rig.from_json`).
+        text: String = text_arg("text");
+        /// `ledger` (`simulate`).
+        ledger: bool = flag_arg("ledger");
+        /// `window` (`diagnose`): None is the smoother's own choice.
+        window: Option<i64> = int_arg("window", "samples");
+    }
+
+    /// `h_max` (`simulate`, `simulate_batch`): None is the default bound.
+    pub fn h_max(x: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+        if x.is_none() {
+            return Ok(None);
+        }
+        number_arg("h_max", x).map(Some)
+    }
+}
+
+/// A mapping given as argument `name` (`what` its keys and values map,
+/// for the message): a dict as it is, or any other object with `keys()`
+/// and `[]` — a `collections.abc.Mapping`, a `mappingproxy`, a pandas
+/// DataFrame (its columns) — as `dict(x)`, the dict of its items.
+/// `None` when `x` is none of these; [`mapping_arg`] makes that an error.
+pub fn as_mapping<'py>(x: &Bound<'py, PyAny>) -> PyResult<Option<Bound<'py, PyDict>>> {
+    if let Ok(d) = x.cast::<PyDict>() {
+        return Ok(Some(d.clone()));
+    }
+    if x.is_instance_of::<PyString>() || !x.hasattr("keys")? {
+        return Ok(None);
+    }
+    let d = x.py().get_type::<PyDict>().call1((x,))?;
+    Ok(Some(d.cast_into::<PyDict>()?))
+}
+
+/// [`as_mapping`], where anything else is a TypeError naming the argument
+/// (`params: expected a dict of {path: values}, got [('load.mass', ...)]
+/// (a list)`).
+pub fn mapping_arg<'py>(
+    name: &str,
+    what: &str,
+    x: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
+    as_mapping(x)?.ok_or_else(|| match given(x) {
+        Ok(g) => PyTypeError::new_err(format!("{name}: expected a dict of {what}, got {g}")),
+        Err(e) => e,
+    })
+}
+
+/// A dict key given in argument `name` that is to be `what` (`parameter
+/// path`, `column name`): a str, else a TypeError naming the argument and
+/// the key (`params: a key is a parameter path (a str), got 1 (an int)`),
+/// not PyO3's bare `'int' object is not an instance of 'str'`.
+pub fn key_arg(name: &str, what: &str, k: &Bound<'_, PyAny>) -> PyResult<String> {
+    match k.cast::<PyString>() {
+        Ok(s) => Ok(s.to_string()),
+        Err(_) => Err(PyTypeError::new_err(format!(
+            "{name}: a key is a {what} (a str), got {}",
+            given(k)?
+        ))),
+    }
 }
 
 /// A count given as argument `name` (at least 1), or `None`; below 1 is a
@@ -333,10 +553,14 @@ pub fn py_to_json(x: &Bound<'_, PyAny>) -> Option<Value> {
     None
 }
 
-/// Named arrays (the channels of a run or a batch), in order.
+/// Named arrays (the channels of a run or a batch), in order, with their
+/// units.
 pub struct Named<T> {
     /// Names, in order.
     pub names: Vec<String>,
+    /// One unit per name: the CLI header's (`m`, `Pa`, `-`; `V` for a
+    /// pump rig's `command`).
+    pub units: Vec<String>,
     /// One array per name (read-only: [`frozen`]).
     pub values: Vec<Py<T>>,
 }
@@ -360,20 +584,48 @@ impl<T: pyo3::PyTypeInfo> Named<T> {
             .ok_or_else(|| no_channel(name, &self.names))
     }
 
+    /// `{name: unit}`, in order.
+    pub fn units_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (n, u) in self.names.iter().zip(&self.units) {
+            d.set_item(n, u)?;
+        }
+        Ok(d)
+    }
+
     /// Whether there is an array named `name`.
     pub fn contains(&self, name: &str) -> bool {
         self.names.iter().any(|n| n == name)
     }
 
-    /// Puts the names (`"names"`) and the arrays in order (`"values"`)
-    /// into a pickled state `d`.
+    /// Puts the names (`"names"`), units (`"units"`) and the arrays in
+    /// order (`"values"`) into a pickled state `d`.
     pub fn pickle_into(&self, d: &Bound<'_, PyDict>) -> PyResult<()> {
         let py = d.py();
         d.set_item("names", &self.names)?;
+        d.set_item("units", &self.units)?;
         d.set_item(
             "values",
             PyList::new(py, self.values.iter().map(|v| v.clone_ref(py)))?,
         )
+    }
+
+    /// Named arrays from a pickled state's `names`, `units` and `values`
+    /// ([`Named::pickle_into`]); `Err` with what is wrong when their
+    /// numbers differ.
+    pub fn from_state(
+        names: Vec<String>,
+        units: Vec<String>,
+        values: Vec<Py<T>>,
+    ) -> Result<Self, &'static str> {
+        if values.len() != names.len() || units.len() != names.len() {
+            return Err("names, values and units differ in number");
+        }
+        Ok(Self {
+            names,
+            units,
+            values,
+        })
     }
 }
 

@@ -2,7 +2,7 @@
 //! record (crate `hydrocyl-identify`): residuals, the missing effects,
 //! refits, before/after; the report as a dict (the CLI's `--report` JSON).
 
-use crate::convert::{json_to_py, vector_arg};
+use crate::convert::{args, as_mapping, json_to_py, key_arg, vector_arg};
 use crate::errors::{detached, Failure};
 use crate::rig::Rig;
 use hydrocyl_identify::catalog::EffectId;
@@ -12,7 +12,6 @@ use hydrocyl_identify::valve::diagnose_valve;
 use hydrocyl_system::rig::valve_rig_from;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 /// Name of a record given as a dict, in messages (its CSV rows: row 2 is
 /// element 0).
@@ -23,21 +22,25 @@ const DICT_RECORD: &str = "record (dict; row 2 = element 0)";
 /// `command`, `position`, `p1 [bar]`, ...), checked by the same rules.
 fn read_record(obj: &Bound<'_, PyAny>) -> PyResult<Record> {
     let input = |e: hydrocyl_identify::data::DataError| PyValueError::new_err(e.to_string());
-    if let Ok(d) = obj.cast::<PyDict>() {
+    if let Some(d) = as_mapping(obj)? {
         let mut w = csv::Writer::from_writer(Vec::new());
         let mut cols = Vec::new();
         let mut header = Vec::new();
         for (k, v) in d.iter() {
-            header.push(k.extract::<String>()?);
-            cols.push(vector_arg(&format!("{DICT_RECORD}: column {k}"), &v)?);
+            let name = key_arg("record", "column name", &k)?;
+            cols.push(vector_arg(&format!("{DICT_RECORD}: column '{name}'"), &v)?);
+            header.push(name);
         }
         let csv_err = |e: csv::Error| PyValueError::new_err(format!("{DICT_RECORD}: {e}"));
         w.write_record(&header).map_err(csv_err)?;
-        let n = cols.iter().map(Vec::len).max().unwrap_or(0);
+        // the columns' headers in quotes, as the CSV readers name them
+        let longest = (0..cols.len()).max_by_key(|&j| (cols[j].len(), usize::MAX - j));
+        let n = longest.map_or(0, |j| cols[j].len());
         if let Some((h, c)) = header.iter().zip(&cols).find(|(_, c)| c.len() != n) {
             return Err(PyValueError::new_err(format!(
-                "{DICT_RECORD}: column `{h}` has {} values, another {n}",
-                c.len()
+                "{DICT_RECORD}: column '{h}' has {} values, column '{}' {n}",
+                c.len(),
+                header[longest.unwrap_or(0)]
             )));
         }
         for i in 0..n {
@@ -97,9 +100,9 @@ pub fn diagnose<'py>(
     py: Python<'py>,
     rig: &Rig,
     record: &Bound<'py, PyAny>,
-    min_share: f64,
-    holdout: f64,
-    window: Option<i64>,
+    #[pyo3(from_py_with = args::min_share)] min_share: f64,
+    #[pyo3(from_py_with = args::holdout)] holdout: f64,
+    #[pyo3(from_py_with = args::window)] window: Option<i64>,
     effects: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let bad = |m: String| Err(PyValueError::new_err(m));

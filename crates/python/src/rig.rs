@@ -2,7 +2,7 @@
 //! it, edited by the same parameter paths as `--set`, checked after every
 //! edit, and simulated on a sampled command.
 
-use crate::convert::{json_to_py, set_text, vector_arg};
+use crate::convert::{args, json_to_py, key_arg, mapping_arg, set_text, vector_arg};
 use crate::errors::interruptible;
 use crate::run::PyRun;
 use crate::sim;
@@ -202,7 +202,8 @@ impl Rig {
     /// older kind read as its netlist, a retired kind named, then checked);
     /// messages name the text `JSON text` where `load` names the file.
     #[staticmethod]
-    fn from_json(text: &str) -> PyResult<Self> {
+    fn from_json(#[pyo3(from_py_with = args::text)] text: String) -> PyResult<Self> {
+        let text = text.as_str();
         let value = rig::parse(text, JSON_TEXT).map_err(input)?;
         rig::check(&value).map_err(|e| input(rig::at_line_in(e, text, JSON_TEXT)))?;
         Ok(Self::new(value))
@@ -244,19 +245,24 @@ impl Rig {
     /// a string replaces a string), then checks the rig. On error
     /// (ValueError, the CLI's message) the rig is unchanged. Values are SI,
     /// as the rig file names them.
-    fn set(&self, path: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        self.edit(&[format!("{path}={}", set_text(value)?)])
+    fn set(
+        &self,
+        #[pyo3(from_py_with = args::path)] path: String,
+        value: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        self.edit(&[format!("{path}={}", set_text(&path, value)?)])
     }
 
     /// Sets several parameters (`{path: value}`, None for `null`), in
     /// order, then checks the rig once (for changes that are only
     /// consistent together). On error the rig is unchanged.
     /// `rig.update(rig.parameters())` changes no value (a default it writes out stays the default).
-    fn update(&self, values: &Bound<'_, PyDict>) -> PyResult<()> {
+    fn update(&self, values: &Bound<'_, PyAny>) -> PyResult<()> {
+        let values = mapping_arg("values", "{path: value}", values)?;
         let mut assignments = Vec::with_capacity(values.len());
         for (k, x) in values.iter() {
-            let path: String = k.extract()?;
-            assignments.push(format!("{path}={}", set_text(&x)?));
+            let path = key_arg("values", "parameter path", &k)?;
+            assignments.push(format!("{path}={}", set_text(&path, &x)?));
         }
         self.edit(&assignments)
     }
@@ -269,8 +275,12 @@ impl Rig {
     /// rig.get("valve.orifice.cd")`; the values of `parameters()`). An older
     /// rig kind's JSON path may also give a string or a list. ValueError for
     /// a path the rig does not have.
-    fn get<'py>(&self, py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyAny>> {
-        json_to_py(py, &self.at(path).map_err(input)?)
+    fn get<'py>(
+        &self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = args::path)] path: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.at(&path).map_err(input)?)
     }
 
     /// Every numeric (or `null`) parameter: `{path: value}` in component
@@ -378,10 +388,10 @@ impl Rig {
         t: &Bound<'_, PyAny>,
         u: &Bound<'_, PyAny>,
         solver: &str,
-        rtol: f64,
-        rk4_step: f64,
-        h_max: Option<f64>,
-        ledger: bool,
+        #[pyo3(from_py_with = args::rtol)] rtol: f64,
+        #[pyo3(from_py_with = args::rk4_step)] rk4_step: f64,
+        #[pyo3(from_py_with = args::h_max)] h_max: Option<f64>,
+        #[pyo3(from_py_with = args::ledger)] ledger: bool,
     ) -> PyResult<PyRun> {
         let (t, u) = (vector_arg("t", t)?, vector_arg("u", u)?);
         let value = self.snapshot();

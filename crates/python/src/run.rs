@@ -26,7 +26,6 @@ pub struct PyRun {
     time: Py<PyArray1<f64>>,
     n: usize,
     channels: Named<PyArray1<f64>>,
-    units: Vec<String>,
     stats: Vec<(String, f64)>,
     diagnostics: Vec<(String, f64)>,
     /// [`Ledger::to_json`], or why there is no ledger; `None` unless asked.
@@ -76,9 +75,9 @@ impl PyRun {
         Ok(Self {
             n: r.time.len(),
             time: array(py, r.time)?,
-            units: r.channels.iter().map(|c| c.unit.to_string()).collect(),
             channels: Named {
                 names: r.channels.iter().map(|c| c.name.clone()).collect(),
+                units: r.channels.iter().map(|c| c.unit.to_string()).collect(),
                 values: r
                     .channels
                     .into_iter()
@@ -123,14 +122,11 @@ impl PyRun {
         self.channels.dict(py)
     }
 
-    /// `{channel: SI unit}` (`Pa` is gauge pressure, `1` dimensionless).
+    /// `{channel: SI unit}`, the CLI header's (`Pa` is gauge pressure, `-`
+    /// dimensionless; `command` in `V` on a pump rig).
     #[getter]
     fn units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        for (n, u) in self.channels.names.iter().zip(&self.units) {
-            d.set_item(n, u)?;
-        }
-        Ok(d)
+        self.channels.units_dict(py)
     }
 
     /// Solver statistics: `steps`, `rejected`, `rhs_evals`, `jac_evals`,
@@ -227,7 +223,6 @@ impl PyRun {
         let d = PyDict::new(py);
         d.set_item("time", self.time.clone_ref(py))?;
         self.channels.pickle_into(&d)?;
-        d.set_item("units", &self.units)?;
         d.set_item("stats", self.stats.clone())?;
         d.set_item("diagnostics", self.diagnostics.clone())?;
         match &self.ledger {
@@ -262,9 +257,7 @@ impl PyRun {
             })
             .collect::<PyResult<Vec<_>>>()?;
         let units: Vec<String> = item("units")?.extract()?;
-        if values.len() != names.len() || units.len() != names.len() {
-            return Err(bad_state("names, values and units differ in number"));
-        }
+        let channels = Named::from_state(names, units, values).map_err(bad_state)?;
         let ledger = item("ledger")?;
         let ledger = if ledger.is_none() {
             None
@@ -278,8 +271,7 @@ impl PyRun {
         Ok(Self {
             time,
             n,
-            channels: Named { names, values },
-            units,
+            channels,
             stats: item("stats")?.extract()?,
             diagnostics: item("diagnostics")?.extract()?,
             ledger,

@@ -45,8 +45,16 @@ pub fn options(
 }
 
 /// The command: a first-order-hold table of `u` over `t` (the CLI's command
-/// CSV), at least two samples. The run is sampled at the same `t`.
+/// CSV), at least two samples, one value of `u` per time of `t` (else the
+/// lengths are named, not a sample). The run is sampled at the same `t`.
 pub fn command(t: &[f64], u: &[f64]) -> Outcome<Signal> {
+    if t.len() != u.len() {
+        return Err(Failure::Input(format!(
+            "command (t, u): t has {} samples but u has {} (one command value per time)",
+            t.len(),
+            u.len()
+        )));
+    }
     if t.len() < 2 {
         return Err(Failure::Input(format!(
             "command (t, u): needs at least two samples, found {}",

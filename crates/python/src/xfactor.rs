@@ -1,7 +1,7 @@
 //! `hydrocyl.xfactor`: Leaney's X factor (thesis eqs 3.4–3.30, crate
 //! `hydrocyl-xfactor`) over an array of spool travels.
 
-use crate::convert::real_array;
+use crate::convert::{args, real_array};
 use crate::errors::{detached, Failure};
 use hydrocyl_xfactor::XFactorError;
 use numpy::{IntoPyArray, PyArrayDyn};
@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 #[pyfunction]
 pub fn xfactor<'py>(
     py: Python<'py>,
-    gamma: f64,
+    #[pyo3(from_py_with = args::gamma)] gamma: f64,
     travel: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let travel = real_array("travel", "an array of numbers", travel)?;

@@ -175,3 +175,18 @@ def test_a_batch_names_a_parameter_out_of_range_as_rig_set_does():
     assert str(batch.value) == f"run 1 ({path}=-1.0): {single.value}"
     kept = hydrocyl.simulate_batch(rig, t, u, {path: [rig.get(path), -1.0]}, on_error="nan")
     assert kept.errors[1] == f"run 1 ({path}=-1.0): {single.value}"
+
+
+@pytest.mark.parametrize("preset", ["leaney-moog", "wang-hybrid"])
+def test_a_batch_carries_the_units_of_its_channels_as_a_run_does(preset):
+    """batch.units is {channel: unit} as run.units (the CLI header's:
+    `command` in V on a pump rig), for the channels kept, in their order."""
+    rig = hydrocyl.Rig.load(preset)
+    t = np.linspace(0.0, 0.02, 41)
+    u = np.zeros_like(t)
+    run = rig.simulate(t, u)
+    mass = path_of(rig, "mass")
+    batch = hydrocyl.simulate_batch(rig, t, u, {mass: [rig.get(mass)] * 2})
+    assert list(batch.units.items()) == list(run.units.items())
+    kept = hydrocyl.simulate_batch(rig, t, u, {mass: [rig.get(mass)]}, channels=["p1", "position"])
+    assert list(kept.units.items()) == [("position", "m"), ("p1", "Pa")]

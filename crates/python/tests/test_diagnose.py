@@ -66,7 +66,7 @@ def test_a_dict_record_column_of_complex_numbers_is_a_type_error_naming_it(repo)
     data = np.loadtxt(path, delimiter=",", skiprows=1)
     record = {h: data[:, i] for i, h in enumerate(header)}
     record[header[1]] = record[header[1]].astype(np.complex128)
-    with pytest.raises(TypeError, match=rf"column {re.escape(header[1])}: complex numbers are not accepted"):
+    with pytest.raises(TypeError, match=rf"column '{re.escape(header[1])}': complex numbers are not accepted"):
         hydrocyl.diagnose(hydrocyl.Rig.load("leaney-moog"), record, effects=["internal_leakage"])
 
 
@@ -83,6 +83,12 @@ def test_diagnose_errors(repo):
         hydrocyl.diagnose(rig, {"time": t, "command": 0 * t})
     with pytest.raises(ValueError, match="no-such.csv"):
         hydrocyl.diagnose(rig, str(repo / "no-such.csv"))
+    # a dict record's columns are named in quotes, as the CSV readers name them
+    with pytest.raises(ValueError) as e:
+        hydrocyl.diagnose(rig, {"time": t, "command": t[:-2], "position": t})
+    assert str(e.value) == "record (dict; row 2 = element 0): column 'command' has 48 values, column 'time' 50"
+    with pytest.raises(ValueError, match=r"^record \(dict; row 2 = element 0\): column 'p1 \[bar\]': expected a 1-D array"):
+        hydrocyl.diagnose(rig, {"time": t, "p1 [bar]": np.zeros((2, 2))})
 
 
 @pytest.mark.parametrize("window", [1, 0, -1])

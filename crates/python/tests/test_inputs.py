@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import hydrocyl
-from conftest import unaligned
+from conftest import REPO, unaligned
 
 
 def big_endian(a):
@@ -198,3 +198,153 @@ def test_strings_are_a_value_error_naming_the_argument(rig, command):
     t, _ = command
     with pytest.raises(ValueError, match=r"^u: expected a 1-D array of numbers, got a ndarray of <U3 \(not numbers\)$"):
         rig.simulate(t, np.full(t.size, "0.5"))
+
+
+def number_arguments(rig, command):
+    """(argument name, call with that argument set to x) for every argument
+    that is one real number."""
+    t, u = command
+    rec = str(REPO / "fixtures/measured/valve-none.csv")
+    batch = lambda **kw: hydrocyl.simulate_batch(rig, t, u, {"load.mass": [50.0]}, **kw)  # noqa: E731
+    return [
+        ("gamma", lambda x: hydrocyl.xfactor(x, [0.0])),
+        ("rtol", lambda x: rig.simulate(t, u, rtol=x)),
+        ("rk4_step", lambda x: rig.simulate(t, u, solver="rk4", rk4_step=x)),
+        ("h_max", lambda x: rig.simulate(t, u, h_max=x)),
+        ("rtol", lambda x: batch(rtol=x)),
+        ("rk4_step", lambda x: batch(solver="rk4", rk4_step=x)),
+        ("h_max", lambda x: batch(h_max=x)),
+        ("min_share", lambda x: hydrocyl.diagnose(rig, rec, min_share=x)),
+        ("holdout", lambda x: hydrocyl.diagnose(rig, rec, holdout=x)),
+    ]
+
+
+@pytest.mark.parametrize(
+    "bad, why",
+    [
+        ("1e-6", r"expected a number, got a str \('1e-6'\)"),
+        (np.array([1e-6, 1e-5]), r"expected a number, got a 1-D array of shape \(2\)"),
+        (1 + 0j, r"complex numbers are not accepted"),
+        (True, r"booleans are not accepted as numbers"),
+    ],
+)
+def test_an_argument_that_is_not_one_number_is_a_type_error_naming_it(rig, command, bad, why):
+    """A number argument given as a str, an array, a complex or a bool is a
+    TypeError that names the argument, as an array argument's is (not
+    PyO3's bare `must be real number, not str`)."""
+    for name, call in number_arguments(rig, command):
+        with pytest.raises(TypeError, match=rf"^{re.escape(name)}: {why}"):
+            call(bad)
+
+
+def test_a_number_argument_takes_ints_and_numpy_scalars(rig, command, reference):
+    t, u = command
+    same_run(rig.simulate(t, u, rtol=np.float64(1e-6), h_max=np.float64(0.01)), reference)
+    same_run(rig.simulate(t, u, h_max=np.array(0.01)), reference)
+    assert hydrocyl.xfactor(2, [0.0]) == hydrocyl.xfactor(np.int64(2), [0.0]) == hydrocyl.xfactor(2.0, [0.0])
+
+
+@pytest.mark.parametrize(
+    "call, name, what",
+    [
+        (lambda rig, t, u: hydrocyl.simulate_batch(rig, t, u, {1: [50.0]}), "params", "parameter path"),
+        (lambda rig, t, u: rig.update({("load", "mass"): 50.0}), "values", "parameter path"),
+        (lambda rig, t, u: hydrocyl.diagnose(rig, {"time": t, 2: u}), "record", "column name"),
+    ],
+)
+def test_a_key_that_is_not_a_str_is_a_type_error_naming_the_argument(rig, command, call, name, what):
+    t, u = command
+    with pytest.raises(TypeError, match=rf"^{name}: a key is a {what} \(a str\), got .* \(an? (int|tuple)\)$"):
+        call(rig, t, u)
+
+
+@pytest.mark.parametrize(
+    "name, call, why",
+    [
+        ("ledger", lambda rig, t, u: rig.simulate(t, u, ledger=1), r"expected True or False, got 1 \(an int\)"),
+        ("ledger", lambda rig, t, u: rig.simulate(t, u, ledger="yes"), r"expected True or False, got 'yes' \(a str\)"),
+        ("window", lambda rig, t, u: hydrocyl.diagnose(rig, "rec.csv", window=3.5), r"expected an int \(samples\) or None, got 3\.5 \(a float\)"),
+        ("window", lambda rig, t, u: hydrocyl.diagnose(rig, "rec.csv", window=True), r"expected an int \(samples\) or None, got True \(a bool\)"),
+        ("path", lambda rig, t, u: rig.set(5, 1.0), r"expected a str, got 5 \(an int\)"),
+        ("path", lambda rig, t, u: rig.get(None), r"expected a str, got None"),
+        ("text", lambda rig, t, u: hydrocyl.Rig.from_json(b"{}"), r"expected a str, got b'\{\}' \(a bytes\)"),
+    ],
+)
+def test_an_argument_of_another_type_is_a_type_error_naming_it(rig, command, name, call, why):
+    """A str, bool or int argument of another type is a TypeError naming
+    the argument, not PyO3's bare `'None' is not an instance of 'str'`
+    (`solver` and `on_error`, whose defaults are str literals in the
+    signature, are not among them)."""
+    t, u = command
+    with pytest.raises(TypeError, match=rf"^{name}: {why}") as e:
+        call(rig, t, u)
+    # the message is one line (PyO3 adds a note, shown in tracebacks only)
+    assert "\n" not in str(e.value)
+
+
+def test_an_int_window_may_be_a_numpy_int(rig):
+    rec = str(REPO / "fixtures/measured/valve-none.csv")
+    with pytest.raises(ValueError, match=r"^window 1: must be at least 2"):
+        hydrocyl.diagnose(rig, rec, window=np.int64(1))
+
+
+class TableLike:
+    """A table that is not a dict but has `keys()` and `[]` (as a pandas
+    DataFrame: `dict(table)` is its columns)."""
+
+    def __init__(self, columns):
+        self._columns = dict(columns)
+
+    def keys(self):
+        return list(self._columns)
+
+    def __getitem__(self, k):
+        return self._columns[k]
+
+
+def test_a_mapping_that_is_not_a_dict_is_read_as_its_items(rig, command, reference):
+    """`params`, `rig.update`'s values and a `diagnose` record are typed
+    Mapping: a mappingproxy, a collections.abc.Mapping or a DataFrame-like
+    table (keys() and []) is read as the dict of its items, not refused as
+    `'mappingproxy' object is not an instance of 'dict'`."""
+    import collections.abc
+    import types
+
+    class Frozen(collections.abc.Mapping):
+        def __init__(self, d):
+            self._d = dict(d)
+
+        def __getitem__(self, k):
+            return self._d[k]
+
+        def __iter__(self):
+            return iter(self._d)
+
+        def __len__(self):
+            return len(self._d)
+
+    t, u = command
+    sets = {"load.mass": np.array([40.0, 60.0])}
+    want = hydrocyl.simulate_batch(rig, t, u, sets)
+    for wrap in (types.MappingProxyType, Frozen, TableLike):
+        got = hydrocyl.simulate_batch(rig, t, u, wrap(sets))
+        np.testing.assert_array_equal(got["position"], want["position"])
+        one = rig.copy()
+        one.update(wrap({"load.mass": 40.0}))
+        assert one.get("load.mass") == 40.0
+    # a record read as the dict of its columns (not refused as no path)
+    with pytest.raises(ValueError, match=r"^record \(dict; row 2 = element 0\): only 3 samples"):
+        hydrocyl.diagnose(rig, TableLike({"time": t[:3], "command": u[:3], "position": u[:3]}))
+
+
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda rig, t, u: hydrocyl.simulate_batch(rig, t, u, [("load.mass", [50.0])]), "params"),
+        (lambda rig, t, u: rig.update([("load.mass", 50.0)]), "values"),
+    ],
+)
+def test_a_list_of_pairs_for_a_mapping_is_a_type_error_naming_it(rig, command, call, name):
+    t, u = command
+    with pytest.raises(TypeError, match=rf"^{name}: expected a dict of .*, got \[\('load.mass'"):
+        call(rig, t, u)

@@ -96,6 +96,7 @@ def assert_same_run(a, b):
 
 def assert_same_batch(a, b):
     assert a.names == b.names and len(a) == len(b)
+    assert list(a.units.items()) == list(b.units.items())
     assert same_array(a.time, b.time) and same_array(a.ok, b.ok)
     for name in a.names:
         assert same_array(a[name], b[name]), name

@@ -124,6 +124,39 @@ def test_set_rejects_values_that_are_not_parameters():
         rig.set(path_of(rig, "mass"), [1, 2])
 
 
+def test_a_numpy_bool_or_complex_is_not_read_as_a_number_and_errors_name_the_path():
+    """numpy's bool and complex scalars are what Python's are: a bool is
+    refused for a number (`np.True_` was set as 1.0, `True` refused), a
+    complex is refused (np.complex128(3+1j) was set as 3.0, the imaginary
+    part dropped with only a ComplexWarning); a value that is not one
+    number names the path; the rig is left unchanged."""
+    import warnings
+
+    rig = hydrocyl.Rig.load("leaney-moog")
+    before = rig.get("load.mass")
+    with pytest.raises(ValueError) as py_bool:
+        rig.set("load.mass", True)
+    with pytest.raises(ValueError) as np_bool:
+        rig.set("load.mass", np.True_)
+    assert str(np_bool.value) == str(py_bool.value)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for z in (3 + 1j, np.complex128(3 + 1j), np.array(3 + 0j)):
+            with pytest.raises(TypeError, match=r"^rig `load.mass`: .* is complex; a parameter is a real number$"):
+                rig.set("load.mass", z)
+            with pytest.raises(TypeError, match=r"^rig `load.mass`: .* is complex"):
+                rig.update({"load.mass": z})
+    with pytest.raises(TypeError, match=r"^rig `load.mass`: expected a number, got a 1-D array of shape \(2\)"):
+        rig.set("load.mass", np.array([1.0, 2.0]))
+    with pytest.raises(TypeError, match=r"^rig `load.mass`: a parameter is a number, a string, a bool or None, not dict$"):
+        rig.set("load.mass", {"a": 1})
+    assert rig.get("load.mass") == before
+    # numpy's numbers and 0-D arrays are numbers
+    for x in (np.float32(60.5), np.int64(61), np.array(62.0)):
+        rig.set("load.mass", x)
+        assert rig.get("load.mass") == float(x)
+
+
 def test_describe_gives_each_parameters_value_unit_and_meaning_from_the_registry(cli):
     """`describe()` (documented, once missing): `{path: {value, unit, doc}}`
     for every parameter, the unit and meaning those of the component

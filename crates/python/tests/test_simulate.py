@@ -132,8 +132,13 @@ def test_bad_commands(step):
     t_back[5] = t_back[4]
     with pytest.raises(ValueError, match="command sample 5: time .* does not increase"):
         rig.simulate(t_back, u)
-    with pytest.raises(ValueError, match="401 times but 400 values"):
+    # t and u of different lengths: said so, not as a sample's fault
+    # (it was `command sample 400: 401 times but 400 values`)
+    with pytest.raises(ValueError) as e:
         rig.simulate(t, u[:-1])
+    assert str(e.value) == "command (t, u): t has 401 samples but u has 400 (one command value per time)"
+    with pytest.raises(ValueError, match=r"^command \(t, u\): t has 401 samples but u has 402"):
+        hydrocyl.simulate_batch(rig, t, np.append(u, 0.0), {"load.mass": [50.0]})
     with pytest.raises(ValueError, match="at least two samples"):
         rig.simulate(t[:1], u[:1])
 

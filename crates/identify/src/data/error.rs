@@ -123,7 +123,10 @@ pub enum DataError {
         file: String,
     },
     /// A cell is not a number.
-    #[error("{file}: row {row}, column '{column}': '{text}' is not a number")]
+    #[error(
+        "{file}: row {row}, column '{column}': '{text}' is not a number{}",
+        decimal_comma_hint(text)
+    )]
     NotANumber {
         /// The file.
         file: String,
@@ -263,6 +266,27 @@ pub enum DataError {
         /// Samples needed.
         min: usize,
     },
+}
+
+/// The hint after "is not a number" for a cell written with a decimal
+/// comma (`0,5`, `-1,25e-3`: a spreadsheet in a locale that writes one,
+/// its cells quoted in a comma-separated file): ``(a decimal comma:
+/// hydrocyl reads a decimal point, `0.5`)``; empty for any other text.
+fn decimal_comma_hint(text: &str) -> String {
+    let Some((int, frac)) = text.trim().split_once(',') else {
+        return String::new();
+    };
+    let int_digits = int.strip_prefix(['-', '+']).unwrap_or(int);
+    let mantissa = frac.split(['e', 'E']).next().unwrap_or(frac);
+    let digits = |d: &str| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit());
+    let point = format!("{int},{frac}").replacen(',', ".", 1);
+    if !digits(int_digits) || !digits(mantissa) || point.trim().parse::<f64>().is_err() {
+        return String::new();
+    }
+    format!(
+        " (a decimal comma: hydrocyl reads a decimal point, `{}`)",
+        point.trim()
+    )
 }
 
 impl DataError {

@@ -53,6 +53,42 @@ pub fn foreign_separator(headers: &[&str]) -> Option<String> {
     ))
 }
 
+/// Why a file's bytes are not UTF-8 text that a CSV reader can read, when
+/// they are text in a wide encoding: UTF-16 or UTF-32, told by its
+/// byte-order mark, or UTF-16 without one, told by a NUL byte beside each
+/// character of the first line (a spreadsheet's "Unicode text" export).
+/// Read as UTF-8 such a file's header would be `t\0i\0m\0e\0`, which no
+/// column matches ("missing column 'time'"). Every CSV reader of hydrocyl
+/// (records, command files) gives this message for row 1.
+pub fn foreign_encoding(bytes: &[u8]) -> Option<String> {
+    let (encoding, mark) = match bytes {
+        [0xFF, 0xFE, 0, 0, ..] => ("UTF-32", Some("FF FE 00 00")),
+        [0, 0, 0xFE, 0xFF, ..] => ("UTF-32", Some("00 00 FE FF")),
+        [0xFF, 0xFE, ..] => ("UTF-16", Some("FF FE")),
+        [0xFE, 0xFF, ..] => ("UTF-16", Some("FE FF")),
+        _ => {
+            // UTF-16 without a mark: ASCII characters each with a NUL byte
+            // before (big-endian) or after (little-endian) it
+            let line = bytes.split(|&b| b == b'\n').next().unwrap_or(bytes);
+            let head = &line[..line.len().min(64) & !1];
+            let ascii = |b: u8| b != 0 && b.is_ascii();
+            let le = head.chunks(2).all(|c| ascii(c[0]) && c[1] == 0);
+            let be = head.chunks(2).all(|c| c[0] == 0 && ascii(c[1]));
+            if head.len() < 4 || !(le || be) {
+                return None;
+            }
+            ("UTF-16", None)
+        }
+    };
+    let mark = mark.map_or_else(
+        || "no byte-order mark, a NUL byte beside each character".to_string(),
+        |m| format!("byte-order mark {m}"),
+    );
+    Some(format!(
+        "the file is {encoding} text ({mark}); hydrocyl reads UTF-8 (or ASCII) text: save it as UTF-8 CSV"
+    ))
+}
+
 /// Finds the signals among `headers` (trimmed), directly or through `map`.
 fn map_columns(file: &str, headers: &[&str], map: &ColumnMap) -> Result<Columns, DataError> {
     if let Some(reason) = foreign_separator(headers) {
@@ -142,6 +178,13 @@ impl Record {
             file: file.clone(),
             reason: e.to_string(),
         })?;
+        if let Some(reason) = foreign_encoding(&bytes) {
+            return Err(DataError::Malformed {
+                file,
+                row: 1,
+                reason,
+            });
+        }
         // bytes that are not UTF-8 (a logger's `°C` in Windows-1252 in a
         // column that is not a signal) are kept as U+FFFD: such a column is
         // kept and ignored, and a signal's cell or header with one is
@@ -192,7 +235,7 @@ impl Record {
                     hint: if map.0.contains_key(&Signal::Time) {
                         String::new()
                     } else {
-                        unread_header_hint(&header_list, "time")
+                        missing_time_hint(&header_list)
                     },
                     column: map
                         .0
@@ -397,6 +440,34 @@ pub fn unread_header_hint<S: AsRef<str>>(headers: &[S], signal: &str) -> String 
         .unwrap_or_default()
 }
 
+/// Where `time` is missing from a file whose row 1 is `headers`: the hint
+/// of [`unread_header_hint`]; or, where row 1 is not a header at all but a
+/// line above it — a comment (`# ...`, `% ...`, `// ...`) or a
+/// spreadsheet's separator line (`sep=,`) — `(row 1, 'sep=', is not a
+/// header: the header must be the file's first line; delete the line(s)
+/// above it)`; empty where there is neither. Both CSV readers (records,
+/// command files) end their "missing column 'time'" with it.
+pub fn missing_time_hint<S: AsRef<str>>(headers: &[S]) -> String {
+    let hint = unread_header_hint(headers, "time");
+    if !hint.is_empty() {
+        return hint;
+    }
+    let Some(first) = headers.first().map(|h| h.as_ref().trim()) else {
+        return hint;
+    };
+    let first = first.trim_start_matches('\u{feff}');
+    let above = ["#", "%", "//"].iter().any(|p| first.starts_with(p))
+        || first
+            .get(..4)
+            .is_some_and(|p| p.eq_ignore_ascii_case("sep="));
+    if !above {
+        return hint;
+    }
+    format!(
+        " (row 1, '{first}', is not a header: the header must be the file's first line; delete the line(s) above it)"
+    )
+}
+
 /// The file line (1-based, blank lines counted) of byte offsets of a text,
 /// asked in increasing order: the CSV reader's own line count skips the
 /// blank lines it skips. Shared by every CSV reader of hydrocyl.
@@ -484,6 +555,93 @@ mod tests {
                 e.contains("row 1") && e.contains(&format!("separated by {sep}")),
                 "{e}"
             );
+        }
+    }
+
+    #[test]
+    fn a_utf16_or_utf32_file_is_named_as_such() {
+        let text = "time,command,position\n0,0,0\n1,0,0\n";
+        let utf16le: Vec<u8> = text.encode_utf16().flat_map(u16::to_le_bytes).collect();
+        let utf16be: Vec<u8> = text.encode_utf16().flat_map(u16::to_be_bytes).collect();
+        let utf32le: Vec<u8> = text
+            .chars()
+            .flat_map(|c| (c as u32).to_le_bytes())
+            .collect();
+        let with_mark = |mark: &[u8], b: &[u8]| [mark, b].concat();
+        let dir = std::env::temp_dir().join(format!("hydrocyl-utf16-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (bytes, words) in [
+            (
+                with_mark(&[0xFF, 0xFE], &utf16le),
+                "UTF-16 text (byte-order mark FF FE)",
+            ),
+            (
+                with_mark(&[0xFE, 0xFF], &utf16be),
+                "UTF-16 text (byte-order mark FE FF)",
+            ),
+            (utf16le.clone(), "UTF-16 text (no byte-order mark"),
+            (utf16be, "UTF-16 text (no byte-order mark"),
+            (
+                with_mark(&[0xFF, 0xFE, 0, 0], &utf32le),
+                "UTF-32 text (byte-order mark FF FE 00 00)",
+            ),
+        ] {
+            let p = dir.join("rec.csv");
+            std::fs::write(&p, &bytes).unwrap();
+            let e = Record::read(&p).unwrap_err().to_string();
+            assert!(
+                e.starts_with(&format!("{}: row 1: the file is {words}", p.display()))
+                    && e.contains("save it as UTF-8 CSV")
+                    && !e.contains('\n'),
+                "{e}"
+            );
+        }
+        // UTF-8 text, with its mark or not, and a one-character line are not
+        for ok in [text.as_bytes(), "\u{feff}time\n".as_bytes(), b"t\n0\n"] {
+            assert_eq!(foreign_encoding(ok), None);
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_line_above_the_header_is_named_as_not_the_header() {
+        let body = "time,position\n0,0\n1,0\n2,0\n3,0\n4,0\n5,0\n6,0\n7,0\n";
+        for (line, cell) in [
+            ("sep=,", "sep="),
+            ("SEP=,", "SEP="),
+            ("# rig 3, 2024-05-01", "# rig 3"),
+            ("% logged", "% logged"),
+            ("\u{feff}// export", "// export"),
+        ] {
+            let e = parse(&format!("{line}\n{body}")).unwrap_err().to_string();
+            assert_eq!(
+                e,
+                format!("t.csv: row 1: missing column 'time' (row 1, '{cell}', is not a header: the header must be the file's first line; delete the line(s) above it)")
+            );
+        }
+        // a header without time that is a header gets no such hint
+        let e = parse("position,p1\n0,0\n").unwrap_err().to_string();
+        assert_eq!(e, "t.csv: row 1: missing column 'time'");
+    }
+
+    #[test]
+    fn a_decimal_comma_is_named_with_the_number_meant() {
+        let ok = "time,position\n0,0\n1,0\n2,0\n3,0\n4,0\n5,0\n6,0\n7,0\n";
+        for (cell, meant) in [("0,5", "0.5"), ("-1,25e-3", "-1.25e-3"), (" 12,0 ", "12.0")] {
+            let e = parse(&ok.replace("3,0", &format!("3,\"{cell}\"")))
+                .unwrap_err()
+                .to_string();
+            assert_eq!(
+                e,
+                format!("t.csv: row 5, column 'position': '{}' is not a number (a decimal comma: hydrocyl reads a decimal point, `{meant}`)", cell.trim())
+            );
+        }
+        // text that is no number with a decimal comma gets no hint
+        for cell in ["1,2,3", "a,5", "5,", ",5", "abc"] {
+            let e = parse(&ok.replace("3,0", &format!("3,\"{cell}\"")))
+                .unwrap_err()
+                .to_string();
+            assert!(e.ends_with("is not a number"), "{e}");
         }
     }
 

@@ -318,20 +318,26 @@ fn table_of(
     })
 }
 
-/// The fast path's view of command CSV `bytes` (of file `file`): the
-/// plain text and where its columns are; `None` for the full reader.
-fn plain_columns<'a>(
-    file: &str,
-    bytes: &'a [u8],
-    unit: CommandUnit,
-) -> Option<(PlainCsv<'a>, Columns)> {
-    let text = std::str::from_utf8(bytes).ok()?;
-    let csv = PlainCsv::new(text)?;
-    // the header cells split and trimmed as the full reader reads a header
-    // without quotes (which a plain one is): building that reader (its
-    // state machine) cost more than reading a short command file
-    let c = columns_of(file, csv.headers(), unit).ok()?;
-    Some((csv, c))
+/// The fast path's view of command CSV `bytes`: its plain text; `None`
+/// for the full reader.
+fn plain_text(bytes: &[u8]) -> Option<PlainCsv<'_>> {
+    PlainCsv::new(std::str::from_utf8(bytes).ok()?)
+}
+
+/// Where the columns of `unit` are in the plain text `csv` of file `file`;
+/// `None` for the full reader. The header cells are split and trimmed as
+/// the full reader reads a header without quotes (which a plain one is):
+/// building that reader (its state machine) cost more than reading a short
+/// command file.
+fn plain_columns(file: &str, csv: &PlainCsv, unit: CommandUnit) -> Option<Columns> {
+    columns_of(file, csv.headers(), unit).ok()
+}
+
+/// The second half of the body of the plain text `csv` (after
+/// [`cut_of`]); `None` when it is not long enough to halve.
+fn second_half<'a>(csv: &PlainCsv<'a>) -> Option<&'a [u8]> {
+    let body = csv.body().as_bytes();
+    Some(&body[cut_of(body)?..])
 }
 
 /// Where a plain body long enough to halve is cut: after the line end at
@@ -343,16 +349,6 @@ fn cut_of(body: &[u8]) -> Option<usize> {
     let mid = body.len() / 2;
     let at = body[mid..].iter().position(|&b| b == b'\n')?;
     Some(mid + at + 1).filter(|&cut| cut < body.len())
-}
-
-/// The plain text of command CSV `bytes` and the second half of its body
-/// (after [`cut_of`]); `None` when it is not plain or not long enough to
-/// halve.
-fn second_half(bytes: &[u8]) -> Option<(PlainCsv<'_>, &[u8])> {
-    let csv = PlainCsv::new(std::str::from_utf8(bytes).ok()?)?;
-    let body = csv.body().as_bytes();
-    let piece = &body[cut_of(body)?..];
-    Some((csv, piece))
 }
 
 /// The cells of columns `[time, command]` (indices) of the whole lines
@@ -389,19 +385,20 @@ struct Early {
 }
 
 impl Early {
-    /// Parses the halves of `bytes` (a plain body long enough to halve;
-    /// else `None`); the second only when `second_taken` was not yet set
-    /// (by the caller, which then parses it), and sets it.
-    fn parse(bytes: &[u8], second_taken: &AtomicBool) -> Option<Self> {
-        let csv = PlainCsv::new(std::str::from_utf8(bytes).ok()?)?;
+    /// Parses the halves of the plain text `csv` (a body long enough to
+    /// halve; else `None`); the second only when `second_taken` was not yet
+    /// set (by the caller, which then parses it), and sets it.
+    fn parse(csv: &PlainCsv, second_taken: &AtomicBool) -> Option<Self> {
         let names: Vec<&str> = csv.headers().map(|h| name_unit(h).0).collect();
         let at = |name: &str| names.iter().position(|n| *n == name);
-        let columns = [at("time")?, at("command").or_else(|| at("reference"))?];
+        let input =
+            at(CommandUnit::Normalised.column()).or_else(|| at(CommandUnit::Reference.column()))?;
+        let columns = [at("time")?, input];
         let body = csv.body().as_bytes();
         let cut = cut_of(body)?;
-        let first = parse_piece(&csv, columns, &body[..cut]);
+        let first = parse_piece(csv, columns, &body[..cut]);
         let second = (!second_taken.swap(true, Ordering::AcqRel))
-            .then(|| parse_piece(&csv, columns, &body[cut..]));
+            .then(|| parse_piece(csv, columns, &body[cut..]));
         Some(Early {
             columns,
             first,
@@ -486,29 +483,28 @@ impl Ahead {
             let _ = send.send(b.clone());
         }
         crate::progress::mark("command: read");
-        let early = read
-            .as_ref()
-            .ok()
-            .and_then(|b| Early::parse(b, second_taken));
+        let csv = read.as_deref().ok().and_then(|b| plain_text(b));
+        let early = csv.as_ref().and_then(|c| Early::parse(c, second_taken));
         crate::progress::mark("command: parsed early");
         // the run stopped before it needed the command: nothing to say
         let Ok(unit) = told.recv() else {
             return Ok(Read::Whole(None));
         };
         crate::progress::mark("command: unit told");
-        let bytes = read?;
-        if let Some((csv, c)) = plain_columns(&path.display().to_string(), &bytes, unit) {
+        if let Some(csv) = &csv {
             let body = csv.body().as_bytes();
-            if let Some(cut) = cut_of(body) {
+            let file = path.display().to_string();
+            if let (Some(c), Some(cut)) = (plain_columns(&file, csv, unit), cut_of(body)) {
                 let columns = [c.time, c.command];
                 return Ok(match early.filter(|e| e.columns == columns) {
                     Some(e) => Read::Half(e.first, e.second),
                     // parsed on other columns: the second half, if this
                     // thread took it, is parsed again by the caller
-                    None => Read::Half(parse_piece(&csv, columns, &body[..cut]), None),
+                    None => Read::Half(parse_piece(csv, columns, &body[..cut]), None),
                 });
             }
         }
+        let bytes = read?;
         read_table(path, &bytes, unit).map(|t| Read::Whole(Some(t)))
     }
 
@@ -524,49 +520,51 @@ impl Ahead {
     pub fn table(self, unit: CommandUnit) -> Result<Option<Table>, CliError> {
         let file = self.path.display().to_string();
         let bytes = self.bytes.recv().ok();
-        let columns = bytes
-            .as_ref()
-            .and_then(|b| plain_columns(&file, b, unit).map(|(_, c)| c));
-        let parse_second = |b: &[u8], c: &Columns| -> Option<Piece> {
-            let (csv, piece) = second_half(b)?;
-            Some(parse_piece(&csv, [c.time, c.command], piece))
+        // the plain text, the unit's columns in it and its second half
+        let plain = bytes.as_deref().and_then(|b| {
+            let csv = plain_text(b)?;
+            let c = plain_columns(&file, &csv, unit)?;
+            let piece = second_half(&csv)?;
+            Some((csv, c, piece))
+        });
+        let parse_second = |(csv, c, piece): &(PlainCsv, Columns, &[u8])| -> Piece {
+            parse_piece(csv, [c.time, c.command], piece)
         };
         // the second half here, unless the reading thread took it first
-        let mut second = match (&bytes, &columns) {
-            (Some(b), Some(c)) if !self.second_taken.swap(true, Ordering::AcqRel) => {
-                parse_second(b, c)
-            }
+        let mut second = match &plain {
+            Some(p) if !self.second_taken.swap(true, Ordering::AcqRel) => Some(parse_second(p)),
             _ => None,
         };
         let read = self
             .read
             .recv()
             .map_err(|_| CliError::Input("the command file's reader failed".into()))??;
-        let (first, bytes) = match (read, bytes) {
-            (Read::Whole(t), _) => return Ok(t),
-            (Read::Half(first, early), Some(bytes)) => {
+        let first = match read {
+            Read::Whole(t) => return Ok(t),
+            Read::Half(first, early) => {
                 // the thread's second half (on the unit's columns), or, if
                 // it took it and parsed it on others, the second half now
                 second = second.or(early);
                 if second.is_none() {
-                    second = columns.as_ref().and_then(|c| parse_second(&bytes, c));
+                    second = plain.as_ref().map(parse_second);
                 }
-                (first, bytes)
+                first
             }
-            (Read::Half(..), None) => return Err(CliError::Input(format!("{file}: not read"))),
         };
-        let blank = second_half(&bytes)
-            .is_some_and(|(_, piece)| piece.iter().all(|&b| b == b'\n' || b == b'\r'));
         // both halves plain (blank lines only at the very end), or the
         // full reader, which names what is wrong
-        let halves = second.zip(columns).and_then(|(second, c)| {
+        let halves = second.zip(plain).and_then(|(second, (_, c, piece))| {
             let ((end, mut first), (_, mut second)) = (first?, second?);
-            if end == Body::BlankEnd && !blank {
+            if end == Body::BlankEnd && !piece.iter().all(|&b| b == b'\n' || b == b'\r') {
                 return None;
             }
             scaled_halves(&mut first, &mut second, &c)?;
             Some((first, second, c.time_header))
         });
+        // a half read by the thread and no bytes here: the thread read them
+        let Some(bytes) = bytes else {
+            return Err(CliError::Input(format!("{file}: not read")));
+        };
         match halves {
             Some((first, second, column)) => {
                 // the file's bytes, done with, are freed first: the table

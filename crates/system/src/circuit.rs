@@ -590,24 +590,41 @@ impl Circuit {
             k.x.extend_from_slice(x);
         }
         let mut w = self.wires.borrow_mut();
-        for &a in &self.accumulators {
-            w.zero(a);
-        }
-        for (c, o) in self.comps.iter().zip(self.offsets.windows(2)) {
-            c.publish(t, &x[o[0]..o[1]], &mut w);
-        }
-        self.evaluate_steps(&self.order, t, x, &mut w);
+        self.publish_and_evaluate(None, &self.order, t, x, &mut w);
         if !self.settlers.is_empty() {
             self.settle(t, x, &mut w);
         }
     }
 
-    /// Runs `steps` on the published wires (the accumulators zeroed):
-    /// every step for [`Circuit::fill`], or those some wires depend on
+    /// Zeroes the accumulators, publishes the components `publishers`
+    /// (every one for `None`) and runs `steps`: all of them for
+    /// [`Circuit::fill`], or what some wires depend on
     /// ([`Circuit::partial_for`]).
     #[inline]
-    fn evaluate_steps(&self, steps: &[Step], t: f64, x: &[f64], w: &mut Wires) {
+    fn publish_and_evaluate(
+        &self,
+        publishers: Option<&[usize]>,
+        steps: &[Step],
+        t: f64,
+        x: &[f64],
+        w: &mut Wires,
+    ) {
+        for &a in &self.accumulators {
+            w.zero(a);
+        }
         let xs = |i: usize| &x[self.offsets[i]..self.offsets[i + 1]];
+        match publishers {
+            None => {
+                for (c, o) in self.comps.iter().zip(self.offsets.windows(2)) {
+                    c.publish(t, &x[o[0]..o[1]], w);
+                }
+            }
+            Some(p) => {
+                for &i in p {
+                    self.comps[i].publish(t, xs(i), w);
+                }
+            }
+        }
         for step in steps {
             match *step {
                 Step::Evaluate(i) => self.comps[i].evaluate(t, xs(i), w),

@@ -143,13 +143,7 @@ impl Circuit {
         // the table is no full evaluation at any point now
         self.filled.borrow_mut().valid = false;
         let mut w = self.wires.borrow_mut();
-        for &a in &self.accumulators {
-            w.zero(a);
-        }
-        for &i in &partial.publishers {
-            self.comps[i].publish(t, &x[self.offsets[i]..self.offsets[i + 1]], &mut w);
-        }
-        self.evaluate_steps(&partial.steps, t, x, &mut w);
+        self.publish_and_evaluate(Some(&partial.publishers), &partial.steps, t, x, &mut w);
         for (o, wire) in out.iter_mut().zip(wires) {
             *o = w.get(*wire);
         }

@@ -218,23 +218,15 @@ pub fn simulate_batch(
     t: &Bound<'_, PyAny>,
     u: &Bound<'_, PyAny>,
     params: &Bound<'_, PyAny>,
-    solver: &str,
+    #[pyo3(from_py_with = args::solver)] solver: &'static str,
     #[pyo3(from_py_with = args::rtol)] rtol: f64,
     #[pyo3(from_py_with = args::rk4_step)] rk4_step: f64,
     #[pyo3(from_py_with = args::h_max)] h_max: Option<f64>,
     channels: Option<&Bound<'_, PyAny>>,
     threads: Option<&Bound<'_, PyAny>>,
-    on_error: &str,
+    #[pyo3(from_py_with = args::on_error)] on_error: &'static str,
 ) -> PyResult<PyBatch> {
-    let raise = match on_error {
-        "raise" => true,
-        "nan" => false,
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "on_error: `{other}` is not `raise` or `nan`"
-            )))
-        }
-    };
+    let raise = on_error == "raise";
     let threads = threads_arg(threads)?;
     let channels = names_arg("channels", channels)?;
     let (t, u) = (vector_arg("t", t)?, vector_arg("u", u)?);

@@ -395,6 +395,29 @@ pub mod args {
         window: Option<i64> = int_arg("window", "samples");
     }
 
+    /// `solver` (`simulate`, `simulate_batch`): a method's name, checked as
+    /// the CLI's `--solver` is; a name that is no str is a TypeError naming
+    /// the argument. The name is returned as the method's own (`'static`:
+    /// the signature's default, `"auto"`, is then a literal its text
+    /// signature shows).
+    pub fn solver(x: &Bound<'_, PyAny>) -> PyResult<&'static str> {
+        let name = text_arg("solver", x)?;
+        hydrocyl_system::run::Solver::parse_or_why(&name)
+            .map(hydrocyl_system::run::Solver::name)
+            .map_err(|why| pyo3::exceptions::PyValueError::new_err(format!("solver: {why}")))
+    }
+
+    /// `on_error` (`simulate_batch`): `"raise"` or `"nan"`.
+    pub fn on_error(x: &Bound<'_, PyAny>) -> PyResult<&'static str> {
+        match text_arg("on_error", x)?.as_str() {
+            "raise" => Ok("raise"),
+            "nan" => Ok("nan"),
+            other => Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "on_error: `{other}` is not `raise` or `nan`"
+            ))),
+        }
+    }
+
     /// `h_max` (`simulate`, `simulate_batch`): None is the default bound.
     pub fn h_max(x: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
         if x.is_none() {

@@ -387,7 +387,7 @@ impl Rig {
         py: Python<'_>,
         t: &Bound<'_, PyAny>,
         u: &Bound<'_, PyAny>,
-        solver: &str,
+        #[pyo3(from_py_with = args::solver)] solver: &'static str,
         #[pyo3(from_py_with = args::rtol)] rtol: f64,
         #[pyo3(from_py_with = args::rk4_step)] rk4_step: f64,
         #[pyo3(from_py_with = args::h_max)] h_max: Option<f64>,

@@ -268,18 +268,43 @@ def test_a_key_that_is_not_a_str_is_a_type_error_naming_the_argument(rig, comman
         ("path", lambda rig, t, u: rig.set(5, 1.0), r"expected a str, got 5 \(an int\)"),
         ("path", lambda rig, t, u: rig.get(None), r"expected a str, got None"),
         ("text", lambda rig, t, u: hydrocyl.Rig.from_json(b"{}"), r"expected a str, got b'\{\}' \(a bytes\)"),
+        ("solver", lambda rig, t, u: rig.simulate(t, u, solver=3), r"expected a str, got 3 \(an int\)"),
+        ("solver", lambda rig, t, u: hydrocyl.simulate_batch(rig, t, u, [{}], solver=None), r"expected a str, got None"),
+        ("on_error", lambda rig, t, u: hydrocyl.simulate_batch(rig, t, u, [{}], on_error=True), r"expected a str, got True \(a bool\)"),
     ],
 )
 def test_an_argument_of_another_type_is_a_type_error_naming_it(rig, command, name, call, why):
     """A str, bool or int argument of another type is a TypeError naming
-    the argument, not PyO3's bare `'None' is not an instance of 'str'`
-    (`solver` and `on_error`, whose defaults are str literals in the
-    signature, are not among them)."""
+    the argument, not PyO3's bare `'None' is not an instance of 'str'`."""
     t, u = command
     with pytest.raises(TypeError, match=rf"^{name}: {why}") as e:
         call(rig, t, u)
     # the message is one line (PyO3 adds a note, shown in tracebacks only)
     assert "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize(
+    "call, why",
+    [
+        (lambda rig, t, u: rig.simulate(t, u, solver="dopri"), r"^solver: unknown method `dopri` \(use auto, dp45, rosenbrock, rk4 or exponential\)"),
+        (lambda rig, t, u: hydrocyl.simulate_batch(rig, t, u, [{}], solver="DP45"), r"^solver: unknown method `DP45`"),
+        (lambda rig, t, u: hydrocyl.simulate_batch(rig, t, u, [{}], on_error="ignore"), r"^on_error: `ignore` is not `raise` or `nan`"),
+    ],
+)
+def test_an_unknown_solver_or_on_error_is_a_value_error_naming_it(rig, command, call, why):
+    t, u = command
+    with pytest.raises(ValueError, match=why) as e:
+        call(rig, t, u)
+    # one line (PyO3's note naming the argument shows in tracebacks only)
+    assert "\n" not in str(e.value)
+
+
+def test_the_str_defaults_stay_in_the_text_signatures():
+    """`solver` and `on_error` are read by functions that name them in
+    their errors; their defaults are still shown in the signatures."""
+    assert 'solver="auto"' in hydrocyl.Rig.simulate.__text_signature__
+    assert 'solver="auto"' in hydrocyl.simulate_batch.__text_signature__
+    assert 'on_error="raise"' in hydrocyl.simulate_batch.__text_signature__
 
 
 def test_an_int_window_may_be_a_numpy_int(rig):

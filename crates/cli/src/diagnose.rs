@@ -557,7 +557,6 @@ fn plot_residual(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hydrocyl_identify::data::Signal;
 
     fn stems(paths: &[&str]) -> Vec<String> {
         let p: Vec<PathBuf> = paths.iter().map(PathBuf::from).collect();

@@ -242,16 +242,26 @@ def xfactor(gamma: float, travel: ArrayLike) -> npt.NDArray[np.float64]:
 
 def diagnose(
     rig: Rig,
-    record: Union[str, os.PathLike[str], Mapping[str, ArrayLike]],
+    record: Union[
+        str,
+        os.PathLike[str],
+        Mapping[str, ArrayLike],
+        Sequence[Union[str, os.PathLike[str], Mapping[str, ArrayLike]]],
+    ],
     *,
     min_share: float = 0.03,
     holdout: float = 0.3,
     window: Optional[int] = None,
     effects: Union[str, Sequence[str], None] = None,
 ) -> dict[str, Any]:
-    """``hydrocyl diagnose`` on a valve rig and one measured record (CSV
-    path or dict of arrays by column name, SI or with unit suffixes); the
-    report as a dict. ``window`` is at least 2 (a narrower one interpolates
+    """``hydrocyl diagnose`` on any rig the CLI diagnoses (a friction bench
+    such as ``emps`` or ``tudelft-seal-25``, or a netlist with a cylinder on
+    a mass such as ``leaney-moog`` or ``wang-hybrid``; another is a
+    ValueError naming why) and one measured record (CSV path or dict of
+    arrays by column name, SI or with unit suffixes, read through the rig's
+    ``identify.columns``) or a list of records fitted jointly (a friction
+    bench; a record given twice is refused); the report as a dict, the
+    JSON of ``--report``. ``window`` is at least 2 (a narrower one interpolates
     the order-3 smoother's coefficients). ``effects``: the effect ids the
     loop may add, a list or one string (split at commas, as the CLI's
     ``--effects``); any other type is a TypeError naming ``effects``."""

@@ -6,14 +6,11 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-use hydrocyl_identify::bench::{self, FrictionBench};
 use hydrocyl_identify::catalog::EffectId;
-use hydrocyl_identify::data::{ColumnMap, Record};
+use hydrocyl_identify::data::{repeated_record, Record, RecordInput};
 use hydrocyl_identify::diagnose::{
-    diagnose_bench, small_sample_warning, DiagnoseOptions, RecordTrace,
+    small_sample_warning, DiagnoseError, DiagnoseOptions, DiagnoseRig, RecordTrace,
 };
-use hydrocyl_identify::valve::{diagnose_rig_traced, Model};
-use hydrocyl_system::rig::valve_rig_from;
 
 use crate::error::CliError;
 use crate::output::Outputs;
@@ -67,51 +64,16 @@ pub struct Args {
     pub progress: bool,
 }
 
-/// A rig `diagnose` can run.
-enum Rig {
-    Bench(FrictionBench),
-    /// Any netlist with a cylinder on a mass (the valve rig, the hybrid rig,
-    /// a user's circuit), or a `valve-cylinder` rig file as its netlist;
-    /// with the column map of its identification section.
-    Net(Box<Model>, ColumnMap),
-}
-
-/// The column map of a netlist's identification section (`identify.columns`).
-fn net_columns(v: &serde_json::Value) -> Result<ColumnMap, String> {
-    let s = hydrocyl_system::netlist::read(v)
-        .map_err(|e| hydrocyl_system::rig::RigError::from(e).to_string())?;
-    let mut map = ColumnMap::default();
-    for (role, header) in s.identify.map(|i| i.columns).unwrap_or_default() {
-        let sig = hydrocyl_identify::data::Signal::from_name(&role)
-            .ok_or_else(|| format!("`identify.columns.{role}`: not a measured-data signal"))?;
-        map.0.insert(sig, header);
-    }
-    Ok(map)
-}
-
-fn net_rig_with_columns(v: &serde_json::Value) -> Result<Rig, String> {
-    Ok(Rig::Net(Box::new(net_rig(v)?), net_columns(v)?))
-}
-
-fn net_rig(v: &serde_json::Value) -> Result<Model, String> {
-    if v.get("kind").and_then(|k| k.as_str()) == Some(hydrocyl_system::valve_rig::KIND) {
-        let r = valve_rig_from(v).map_err(|e| e.to_string())?;
-        return Model::from_valve_rig(&r);
-    }
-    Model::new(v)
-}
-
-fn load_rig(spec: &str) -> Result<Rig, CliError> {
-    if let Some(r) = bench::preset(spec) {
-        return Ok(Rig::Bench(r));
-    }
-    let unsupported = |e: &dyn std::fmt::Display| {
-        CliError::Input(format!(
-            "--rig {spec}: not supported for this rig kind (diagnose takes a netlist with a `cylinder` on a `mass`, a valve-cylinder rig file or a friction bench): {e}"
-        ))
+/// The rig of `--rig` as `diagnose` runs it: which loop, with which column
+/// map, is [`DiagnoseRig::from_value`]'s decision (the one Python's
+/// `hydrocyl.diagnose` makes); this reads the preset or file and words the
+/// errors for `--rig`.
+fn load_rig(spec: &str) -> Result<DiagnoseRig, CliError> {
+    let of_value = |v: &serde_json::Value| {
+        DiagnoseRig::from_value(v).map_err(|e| CliError::Input(format!("--rig {spec}: {e}")))
     };
     if let Some(v) = hydrocyl_system::rig::preset(spec) {
-        return net_rig_with_columns(&v).map_err(|e| unsupported(&e));
+        return of_value(&v);
     }
     if !Path::new(spec).exists() {
         return Err(CliError::Input(format!(
@@ -122,26 +84,18 @@ fn load_rig(spec: &str) -> Result<Rig, CliError> {
     // a friction bench (a netlist whose identification section names the
     // `friction-bench` model, or an older `friction-bench` file)
     if let Some((b, _)) = crate::bench_sim::load(spec, &[])? {
-        return Ok(Rig::Bench(b));
+        return Ok(DiagnoseRig::Bench(b));
     }
-    // duplicate keys refused, errors with the JSON path and line
+    // duplicate keys refused, errors with the JSON path and line; an older
+    // rig kind (`valve-cylinder`) is read as its netlist
     let v = hydrocyl_system::rig::load(spec).map_err(|e| CliError::Input(e.to_string()))?;
-    match v.get("kind").and_then(|k| k.as_str()).unwrap_or("") {
-        // an older rig kind (`valve-cylinder`) is read as its netlist (rig::load)
-        k if k == hydrocyl_system::netlist::KIND => {
-            // a netlist that does not check (an algebraic loop, a bad
-            // parameter) is named as such, with its file and line
-            hydrocyl_system::rig::check(&v)
-                .map_err(|e| CliError::Input(hydrocyl_system::rig::at_line(e, spec).to_string()))?;
-            net_rig_with_columns(&v).map_err(|e| unsupported(&e))
-        }
-        k => Err(unsupported(&format!(
-            "kind '{k}' (kinds: {}, {}, {})",
-            bench::KIND,
-            hydrocyl_system::netlist::KIND,
-            hydrocyl_system::valve_rig::KIND
-        ))),
+    if v.get("kind").and_then(|k| k.as_str()) == Some(hydrocyl_system::netlist::KIND) {
+        // a netlist that does not check (an algebraic loop, a bad
+        // parameter) is named as such, with its file and line
+        hydrocyl_system::rig::check(&v)
+            .map_err(|e| CliError::Input(hydrocyl_system::rig::at_line(e, spec).to_string()))?;
     }
+    of_value(&v)
 }
 
 /// The presets `diagnose` takes (a friction bench, or a netlist with a
@@ -205,14 +159,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let Some(dir) = &args.plots {
         outputs.check_dir("--plots", dir)?;
     }
-    let columns = match &rig {
-        Rig::Bench(b) => b.columns.clone(),
-        Rig::Net(_, columns) => columns.clone(),
-    };
     let records = args
         .data
         .iter()
-        .map(|p| Record::read_mapped(p, &columns))
+        .map(|p| Record::read_mapped(p, rig.columns()))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| CliError::Input(e.to_string()))?;
     // every plot this run can write, named and checked before the fit
@@ -254,24 +204,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         warn();
         bar.set(stage, done as u64, total as u64);
     };
-    let (report, traces) = match &rig {
-        Rig::Bench(b) => {
-            let o = diagnose_bench(b, &records, &opts, &mut progress)
-                .map_err(|e| CliError::Input(e.to_string()))?;
-            (o.report, o.traces)
-        }
-        Rig::Net(v, _) => {
-            if records.len() != 1 {
-                return Err(CliError::Input(format!(
-                    "--data: a circuit rig is diagnosed on one record at a time ({} given)",
-                    records.len()
-                )));
-            }
-            let o = diagnose_rig_traced(v, &records[0], &opts, &mut progress)
-                .map_err(|e| CliError::Input(e.to_string()))?;
-            (o.report, o.traces)
-        }
-    };
+    let (report, traces) = rig
+        .diagnose(&records, &opts, &mut progress)
+        .map_err(|e| match e {
+            DiagnoseError::OneRecordAtATime(_) => CliError::Input(format!("--data: {e}")),
+            e => CliError::Input(e.to_string()),
+        })?;
     warn();
     bar.finish();
     if let Some(wanted) = &args.effects {
@@ -362,55 +300,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
 /// Refuses a record given twice (exit 2, naming both arguments): the same
 /// file (the same path once resolved through links, or the same file
 /// under two names: a hard link), or two files with the same bytes (a
-/// copy). Fitted jointly, its samples would count twice and every ±
-/// interval would be √2 too narrow. What is not a regular file (a pipe)
-/// is not read here.
+/// copy), as [`repeated_record`] finds them. Fitted jointly, its samples
+/// would count twice and every ± interval would be √2 too narrow.
 fn distinct_records(paths: &[PathBuf]) -> Result<(), CliError> {
-    let meta: Vec<Option<std::fs::Metadata>> = paths
-        .iter()
-        .map(|p| std::fs::metadata(p).ok().filter(|m| m.is_file()))
-        .collect();
-    let canon: Vec<Option<PathBuf>> = paths.iter().map(|p| p.canonicalize().ok()).collect();
-    let twice = |i: usize, j: usize, what: &str| {
-        CliError::Input(format!(
-            "--data {} and --data {} (arguments {} and {}): {what}; its samples would count twice in the joint fit (every ± interval √2 too narrow): give each record once",
-            paths[i].display(),
-            paths[j].display(),
-            i + 1,
-            j + 1
-        ))
-    };
-    for j in 1..paths.len() {
-        for i in 0..j {
-            let (Some(a), Some(b)) = (&meta[i], &meta[j]) else {
-                continue;
-            };
-            if canon[i].is_some() && canon[i] == canon[j] || same_inode(a, b) {
-                return Err(twice(i, j, "the same file, given twice"));
-            }
-            if a.len() == b.len() {
-                if let (Ok(x), Ok(y)) = (std::fs::read(&paths[i]), std::fs::read(&paths[j])) {
-                    if x == y {
-                        return Err(twice(i, j, "the same content (one record under two names)"));
-                    }
-                }
-            }
-        }
+    let inputs: Vec<RecordInput<'_>> = paths.iter().map(|p| RecordInput::File(p)).collect();
+    match repeated_record(&inputs) {
+        None => Ok(()),
+        Some(r) => Err(CliError::Input(r.message(
+            &format!("--data {}", paths[r.first].display()),
+            &format!("--data {}", paths[r.second].display()),
+            "arguments",
+        ))),
     }
-    Ok(())
-}
-
-/// Whether `a` and `b` are one file (device and inode).
-#[cfg(unix)]
-fn same_inode(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {
-    use std::os::unix::fs::MetadataExt;
-    a.dev() == b.dev() && a.ino() == b.ino()
-}
-
-/// Elsewhere the canonical paths and the content decide.
-#[cfg(not(unix))]
-fn same_inode(_: &std::fs::Metadata, _: &std::fs::Metadata) -> bool {
-    false
 }
 
 /// The name each record's plots start with, distinct for distinct records
@@ -451,10 +352,10 @@ fn plot_stems(paths: &[PathBuf]) -> Vec<String> {
 /// The channels a record's plots can be of: a friction bench's `friction`
 /// and `residual`; on a circuit rig every signal the record has (those the
 /// model compares are among them).
-fn plot_channels(rig: &Rig, rec: &Record) -> Vec<&'static str> {
+fn plot_channels(rig: &DiagnoseRig, rec: &Record) -> Vec<&'static str> {
     match rig {
-        Rig::Bench(_) => vec!["friction", "residual"],
-        Rig::Net(..) => hydrocyl_identify::data::Signal::ALL
+        DiagnoseRig::Bench(_) => vec!["friction", "residual"],
+        DiagnoseRig::Net(..) => hydrocyl_identify::data::Signal::ALL
             .into_iter()
             .filter(|&s| s != hydrocyl_identify::data::Signal::Time && rec.get(s).is_some())
             .map(|s| s.name())
@@ -656,7 +557,6 @@ fn plot_residual(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hydrocyl_identify::data::Signal;
 
     fn stems(paths: &[&str]) -> Vec<String> {
         let p: Vec<PathBuf> = paths.iter().map(PathBuf::from).collect();
@@ -707,20 +607,5 @@ mod tests {
         );
         let m = e(&["a.csv", "copy.csv"]).unwrap();
         assert!(m.contains("(arguments 1 and 2): the same content"), "{m}");
-    }
-
-    /// A cylinder netlist's identification section gives diagnose its column
-    /// map; a bad role is refused by its path.
-    #[test]
-    fn a_cylinder_netlist_brings_its_column_map() {
-        let mut v = hydrocyl_system::rig::preset("leaney-moog").unwrap();
-        assert_eq!(net_columns(&v).unwrap(), ColumnMap::default());
-        v["identify"] = serde_json::json!({ "columns": { "position": "x_mm [mm]" } });
-        let map = net_columns(&v).unwrap();
-        assert_eq!(map.0[&Signal::Position], "x_mm [mm]");
-        assert!(matches!(net_rig_with_columns(&v), Ok(Rig::Net(_, m)) if m == map));
-        v["identify"]["columns"] = serde_json::json!({ "x": "x_mm [mm]" });
-        let e = net_columns(&v).unwrap_err();
-        assert!(e.contains("identify.columns.x"), "{e}");
     }
 }

@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 mod decimal;
 mod error;
 mod read;
+mod repeat;
 mod time_axis;
 
 pub use decimal::{scale_decimal, scaled_decimal};
@@ -22,6 +23,7 @@ pub use error::DataError;
 pub use read::{
     foreign_encoding, foreign_separator, missing_time_hint, unread_header_hint, LineCounter,
 };
+pub use repeat::{repeated_record, RecordInput, Repeated};
 pub use time_axis::{beyond_span, GAP_OVER_REST, MAX_GAP_FACTOR, MAX_SPAN_S};
 
 /// A signal of the measured-data format.

@@ -36,7 +36,9 @@ use crate::smooth::{noise_sigma, SmootherInfo};
 mod bench_checks;
 mod bench_loop;
 mod bench_model;
+mod rig;
 pub use bench_loop::diagnose_bench;
+pub use rig::{DiagnoseRig, RigKindError};
 
 /// Fewer samples than this in a record: the report's ± intervals assume
 /// many independent samples, so they are not to be trusted.
@@ -131,6 +133,10 @@ pub enum DiagnoseError {
     /// No records given.
     #[error("no measured records given")]
     NoData,
+    /// Several records given to a rig that is diagnosed on one at a time
+    /// (a circuit: [`DiagnoseRig::Net`]); how many.
+    #[error("a circuit rig is diagnosed on one record at a time ({0} given)")]
+    OneRecordAtATime(usize),
     /// The data checks left nothing to fit.
     #[error("{file}: nothing usable to diagnose: {why}")]
     Unusable {

@@ -35,7 +35,7 @@ mod outliers;
 mod travel;
 mod unit_errors;
 mod velocity_sign;
-pub use coverage::{missing_channels, pressure_scale_problems, GAP_FACTOR, SCALE_FACTOR};
+pub use coverage::{gap_ends, missing_channels, pressure_scale_problems, GAP_FACTOR, SCALE_FACTOR};
 pub use input::input_errors;
 pub use outliers::position_outliers;
 pub use travel::travel_error;

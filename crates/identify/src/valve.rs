@@ -57,6 +57,7 @@ pub mod model;
 mod pairs;
 mod probes;
 mod report;
+mod restart;
 mod sim;
 mod stops;
 

@@ -20,27 +20,37 @@ pub const SCALE_FACTOR: f64 = 5.0;
 /// units, the largest level is compared instead.
 const TANK_SIDE: f64 = 0.2;
 
-/// Gaps in the time axis: steps longer than [`GAP_FACTOR`] times the
-/// median step. One problem on `time`, kept (not left out): every sample
-/// either side is a real measurement, but the input (the command, or a
-/// closed-loop record's reference) is interpolated linearly across each
-/// gap, so the model there runs on an input nobody measured.
-pub(super) fn gap_problem(rec: &Record) -> Option<DataProblem> {
-    let t = &rec.time;
+/// The gaps of a time axis: the median step and the index of the first
+/// sample after each step longer than [`GAP_FACTOR`] times it (none for
+/// fewer than 3 samples or a median step that is not positive). The data
+/// check names them ([`gap_problem`]); the valve loop restarts its
+/// simulation after each from the measured state.
+pub fn gap_ends(t: &[f64]) -> (f64, Vec<usize>) {
     if t.len() < 3 {
-        return None;
+        return (f64::NAN, Vec::new());
     }
     let mut dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
     let mid = dt.len() / 2;
     let median = *dt.select_nth_unstable_by(mid, f64::total_cmp).1;
     if median.is_nan() || median <= 0.0 {
-        return None;
+        return (median, Vec::new());
     }
-    let gaps: Vec<(f64, f64)> = t
-        .windows(2)
-        .filter(|w| w[1] - w[0] > GAP_FACTOR * median)
-        .map(|w| (w[0], w[1]))
+    let ends = (1..t.len())
+        .filter(|&k| t[k] - t[k - 1] > GAP_FACTOR * median)
         .collect();
+    (median, ends)
+}
+
+/// Gaps in the time axis ([`gap_ends`]). One problem on `time`, kept (not
+/// left out): every sample either side is a real measurement, but the input
+/// (the command, or a closed-loop record's reference) is interpolated
+/// linearly across each gap, so the model there runs on an input nobody
+/// measured; a circuit rig's simulation restarts after each gap from the
+/// measured state.
+pub(super) fn gap_problem(rec: &Record) -> Option<DataProblem> {
+    let t = &rec.time;
+    let (median, ends) = gap_ends(t);
+    let gaps: Vec<(f64, f64)> = ends.iter().map(|&k| (t[k - 1], t[k])).collect();
     if gaps.is_empty() {
         return None;
     }
@@ -64,7 +74,7 @@ pub(super) fn gap_problem(rec: &Record) -> Option<DataProblem> {
         Signal::Time,
         ProblemKind::Gap,
         format!(
-            "{} gap(s) in the record, steps over {GAP_FACTOR} times its median step ({median:.3e} s), {total:.4} s in all: {}{more}; the {input} (the model's input) is interpolated linearly across each, so the model runs there on an input nobody measured: a dropped logger buffer? the channels stay in the fit (their samples are measured), but a residual right after a gap is the input's, not the model's",
+            "{} gap(s) in the record, steps over {GAP_FACTOR} times its median step ({median:.3e} s), {total:.4} s in all: {}{more}; the {input} (the model's input) is interpolated linearly across each, so the model runs there on an input nobody measured: a dropped logger buffer? the channels stay in the fit (their samples are measured); a circuit rig's simulation restarts after each gap from the measured position (and velocity and chamber pressures, where measured), so what it drifted across the gap does not count as the model's",
             gaps.len(),
             listed.join(", ")
         ),

@@ -38,8 +38,10 @@ pub(super) struct Prepared {
     pub(super) v0: Option<f64>,
     pub(super) p10: Option<f64>,
     pub(super) p20: Option<f64>,
-    /// Restarts of the simulation where the measured piston leaves a stop.
-    pub(super) restarts: Vec<stops::Restart>,
+    /// Restarts of the simulation from the measured state: where the
+    /// measured piston leaves a stop, and after each gap in the time axis
+    /// ([`restart`]).
+    pub(super) restarts: Vec<restart::Restart>,
     /// Simulations run so far (shared by every copy).
     pub(super) count: Arc<std::sync::atomic::AtomicUsize>,
     /// The latest simulations, to answer a repeated one (shared by every
@@ -198,10 +200,20 @@ pub(super) fn prepare(
     };
     let (p10, p20) = (p0(Signal::P1), p0(Signal::P2));
     let restarts = if position_ok {
-        stops::restarts(
-            x,
-            stroke,
-            (5.0 * noise_sigma(&rec.time, x)).max(1e-4 * stroke),
+        let kept = |sig: Signal| rec.get(sig).filter(|_| !excluded.contains(&sig));
+        let measured = restart::Measured {
+            position: x,
+            velocity: kept(Signal::Velocity),
+            p1: kept(Signal::P1),
+            p2: kept(Signal::P2),
+        };
+        restart::merged(
+            stops::restarts(
+                x,
+                stroke,
+                (5.0 * noise_sigma(&rec.time, x)).max(1e-4 * stroke),
+            ),
+            restart::after_gaps(&t, measured, 0.5 * stroke),
         )
     } else {
         Vec::new()
@@ -327,12 +339,14 @@ pub(super) fn simulate(rig: &Model, p: &Prepared) -> Result<Vec<Vec<f64>>, Strin
 /// [`simulate`] over the first `n` samples only (the training part needs no
 /// more; at least two samples are simulated).
 ///
-/// The circuit is assembled once. At a stop restart (`stops`) the next
-/// segment starts from the last state of the one before with the piston
-/// put on the stop at rest: every other state — spool, chambers, lines,
-/// pump, bristles, the controller's integral — carries on. A rig whose load
-/// has no position and velocity states (`<load>.x`, `<load>.v`) cannot be
-/// restarted on a stop: an error, where the record has a restart.
+/// The circuit is assembled once. At a restart ([`restart`]) the next
+/// segment starts from the last state of the one before with the piston put
+/// where the record says (on the stop at rest; after a gap, at the measured
+/// position, with the velocity and chamber pressures where they are
+/// measured): every other state — spool, chambers, lines, pump, bristles,
+/// the controller's integral — carries on. A rig whose load has no position
+/// and velocity states (`<load>.x`, `<load>.v`) cannot be restarted: an
+/// error, where the record has a restart.
 pub(super) fn simulate_prefix(
     rig: &Model,
     p: &Prepared,
@@ -386,9 +400,12 @@ fn run_prefix(rig: &Model, p: &Prepared, n: usize) -> Result<Vec<Vec<f64>>, Stri
     let load = &rig.roles.load;
     let at = |s: &str| names.iter().position(|n| *n == format!("{load}.{s}"));
     let (kx, kv) = (at("x"), at("v"));
+    let cyl = &rig.roles.cylinder;
+    let chambers =
+        [format!("{cyl}.p1"), format!("{cyl}.p2")].map(|c| names.iter().position(|n| *n == c));
     let mut sim = Simulation::of_circuit(circuit).options(opts);
     let mut out: Vec<Vec<f64>> = vec![Vec::with_capacity(n); p.meas.len()];
-    // One segment per stretch between restarts at stop exits (`stops`).
+    // One segment per stretch between restarts (stop exits, gap ends).
     let mut cuts = p
         .restarts
         .iter()
@@ -400,7 +417,8 @@ fn run_prefix(rig: &Model, p: &Prepared, n: usize) -> Result<Vec<Vec<f64>>, Stri
     };
     if let (Some(r), None) = (cuts.peek(), on_stop) {
         return Err(format!(
-            "the record rests on a stop (restart at t = {} s), but the load `{load}` has no states `{load}.x` and `{load}.v` to put the piston there",
+            "the record {} (restart at t = {} s), but the load `{load}` has no states `{load}.x` and `{load}.v` to put the piston there",
+            r.cause.what(),
             t[r.index]
         ));
     }
@@ -421,7 +439,14 @@ fn run_prefix(rig: &Model, p: &Prepared, n: usize) -> Result<Vec<Vec<f64>>, Stri
         let mut x = run.state(run.time.len() - 1).to_vec();
         if let Some((kx, kv)) = on_stop {
             x[kx] = r.position;
-            x[kv] = 0.0;
+            if let Some(v) = r.velocity {
+                x[kv] = v;
+            }
+        }
+        for (k, p) in chambers.iter().zip(r.pressures) {
+            if let (Some(k), Some(p)) = (k, p) {
+                x[*k] = p;
+            }
         }
         sim = sim.initial_state(x);
         a = b;
@@ -676,9 +701,12 @@ mod tests {
             v0: None,
             p10: None,
             p20: None,
-            restarts: vec![stops::Restart {
+            restarts: vec![restart::Restart {
                 index: 100,
+                cause: restart::Cause::Stop,
                 position: half,
+                velocity: Some(0.0),
+                pressures: [None; 2],
             }],
             count: Default::default(),
             recent: Default::default(),

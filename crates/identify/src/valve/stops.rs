@@ -7,19 +7,10 @@
 //! flow over seconds) does not carry into everything after it: each
 //! segment between stop exits is then compared on its own dynamics.
 
+use super::restart::{Cause, Restart};
+
 /// Fewest consecutive samples at a stop that count as resting on it.
 const MIN_REST: usize = 10;
-
-/// A restart of the simulation from the measured state.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct Restart {
-    /// Sample index where the new segment starts (the middle of the rest:
-    /// the measured piston may already be leaving during the rest's last
-    /// samples, within the noise of the stop).
-    pub index: usize,
-    /// The stop's position \[m\].
-    pub position: f64,
-}
 
 /// The restarts of a record: the middle sample of every rest of at least
 /// [`MIN_REST`] samples on a stop (within `tol` of ±stroke/2) that the
@@ -50,9 +41,14 @@ pub(super) fn restarts(x: &[f64], stroke: f64, tol: f64) -> Vec<Restart> {
         }
         let end = i;
         if end + 1 < n && end > 0 && end + 1 - start >= MIN_REST {
+            // the middle of the rest: the measured piston may already be
+            // leaving in its last samples, within the noise of the stop
             out.push(Restart {
                 index: (start + end) / 2,
+                cause: Cause::Stop,
                 position: f64::from(s) * half,
+                velocity: Some(0.0),
+                pressures: [None; 2],
             });
         }
         i += 1;
@@ -82,7 +78,10 @@ mod tests {
             r,
             [Restart {
                 index: 29,
-                position: 0.25
+                cause: Cause::Stop,
+                position: 0.25,
+                velocity: Some(0.0),
+                pressures: [None; 2],
             }]
         );
     }

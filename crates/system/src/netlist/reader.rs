@@ -68,6 +68,29 @@ pub(crate) fn kind_of(v: &Value) -> &'static str {
     }
 }
 
+/// Why `got` is refused where a number is expected (a parameter, or an
+/// initial state when `what` says so), for a value meaning `doc` in `unit`:
+/// what it is, its meaning and unit, and how to write it — a quoted number
+/// without its quotes, a value with a unit (`"160 bar"`) as the number in
+/// the SI unit the rig takes.
+pub(crate) fn not_a_number(what: &str, got: &Value, doc: &str, unit: &str) -> String {
+    let meaning = format!("{doc} [{unit}]");
+    let how = match got {
+        Value::String(s) => match s.trim().parse::<f64>() {
+            Ok(x) if x.is_finite() => format!("write the number without quotes: {}", s.trim()),
+            _ if unit == "-" => "give a plain number (every rig value is SI)".to_string(),
+            _ => format!("give the number in {unit}: every rig value is SI"),
+        },
+        _ if unit == "-" => "give a plain number".to_string(),
+        _ => format!("give the number in {unit}"),
+    };
+    let shown = match got {
+        Value::String(_) => format!("the string `{got}`"),
+        other => kind_of(other).to_string(),
+    };
+    format!("{what} is a number, got {shown} ({meaning}; {how})")
+}
+
 /// Why `col` cannot be an output column beside `before` (the columns
 /// named so far): a CSV header cell holds a name and a `[unit]`, and the
 /// first column is `time`.

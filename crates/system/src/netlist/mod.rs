@@ -514,6 +514,49 @@ mod tests {
         assert!(e.contains("a plain number"), "{e}");
     }
 
+    /// A port that owns its node with nothing else to join (a generalised
+    /// cylinder's rod-side chamber that no friction law reads, a blocked
+    /// chamber) is listed alone, `["cylinder.B"]`: its node is its own. It
+    /// could not be: a one-port connection was refused, and the port left
+    /// out was refused as dangling, with no way out named. A reading port
+    /// alone is still refused (its node would have no owner), and a port
+    /// left out still is, naming the way out.
+    #[test]
+    fn an_owning_port_listed_alone_keeps_its_node_to_itself() {
+        let mut v = crate::rig::preset("leaney-moog-generalised").unwrap();
+        let conns = v["connections"].as_array_mut().unwrap();
+        let b = conns
+            .iter()
+            .position(|c| c.as_array().unwrap().iter().any(|e| e == "cylinder.B"))
+            .unwrap();
+        conns.remove(b);
+        let e = read_error(&v);
+        assert!(e.starts_with("components.cylinder: port `B`"), "{e}");
+        assert!(e.contains("list it alone, `[\"cylinder.B\"]`"), "{e}");
+        v["connections"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!(["cylinder.B"]));
+        // the friction law reads both chambers or neither: neither here
+        for c in v["connections"].as_array_mut().unwrap() {
+            c.as_array_mut().unwrap().retain(|e| e != "friction.A");
+        }
+        let s = super::read(&v).unwrap();
+        let c = &s.instances.iter().find(|i| i.name == "cylinder").unwrap();
+        assert_eq!(c.nodes.get("B").map(String::as_str), Some("cylinder.B"));
+        let run = crate::rig::circuit(&v, crate::signal::Signal::Constant { value: 0.2 });
+        assert!(run.is_ok(), "{:?}", run.err());
+        // a reading port alone: refused at its connection
+        let mut w = v.clone();
+        w["connections"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!(["friction.A"]));
+        let e = read_error(&w);
+        assert!(e.contains("a connection joins two or more ports"), "{e}");
+        assert!(e.contains("`friction.A` reads its node"), "{e}");
+    }
+
     /// The error of reading `v`, as its path and message.
     fn read_error(v: &serde_json::Value) -> String {
         let e = super::read(v).unwrap_err();

@@ -25,23 +25,56 @@ pub fn locate(e: RigError, source: &str, sets: &[String]) -> CliError {
 /// lm.json)` (a preset has no lines: [`rig::at_line`] names its paths as
 /// `--set` takes them). A path is matched with or without its
 /// `components.` prefix.
+///
+/// An error about a relation between parameters (a chamber length against
+/// the stroke, a tank against the supply) is named at the parameter the
+/// relation bounds; when a `--set` gave one of the others the message names
+/// (by its path, or by its bare name within the erring component), that
+/// `--set` is named too, `(with --set cylinder.stroke=0.7)`: the line of the
+/// bounded parameter holds a value the user did not change.
 pub fn at_line_or_set(e: RigError, source: &str, sets: &[String]) -> RigError {
-    let path = match &e {
-        RigError::Invalid { path, .. } | RigError::OutOfRange { path, .. } => path.clone(),
+    let (path, why) = match &e {
+        RigError::Invalid { path, why } | RigError::OutOfRange { path, why, .. } => {
+            (path.clone(), why.clone())
+        }
         _ => return rig::at_line(e, source),
     };
     let bare = |p: &str| p.trim().trim_start_matches("components.").to_string();
-    let set = sets.iter().find(|s| {
+    let set_path = |s: &String| {
         s.split_once('=')
-            .is_some_and(|(p, _)| !p.trim().is_empty() && bare(p) == bare(&path))
-    });
+            .map(|(p, _)| bare(p))
+            .filter(|p| !p.is_empty())
+    };
+    let direct = sets
+        .iter()
+        .find(|s| set_path(s).is_some_and(|p| p == bare(&path)));
+    let component = bare(&path)
+        .split('.')
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    let others: Vec<String> = sets
+        .iter()
+        .filter(|s| Some(*s) != direct)
+        .filter(|s| {
+            set_path(s).is_some_and(|p| {
+                mentions(&why, &p)
+                    || p.split_once('.')
+                        .is_some_and(|(c, name)| c == component && mentions(&why, name))
+            })
+        })
+        .map(|s| format!("--set {s}"))
+        .collect();
+    let others = others.join(", ");
     // a preset has no lines: its message names the path as `--set` takes
     // it, as Python's `Rig.set` words it
-    let (Some(set), false) = (set, rig::is_preset(source)) else {
-        return rig::at_line(e, source);
+    let by = match (direct, rig::is_preset(source), others.is_empty()) {
+        (Some(set), false, true) => format!("(set by --set {set} on {source})"),
+        (Some(set), false, false) => format!("(set by --set {set} on {source}, with {others})"),
+        (_, _, false) => format!("(with {others})"),
+        (_, _, true) => return rig::at_line(e, source),
     };
-    let by = format!("(set by --set {set} on {source})");
-    match e {
+    let e = match e {
         RigError::Invalid { path, why } => RigError::Invalid {
             why: format!("{why} {by}"),
             path,
@@ -52,7 +85,30 @@ pub fn at_line_or_set(e: RigError, source: &str, sets: &[String]) -> RigError {
             value,
         },
         other => other,
+    };
+    match (direct, rig::is_preset(source)) {
+        (Some(_), false) => e,
+        _ => rig::at_line(e, source),
     }
+}
+
+/// Whether `text` names `word` (a parameter path or name) as a whole:
+/// not inside a longer name (`area_1` in `area_10`, `stroke` in
+/// `spool.stroke`), though `components.` may stand before it.
+fn mentions(text: &str, word: &str) -> bool {
+    let part = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    text.match_indices(word).any(|(i, _)| {
+        let before = &text[..i];
+        let after = &text[i + word.len()..];
+        let starts = before
+            .chars()
+            .next_back()
+            .is_none_or(|c| !part(c) && c != '.')
+            || before.ends_with("components.");
+        let ends = after.chars().next().is_none_or(|c| !part(c))
+            && !(after.starts_with('.') && after[1..].starts_with(|c: char| part(c)));
+        starts && ends
+    })
 }
 
 /// A rig read and checked once, ready to be assembled.

@@ -299,6 +299,103 @@ fn a_bad_initial_state_from_set_names_its_path_and_the_set() {
     }
 }
 
+/// A relation between two parameters that a `--set` of the *other* one
+/// breaks (the stroke against a chamber length, `full_open` against a
+/// relief valve's `cracking`, the supply against the tank) is named at the
+/// parameter the relation bounds, whose line in the file holds a value the
+/// user did not change: the message names the `--set` too. It used to name
+/// only that line, and the `--set` that broke the relation nowhere.
+#[test]
+fn a_relation_broken_by_a_set_of_the_other_parameter_names_the_set() {
+    let d = scratch("set-blame-relation");
+    let cmd = command_file(&d, 11, 1e-3);
+    let rig = d.join("lm.json");
+    let p = hydrocyl()
+        .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
+        .output()
+        .unwrap();
+    assert!(p.status.success());
+    std::fs::write(&rig, &p.stdout).unwrap();
+    let out = d.join("o.csv");
+    for (rig, set, path) in [
+        (
+            rig.to_str().unwrap(),
+            "cylinder.stroke=0.7",
+            "components.cylinder.chamber_length_1",
+        ),
+        (
+            rig.to_str().unwrap(),
+            "cylinder.area_1=0.0005",
+            "components.cylinder.area_2",
+        ),
+        (
+            rig.to_str().unwrap(),
+            "supply.pressure=-1000",
+            "components.tank.pressure",
+        ),
+        ("leaney-moog", "supply.pressure=-1000", "tank.pressure"),
+        (
+            "leaney-moog",
+            "cylinder.stroke=0.7",
+            "cylinder.chamber_length_1",
+        ),
+    ] {
+        let args = [
+            "--rig",
+            rig,
+            "--command",
+            cmd.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            set,
+        ];
+        let e = simulate_fails(&args, &out);
+        assert!(e.contains(&format!("rig `{path}`")), "{e}");
+        assert!(e.contains(&format!("(with --set {set})")), "{e}");
+    }
+    // a --set the message does not name is not blamed: the mass has
+    // nothing to do with the stroke
+    let e = simulate_fails(
+        &[
+            "--rig",
+            rig.to_str().unwrap(),
+            "--command",
+            cmd.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            "cylinder.stroke=0.7",
+            "--set",
+            "load.mass=50",
+        ],
+        &out,
+    );
+    assert!(e.contains("(with --set cylinder.stroke=0.7)"), "{e}");
+    assert!(!e.contains("load.mass"), "{e}");
+    // both the bounded parameter and the other one set: both named
+    let e = simulate_fails(
+        &[
+            "--rig",
+            rig.to_str().unwrap(),
+            "--command",
+            cmd.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            "cylinder.chamber_length_1=0.3",
+            "--set",
+            "cylinder.stroke=0.7",
+        ],
+        &out,
+    );
+    assert!(
+        e.contains("(set by --set cylinder.chamber_length_1=0.3 on ")
+            && e.contains("with --set cylinder.stroke=0.7)"),
+        "{e}"
+    );
+}
+
 #[test]
 fn a_friction_bench_writes_its_command_column_like_every_rig() {
     let d = scratch("bench-command");

@@ -383,9 +383,17 @@ pub fn set(v: &mut Value, path: &str, value: Value) -> Result<(), RigError> {
         )));
     }
     if !(value.is_number() || value.is_null()) {
+        let spec = match rest.strip_prefix("initial.") {
+            Some(state) => ty.state(state).map(|s| ("an initial state", s.doc, s.unit)),
+            None => ty.param(rest).map(|p| ("a parameter", p.doc, p.unit)),
+        };
+        let why = match spec {
+            Some((what, doc, unit)) => reader::not_a_number(what, &value, doc, unit),
+            None => format!("a parameter is a number, got `{value}`"),
+        };
         return Err(RigError::Invalid {
             path: path.to_string(),
-            why: format!("a parameter is a number, got `{value}`"),
+            why,
         });
     }
     registry::insert_path(obj, rest, value);
@@ -459,6 +467,100 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("(`cylinder` is a "), "{e}");
+    }
+
+    /// A value written as text where a number belongs (a quoted number, a
+    /// value with its unit, `"160 bar"`) is refused at its path with the
+    /// parameter's meaning and unit, and how to write it: the number
+    /// without quotes, or the number in the SI unit the parameter takes.
+    /// It used to say only "got a string".
+    #[test]
+    fn a_value_written_as_text_names_the_unit_to_give_it_in() {
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        v["components"]["supply"]["pressure"] = json!("160 bar");
+        let e = read_error(&v);
+        assert!(e.contains("components.supply.pressure"), "{e}");
+        assert!(e.contains("[Pa]") && e.contains("in Pa"), "{e}");
+        v["components"]["supply"]["pressure"] = json!("1.6e7");
+        let e = read_error(&v);
+        assert!(e.contains("without quotes: 1.6e7"), "{e}");
+        // a nested parameter, and a boolean
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        v["components"]["valve"]["orifice"]["density"] = json!(true);
+        let e = read_error(&v);
+        assert!(e.contains("components.valve.orifice.density"), "{e}");
+        assert!(e.contains("a boolean") && e.contains("[kg/m^3]"), "{e}");
+        // an initial state, likewise
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        v["components"]["cylinder"]["initial"]["p1"] = json!("30 bar");
+        let e = read_error(&v);
+        assert!(e.contains("components.cylinder.initial.p1"), "{e}");
+        assert!(e.contains("in Pa"), "{e}");
+        // an unknown parameter is named as unknown, whatever its value
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        v["components"]["load"]["mas"] = json!("500 kg");
+        let e = read_error(&v);
+        assert!(e.contains("has no parameter `mas`"), "{e}");
+        // and a --set of text
+        let mut v = crate::rig::preset("leaney-moog").unwrap();
+        let e = crate::rig::apply_set(&mut v, "supply.pressure=160bar")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("[Pa]") && e.contains("in Pa"), "{e}");
+        // a dimensionless one is a plain number
+        let e = crate::rig::apply_set(&mut v, "valve.flow_gain=90%")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a plain number"), "{e}");
+    }
+
+    /// A port that owns its node with nothing else to join (a generalised
+    /// cylinder's rod-side chamber that no friction law reads, a blocked
+    /// chamber) is listed alone, `["cylinder.B"]`: its node is its own. It
+    /// could not be: a one-port connection was refused, and the port left
+    /// out was refused as dangling, with no way out named. A reading port
+    /// alone is still refused (its node would have no owner), and a port
+    /// left out still is, naming the way out.
+    #[test]
+    fn an_owning_port_listed_alone_keeps_its_node_to_itself() {
+        let mut v = crate::rig::preset("leaney-moog-generalised").unwrap();
+        let conns = v["connections"].as_array_mut().unwrap();
+        let b = conns
+            .iter()
+            .position(|c| c.as_array().unwrap().iter().any(|e| e == "cylinder.B"))
+            .unwrap();
+        conns.remove(b);
+        let e = read_error(&v);
+        assert!(e.starts_with("components.cylinder: port `B`"), "{e}");
+        assert!(e.contains("list it alone, `[\"cylinder.B\"]`"), "{e}");
+        v["connections"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!(["cylinder.B"]));
+        // the friction law reads both chambers or neither: neither here
+        for c in v["connections"].as_array_mut().unwrap() {
+            c.as_array_mut().unwrap().retain(|e| e != "friction.A");
+        }
+        let s = super::read(&v).unwrap();
+        let c = &s.instances.iter().find(|i| i.name == "cylinder").unwrap();
+        assert_eq!(c.nodes.get("B").map(String::as_str), Some("cylinder.B"));
+        let run = crate::rig::circuit(&v, crate::signal::Signal::Constant { value: 0.2 });
+        assert!(run.is_ok(), "{:?}", run.err());
+        // a reading port alone: refused at its connection
+        let mut w = v.clone();
+        w["connections"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!(["friction.A"]));
+        let e = read_error(&w);
+        assert!(e.contains("a connection joins two or more ports"), "{e}");
+        assert!(e.contains("`friction.A` reads its node"), "{e}");
+    }
+
+    /// The error of reading `v`, as its path and message.
+    fn read_error(v: &serde_json::Value) -> String {
+        let e = super::read(v).unwrap_err();
+        format!("{}: {}", e.path, e.why)
     }
 
     /// The netlist's name is a string: another value is refused at `name`,

@@ -68,6 +68,47 @@ pub(crate) fn kind_of(v: &Value) -> &'static str {
     }
 }
 
+/// Whether the one-element connection `items` names a port that owns its
+/// node (`["cylinder.B"]`): listed alone, it keeps the node to itself (a
+/// chamber nothing else reads, a blocked port), where a port left out is
+/// refused as dangling. An unknown component or port is not such a port
+/// (the connection is then refused as too short).
+fn alone_owns(items: &[Value], instances: &[Instance]) -> bool {
+    let [Value::String(s)] = items else {
+        return false;
+    };
+    s.split_once('.').is_some_and(|(c, p)| {
+        instances
+            .iter()
+            .find(|i| i.name == c)
+            .and_then(|i| i.ty.port(p))
+            .is_some_and(|ps| ps.role == Role::Owns)
+    })
+}
+
+/// Why `got` is refused where a number is expected (a parameter, or an
+/// initial state when `what` says so), for a value meaning `doc` in `unit`:
+/// what it is, its meaning and unit, and how to write it — a quoted number
+/// without its quotes, a value with a unit (`"160 bar"`) as the number in
+/// the SI unit the rig takes.
+pub(crate) fn not_a_number(what: &str, got: &Value, doc: &str, unit: &str) -> String {
+    let meaning = format!("{doc} [{unit}]");
+    let how = match got {
+        Value::String(s) => match s.trim().parse::<f64>() {
+            Ok(x) if x.is_finite() => format!("write the number without quotes: {}", s.trim()),
+            _ if unit == "-" => "give a plain number (every rig value is SI)".to_string(),
+            _ => format!("give the number in {unit}: every rig value is SI"),
+        },
+        _ if unit == "-" => "give a plain number".to_string(),
+        _ => format!("give the number in {unit}"),
+    };
+    let shown = match got {
+        Value::String(_) => format!("the string `{got}`"),
+        other => kind_of(other).to_string(),
+    };
+    format!("{what} is a number, got {shown} ({meaning}; {how})")
+}
+
 /// Why `col` cannot be an output column beside `before` (the columns
 /// named so far): a CSV header cell holds a name and a `[unit]`, and the
 /// first column is `time`.
@@ -199,8 +240,14 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                 "a connection is an array of two or more `component.port` (or node) names",
             );
         };
-        if items.len() < 2 {
-            return err(at, "a connection joins two or more ports");
+        if items.len() < 2 && !alone_owns(items, &instances) {
+            let why = match items.first().and_then(Value::as_str) {
+                Some(s) if s.contains('.') => format!(
+                    "a connection joins two or more ports; a port is listed alone only to keep the node it owns to itself, and `{s}` reads its node (join it to the node's owner)"
+                ),
+                _ => "a connection joins two or more ports".to_string(),
+            };
+            return err(at, why);
         }
         if let Some(j) = conns[..ci].iter().position(|d| same_connection(c, d)) {
             return err(
@@ -365,10 +412,17 @@ pub fn read(v: &Value) -> Result<Schematic, NetlistError> {
                 return err(
                     format!("components.{}", inst.name),
                     format!(
-                        "port `{}` ({}, {}) is not connected",
+                        "port `{}` ({}, {}) is not connected{}",
                         p.name,
                         p.domain.name(),
-                        p.doc
+                        p.doc,
+                        match p.role {
+                            Role::Owns => format!(
+                                ": join it, or list it alone, `[\"{}.{}\"]`, to keep the node it owns to itself",
+                                inst.name, p.name
+                            ),
+                            Role::Reads => String::new(),
+                        }
                     ),
                 );
             }

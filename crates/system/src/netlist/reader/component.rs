@@ -1,7 +1,7 @@
 //! Reading one component of a netlist: its type, its parameters (checked,
 //! defaults filled) and its initial states, into an [`Instance`].
 
-use super::{err, kind_of, valid_name, NetlistError};
+use super::{err, kind_of, not_a_number, valid_name, NetlistError};
 use crate::netlist::registry::{lookup, types, Default, Instance};
 use serde_json::{Map, Value};
 use std::collections::BTreeMap;
@@ -11,13 +11,16 @@ use std::collections::BTreeMap;
 /// a value only for a parameter that may be absent (see [`read_instance`]).
 /// A parameter given twice, flat (`"orifice.cd"`) and nested (`"orifice":
 /// {"cd": …}`), is refused at the later key: `given` holds how each dotted
-/// name was spelled.
+/// name was spelled. Leaves of another kind (a string, a boolean, an
+/// array) go to `wrong` (dotted name → JSON path and value), refused by
+/// [`read_instance`] once it knows the name is a parameter.
 fn flatten(
     m: &Map<String, Value>,
     prefix: &str,
     path: &str,
     out: &mut BTreeMap<String, f64>,
     nulls: &mut BTreeMap<String, String>,
+    wrong: &mut BTreeMap<String, (String, Value)>,
     given: &mut BTreeMap<String, String>,
 ) -> Result<(), NetlistError> {
     for (k, v) in m {
@@ -48,12 +51,9 @@ fn flatten(
             Value::Null => {
                 nulls.insert(name, at);
             }
-            Value::Object(o) => flatten(o, &name, &at, out, nulls, given)?,
+            Value::Object(o) => flatten(o, &name, &at, out, nulls, wrong, given)?,
             other => {
-                return err(
-                    at,
-                    format!("a parameter is a number, got {}", kind_of(other)),
-                );
+                wrong.insert(name, (at, other.clone()));
             }
         }
     }
@@ -103,6 +103,7 @@ pub(super) fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistEr
     // parameters
     let mut given = BTreeMap::new();
     let mut nulls = BTreeMap::new();
+    let mut wrong = BTreeMap::new();
     let rest: Map<String, Value> = obj
         .iter()
         .filter(|(k, _)| !RESERVED.contains(&k.as_str()))
@@ -114,9 +115,10 @@ pub(super) fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistEr
         &path,
         &mut given,
         &mut nulls,
+        &mut wrong,
         &mut BTreeMap::new(),
     )?;
-    for k in given.keys().chain(nulls.keys()) {
+    for k in given.keys().chain(nulls.keys()).chain(wrong.keys()) {
         if ty.param(k).is_none() {
             return err(
                 format!("{path}.{k}"),
@@ -133,6 +135,9 @@ pub(super) fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistEr
     }
     let mut params = BTreeMap::new();
     for p in ty.params {
+        if let Some((at, v)) = wrong.get(p.name) {
+            return err(at.clone(), not_a_number("a parameter", v, p.doc, p.unit));
+        }
         let at = format!("{path}.{}", p.name);
         // `null` means "absent" only where absent has a meaning of its own
         // (no end stop, no Stribeck hump); elsewhere it would silently be
@@ -212,7 +217,7 @@ pub(super) fn read_instance(name: &str, v: &Value) -> Result<Instance, NetlistEr
                 Default::Absent => None,
                 Default::Required => return err(at, format!("missing ({} [{}])", s.doc, s.unit)),
             },
-            Some(other) => return err(at, format!("must be a number, got {}", kind_of(other))),
+            Some(other) => return err(at, not_a_number("an initial state", other, s.doc, s.unit)),
         };
         initial.insert(s.name.to_string(), value);
     }

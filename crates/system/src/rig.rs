@@ -233,6 +233,12 @@ pub fn load(name_or_path: &str) -> Result<Value, RigError> {
 /// netlist. [`load`] reads a file through it.
 pub fn parse(text: &str, source: &str) -> Result<Value, RigError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    if text.trim().is_empty() {
+        return Err(RigError::Invalid {
+            path: source.into(),
+            why: "empty, or only blanks: a rig is a JSON object (`hydrocyl simulate --rig leaney-moog --print-rig` prints one to start from)".into(),
+        });
+    }
     let v: Value = serde_json::from_str(text).map_err(|e| RigError::Invalid {
         path: source.into(),
         why: format!("not valid JSON: {e}"),

@@ -69,6 +69,22 @@ fn a_commands_limit_is_the_stroke_the_pumps_rating_or_none() {
     );
 }
 
+/// An empty or blank rig file is named so, not as JSON that ended early
+/// (`EOF while parsing a value at line 1 column 0`).
+#[test]
+fn an_empty_rig_is_named_empty() {
+    for text in ["", " \n\t\n", "\u{feff}"] {
+        let e = parse(text, "r.json").unwrap_err().to_string();
+        assert!(
+            e.contains("r.json") && e.contains("empty, or only blanks"),
+            "{e}"
+        );
+        assert!(!e.contains("EOF"), "{e}");
+    }
+    let e = parse("{", "r.json").unwrap_err().to_string();
+    assert!(e.contains("not valid JSON: EOF"), "{e}");
+}
+
 #[test]
 fn a_kind_that_is_not_a_string_is_named_so_not_missing() {
     let e = check(&serde_json::json!({"kind": 5}))

@@ -51,6 +51,15 @@ class CavitationWarning(UserWarning):
     where the cylinder's type has it). Warned by ``Rig.simulate`` and, per
     parameter set, ``simulate_batch``."""
 
+class ParameterWarning(UserWarning):
+    """A rig parameter inside its range but far outside what real rigs have
+    (a bulk modulus of 7000 Pa, a bore area of 1963 m^2, an oil density of
+    0.87 kg/m^3): the mark of a value written in another unit (bar, mm^2,
+    g/cm^3), which runs and gives consistent nonsense. The run is returned;
+    the message names the parameter by its ``Rig.set`` path, the usual span
+    and the unit the value was likely meant in (the CLI's warning). Warned by
+    ``Rig.simulate`` and, per parameter set, ``simulate_batch``."""
+
 class RatingWarning(UserWarning):
     """The command goes beyond the limit of what the run's input drives: a
     normalised spool demand outside +-1 (the spool's stroke: the valve

@@ -64,6 +64,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // errors name the file and line of their JSON path
     rig::check(&value)
         .map_err(|e| input(&crate::rigfile::at_line_or_set(e, &rig_arg, &args.set)))?;
+    // a unit slip runs (and exports): warned of, as `simulate` warns of it
+    if let Ok(s) = hydrocyl_system::netlist::read(&value) {
+        for w in hydrocyl_system::netlist::implausible(&s) {
+            crate::console::note(format_args!("hydrocyl: warning: {w}"));
+        }
+    }
     let library = find_library(args.library.as_deref()).map_err(|e| input(&e))?;
     // the FMU must not be written over an input: the rig file or the library
     let rig_file = (!rig::is_preset(&rig_arg)).then(|| PathBuf::from(&rig_arg));

@@ -157,6 +157,15 @@ impl Checked {
         self.schematic.input_is_set_point()
     }
 
+    /// Prints a warning on standard error for each parameter far outside
+    /// what real rigs have ([`netlist::implausible`]: a unit slip, which
+    /// runs), named by the path `--set` takes.
+    pub fn warn_implausible(&self) {
+        for w in netlist::implausible(&self.schematic) {
+            crate::console::note(format_args!("hydrocyl: warning: {w}"));
+        }
+    }
+
     /// What the run's command is checked against (the spool's stroke, a
     /// pump's rating, or nothing: [`rig::CommandLimit::of`], from this one
     /// reading of the netlist, as

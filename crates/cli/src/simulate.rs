@@ -433,6 +433,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     crate::progress::mark("rig loaded");
     let checked = crate::rigfile::check(&value, &args.rig, &args.set)?;
     check_initial_pressures(&checked)?;
+    if !args.quiet {
+        checked.warn_implausible();
+    }
     crate::progress::mark("rig checked");
     if args.print_rig {
         // what `simulate` would refuse is refused here too: the components

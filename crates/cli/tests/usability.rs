@@ -30,6 +30,19 @@ fn command_file(dir: &Path, n: usize, dt: f64) -> PathBuf {
     p
 }
 
+/// The `leaney-moog` preset as `--print-rig` prints it, written to
+/// `lm.json` in `dir` (a rig file whose lines errors name).
+fn printed_rig(dir: &Path) -> PathBuf {
+    let p = hydrocyl()
+        .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
+        .output()
+        .unwrap();
+    assert!(p.status.success());
+    let rig = dir.join("lm.json");
+    std::fs::write(&rig, &p.stdout).unwrap();
+    rig
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -218,13 +231,7 @@ fn argument_errors_are_one_line_naming_the_option_and_the_help() {
 fn a_bad_value_from_set_names_the_set_not_a_line_of_the_rig_file() {
     let d = scratch("set-blame");
     let cmd = command_file(&d, 11, 1e-3);
-    let rig = d.join("lm.json");
-    let p = hydrocyl()
-        .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
-        .output()
-        .unwrap();
-    assert!(p.status.success());
-    std::fs::write(&rig, &p.stdout).unwrap();
+    let rig = printed_rig(&d);
     let out = d.join("o.csv");
     let base = [
         "--rig",
@@ -242,7 +249,7 @@ fn a_bad_value_from_set_names_the_set_not_a_line_of_the_rig_file() {
     assert!(!e.contains("line "), "{e}");
     // the same value in the file itself: its line
     let text =
-        String::from_utf8(p.stdout)
+        std::fs::read_to_string(&rig)
             .unwrap()
             .replacen("\"mass\": 100.0", "\"mass\": -1.0", 1);
     assert!(text.contains("\"mass\": -1.0"));
@@ -260,13 +267,7 @@ fn a_bad_value_from_set_names_the_set_not_a_line_of_the_rig_file() {
 fn a_bad_initial_state_from_set_names_its_path_and_the_set() {
     let d = scratch("set-blame-initial");
     let cmd = command_file(&d, 11, 1e-3);
-    let rig = d.join("lm.json");
-    let p = hydrocyl()
-        .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
-        .output()
-        .unwrap();
-    assert!(p.status.success());
-    std::fs::write(&rig, &p.stdout).unwrap();
+    let rig = printed_rig(&d);
     let out = d.join("o.csv");
     for (sets, path) in [
         (
@@ -309,13 +310,7 @@ fn a_bad_initial_state_from_set_names_its_path_and_the_set() {
 fn a_relation_broken_by_a_set_of_the_other_parameter_names_the_set() {
     let d = scratch("set-blame-relation");
     let cmd = command_file(&d, 11, 1e-3);
-    let rig = d.join("lm.json");
-    let p = hydrocyl()
-        .args(["simulate", "--rig", "leaney-moog", "--print-rig"])
-        .output()
-        .unwrap();
-    assert!(p.status.success());
-    std::fs::write(&rig, &p.stdout).unwrap();
+    let rig = printed_rig(&d);
     let out = d.join("o.csv");
     for (rig, set, path) in [
         (
@@ -663,5 +658,59 @@ fn a_set_with_the_json_path_names_the_parameter_path() {
     assert!(
         e.contains("without the JSON path's `components.`: `load.mass`"),
         "{e}"
+    );
+}
+
+/// A parameter inside its range but far outside what real rigs have (a
+/// bulk modulus written in bar) runs, with a warning that names it and the
+/// unit it was likely meant in; `--quiet` silences it, a preset as shipped
+/// has none, and `fmu` warns of it too.
+#[test]
+fn a_unit_slip_in_a_parameter_is_warned_of_and_still_runs() {
+    let d = scratch("slip");
+    let cmd = command_file(&d, 201, 1e-3);
+    let out = d.join("o.csv");
+    let run = |extra: &[&str]| {
+        let o = hydrocyl()
+            .args(["simulate", "--rig", "leaney-moog", "--command"])
+            .arg(&cmd)
+            .arg("--out")
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(out.exists());
+        stderr(&o)
+    };
+    let slip = ["--set", "cylinder.bulk_modulus=7000"];
+    let e = run(&slip);
+    let warned: Vec<&str> = e.lines().filter(|l| l.contains("warning")).collect();
+    assert_eq!(
+        warned,
+        ["hydrocyl: warning: rig `cylinder.bulk_modulus`: 7000 [Pa] is far outside the usual 5e7 to 5e9 [Pa] of effective bulk modulus B of the chambers: a value in bar? (7000 bar = 7e8 Pa)"],
+        "{e}"
+    );
+    assert!(!run(&[]).contains("warning"));
+    assert!(run(&[&slip[..], &["--quiet"]].concat()).is_empty());
+    // fmu warns before it looks for its library (missing here: exit 2)
+    let o = hydrocyl()
+        .args([
+            "fmu",
+            "--rig",
+            "leaney-moog",
+            "--set",
+            "cylinder.area_1=1963",
+            "--out",
+        ])
+        .arg(d.join("r.fmu"))
+        .args(["--library", "/nonexistent/libhydrocyl_fmu.so"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("warning: rig `cylinder.area_1`: 1963 [m^2] is far outside"),
+        "{}",
+        stderr(&o)
     );
 }

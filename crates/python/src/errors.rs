@@ -51,6 +51,18 @@ pyo3::create_exception!(
      the command reaching it); a batch names the run."
 );
 
+pyo3::create_exception!(
+    hydrocyl,
+    ParameterWarning,
+    PyUserWarning,
+    "A rig parameter inside its range but far outside what real rigs have \
+     (a bulk modulus of 7000 Pa, a bore area of 1963 m^2, an oil density of \
+     0.87 kg/m^3): the mark of a value written in another unit (bar, mm^2, \
+     g/cm^3), which runs and gives consistent nonsense. The run is returned; \
+     the message names the parameter by its path, the usual span and the \
+     unit the value was likely meant in (the CLI's warning)."
+);
+
 /// A warning a run that is returned leaves, raised with Python's
 /// `warnings.warn` once the run is (once per run; in a batch, naming it).
 #[derive(Debug, Clone, PartialEq)]
@@ -61,6 +73,9 @@ pub enum RunWarning {
     /// A chamber far below vacuum in a run that did not blow up: a
     /// [`CavitationWarning`].
     Cavitation(String),
+    /// A parameter far outside what real rigs have (a unit slip,
+    /// `netlist::implausible`): a [`ParameterWarning`].
+    Parameter(String),
 }
 
 impl RunWarning {
@@ -69,6 +84,7 @@ impl RunWarning {
         match self {
             RunWarning::Rating(m) => RunWarning::Rating(format!("{what}: {m}")),
             RunWarning::Cavitation(m) => RunWarning::Cavitation(format!("{what}: {m}")),
+            RunWarning::Parameter(m) => RunWarning::Parameter(format!("{what}: {m}")),
         }
     }
 
@@ -77,6 +93,7 @@ impl RunWarning {
         let (category, message) = match self {
             RunWarning::Rating(m) => (py.get_type::<RatingWarning>(), m),
             RunWarning::Cavitation(m) => (py.get_type::<CavitationWarning>(), m),
+            RunWarning::Parameter(m) => (py.get_type::<ParameterWarning>(), m),
         };
         let message = std::ffi::CString::new(message.replace('\0', " "))
             .map_err(|e| PyValueError::new_err(e.to_string()))?;

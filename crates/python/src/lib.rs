@@ -63,6 +63,10 @@ fn hydrocyl(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m.py().get_type::<errors::CavitationWarning>(),
     )?;
     m.add("RatingWarning", m.py().get_type::<errors::RatingWarning>())?;
+    m.add(
+        "ParameterWarning",
+        m.py().get_type::<errors::ParameterWarning>(),
+    )?;
     m.add_class::<rig::Rig>()?;
     m.add_class::<run::PyRun>()?;
     m.add_class::<batch::PyBatch>()?;

@@ -120,11 +120,18 @@ pub fn simulate(
             .map(|w| RunWarning::Rating(format!("command (t, u): {w}"))),
         _ => None,
     };
+    // a parameter far outside what real rigs have: a unit slip, warned of
+    // as the CLI warns of it
+    let implausible = hydrocyl_system::netlist::read(value)
+        .map(|s| hydrocyl_system::netlist::implausible(&s))
+        .unwrap_or_default();
     Ok(Simulated {
         run,
         ledger,
-        warnings: rating
+        warnings: implausible
             .into_iter()
+            .map(RunWarning::Parameter)
+            .chain(rating)
             .chain(cavitation.map(RunWarning::Cavitation))
             .collect(),
     })

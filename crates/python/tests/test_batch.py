@@ -2,6 +2,7 @@
 count, errors naming the set, and the GIL released while it runs."""
 
 import threading
+import warnings
 
 import numpy as np
 import pytest
@@ -190,3 +191,30 @@ def test_a_batch_carries_the_units_of_its_channels_as_a_run_does(preset):
     assert list(batch.units.items()) == list(run.units.items())
     kept = hydrocyl.simulate_batch(rig, t, u, {mass: [rig.get(mass)]}, channels=["p1", "position"])
     assert list(kept.units.items()) == [("position", "m"), ("p1", "Pa")]
+
+
+def test_a_unit_slip_is_a_parameter_warning_naming_the_set_and_the_unit_meant():
+    """A bulk modulus written in bar (7000 for 7e8 Pa) is inside its range
+    and runs; the set is warned of by its number, with the CLI's message
+    (`hydrocyl simulate --set cylinder.bulk_modulus=7000`), and so is
+    `Rig.simulate` on it. The preset as shipped is not."""
+    assert issubclass(hydrocyl.ParameterWarning, UserWarning)
+    t = np.linspace(0.0, 0.1, 101)
+    u = np.full(101, 0.1)
+    rig = hydrocyl.Rig.load("leaney-moog")
+    params = {"cylinder.bulk_modulus": np.array([7e8, 7000.0])}
+    with pytest.warns(hydrocyl.ParameterWarning) as w:
+        batch = hydrocyl.simulate_batch(rig, t, u, params)
+    assert [str(x.message) for x in w] == [
+        "run 1 (cylinder.bulk_modulus=7000.0): rig `cylinder.bulk_modulus`: 7000 [Pa] is far "
+        "outside the usual 5e7 to 5e9 [Pa] of effective bulk modulus B of the chambers: "
+        "a value in bar? (7000 bar = 7e8 Pa)"
+    ]
+    assert batch.ok.all()
+    rig.set("cylinder.bulk_modulus", 7000.0)
+    with pytest.warns(hydrocyl.ParameterWarning, match=r"^rig `cylinder.bulk_modulus`: 7000 \[Pa\]"):
+        run = rig.simulate(t, u)
+    assert len(run.time) == 101
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        hydrocyl.Rig.load("leaney-moog").simulate(t, u)

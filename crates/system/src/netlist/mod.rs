@@ -43,6 +43,7 @@ mod inputs;
 pub mod locate;
 pub mod migrate;
 pub mod overlay;
+mod plausible;
 pub mod reader;
 pub mod registry;
 
@@ -56,6 +57,7 @@ use crate::signal::Signal;
 pub(crate) use catalog::friction_terms_of as catalog_friction_terms;
 pub(crate) use catalog::typed_view_friction_law;
 pub use inputs::{samples_beyond, stroke_warning, InputRating, INPUT_TYPES};
+pub use plausible::implausible;
 pub use reader::{read, NetlistError, Schematic};
 use registry::StateSpec;
 use serde_json::{Map, Value};

@@ -207,9 +207,66 @@ pub struct ParamSpec {
     pub range: Range,
     /// What it is.
     pub doc: &'static str,
+    /// The span real rigs' values lie in, `(low, high)`, where it is narrow
+    /// enough that a value far outside is a unit slip (bar for Pa, mm for
+    /// m): [`ParamSpec::implausible`] warns of it; the value still runs.
+    pub typical: Option<(f64, f64)>,
 }
 
+/// Other units a value may have been written in by mistake, by SI unit:
+/// the name and what one of it is in the SI unit.
+const SLIPS: &[(&str, &[(&str, f64)])] = &[
+    (
+        "Pa",
+        &[("bar", 1e5), ("MPa", 1e6), ("kPa", 1e3), ("psi", 6894.757)],
+    ),
+    ("m", &[("mm", 1e-3), ("cm", 1e-2)]),
+    ("m^2", &[("mm²", 1e-6), ("cm²", 1e-4)]),
+    ("kg/m^3", &[("g/cm³", 1e3)]),
+];
+
 impl ParamSpec {
+    /// This parameter with the span real rigs' values lie in (see
+    /// [`ParamSpec::typical`]).
+    pub const fn typical(mut self, low: f64, high: f64) -> Self {
+        self.typical = Some((low, high));
+        self
+    }
+
+    /// Why `value` (inside the range) is far outside the span real rigs'
+    /// values lie in, with the unit it may have been written in: `14000
+    /// [Pa] is far outside the usual 5e7 to 5e9 [Pa] of effective bulk
+    /// modulus …: a value in bar? (14000 bar = 1.4e9 Pa)`; `None` inside
+    /// the span, or for a parameter without one.
+    pub fn implausible(&self, value: f64) -> Option<String> {
+        let (low, high) = self.typical?;
+        if !value.is_finite() || (low..=high).contains(&value) {
+            return None;
+        }
+        let unit = self.unit;
+        let slip = SLIPS
+            .iter()
+            .find(|(u, _)| *u == unit)
+            .and_then(|(_, slips)| {
+                slips
+                    .iter()
+                    .find(|(_, f)| (low..=high).contains(&(value * f)))
+            })
+            .map_or_else(
+                || "check its unit: every rig value is SI".to_string(),
+                |(name, f)| {
+                    format!(
+                        "a value in {name}? ({value} {name} = {:e} {unit})",
+                        value * f
+                    )
+                },
+            );
+        Some(format!(
+            "{value} [{unit}] is far outside the usual {low:e} to {high:e} [{unit}] of {}: {slip}",
+            self.doc
+        ))
+    }
+
     /// Checks a value given for this parameter on its own: inside its
     /// range. The error says the value and the rule.
     pub fn check(&self, value: f64) -> Result<(), String> {
@@ -239,6 +296,7 @@ pub const fn param(
         default,
         range,
         doc,
+        typical: None,
     }
 }
 

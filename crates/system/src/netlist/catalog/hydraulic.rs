@@ -64,7 +64,8 @@ macro_rules! orifice_params {
                 Required,
                 Range::POSITIVE,
                 "oil density ρ",
-            ),
+            )
+            .typical(500.0, 2000.0),
             param(
                 concat!($p, "dp_transition"),
                 "Pa",
@@ -130,7 +131,7 @@ pub const TYPES: &[ComponentType] = &[
                 Required,
                 Range::POSITIVE,
                 "bulk modulus B of the liquid (the effective one without air)",
-            ),
+            ).typical(5e7, 5e9),
             AIR[0],
             AIR[1],
             AIR[2],

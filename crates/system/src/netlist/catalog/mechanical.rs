@@ -23,42 +23,48 @@ const CYLINDER: [ParamSpec; 10] = [
         Required,
         Range::POSITIVE,
         "cap-side piston area A1",
-    ),
+    )
+    .typical(1e-7, 1.0),
     param(
         "area_2",
         "m^2",
         Required,
         Range::POSITIVE,
         "rod-side annulus area A2",
-    ),
+    )
+    .typical(1e-7, 1.0),
     param(
         "stroke",
         "m",
         Required,
         Range::POSITIVE,
         "stroke; the piston moves in ±stroke/2 from mid-stroke",
-    ),
+    )
+    .typical(1e-4, 20.0),
     param(
         "chamber_length_1",
         "m",
         Required,
         Range::POSITIVE,
         "V1 = A1 (l1 + x)",
-    ),
+    )
+    .typical(1e-4, 20.0),
     param(
         "chamber_length_2",
         "m",
         Required,
         Range::POSITIVE,
         "V2 = A2 (l2 − x)",
-    ),
+    )
+    .typical(1e-4, 20.0),
     param(
         "bulk_modulus",
         "Pa",
         Required,
         Range::POSITIVE,
         "effective bulk modulus B of the chambers",
-    ),
+    )
+    .typical(5e7, 5e9),
     param(
         "internal_leakage",
         "m^3/(s Pa)",

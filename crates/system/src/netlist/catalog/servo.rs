@@ -29,7 +29,8 @@ pub(super) const METERING: [ParamSpec; 7] = {
             Required,
             Range::POSITIVE,
             "spool diameter D; area gradient π D",
-        ),
+        )
+        .typical(1e-4, 0.2),
         o[0],
         o[1],
         o[2],
@@ -171,7 +172,8 @@ pub const TYPES: &[ComponentType] = &[
                 Required,
                 Range::POSITIVE,
                 "spool stroke x_max (demand u · x_max, saturation)",
-            ),
+            )
+            .typical(1e-5, 0.02),
             param(
                 "time_constant",
                 "s",
@@ -204,7 +206,8 @@ pub const TYPES: &[ComponentType] = &[
                 Required,
                 Range::POSITIVE,
                 "spool stroke x_max",
-            ),
+            )
+            .typical(1e-5, 0.02),
             param(
                 "natural_frequency",
                 "rad/s",

@@ -23,7 +23,7 @@ const TANK_SIDE: f64 = 0.2;
 /// The gaps of a time axis: the median step and the index of the first
 /// sample after each step longer than [`GAP_FACTOR`] times it (none for
 /// fewer than 3 samples or a median step that is not positive). The data
-/// check names them ([`gap_problem`]); the valve loop restarts its
+/// check names them (the `gap` data problem); the valve loop restarts its
 /// simulation after each from the measured state.
 pub fn gap_ends(t: &[f64]) -> (f64, Vec<usize>) {
     if t.len() < 3 {

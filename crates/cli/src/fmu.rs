@@ -67,7 +67,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // a unit slip runs (and exports): warned of, as `simulate` warns of it
     if let Ok(s) = hydrocyl_system::netlist::read(&value) {
         for w in hydrocyl_system::netlist::implausible(&s) {
-            crate::console::note(format_args!("hydrocyl: warning: {w}"));
+            crate::console::hold_warning(w);
         }
     }
     let library = find_library(args.library.as_deref()).map_err(|e| input(&e))?;
@@ -96,5 +96,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
         out.display(),
         library.display()
     ));
+    crate::console::print_held(false);
     Ok(())
 }

@@ -261,7 +261,7 @@ fn main() {
             std::process::exit(141)
         }
         Err(e) => {
-            console::note(format_args!("hydrocyl: error: {e}"));
+            console::note(format_args!("{}", console::error_line(&e)));
             std::process::exit(2);
         }
         Ok(()) => {}

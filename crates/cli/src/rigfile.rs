@@ -157,12 +157,13 @@ impl Checked {
         self.schematic.input_is_set_point()
     }
 
-    /// Prints a warning on standard error for each parameter far outside
-    /// what real rigs have ([`netlist::implausible`]: a unit slip, which
-    /// runs), named by the path `--set` takes.
-    pub fn warn_implausible(&self) {
+    /// Holds a warning ([`crate::console::hold_warning`]) for each
+    /// parameter far outside what real rigs have
+    /// ([`netlist::implausible`]: a unit slip, which runs), named by the
+    /// path `--set` takes.
+    pub fn hold_implausible(&self) {
         for w in netlist::implausible(&self.schematic) {
-            crate::console::note(format_args!("hydrocyl: warning: {w}"));
+            crate::console::hold_warning(w);
         }
     }
 

@@ -433,9 +433,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     crate::progress::mark("rig loaded");
     let checked = crate::rigfile::check(&value, &args.rig, &args.set)?;
     check_initial_pressures(&checked)?;
-    if !args.quiet {
-        checked.warn_implausible();
-    }
+    checked.hold_implausible();
     crate::progress::mark("rig checked");
     if args.print_rig {
         // what `simulate` would refuse is refused here too: the components
@@ -446,7 +444,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         // a netlist is printed with every parameter written out (defaults
         // filled in), under the paths `--set` takes
         let text = rig::printed(&value).map_err(rig_err)?;
-        return crate::console::print(&format!("{text}\n"));
+        crate::console::print(&format!("{text}\n"))?;
+        crate::console::print_held(args.quiet);
+        return Ok(());
     }
     let solver = run_settings(&args)?;
     let (Some(cmd_path), Some(out)) = (args.command, args.out) else {
@@ -725,6 +725,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     outputs.commit(args.fsync)?;
     crate::progress::mark("output committed");
+    crate::console::print_held(args.quiet);
     if args.quiet {
         return Ok(());
     }

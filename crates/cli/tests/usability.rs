@@ -693,7 +693,9 @@ fn a_unit_slip_in_a_parameter_is_warned_of_and_still_runs() {
     );
     assert!(!run(&[]).contains("warning"));
     assert!(run(&[&slip[..], &["--quiet"]].concat()).is_empty());
-    // fmu warns before it looks for its library (missing here: exit 2)
+    // a command that fails after the rig is read keeps its one error line,
+    // the warning after it (it may explain the failure): fmu without its
+    // library, simulate on a command file that is not there
     let o = hydrocyl()
         .args([
             "fmu",
@@ -707,10 +709,31 @@ fn a_unit_slip_in_a_parameter_is_warned_of_and_still_runs() {
         .args(["--library", "/nonexistent/libhydrocyl_fmu.so"])
         .output()
         .unwrap();
+    let e = stderr(&o);
     assert_eq!(o.status.code(), Some(2));
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(e.starts_with("hydrocyl: error: "), "{e}");
     assert!(
-        stderr(&o).contains("warning: rig `cylinder.area_1`: 1963 [m^2] is far outside"),
-        "{}",
-        stderr(&o)
+        e.contains(" (and a warning: rig `cylinder.area_1`: 1963 [m^2] is far outside"),
+        "{e}"
+    );
+    let o = hydrocyl()
+        .args([
+            "simulate",
+            "--rig",
+            "leaney-moog",
+            "--command",
+            "/nonexistent.csv",
+            "--out",
+        ])
+        .arg(&out)
+        .args(slip)
+        .output()
+        .unwrap();
+    let e = stderr(&o);
+    assert_eq!((o.status.code(), e.lines().count()), (Some(2), 1), "{e}");
+    assert!(
+        e.contains("(and a warning: rig `cylinder.bulk_modulus`"),
+        "{e}"
     );
 }

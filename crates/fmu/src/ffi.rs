@@ -89,8 +89,11 @@ fn log_with(cb: &CallbackFunctions, name: &CStr, status: Status, message: &str) 
 }
 
 impl Instance {
+    /// Logs `message` through the importer's logger: warnings and errors
+    /// always, anything else only with logging on (`fmi2Instantiate`'s
+    /// `loggingOn`, `fmi2SetDebugLogging`).
     fn log(&self, status: Status, message: &str) {
-        if status >= ERROR || self.logging {
+        if status >= WARNING || self.logging {
             log_with(&self.callbacks, &self.name, status, message);
         }
     }
@@ -322,12 +325,22 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> Status {
 }
 
 /// `fmi2ExitInitializationMode`: checks the parameters set as a whole and
-/// assembles the circuit.
+/// assembles the circuit; `fmi2Warning`, each warning logged, where a
+/// parameter is far outside what real rigs have (a unit slip).
 #[no_mangle]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> Status {
     unsafe {
         with(c, "fmi2ExitInitializationMode", |i| {
-            i.slave.exit_initialization().map(|_| OK)
+            i.slave.exit_initialization().map(|warnings| {
+                for w in &warnings {
+                    i.log(WARNING, &format!("fmi2ExitInitializationMode: {w}"));
+                }
+                if warnings.is_empty() {
+                    OK
+                } else {
+                    WARNING
+                }
+            })
         })
     }
 }

@@ -139,12 +139,17 @@ impl Slave {
     /// (the rig's rules that relate several of them) and assembles the
     /// circuit, at the rig's initial state. A rig the parameters make invalid
     /// is an error naming the parameters set; the instance stays in
-    /// initialisation mode, where they can be corrected.
-    pub fn exit_initialization(&mut self) -> Result<(), SlaveError> {
+    /// initialisation mode, where they can be corrected. What it returns
+    /// are the warnings of the parameters far outside what real rigs have
+    /// (`netlist::implausible`: a unit slip, which runs), as `hydrocyl
+    /// simulate` warns of them.
+    pub fn exit_initialization(&mut self) -> Result<Vec<String>, SlaveError> {
         self.expect(&[Phase::Initializing], "fmi2ExitInitializationMode")?;
         self.ensure_sim()?;
         self.phase = Phase::Stepping;
-        Ok(())
+        Ok(hydrocyl_system::netlist::read(&self.rig)
+            .map(|s| hydrocyl_system::netlist::implausible(&s))
+            .unwrap_or_default())
     }
 
     /// `fmi2Terminate`.

@@ -128,3 +128,34 @@ def test_a_refused_solver_parameter_states_its_rule(export):
     assert "solver.rtol` = 1e-300 rejected: below 1e-14" in messages[-1], messages
     s.freeInstance()
     shutil.rmtree(d, ignore_errors=True)
+
+
+def test_a_unit_slip_in_a_parameter_is_a_warning_at_initialisation(export):
+    """A bulk modulus written in bar (7000 for 7e8 Pa) is inside its range:
+    the instance initialises and steps, with fmi2Warning and the CLI's
+    warning logged (logging off: warnings are logged as errors are); the
+    preset as shipped initialises with fmi2OK and logs nothing."""
+    messages = []
+
+    def logger(env, name, status, category, message):
+        messages.append((status, message.decode()))
+
+    path = export("leaney-moog")
+    s, vr, d = open_fmu(path, logger=logger)
+    s.setReal([vr["cylinder.bulk_modulus"]], [7000.0])
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    assert s.exitInitializationMode() == 1  # fmi2Warning
+    assert messages == [(1, "fmi2ExitInitializationMode: rig `cylinder.bulk_modulus`: 7000 [Pa] "
+                            "is far outside the usual 5e7 to 5e9 [Pa] of effective bulk modulus B "
+                            "of the chambers: a value in bar? (7000 bar = 7e8 Pa)")]
+    s.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
+    s2, vr2, d2 = open_fmu(path, "b", logger=logger)
+    messages.clear()
+    s2.setupExperiment(startTime=0.0)
+    s2.enterInitializationMode()
+    assert s2.exitInitializationMode() == 0  # fmi2OK
+    assert messages == []
+    for x, dx in ((s, d), (s2, d2)):
+        x.freeInstance()
+        shutil.rmtree(dx, ignore_errors=True)

@@ -312,22 +312,30 @@ fn a_relation_broken_by_a_set_of_the_other_parameter_names_the_set() {
     let cmd = command_file(&d, 11, 1e-3);
     let rig = printed_rig(&d);
     let out = d.join("o.csv");
+    // `simulate --rig <rig>` with `sets`, which must fail: its error line
+    let fails = |rig: &str, sets: &[&str]| {
+        let mut args = vec![
+            "--rig",
+            rig,
+            "--command",
+            cmd.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        simulate_fails(&args, &out)
+    };
+    let file = rig.to_str().unwrap();
     for (rig, set, path) in [
         (
-            rig.to_str().unwrap(),
+            file,
             "cylinder.stroke=0.7",
             "components.cylinder.chamber_length_1",
         ),
-        (
-            rig.to_str().unwrap(),
-            "cylinder.area_1=0.0005",
-            "components.cylinder.area_2",
-        ),
-        (
-            rig.to_str().unwrap(),
-            "supply.pressure=-1000",
-            "components.tank.pressure",
-        ),
+        (file, "cylinder.area_1=0.0005", "components.cylinder.area_2"),
+        (file, "supply.pressure=-1000", "components.tank.pressure"),
         ("leaney-moog", "supply.pressure=-1000", "tank.pressure"),
         (
             "leaney-moog",
@@ -335,54 +343,19 @@ fn a_relation_broken_by_a_set_of_the_other_parameter_names_the_set() {
             "cylinder.chamber_length_1",
         ),
     ] {
-        let args = [
-            "--rig",
-            rig,
-            "--command",
-            cmd.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--set",
-            set,
-        ];
-        let e = simulate_fails(&args, &out);
+        let e = fails(rig, &[set]);
         assert!(e.contains(&format!("rig `{path}`")), "{e}");
         assert!(e.contains(&format!("(with --set {set})")), "{e}");
     }
     // a --set the message does not name is not blamed: the mass has
     // nothing to do with the stroke
-    let e = simulate_fails(
-        &[
-            "--rig",
-            rig.to_str().unwrap(),
-            "--command",
-            cmd.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--set",
-            "cylinder.stroke=0.7",
-            "--set",
-            "load.mass=50",
-        ],
-        &out,
-    );
+    let e = fails(file, &["cylinder.stroke=0.7", "load.mass=50"]);
     assert!(e.contains("(with --set cylinder.stroke=0.7)"), "{e}");
     assert!(!e.contains("load.mass"), "{e}");
     // both the bounded parameter and the other one set: both named
-    let e = simulate_fails(
-        &[
-            "--rig",
-            rig.to_str().unwrap(),
-            "--command",
-            cmd.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--set",
-            "cylinder.chamber_length_1=0.3",
-            "--set",
-            "cylinder.stroke=0.7",
-        ],
-        &out,
+    let e = fails(
+        file,
+        &["cylinder.chamber_length_1=0.3", "cylinder.stroke=0.7"],
     );
     assert!(
         e.contains("(set by --set cylinder.chamber_length_1=0.3 on ")

@@ -96,9 +96,11 @@ pub fn simulate(
         return Err(Failure::Interrupted);
     }
     let mut limit = None;
+    let mut implausible = Vec::new();
     let run = Simulation::new(value, command.clone())
         .and_then(|s| {
             limit = s.command_limit().cloned();
+            implausible = s.implausible().to_vec();
             s.options(opts.clone()).stop_on(Arc::clone(stop)).run(t)
         })
         .map_err(|e| match e {
@@ -120,11 +122,6 @@ pub fn simulate(
             .map(|w| RunWarning::Rating(format!("command (t, u): {w}"))),
         _ => None,
     };
-    // a parameter far outside what real rigs have: a unit slip, warned of
-    // as the CLI warns of it
-    let implausible = hydrocyl_system::netlist::read(value)
-        .map(|s| hydrocyl_system::netlist::implausible(&s))
-        .unwrap_or_default();
     Ok(Simulated {
         run,
         ledger,

@@ -456,16 +456,18 @@ pub fn circuit(v: &Value, command: Signal) -> Result<crate::Circuit, RigError> {
 pub(crate) fn assembled(
     v: &Value,
     command: Signal,
-) -> Result<(crate::Circuit, Option<CommandLimit>), RigError> {
+) -> Result<(crate::Circuit, Option<CommandLimit>, Vec<String>), RigError> {
     let v = migrated(v)?;
     let kind = kind_of(&v)?;
     if kind.kind != crate::netlist::KIND {
-        return Ok(((kind.circuit)(&v, command)?, None));
+        return Ok(((kind.circuit)(&v, command)?, None, Vec::new()));
     }
-    // `netlist::circuit`, with the schematic kept for the limit
+    // `netlist::circuit`, with the schematic kept for the limit and the
+    // parameters' plausibility
     let s = crate::netlist::schematic(&v)?;
     let limit = CommandLimit::of(&s);
-    Ok((crate::netlist::assemble(&s, command)?, limit))
+    let implausible = crate::netlist::implausible(&s);
+    Ok((crate::netlist::assemble(&s, command)?, limit, implausible))
 }
 
 /// What a rig's command is checked against before a run, as `hydrocyl

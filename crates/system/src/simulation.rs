@@ -71,6 +71,9 @@ pub struct Simulation {
     /// The limit of the rig's command, from the netlist read in
     /// [`Simulation::new`] ([`Simulation::command_limit`]).
     command_limit: Option<CommandLimit>,
+    /// The warnings of the rig's parameters far outside what real rigs
+    /// have, from the same reading ([`Simulation::implausible`]).
+    implausible: Vec<String>,
 }
 
 impl Simulation {
@@ -80,9 +83,10 @@ impl Simulation {
     /// limit its command is checked against ([`Simulation::command_limit`])
     /// both come from that reading.
     pub fn new(rig: &Value, command: Signal) -> Result<Self, RigError> {
-        let (circuit, limit) = rig::assembled(rig, command)?;
+        let (circuit, limit, implausible) = rig::assembled(rig, command)?;
         let mut s = Self::of_circuit(circuit);
         s.command_limit = limit;
+        s.implausible = implausible;
         Ok(s)
     }
 
@@ -97,6 +101,7 @@ impl Simulation {
             now: None,
             stop: None,
             command_limit: None,
+            implausible: Vec::new(),
         }
     }
 
@@ -135,6 +140,15 @@ impl Simulation {
     /// assembled by hand ([`Simulation::of_circuit`]) has none.
     pub fn command_limit(&self) -> Option<&CommandLimit> {
         self.command_limit.as_ref()
+    }
+
+    /// The warnings of the rig's parameters that lie far outside what real
+    /// rigs have (a unit slip, which runs: [`crate::netlist::implausible`]),
+    /// as `hydrocyl simulate` warns of them; from the netlist read by
+    /// [`Simulation::new`] (not once more); none for a simulation of a
+    /// circuit assembled by hand.
+    pub fn implausible(&self) -> &[String] {
+        &self.implausible
     }
 
     /// The assembled circuit (its components, probes, state names; the energy

@@ -92,5 +92,12 @@ mod tests {
             w[0].ends_with("check its unit: every rig value is SI"),
             "{w:?}"
         );
+        // a simulation keeps them from its own reading of the netlist
+        let cmd = crate::signal::Signal::Constant { value: 0.0 };
+        let sim = crate::simulation::Simulation::new(&v, cmd.clone()).unwrap();
+        assert_eq!(sim.implausible(), w);
+        let preset = crate::rig::preset("leaney-moog").unwrap();
+        let sim = crate::simulation::Simulation::new(&preset, cmd).unwrap();
+        assert!(sim.implausible().is_empty());
     }
 }
